@@ -1,0 +1,475 @@
+//! glTF 2.0: `.gltf` with external or data-URI buffers, and `.glb`. The node hierarchy with matrices or
+//! TRS; every triangle primitive (lists, strips, fans) with u8, u16, u32 or no indices; the base colour
+//! factor and double-sidedness; perspective cameras and KHR_lights_punctual lights.
+//!
+//! The gltf crate parses and validates the JSON (index ranges, enum values). Everything that touches
+//! bytes is done here, with bounds checks: the GLB container, buffer sources, and accessor reads (offsets,
+//! strides, component types), so a short or lying file gives an error instead of a panic.
+
+use std::collections::HashMap;
+use std::path::Path;
+
+use glam::{Mat4, Vec3};
+use gltf::accessor::{DataType, Dimensions};
+use gltf::mesh::{Mode, Semantic};
+
+use super::{AssetError, AssetFault, read_file};
+use crate::mesh::Mesh;
+use crate::scene::{Camera, Light, LightKind, Material, MaterialKey, MeshKey, NodeKey, Scene};
+
+type Fault = AssetFault;
+
+pub(super) fn load(path: &Path) -> Result<Scene, AssetError> {
+    parse(path).map_err(|f| AssetError::new(path, f))
+}
+
+/// The JSON and BIN chunks of a GLB container.
+fn split_glb(bytes: &[u8]) -> Result<(&[u8], Option<&[u8]>), Fault> {
+    let u32_at = |o: usize| -> Result<u32, Fault> {
+        bytes
+            .get(o..o + 4)
+            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+            .ok_or_else(|| Fault::Truncated("GLB header or chunk header cut short".into()))
+    };
+    if u32_at(4)? != 2 {
+        return Err(Fault::Unsupported(format!("GLB container version {}", u32_at(4)?)));
+    }
+    let total = u32_at(8)? as usize;
+    if total > bytes.len() {
+        return Err(Fault::Truncated(format!("GLB header says {total} bytes, the file has {}", bytes.len())));
+    }
+    let (mut json, mut bin, mut at) = (None, None, 12usize);
+    while at + 8 <= total {
+        let (len, kind) = (u32_at(at)? as usize, u32_at(at + 4)?);
+        let data = bytes
+            .get(at + 8..at + 8 + len)
+            .ok_or_else(|| Fault::Truncated(format!("GLB chunk at byte {at} runs past the end")))?;
+        match kind {
+            0x4E4F_534A if json.is_none() => json = Some(data),
+            0x004E_4942 if bin.is_none() => bin = Some(data),
+            _ => {}
+        }
+        at += 8 + len;
+    }
+    Ok((json.ok_or_else(|| Fault::Malformed("GLB has no JSON chunk".into()))?, bin))
+}
+
+fn base64_decode(s: &str) -> Result<Vec<u8>, Fault> {
+    let value = |c: u8| -> Result<u32, Fault> {
+        Ok(match c {
+            b'A'..=b'Z' => u32::from(c - b'A'),
+            b'a'..=b'z' => u32::from(c - b'a') + 26,
+            b'0'..=b'9' => u32::from(c - b'0') + 52,
+            b'+' | b'-' => 62,
+            b'/' | b'_' => 63,
+            _ => return Err(Fault::Malformed(format!("'{}' in a base64 data URI", c as char))),
+        })
+    };
+    let digits: Vec<u8> = s.bytes().filter(|&c| c != b'=' && !c.is_ascii_whitespace()).collect();
+    let mut out = Vec::with_capacity(digits.len() * 3 / 4);
+    for chunk in digits.chunks(4) {
+        let mut acc = 0u32;
+        for (i, &c) in chunk.iter().enumerate() {
+            acc |= value(c)? << (18 - 6 * i);
+        }
+        let bytes = acc.to_be_bytes();
+        out.extend_from_slice(&bytes[1..chunk.len()]);
+    }
+    Ok(out)
+}
+
+fn percent_decode(s: &str) -> String {
+    let b = s.as_bytes();
+    let hex = |c: u8| (c as char).to_digit(16);
+    let mut out = Vec::with_capacity(b.len());
+    let mut i = 0;
+    while i < b.len() {
+        if b[i] == b'%'
+            && i + 2 < b.len()
+            && let (Some(h), Some(l)) = (hex(b[i + 1]), hex(b[i + 2]))
+        {
+            out.push((h * 16 + l) as u8);
+            i += 3;
+            continue;
+        }
+        out.push(b[i]);
+        i += 1;
+    }
+    String::from_utf8_lossy(&out).into_owned()
+}
+
+fn load_buffers(doc: &gltf::Document, dir: &Path, bin: Option<&[u8]>) -> Result<Vec<Vec<u8>>, Fault> {
+    doc.buffers()
+        .map(|b| {
+            let data = match b.source() {
+                gltf::buffer::Source::Bin => bin
+                    .ok_or_else(|| {
+                        Fault::Malformed(format!("buffer {} refers to a GLB BIN chunk that is missing", b.index()))
+                    })?
+                    .to_vec(),
+                gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => {
+                    let (_, payload) = uri
+                        .split_once(";base64,")
+                        .ok_or_else(|| Fault::Unsupported("a data URI that is not base64".into()))?;
+                    base64_decode(payload)?
+                }
+                gltf::buffer::Source::Uri(uri) => {
+                    let file = dir.join(percent_decode(uri));
+                    read_file(&file).map_err(|f| match f {
+                        Fault::NotFound(_) => {
+                            Fault::NotFound(format!("{} (buffer {} of the model)", file.display(), b.index()))
+                        }
+                        other => other,
+                    })?
+                }
+            };
+            if data.len() < b.length() {
+                return Err(Fault::Truncated(format!(
+                    "buffer {} holds {} bytes, the file declares {}",
+                    b.index(),
+                    data.len(),
+                    b.length()
+                )));
+            }
+            Ok(data)
+        })
+        .collect()
+}
+
+/// An accessor's elements as f64 components, bounds-checked against its view and buffer.
+fn read_accessor(acc: &gltf::Accessor, buffers: &[Vec<u8>], what: &str) -> Result<Vec<[f64; 3]>, Fault> {
+    if acc.sparse().is_some() {
+        return Err(Fault::Unsupported(format!("sparse accessor {} ({what})", acc.index())));
+    }
+    let view = acc
+        .view()
+        .ok_or_else(|| Fault::Unsupported(format!("accessor {} ({what}) has no buffer view", acc.index())))?;
+    let buffer = &buffers[view.buffer().index()];
+    let view_end = view.offset().checked_add(view.length()).filter(|&e| e <= buffer.len()).ok_or_else(|| {
+        Fault::Truncated(format!("buffer view {} runs past the end of buffer {}", view.index(), view.buffer().index()))
+    })?;
+    let view_bytes = &buffer[view.offset()..view_end];
+    let comps = acc.dimensions().multiplicity();
+    let csize = acc.data_type().size();
+    let elem = comps * csize;
+    let stride = view.stride().unwrap_or(elem);
+    if stride < elem {
+        return Err(Fault::Malformed(format!(
+            "buffer view {} has stride {stride} below its element size {elem}",
+            view.index()
+        )));
+    }
+    let count = acc.count();
+    if count > 0 {
+        let need = (count - 1).checked_mul(stride).and_then(|n| n.checked_add(acc.offset() + elem));
+        if need.is_none_or(|n| n > view_bytes.len()) {
+            return Err(Fault::Truncated(format!(
+                "accessor {} ({what}) reads past the end of buffer view {}",
+                acc.index(),
+                view.index()
+            )));
+        }
+    }
+    let norm = acc.normalized();
+    let read = |o: usize| -> f64 {
+        let b = &view_bytes[o..o + csize];
+        match acc.data_type() {
+            DataType::I8 => {
+                let v = f64::from(b[0] as i8);
+                if norm { (v / 127.0).max(-1.0) } else { v }
+            }
+            DataType::U8 => {
+                let v = f64::from(b[0]);
+                if norm { v / 255.0 } else { v }
+            }
+            DataType::I16 => {
+                let v = f64::from(i16::from_le_bytes([b[0], b[1]]));
+                if norm { (v / 32767.0).max(-1.0) } else { v }
+            }
+            DataType::U16 => {
+                let v = f64::from(u16::from_le_bytes([b[0], b[1]]));
+                if norm { v / 65535.0 } else { v }
+            }
+            DataType::U32 => f64::from(u32::from_le_bytes([b[0], b[1], b[2], b[3]])),
+            DataType::F32 => f64::from(f32::from_le_bytes([b[0], b[1], b[2], b[3]])),
+        }
+    };
+    Ok((0..count)
+        .map(|i| {
+            let base = acc.offset() + i * stride;
+            let mut e = [0.0; 3];
+            for (c, slot) in e.iter_mut().enumerate().take(comps.min(3)) {
+                *slot = read(base + c * csize);
+            }
+            e
+        })
+        .collect())
+}
+
+fn read_vec3(acc: &gltf::Accessor, buffers: &[Vec<u8>], what: &str) -> Result<Vec<Vec3>, Fault> {
+    if acc.dimensions() != Dimensions::Vec3 || acc.data_type() != DataType::F32 {
+        return Err(Fault::WrongAccessor(format!(
+            "{what} accessor {} is {:?} of {:?}, expected Vec3 of F32",
+            acc.index(),
+            acc.dimensions(),
+            acc.data_type()
+        )));
+    }
+    Ok(read_accessor(acc, buffers, what)?.iter().map(|e| Vec3::new(e[0] as f32, e[1] as f32, e[2] as f32)).collect())
+}
+
+fn read_indices(acc: &gltf::Accessor, buffers: &[Vec<u8>]) -> Result<Vec<u32>, Fault> {
+    if acc.dimensions() != Dimensions::Scalar
+        || !matches!(acc.data_type(), DataType::U8 | DataType::U16 | DataType::U32)
+    {
+        return Err(Fault::WrongAccessor(format!(
+            "index accessor {} is {:?} of {:?}, expected Scalar of U8, U16 or U32",
+            acc.index(),
+            acc.dimensions(),
+            acc.data_type()
+        )));
+    }
+    Ok(read_accessor(acc, buffers, "indices")?.iter().map(|e| e[0] as u32).collect())
+}
+
+/// Triangles of a primitive from its index list (or 0..n without indices).
+fn assemble(mode: Mode, idx: &[u32]) -> Vec<[u32; 3]> {
+    match mode {
+        Mode::Triangles => idx.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect(),
+        // Strips alternate winding so every triangle keeps the first one's orientation.
+        Mode::TriangleStrip => (2..idx.len())
+            .map(|i| if i % 2 == 0 { [idx[i - 2], idx[i - 1], idx[i]] } else { [idx[i - 1], idx[i - 2], idx[i]] })
+            .filter(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2])
+            .collect(),
+        Mode::TriangleFan => (2..idx.len()).map(|i| [idx[0], idx[i - 1], idx[i]]).collect(),
+        Mode::Points | Mode::Lines | Mode::LineLoop | Mode::LineStrip => Vec::new(),
+    }
+}
+
+fn check_required_extensions(root: &gltf::json::Root) -> Result<(), Fault> {
+    for ext in &root.extensions_required {
+        let what = match ext.as_str() {
+            "KHR_draco_mesh_compression" => "Draco mesh compression (KHR_draco_mesh_compression)".to_string(),
+            "EXT_meshopt_compression" | "KHR_meshopt_compression" => format!("meshopt compression ({ext})"),
+            "KHR_lights_punctual"
+            | "KHR_materials_unlit"
+            | "KHR_texture_transform"
+            | "KHR_materials_emissive_strength" => continue,
+            other => format!("required extension {other}"),
+        };
+        return Err(Fault::Unsupported(what));
+    }
+    Ok(())
+}
+
+struct Loader<'a> {
+    buffers: Vec<Vec<u8>>,
+    scene: Scene,
+    meshes: HashMap<(usize, usize), (MeshKey, MaterialKey)>,
+    materials: HashMap<Option<usize>, MaterialKey>,
+    doc: &'a gltf::Document,
+    triangles: usize,
+}
+
+impl Loader<'_> {
+    fn material(&mut self, m: &gltf::Material) -> MaterialKey {
+        *self.materials.entry(m.index()).or_insert_with(|| {
+            let c = m.pbr_metallic_roughness().base_color_factor();
+            let name = m.name().unwrap_or("material");
+            self.scene.add_material(Material {
+                two_sided: m.double_sided(),
+                ..Material::colored(name, Vec3::new(c[0], c[1], c[2]))
+            })
+        })
+    }
+
+    /// The scene meshes of a glTF mesh: one per triangle primitive, shared by every node that uses it.
+    fn primitives(&mut self, mesh: &gltf::Mesh) -> Result<Vec<(MeshKey, MaterialKey)>, Fault> {
+        let mut out = Vec::new();
+        for prim in mesh.primitives() {
+            let id = (mesh.index(), prim.index());
+            if let Some(&k) = self.meshes.get(&id) {
+                out.push(k);
+                continue;
+            }
+            if matches!(prim.mode(), Mode::Points | Mode::Lines | Mode::LineLoop | Mode::LineStrip) {
+                continue;
+            }
+            let what = format!("mesh {} primitive {}", mesh.index(), prim.index());
+            let pos_acc =
+                prim.get(&Semantic::Positions).ok_or_else(|| Fault::Malformed(format!("{what} has no POSITION")))?;
+            let positions = read_vec3(&pos_acc, &self.buffers, "POSITION")?;
+            let idx = match prim.indices() {
+                Some(a) => read_indices(&a, &self.buffers)?,
+                None => (0..positions.len() as u32).collect(),
+            };
+            let triangles = assemble(prim.mode(), &idx);
+            self.triangles += triangles.len();
+            let mesh_result = match prim.get(&Semantic::Normals) {
+                Some(n) => {
+                    let normals = read_vec3(&n, &self.buffers, "NORMAL")?;
+                    Mesh::with_normals(positions, normals, triangles)
+                }
+                None => Mesh::new(positions, triangles),
+            };
+            let m = mesh_result.map_err(|e| Fault::Mesh(what, e))?;
+            let mat = self.material(&prim.material());
+            let key = (self.scene.add_mesh(m), mat);
+            self.meshes.insert(id, key);
+            out.push(key);
+        }
+        Ok(out)
+    }
+
+    /// Adds a node and its subtree; `path` holds the nodes above, to find cycles.
+    fn node(
+        &mut self,
+        node: gltf::Node,
+        parent: Option<NodeKey>,
+        parent_world: Mat4,
+        path: &mut Vec<usize>,
+        seen: &mut [bool],
+    ) -> Result<(), Fault> {
+        if path.contains(&node.index()) {
+            return Err(Fault::Cycle(format!("node {} is its own ancestor", node.index())));
+        }
+        if std::mem::replace(&mut seen[node.index()], true) {
+            return Err(Fault::Cycle(format!("node {} has more than one parent", node.index())));
+        }
+        let local = Mat4::from_cols_array_2d(&node.transform().matrix());
+        if !local.is_finite() {
+            return Err(Fault::Malformed(format!("node {} has a non-finite transform", node.index())));
+        }
+        let name = node.name().map_or_else(|| format!("node {}", node.index()), str::to_string);
+        let key = self.scene.add_node(&name, parent, local).map_err(|e| Fault::Malformed(e.to_string()))?;
+        let world = parent_world * local;
+        if let Some(mesh) = node.mesh() {
+            let prims = self.primitives(&mesh)?;
+            for (i, p) in prims.into_iter().enumerate() {
+                // A node holds one mesh; extra primitives hang below it as children at the same place.
+                let target = if i == 0 {
+                    key
+                } else {
+                    self.scene
+                        .add_node(&format!("{name} #{i}"), Some(key), Mat4::IDENTITY)
+                        .map_err(|e| Fault::Malformed(e.to_string()))?
+                };
+                self.scene.set_mesh(target, Some(p)).map_err(|e| Fault::Malformed(e.to_string()))?;
+            }
+        }
+        let (_, rot, trans) = world.to_scale_rotation_translation();
+        let forward = (rot * Vec3::NEG_Z).normalize_or(Vec3::NEG_Z);
+        if let Some(cam) = node.camera()
+            && let gltf::camera::Projection::Perspective(p) = cam.projection()
+        {
+            let up = (rot * Vec3::Y).normalize_or(Vec3::Y);
+            let camera = Camera { eye: trans, target: trans + forward, up, fov_y: p.yfov(), near: p.znear().max(1e-4) };
+            if camera.validate().is_ok() {
+                self.scene.add_camera(camera);
+            }
+        }
+        if let Some(l) = node.light() {
+            use gltf::khr_lights_punctual::Kind;
+            let kind = match l.kind() {
+                Kind::Directional => LightKind::Directional { direction: forward },
+                Kind::Point => LightKind::Point { position: trans },
+                Kind::Spot { outer_cone_angle, .. } => LightKind::Spot {
+                    position: trans,
+                    direction: forward,
+                    cone_angle: (2.0 * outer_cone_angle).clamp(1e-3, 3.1),
+                },
+            };
+            let light = Light { kind, color: Vec3::from(l.color()), intensity: 1.0, radius: 0.05 };
+            if light.validate().is_ok() {
+                self.scene.add_light(light);
+            }
+        }
+        path.push(node.index());
+        for child in node.children() {
+            self.node(child, Some(key), world, path, seen)?;
+        }
+        path.pop();
+        Ok(())
+    }
+}
+
+fn parse(path: &Path) -> Result<Scene, Fault> {
+    let bytes = read_file(path)?;
+    let (json, bin) = if bytes.starts_with(b"glTF") { split_glb(&bytes)? } else { (bytes.as_slice(), None) };
+    let root: gltf::json::Root =
+        gltf::json::deserialize::from_slice(json).map_err(|e| Fault::Malformed(format!("JSON: {e}")))?;
+    check_required_extensions(&root)?;
+    let doc = match gltf::Document::from_json(root.clone()) {
+        Ok(doc) => doc,
+        Err(gltf::Error::Validation(errs)) => {
+            // POSITION min/max are required by the spec but many exporters leave them out; the loader
+            // computes bounds itself, so only that omission is forgiven.
+            let errs: Vec<_> = errs
+                .into_iter()
+                .filter(|(p, _)| {
+                    !(p.as_str().contains("POSITION") && (p.as_str().ends_with(".min") || p.as_str().ends_with(".max")))
+                })
+                .collect();
+            if let Some((p, e)) = errs.first() {
+                return Err(Fault::Malformed(format!("{} validation error(s), first: {p}: {e}", errs.len())));
+            }
+            gltf::Document::from_json_without_validation(root)
+        }
+        Err(other) => return Err(Fault::Malformed(other.to_string())),
+    };
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let buffers = load_buffers(&doc, dir, bin)?;
+    let mut loader = Loader {
+        buffers,
+        scene: Scene::new(),
+        meshes: HashMap::new(),
+        materials: HashMap::new(),
+        doc: &doc,
+        triangles: 0,
+    };
+    let roots: Vec<gltf::Node> = match doc.default_scene().or_else(|| doc.scenes().next()) {
+        Some(s) => s.nodes().collect(),
+        None => {
+            // No scene: every node that is nobody's child is a root.
+            let children: Vec<usize> =
+                doc.nodes().flat_map(|n| n.children().map(|c| c.index()).collect::<Vec<_>>()).collect();
+            doc.nodes().filter(|n| !children.contains(&n.index())).collect()
+        }
+    };
+    if roots.is_empty() && doc.nodes().len() > 0 {
+        return Err(Fault::Cycle("every node is some node's child, so there is no root".into()));
+    }
+    let mut seen = vec![false; loader.doc.nodes().len()];
+    for r in roots {
+        loader.node(r, None, Mat4::IDENTITY, &mut Vec::new(), &mut seen)?;
+    }
+    if loader.triangles == 0 {
+        let any_prims = doc.meshes().any(|m| m.primitives().len() > 0);
+        return Err(if any_prims {
+            Fault::Unsupported("only points or lines primitives, no triangles".into())
+        } else {
+            Fault::Unsupported("no meshes in the default scene".into())
+        });
+    }
+    Ok(loader.scene)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn base64_and_percent() {
+        assert_eq!(base64_decode("SGVsbG8=").unwrap(), b"Hello");
+        assert_eq!(base64_decode("AAEC").unwrap(), vec![0, 1, 2]);
+        assert!(base64_decode("A*").is_err());
+        assert_eq!(percent_decode("a%20b.bin"), "a b.bin");
+    }
+
+    #[test]
+    fn strips_keep_winding() {
+        let t = assemble(Mode::TriangleStrip, &[0, 1, 2, 3]);
+        assert_eq!(t, vec![[0, 1, 2], [2, 1, 3]]);
+        assert_eq!(assemble(Mode::TriangleFan, &[0, 1, 2, 3]), vec![[0, 1, 2], [0, 2, 3]]);
+    }
+}

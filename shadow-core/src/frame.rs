@@ -1,0 +1,172 @@
+//! What a frame hands to the techniques (DESIGN 5, step 1): world-space instances with their meshes and
+//! cached adjacency, the scene bounds, the camera and the lights.
+//!
+//! Nothing here depends on the light: silhouettes and volumes are found every frame by
+//! [`FrameInputs::shadow_volumes`], as the papers require.
+
+use std::sync::Arc;
+
+use glam::{Mat4, Vec3};
+use rayon::prelude::*;
+
+use crate::bounds::Aabb;
+use crate::geometry::adjacency::Adjacency;
+use crate::geometry::silhouette::{CastMode, silhouette};
+use crate::geometry::volume::{Caps, ShadowVolume, extrude};
+use crate::light::{LightView, LightViewError};
+use crate::mesh::Mesh;
+use crate::scene::{Camera, CameraKey, Light, MeshKey, NodeKey, Scene, SceneError};
+
+/// One drawn mesh in world space.
+#[derive(Clone, Debug)]
+pub struct Instance {
+    /// The node that draws it.
+    pub node: NodeKey,
+    /// The mesh's key (backends cache uploads by key and version).
+    pub mesh_key: MeshKey,
+    /// Changes whenever the mesh behind the key is replaced.
+    pub mesh_version: u64,
+    /// The geometry, in the mesh's own space.
+    pub mesh: Arc<Mesh>,
+    /// Its adjacency (cached by the scene per mesh).
+    pub adjacency: Arc<Adjacency>,
+    /// Mesh space to world space.
+    pub world_from_local: Mat4,
+    /// World space to mesh space.
+    pub local_from_world: Mat4,
+    /// The transform mirrors (negative determinant): front faces wind clockwise in world space.
+    pub mirrored: bool,
+    /// Linear albedo.
+    pub base_color: Vec3,
+    /// Lit from both sides.
+    pub two_sided: bool,
+    /// Blocks light (node and material flags combined).
+    pub casts_shadow: bool,
+    /// Shows shadows (node and material flags combined).
+    pub receives_shadow: bool,
+    /// World-space bounds.
+    pub bounds: Aabb,
+}
+
+/// The shadow volume of one casting instance, in that instance's mesh space.
+#[derive(Clone, Debug)]
+pub struct InstanceVolume {
+    /// Index into [`FrameInputs::instances`].
+    pub instance: usize,
+    /// Sides and caps.
+    pub volume: ShadowVolume,
+    /// Number of silhouette edges (before weights).
+    pub silhouette_edges: usize,
+}
+
+/// Why a frame could not be assembled.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum FrameError {
+    /// Bad camera or light, or an unknown key.
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    /// No light view could be fitted.
+    #[error(transparent)]
+    LightView(#[from] LightViewError),
+    /// The scene draws nothing.
+    #[error("the scene has no meshes to draw")]
+    Empty,
+}
+
+/// Everything a technique may read about the scene for one frame.
+#[derive(Clone, Debug)]
+pub struct FrameInputs {
+    /// Drawn meshes, depth-first from the scene roots.
+    pub instances: Vec<Instance>,
+    /// World bounds of every instance.
+    pub bounds: Aabb,
+    /// The camera of this frame.
+    pub camera: Camera,
+    /// The lights of this frame.
+    pub lights: Vec<Light>,
+}
+
+impl FrameInputs {
+    /// Collects the scene's instances (building any missing adjacency) with the given camera and lights.
+    ///
+    /// # Errors
+    /// An invalid camera or light, or an empty scene.
+    pub fn new(scene: &Scene, camera: Camera, lights: Vec<Light>) -> Result<Self, FrameError> {
+        camera.validate()?;
+        for l in &lights {
+            l.validate()?;
+        }
+        let instances: Vec<Instance> = scene
+            .drawables()
+            .filter_map(|(node, n, mesh_key, material)| {
+                let mesh = scene.mesh(mesh_key)?.clone();
+                let world = n.world_transform();
+                Some(Instance {
+                    node,
+                    mesh_key,
+                    mesh_version: scene.mesh_version(mesh_key)?,
+                    adjacency: scene.adjacency(mesh_key)?,
+                    world_from_local: world,
+                    local_from_world: world.inverse(),
+                    mirrored: world.determinant() < 0.0,
+                    base_color: material.base_color,
+                    two_sided: material.two_sided,
+                    casts_shadow: n.casts_shadow() && material.casts_shadow,
+                    receives_shadow: n.receives_shadow() && material.receives_shadow,
+                    bounds: mesh.bounds().transformed(world),
+                    mesh,
+                })
+            })
+            .collect();
+        if instances.is_empty() {
+            return Err(FrameError::Empty);
+        }
+        let bounds = instances.iter().fold(Aabb::EMPTY, |b, i| b.union(i.bounds));
+        Ok(Self { instances, bounds, camera, lights })
+    }
+
+    /// The frame seen through one of the scene's cameras, with all of the scene's lights.
+    ///
+    /// # Errors
+    /// As [`FrameInputs::new`], or an unknown camera key.
+    pub fn from_scene(scene: &Scene, camera: CameraKey) -> Result<Self, FrameError> {
+        let cam = *scene.camera(camera).ok_or(SceneError::UnknownKey("camera"))?;
+        Self::new(scene, cam, scene.lights().map(|(_, l)| *l).collect())
+    }
+
+    /// Total triangles drawn.
+    #[must_use]
+    pub fn triangle_count(&self) -> usize {
+        self.instances.iter().map(|i| i.mesh.triangle_count()).sum()
+    }
+
+    /// The light's projections fitted to this frame's instances.
+    ///
+    /// # Errors
+    /// An invalid light.
+    pub fn light_view(&self, light: &Light) -> Result<LightView, LightViewError> {
+        let boxes: Vec<Aabb> = self.instances.iter().map(|i| i.bounds).collect();
+        LightView::fit(light, &boxes)
+    }
+
+    /// Shadow volumes of every casting instance for the light, found afresh (in parallel over instances).
+    #[must_use]
+    pub fn shadow_volumes(&self, light: &LightView, caps: Caps) -> Vec<InstanceVolume> {
+        let world_light = light.source();
+        self.instances
+            .par_iter()
+            .enumerate()
+            .filter(|(_, inst)| inst.casts_shadow)
+            .map(|(i, inst)| {
+                let local_light = world_light.transformed(inst.local_from_world);
+                let adj = &inst.adjacency;
+                let sil = silhouette(adj, local_light, CastMode::for_mesh(adj));
+                InstanceVolume {
+                    instance: i,
+                    silhouette_edges: sil.edges.len(),
+                    volume: extrude(adj, &sil, local_light, caps),
+                }
+            })
+            .collect()
+    }
+}

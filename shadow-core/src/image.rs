@@ -1,0 +1,240 @@
+//! Images: row-major, top-left origin, pixel (x, y) centred at (x + 0.5, y + 0.5) (DESIGN 4).
+//!
+//! Also the colour helpers every report uses: sRGB encoding, PNG output, visibility and error false-colour.
+
+use std::path::Path;
+
+/// An 8-bit sRGB colour.
+pub type Rgb8 = [u8; 3];
+
+/// A `width x height` grid of `T`, row-major from the top-left corner.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Image<T> {
+    width: u32,
+    height: u32,
+    data: Vec<T>,
+}
+
+/// Why an image could not be written.
+#[derive(Debug, thiserror::Error)]
+#[error("cannot write {path}: {source}")]
+pub struct ImageWriteError {
+    /// The file.
+    pub path: String,
+    /// What went wrong.
+    #[source]
+    pub source: ::image::ImageError,
+}
+
+impl<T: Clone> Image<T> {
+    /// An image filled with `value`.
+    #[must_use]
+    pub fn new(width: u32, height: u32, value: T) -> Self {
+        Self { width, height, data: vec![value; width as usize * height as usize] }
+    }
+}
+
+impl<T> Image<T> {
+    /// An image over existing row-major data, or `None` when the length is not `width * height`.
+    #[must_use]
+    pub fn from_vec(width: u32, height: u32, data: Vec<T>) -> Option<Self> {
+        (data.len() == width as usize * height as usize).then_some(Self { width, height, data })
+    }
+
+    /// An image whose pixel (x, y) is `f(x, y)`.
+    #[must_use]
+    pub fn from_fn(width: u32, height: u32, mut f: impl FnMut(u32, u32) -> T) -> Self {
+        let mut data = Vec::with_capacity(width as usize * height as usize);
+        for y in 0..height {
+            for x in 0..width {
+                data.push(f(x, y));
+            }
+        }
+        Self { width, height, data }
+    }
+
+    /// Width in pixels.
+    #[must_use]
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+
+    /// Height in pixels.
+    #[must_use]
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+
+    /// Row-major pixels.
+    #[must_use]
+    pub fn data(&self) -> &[T] {
+        &self.data
+    }
+
+    /// Row-major pixels, mutable.
+    pub fn data_mut(&mut self) -> &mut [T] {
+        &mut self.data
+    }
+
+    /// The pixel data, consuming the image.
+    #[must_use]
+    pub fn into_vec(self) -> Vec<T> {
+        self.data
+    }
+
+    /// Index of pixel (x, y) in [`Image::data`].
+    #[must_use]
+    pub fn index(&self, x: u32, y: u32) -> usize {
+        y as usize * self.width as usize + x as usize
+    }
+
+    /// Pixel (x, y).
+    ///
+    /// # Panics
+    /// When (x, y) is outside the image.
+    #[must_use]
+    pub fn get(&self, x: u32, y: u32) -> &T {
+        assert!(x < self.width && y < self.height, "pixel ({x}, {y}) outside {}x{}", self.width, self.height);
+        &self.data[self.index(x, y)]
+    }
+
+    /// Pixel (x, y), mutable.
+    ///
+    /// # Panics
+    /// When (x, y) is outside the image.
+    pub fn get_mut(&mut self, x: u32, y: u32) -> &mut T {
+        assert!(x < self.width && y < self.height, "pixel ({x}, {y}) outside {}x{}", self.width, self.height);
+        let i = self.index(x, y);
+        &mut self.data[i]
+    }
+
+    /// Row `y`.
+    #[must_use]
+    pub fn row(&self, y: u32) -> &[T] {
+        let w = self.width as usize;
+        &self.data[y as usize * w..(y as usize + 1) * w]
+    }
+
+    /// A new image of `f` applied to every pixel.
+    #[must_use]
+    pub fn map<U>(&self, f: impl FnMut(&T) -> U) -> Image<U> {
+        Image { width: self.width, height: self.height, data: self.data.iter().map(f).collect() }
+    }
+
+    /// True when both images have the same size.
+    #[must_use]
+    pub fn same_size<U>(&self, other: &Image<U>) -> bool {
+        self.width == other.width && self.height == other.height
+    }
+}
+
+impl Image<Rgb8> {
+    /// Writes the image as an 8-bit RGB PNG.
+    ///
+    /// # Errors
+    /// When the file cannot be created or encoded.
+    pub fn save_png(&self, path: impl AsRef<Path>) -> Result<(), ImageWriteError> {
+        let path = path.as_ref();
+        let bytes: Vec<u8> = self.data.iter().flatten().copied().collect();
+        ::image::save_buffer(path, &bytes, self.width, self.height, ::image::ExtendedColorType::Rgb8)
+            .map_err(|source| ImageWriteError { path: path.display().to_string(), source })
+    }
+
+    /// Reads an 8-bit RGB PNG (any PNG is converted to RGB8).
+    ///
+    /// # Errors
+    /// When the file cannot be read or decoded.
+    pub fn load_png(path: impl AsRef<Path>) -> Result<Self, ImageWriteError> {
+        let path = path.as_ref();
+        let img = ::image::open(path)
+            .map_err(|source| ImageWriteError { path: path.display().to_string(), source })?
+            .into_rgb8();
+        let (w, h) = img.dimensions();
+        let data = img.into_raw().chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+        Ok(Self { width: w, height: h, data })
+    }
+}
+
+/// Linear [0, 1] to the sRGB transfer curve, 8 bits, rounded to nearest.
+#[must_use]
+pub fn linear_to_srgb8(v: f32) -> u8 {
+    let v = v.clamp(0.0, 1.0);
+    let s = if v <= 0.003_130_8 { 12.92 * v } else { 1.055 * v.powf(1.0 / 2.4) - 0.055 };
+    (s * 255.0 + 0.5) as u8
+}
+
+/// sRGB 8-bit to linear [0, 1].
+#[must_use]
+pub fn srgb8_to_linear(v: u8) -> f32 {
+    let s = f32::from(v) / 255.0;
+    if s <= 0.040_45 { s / 12.92 } else { ((s + 0.055) / 1.055).powf(2.4) }
+}
+
+/// Visibility as grey: lit white, shadow black; pixels outside `mask` dark blue so they read as "no receiver".
+#[must_use]
+pub fn visibility_to_rgb(vis: &Image<f32>, mask: &Image<bool>) -> Image<Rgb8> {
+    Image::from_fn(vis.width(), vis.height(), |x, y| {
+        if *mask.get(x, y) {
+            let g = (vis.get(x, y).clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
+            [g, g, g]
+        } else {
+            [24, 28, 48]
+        }
+    })
+}
+
+/// The error heat map of DESIGN 11: false shadow red, false light blue, agreement grey (lit light, shadowed
+/// dark), no receiver black.
+#[must_use]
+pub fn error_map(test: &Image<f32>, reference: &Image<f32>, mask: &Image<bool>) -> Image<Rgb8> {
+    Image::from_fn(test.width(), test.height(), |x, y| {
+        if !*mask.get(x, y) {
+            return [0, 0, 0];
+        }
+        let (t, r) = (*test.get(x, y) >= 0.5, *reference.get(x, y) >= 0.5);
+        match (t, r) {
+            (false, true) => [230, 40, 40],
+            (true, false) => [40, 90, 240],
+            (true, true) => [150, 150, 150],
+            (false, false) => [70, 70, 70],
+        }
+    })
+}
+
+/// A scalar field as a blue-to-yellow ramp between `lo` and `hi` (debug views of depth maps); NaN is black.
+#[must_use]
+pub fn false_colour(values: &Image<f32>, lo: f32, hi: f32) -> Image<Rgb8> {
+    let span = (hi - lo).max(f32::MIN_POSITIVE);
+    values.map(|&v| {
+        if v.is_nan() {
+            return [0, 0, 0];
+        }
+        let t = ((v - lo) / span).clamp(0.0, 1.0);
+        // A perceptually ordered ramp: dark blue, teal, yellow.
+        let r = (255.0 * (1.5 * t - 0.5).clamp(0.0, 1.0)) as u8;
+        let g = (255.0 * (0.15 + 0.85 * t)) as u8;
+        let b = (255.0 * (0.55 - 0.5 * t).clamp(0.0, 1.0)) as u8;
+        [r, g, b]
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn srgb_round_trip() {
+        for v in 0..=255u8 {
+            assert_eq!(linear_to_srgb8(srgb8_to_linear(v)), v);
+        }
+        assert_eq!(linear_to_srgb8(0.5), 188);
+    }
+
+    #[test]
+    fn layout_is_row_major_top_left() {
+        let img = Image::from_fn(3, 2, |x, y| (x, y));
+        assert_eq!(img.data()[4], (1, 1));
+        assert_eq!(img.row(1)[2], (2, 1));
+        assert!(Image::from_vec(2, 2, vec![0; 3]).is_none());
+    }
+}

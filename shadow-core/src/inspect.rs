@@ -1,0 +1,82 @@
+//! Mesh statistics of a scene, as `shadowlab inspect` prints them (DESIGN 11).
+
+use crate::bounds::Aabb;
+use crate::frame::FrameInputs;
+use crate::scene::Scene;
+
+/// What `inspect` reports. Counts are after welding coincident positions, summed over drawn instances.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Inspection {
+    /// Triangles drawn.
+    pub triangles: usize,
+    /// Welded vertices.
+    pub vertices: usize,
+    /// Every instance's mesh is closed and consistently wound.
+    pub closed: bool,
+    /// Edges with one face.
+    pub boundary_edges: usize,
+    /// Edges with three or more faces.
+    pub non_manifold_edges: usize,
+    /// Edges with two faces that run the same way.
+    pub inconsistent_edges: usize,
+    /// World bounds.
+    pub bounds: Aabb,
+    /// Silhouette edges of the casting instances from the scene's first light, `None` without a light.
+    pub silhouette_edges: Option<usize>,
+}
+
+impl Inspection {
+    /// Inspects a scene (its first camera is not needed; its first light gives the silhouette).
+    #[must_use]
+    pub fn of(scene: &Scene) -> Self {
+        let mut out = Self {
+            triangles: 0,
+            vertices: 0,
+            closed: true,
+            boundary_edges: 0,
+            non_manifold_edges: 0,
+            inconsistent_edges: 0,
+            bounds: scene.bounds(),
+            silhouette_edges: None,
+        };
+        for (_, _, mesh, _) in scene.drawables() {
+            let (Some(m), Some(adj)) = (scene.mesh(mesh), scene.adjacency(mesh)) else { continue };
+            out.triangles += m.triangle_count();
+            out.vertices += adj.vertex_count();
+            out.closed &= adj.closed();
+            out.boundary_edges += adj.boundary_edge_count();
+            out.non_manifold_edges += adj.non_manifold_edge_count();
+            out.inconsistent_edges += adj.inconsistent_edge_count();
+        }
+        let light = scene.lights().next().map(|(_, l)| *l);
+        let camera = crate::scene::Camera::look_at(glam::Vec3::ONE, glam::Vec3::ZERO, 45.0);
+        if let Some(light) = light
+            && let Ok(frame) = FrameInputs::new(scene, camera, vec![light])
+            && let Ok(view) = frame.light_view(&light)
+        {
+            let volumes = frame.shadow_volumes(&view, crate::geometry::volume::Caps::None);
+            out.silhouette_edges = Some(volumes.iter().map(|v| v.silhouette_edges).sum());
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scenes::{self, SceneParams};
+
+    #[test]
+    fn cylinder_scene() {
+        let s = scenes::build("cylinder", &SceneParams::default()).unwrap();
+        let i = Inspection::of(&s);
+        // Ground (2 triangles, 4 boundary edges) plus a closed 64-segment capped cylinder.
+        assert_eq!(i.triangles, 2 + 64 * 4);
+        assert_eq!(i.boundary_edges, 4);
+        assert!(!i.closed);
+        // The cylinder's silhouette from an oblique light: two vertical edges plus parts of both rims,
+        // and the ground's four boundary edges.
+        let sil = i.silhouette_edges.unwrap();
+        assert!(sil > 4 + 2 && sil < 4 + 2 + 2 * 64, "{sil}");
+    }
+}

@@ -1,0 +1,289 @@
+//! World-space light views for map-based techniques: a spot light is one perspective view, a directional
+//! light one orthographic view fitted to the scene, a point light six 90-degree cube faces. Near and far
+//! planes are fitted to the scene's instance bounds (McCool 6.1: the tighter the range, the better the
+//! depth precision).
+//!
+//! Shadow-map lookup (DESIGN 4), written once here and mirrored in WGSL: a world point projects to light
+//! NDC; `uv = (x * 0.5 + 0.5, 0.5 - y * 0.5)`; texel `i` of an `N`-texel side is centred at `(i + 0.5) / N`;
+//! the point is lit when its depth minus the bias is at most the stored depth.
+
+use glam::camera::rh::proj::directx;
+use glam::camera::rh::view::look_to_mat4;
+use glam::{Mat4, Vec2, Vec3, Vec3Swizzles, Vec4Swizzles};
+
+use crate::bounds::Aabb;
+use crate::geometry::LightSource;
+use crate::scene::{Light, LightKind, SceneError};
+
+/// Why a light view could not be made.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum LightViewError {
+    /// The light's own parameters are unusable.
+    #[error(transparent)]
+    Invalid(#[from] SceneError),
+    /// There is nothing to fit the view to.
+    #[error("the scene is empty: no bounds to fit the light view to")]
+    EmptyScene,
+}
+
+/// One projection of a light view: world to clip, and the fitted depth range.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightProjection {
+    /// World to light view (right-handed, looking down -Z).
+    pub view_from_world: Mat4,
+    /// Light view to clip, depth 0..1.
+    pub clip_from_view: Mat4,
+    /// World to clip.
+    pub clip_from_world: Mat4,
+    /// Near plane distance.
+    pub near: f32,
+    /// Far plane distance.
+    pub far: f32,
+    /// Orthographic (directional light) rather than perspective.
+    pub orthographic: bool,
+}
+
+impl LightProjection {
+    fn new(view_from_world: Mat4, clip_from_view: Mat4, near: f32, far: f32, orthographic: bool) -> Self {
+        Self {
+            view_from_world,
+            clip_from_view,
+            clip_from_world: clip_from_view * view_from_world,
+            near,
+            far,
+            orthographic,
+        }
+    }
+
+    /// Light NDC of a world point (x, y in [-1, 1] inside the view, z depth in [0, 1]).
+    #[must_use]
+    pub fn ndc(&self, p: Vec3) -> Vec3 {
+        self.clip_from_world.project_point3(p)
+    }
+
+    /// Map coordinates and depth of a world point: `uv` with (0, 0) at the top-left of the map.
+    #[must_use]
+    pub fn uv_depth(&self, p: Vec3) -> (Vec2, f32) {
+        let c = self.clip_from_world * p.extend(1.0);
+        let ndc = c.xyz() / c.w;
+        (ndc_to_uv(ndc.xy()), ndc.z)
+    }
+
+    /// The world point at map coordinates `uv` and NDC depth `depth` (McCool's back-projection).
+    #[must_use]
+    pub fn world_from_uv_depth(&self, uv: Vec2, depth: f32) -> Vec3 {
+        let ndc = Vec3::new(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0, depth);
+        self.clip_from_world.inverse().project_point3(ndc)
+    }
+
+    /// Distance along the view axis for an NDC depth.
+    #[must_use]
+    pub fn linear_depth(&self, depth: f32) -> f32 {
+        if self.orthographic {
+            self.near + depth * (self.far - self.near)
+        } else {
+            // directx::perspective: z_ndc = far (d - near) / (d (far - near)).
+            self.near * self.far / (self.far - depth * (self.far - self.near))
+        }
+    }
+}
+
+/// Light NDC x, y to map coordinates (DESIGN 4).
+#[must_use]
+pub fn ndc_to_uv(ndc: Vec2) -> Vec2 {
+    Vec2::new(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5)
+}
+
+/// Which kind of view a light has.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LightViewKind {
+    /// One perspective view covering the cone.
+    Spot,
+    /// One orthographic view covering the scene.
+    Directional,
+    /// Six cube faces: +X, -X, +Y, -Y, +Z, -Z.
+    Point,
+}
+
+/// A light with its fitted projections.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LightView {
+    /// The light.
+    pub light: Light,
+    /// Which layout `projections` has.
+    pub kind: LightViewKind,
+    /// One projection, or six cube faces in the order +X, -X, +Y, -Y, +Z, -Z.
+    pub projections: Vec<LightProjection>,
+}
+
+/// Look direction and up vector of the six cube faces, in the order of [`LightView::projections`].
+pub const CUBE_FACES: [(Vec3, Vec3); 6] = [
+    (Vec3::X, Vec3::NEG_Y),
+    (Vec3::NEG_X, Vec3::NEG_Y),
+    (Vec3::Y, Vec3::Z),
+    (Vec3::NEG_Y, Vec3::NEG_Z),
+    (Vec3::Z, Vec3::NEG_Y),
+    (Vec3::NEG_Z, Vec3::NEG_Y),
+];
+
+/// The cube face whose frustum holds direction `d` (its major axis; ties go to the lower face index).
+#[must_use]
+pub fn cube_face(d: Vec3) -> usize {
+    let a = d.abs();
+    if a.x >= a.y && a.x >= a.z {
+        if d.x >= 0.0 { 0 } else { 1 }
+    } else if a.y >= a.z {
+        if d.y >= 0.0 { 2 } else { 3 }
+    } else if d.z >= 0.0 {
+        4
+    } else {
+        5
+    }
+}
+
+fn safe_up(dir: Vec3) -> Vec3 {
+    if dir.cross(Vec3::Y).length_squared() < 1e-6 { Vec3::Z } else { Vec3::Y }
+}
+
+/// Fitted near and far for a perspective view from `eye`: far is the deepest box corner along `dir`, near
+/// the distance to the closest box (never more than any depth inside it), at least far / 2000.
+fn perspective_range(eye: Vec3, dir: Vec3, boxes: &[Aabb]) -> (f32, f32) {
+    let far = boxes.iter().flat_map(|b| b.corners()).map(|c| (c - eye).dot(dir)).fold(0.0f32, f32::max);
+    let far = (far * 1.01).max(1e-3);
+    let closest = boxes.iter().map(|b| (eye.clamp(b.min, b.max) - eye).length()).fold(f32::INFINITY, f32::min);
+    let near = (closest * 0.95).clamp(far / 2000.0, far * 0.5);
+    (near, far)
+}
+
+impl LightView {
+    /// Fits the light's projections to the given world-space boxes (one per instance keeps it tight).
+    ///
+    /// # Errors
+    /// An invalid light, or no non-empty box.
+    pub fn fit(light: &Light, boxes: &[Aabb]) -> Result<Self, LightViewError> {
+        light.validate()?;
+        let boxes: Vec<Aabb> = boxes.iter().copied().filter(|b| !b.is_empty()).collect();
+        if boxes.is_empty() {
+            return Err(LightViewError::EmptyScene);
+        }
+        let (kind, projections) = match light.kind {
+            LightKind::Spot { position, direction, cone_angle } => {
+                let dir = direction.normalize();
+                let (near, far) = perspective_range(position, dir, &boxes);
+                let view = look_to_mat4(position, dir, safe_up(dir));
+                let proj = directx::perspective(cone_angle, 1.0, near, far);
+                (LightViewKind::Spot, vec![LightProjection::new(view, proj, near, far, false)])
+            }
+            LightKind::Directional { direction } => {
+                let dir = direction.normalize();
+                let all = boxes.iter().fold(Aabb::EMPTY, |a, b| a.union(*b));
+                let center = all.center();
+                let radius = all.size().length() * 0.5 + 1e-3;
+                let view = look_to_mat4(center - dir * (radius * 2.0), dir, safe_up(dir));
+                let in_view = all.transformed(view);
+                // Square texels: the larger extent on both axes, centred.
+                let half = (in_view.max.xy() - in_view.min.xy()).max_element() * 0.5 * 1.01;
+                let mid = in_view.center().xy();
+                let (near, far) = (-in_view.max.z, -in_view.min.z);
+                let pad = (far - near) * 0.01 + 1e-4;
+                let (near, far) = (near - pad, far + pad);
+                let proj = directx::orthographic(mid.x - half, mid.x + half, mid.y - half, mid.y + half, near, far);
+                (LightViewKind::Directional, vec![LightProjection::new(view, proj, near, far, true)])
+            }
+            LightKind::Point { position } => {
+                let faces = CUBE_FACES
+                    .iter()
+                    .map(|&(dir, up)| {
+                        let (near, far) = perspective_range(position, dir, &boxes);
+                        let view = look_to_mat4(position, dir, up);
+                        let proj = directx::perspective(std::f32::consts::FRAC_PI_2, 1.0, near, far);
+                        LightProjection::new(view, proj, near, far, false)
+                    })
+                    .collect();
+                (LightViewKind::Point, faces)
+            }
+        };
+        Ok(Self { light: *light, kind, projections })
+    }
+
+    /// The light as the geometry kernels take it, in world space.
+    #[must_use]
+    pub fn source(&self) -> LightSource {
+        match self.light.kind {
+            LightKind::Spot { position, .. } | LightKind::Point { position } => LightSource::Point(position),
+            LightKind::Directional { direction } => LightSource::Directional(direction.normalize()),
+        }
+    }
+
+    /// Index of the projection that covers world point `p` (the cube face for point lights).
+    #[must_use]
+    pub fn projection_index(&self, p: Vec3) -> usize {
+        match self.light.kind {
+            LightKind::Point { position } => cube_face(p - position),
+            _ => 0,
+        }
+    }
+
+    /// True where the light can reach at all: inside a spot light's cone, everywhere for the others.
+    /// Metrics leave the rest out: no technique has anything to say there.
+    #[must_use]
+    pub fn in_domain(&self, p: Vec3) -> bool {
+        match self.light.kind {
+            LightKind::Spot { position, direction, cone_angle } => {
+                let d = (p - position).normalize_or_zero();
+                d.dot(direction.normalize()) >= (cone_angle * 0.5).cos()
+            }
+            _ => true,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn boxes() -> Vec<Aabb> {
+        vec![
+            Aabb::new(Vec3::new(-5.0, -0.01, -5.0), Vec3::new(5.0, 0.0, 5.0)),
+            Aabb::new(Vec3::splat(-0.5), Vec3::splat(0.5)),
+        ]
+    }
+
+    #[test]
+    fn spot_projects_its_target_to_the_map_centre() {
+        let v = LightView::fit(&Light::spot(Vec3::new(2.0, 4.0, 1.5), Vec3::ZERO, 60.0), &boxes()).unwrap();
+        let (uv, depth) = v.projections[0].uv_depth(Vec3::ZERO);
+        assert!((uv - Vec2::splat(0.5)).length() < 1e-5);
+        assert!(depth > 0.0 && depth < 1.0);
+        let back = v.projections[0].world_from_uv_depth(uv, depth);
+        assert!(back.length() < 1e-3);
+        let p = &v.projections[0];
+        assert!((p.linear_depth(depth) - Vec3::new(2.0, 4.0, 1.5).length()).abs() < 1e-3);
+    }
+
+    #[test]
+    fn directional_view_holds_the_scene() {
+        let v = LightView::fit(&Light::directional(Vec3::new(0.3, -1.0, 0.2)), &boxes()).unwrap();
+        for c in boxes().iter().flat_map(|b| b.corners()) {
+            let ndc = v.projections[0].ndc(c);
+            assert!(ndc.x.abs() <= 1.0 && ndc.y.abs() <= 1.0 && (0.0..=1.0).contains(&ndc.z), "{c} -> {ndc}");
+        }
+    }
+
+    #[test]
+    fn cube_faces_cover_their_directions() {
+        let v = LightView::fit(&Light::point(Vec3::new(0.0, 2.0, 0.0)), &boxes()).unwrap();
+        // Points on the ground, seen through every lower face and the side faces.
+        for p in [
+            Vec3::new(4.0, 0.0, 0.1),
+            Vec3::new(0.3, 0.0, 0.1),
+            Vec3::new(-4.5, 0.0, 2.0),
+            Vec3::new(1.0, 0.0, -4.9),
+            Vec3::new(-2.0, 0.0, 4.0),
+        ] {
+            let d = p - Vec3::new(0.0, 2.0, 0.0);
+            let ndc = v.projections[v.projection_index(p)].ndc(p);
+            assert!(ndc.x.abs() <= 1.0 && ndc.y.abs() <= 1.0 && ndc.z > 0.0, "{d} -> {ndc}");
+        }
+    }
+}

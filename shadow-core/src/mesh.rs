@@ -1,0 +1,220 @@
+//! Triangle meshes: positions, per-vertex shading normals and counter-clockwise triangles.
+//!
+//! A [`Mesh`] is valid by construction: every index is in range, every position and normal is finite, and
+//! there is at least one triangle. Loaders and builders go through [`Mesh::new`] or
+//! [`Mesh::with_normals`], so no backend ever sees a mesh that would rasterize garbage.
+
+use glam::Vec3;
+
+use crate::bounds::Aabb;
+
+/// Why a mesh was refused.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum MeshError {
+    /// No triangles at all.
+    #[error("mesh has no triangles")]
+    Empty,
+    /// A triangle names a vertex that does not exist.
+    #[error("triangle {triangle} uses vertex index {index}, but the mesh has {vertex_count} vertices")]
+    IndexOutOfRange {
+        /// Triangle number.
+        triangle: usize,
+        /// The bad index.
+        index: u32,
+        /// Number of vertices.
+        vertex_count: usize,
+    },
+    /// A position or normal is NaN or infinite.
+    #[error("vertex {vertex} has a non-finite {what} ({value})")]
+    NonFinite {
+        /// Vertex number.
+        vertex: usize,
+        /// "position" or "normal".
+        what: &'static str,
+        /// The offending value, printed.
+        value: String,
+    },
+    /// Normals given, but not one per vertex.
+    #[error("{normals} normals for {positions} positions")]
+    NormalCount {
+        /// Number of normals.
+        normals: usize,
+        /// Number of positions.
+        positions: usize,
+    },
+    /// More vertices than a `u32` index can name.
+    #[error("{0} vertices is more than 32-bit indices can address")]
+    TooManyVertices(usize),
+}
+
+/// An indexed triangle mesh with per-vertex normals. Front faces wind counter-clockwise.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Mesh {
+    positions: Vec<Vec3>,
+    normals: Vec<Vec3>,
+    triangles: Vec<[u32; 3]>,
+}
+
+impl Mesh {
+    /// A mesh with area-weighted vertex normals computed from its triangles.
+    ///
+    /// # Errors
+    /// See [`MeshError`].
+    pub fn new(positions: Vec<Vec3>, triangles: Vec<[u32; 3]>) -> Result<Self, MeshError> {
+        Self::check(&positions, &triangles)?;
+        let normals = vertex_normals(&positions, &triangles);
+        Ok(Self { positions, normals, triangles })
+    }
+
+    /// A mesh with the given shading normals (normalized here; zero normals are replaced by computed ones).
+    ///
+    /// # Errors
+    /// See [`MeshError`].
+    pub fn with_normals(positions: Vec<Vec3>, normals: Vec<Vec3>, triangles: Vec<[u32; 3]>) -> Result<Self, MeshError> {
+        Self::check(&positions, &triangles)?;
+        if normals.len() != positions.len() {
+            return Err(MeshError::NormalCount { normals: normals.len(), positions: positions.len() });
+        }
+        if let Some((vertex, n)) = normals.iter().enumerate().find(|(_, n)| !n.is_finite()) {
+            return Err(MeshError::NonFinite { vertex, what: "normal", value: format!("{n}") });
+        }
+        let computed = vertex_normals(&positions, &triangles);
+        let normals = normals.iter().zip(&computed).map(|(n, c)| n.try_normalize().unwrap_or(*c)).collect();
+        Ok(Self { positions, normals, triangles })
+    }
+
+    fn check(positions: &[Vec3], triangles: &[[u32; 3]]) -> Result<(), MeshError> {
+        if triangles.is_empty() {
+            return Err(MeshError::Empty);
+        }
+        if positions.len() > u32::MAX as usize {
+            return Err(MeshError::TooManyVertices(positions.len()));
+        }
+        if let Some((vertex, p)) = positions.iter().enumerate().find(|(_, p)| !p.is_finite()) {
+            return Err(MeshError::NonFinite { vertex, what: "position", value: format!("{p}") });
+        }
+        let n = positions.len();
+        for (triangle, t) in triangles.iter().enumerate() {
+            if let Some(&index) = t.iter().find(|&&i| i as usize >= n) {
+                return Err(MeshError::IndexOutOfRange { triangle, index, vertex_count: n });
+            }
+        }
+        Ok(())
+    }
+
+    /// Vertex positions.
+    #[must_use]
+    pub fn positions(&self) -> &[Vec3] {
+        &self.positions
+    }
+
+    /// Unit shading normals, one per vertex.
+    #[must_use]
+    pub fn normals(&self) -> &[Vec3] {
+        &self.normals
+    }
+
+    /// Triangles as vertex indices, counter-clockwise seen from the front.
+    #[must_use]
+    pub fn triangles(&self) -> &[[u32; 3]] {
+        &self.triangles
+    }
+
+    /// Number of triangles.
+    #[must_use]
+    pub fn triangle_count(&self) -> usize {
+        self.triangles.len()
+    }
+
+    /// The three corner positions of triangle `t`.
+    #[must_use]
+    pub fn triangle_positions(&self, t: usize) -> [Vec3; 3] {
+        self.triangles[t].map(|i| self.positions[i as usize])
+    }
+
+    /// Bounding box of the positions.
+    #[must_use]
+    pub fn bounds(&self) -> Aabb {
+        Aabb::from_points(self.positions.iter().copied())
+    }
+
+    /// A copy with every position and normal moved by an affine transform (normals by its inverse transpose).
+    /// A mirroring transform reverses the triangles so they stay counter-clockwise outside.
+    #[must_use]
+    pub fn transformed(&self, m: glam::Mat4) -> Self {
+        let normal_m = glam::Mat3::from_mat4(m).inverse().transpose();
+        let mirror = glam::Mat3::from_mat4(m).determinant() < 0.0;
+        Self {
+            positions: self.positions.iter().map(|&p| m.transform_point3(p)).collect(),
+            normals: self.normals.iter().map(|&n| (normal_m * n).normalize_or_zero()).collect(),
+            triangles: if mirror {
+                self.triangles.iter().map(|&[a, b, c]| [a, c, b]).collect()
+            } else {
+                self.triangles.clone()
+            },
+        }
+    }
+
+    /// Appends another mesh's vertices and triangles.
+    pub fn append(&mut self, other: &Mesh) {
+        let base = self.positions.len() as u32;
+        self.positions.extend_from_slice(&other.positions);
+        self.normals.extend_from_slice(&other.normals);
+        self.triangles.extend(other.triangles.iter().map(|t| t.map(|i| i + base)));
+    }
+
+    /// Several meshes as one.
+    ///
+    /// # Errors
+    /// [`MeshError::Empty`] when `parts` is empty.
+    pub fn merged<'a>(parts: impl IntoIterator<Item = &'a Mesh>) -> Result<Self, MeshError> {
+        let mut parts = parts.into_iter();
+        let mut out = parts.next().ok_or(MeshError::Empty)?.clone();
+        for p in parts {
+            out.append(p);
+        }
+        Ok(out)
+    }
+}
+
+/// Unnormalized face normal (twice the area, pointing out of the counter-clockwise side).
+#[must_use]
+pub fn face_normal([a, b, c]: [Vec3; 3]) -> Vec3 {
+    (b - a).cross(c - a)
+}
+
+fn vertex_normals(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Vec3> {
+    let mut normals = vec![Vec3::ZERO; positions.len()];
+    for t in triangles {
+        let n = face_normal(t.map(|i| positions[i as usize]));
+        for &i in t {
+            normals[i as usize] += n;
+        }
+    }
+    normals.iter().map(|n| n.normalize_or(Vec3::Y)).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn refuses_bad_meshes() {
+        let p = vec![Vec3::ZERO, Vec3::X, Vec3::Y];
+        assert_eq!(Mesh::new(p.clone(), vec![]), Err(MeshError::Empty));
+        assert!(matches!(Mesh::new(p.clone(), vec![[0, 1, 3]]), Err(MeshError::IndexOutOfRange { index: 3, .. })));
+        let mut nan = p.clone();
+        nan[1].y = f32::NAN;
+        assert!(matches!(Mesh::new(nan, vec![[0, 1, 2]]), Err(MeshError::NonFinite { vertex: 1, .. })));
+        let m = Mesh::new(p, vec![[0, 1, 2]]).unwrap();
+        assert_eq!(m.normals()[0], Vec3::Z);
+    }
+
+    #[test]
+    fn mirroring_keeps_outside_ccw() {
+        let m = Mesh::new(vec![Vec3::ZERO, Vec3::X, Vec3::Y], vec![[0, 1, 2]]).unwrap();
+        let t = m.transformed(glam::Mat4::from_scale(Vec3::new(-1.0, 1.0, 1.0)));
+        assert!(face_normal(t.triangle_positions(0)).z > 0.0);
+        assert!(t.normals()[0].z > 0.0);
+    }
+}

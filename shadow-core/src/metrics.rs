@@ -1,0 +1,196 @@
+//! Error metrics against a reference (DESIGN 8), over the pixels of a mask (receiver pixels inside the
+//! light's reach).
+//!
+//! Every fraction has the number of masked pixels as its denominator, so the parts add up:
+//! `mismatch = edge_band_mismatch + interior_mismatch = false_shadow + false_light`.
+
+use crate::image::{Image, Rgb8};
+
+/// Half-width in pixels of the band around reference shadow boundaries.
+pub const EDGE_BAND_RADIUS: i32 = 2;
+
+/// Why two images could not be compared.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("cannot compare a {0}x{1} image with a {2}x{3} one")]
+pub struct SizeMismatch(pub u32, pub u32, pub u32, pub u32);
+
+/// Visibility error of a technique against a reference.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct VisibilityMetrics {
+    /// Masked pixels compared.
+    pub pixels: u64,
+    /// Fraction where lit (v >= 0.5) differs from the reference.
+    pub mismatch: f64,
+    /// Mismatch within [`EDGE_BAND_RADIUS`] pixels of a reference shadow boundary.
+    pub edge_band_mismatch: f64,
+    /// Mismatch elsewhere.
+    pub interior_mismatch: f64,
+    /// Shadowed here, lit in the reference (acne).
+    pub false_shadow: f64,
+    /// Lit here, shadowed in the reference (leaks, peter-panning).
+    pub false_light: f64,
+    /// Root mean square visibility difference.
+    pub rmse: f64,
+    /// Mean absolute visibility difference.
+    pub mean_abs: f64,
+}
+
+fn check<A, B>(a: &Image<A>, b: &Image<B>) -> Result<(), SizeMismatch> {
+    if a.same_size(b) { Ok(()) } else { Err(SizeMismatch(a.width(), a.height(), b.width(), b.height())) }
+}
+
+/// Pixels within [`EDGE_BAND_RADIUS`] (Euclidean) of a reference shadow boundary: a masked pixel whose
+/// binary reference visibility differs from a masked 4-neighbour's.
+#[must_use]
+pub fn edge_band(reference: &Image<f32>, mask: &Image<bool>) -> Image<bool> {
+    let (w, h) = (reference.width() as i32, reference.height() as i32);
+    let lit = |x: i32, y: i32| *reference.get(x as u32, y as u32) >= 0.5;
+    let inside = |x: i32, y: i32| x >= 0 && y >= 0 && x < w && y < h && *mask.get(x as u32, y as u32);
+    let boundary = Image::from_fn(w as u32, h as u32, |x, y| {
+        let (x, y) = (x as i32, y as i32);
+        inside(x, y)
+            && [(1, 0), (-1, 0), (0, 1), (0, -1)]
+                .iter()
+                .any(|&(dx, dy)| inside(x + dx, y + dy) && lit(x + dx, y + dy) != lit(x, y))
+    });
+    let r = EDGE_BAND_RADIUS;
+    Image::from_fn(w as u32, h as u32, |x, y| {
+        let (x, y) = (x as i32, y as i32);
+        (-r..=r).any(|dy| {
+            (-r..=r).any(|dx| {
+                dx * dx + dy * dy <= r * r && inside(x + dx, y + dy) && *boundary.get((x + dx) as u32, (y + dy) as u32)
+            })
+        })
+    })
+}
+
+/// Compares a visibility image with a reference over `mask`.
+///
+/// # Errors
+/// When the three images differ in size.
+pub fn compare_visibility(
+    test: &Image<f32>,
+    reference: &Image<f32>,
+    mask: &Image<bool>,
+) -> Result<VisibilityMetrics, SizeMismatch> {
+    check(test, reference)?;
+    check(test, mask)?;
+    let band = edge_band(reference, mask);
+    let (mut n, mut band_miss, mut interior_miss, mut fs, mut fl) = (0u64, 0u64, 0u64, 0u64, 0u64);
+    let (mut sq, mut abs) = (0.0f64, 0.0f64);
+    for i in 0..test.data().len() {
+        if !mask.data()[i] {
+            continue;
+        }
+        n += 1;
+        let (t, r) = (test.data()[i], reference.data()[i]);
+        let d = f64::from(t - r);
+        sq += d * d;
+        abs += d.abs();
+        let (tl, rl) = (t >= 0.5, r >= 0.5);
+        if tl != rl {
+            if band.data()[i] {
+                band_miss += 1;
+            } else {
+                interior_miss += 1;
+            }
+            if rl {
+                fs += 1;
+            } else {
+                fl += 1;
+            }
+        }
+    }
+    let frac = |k: u64| if n == 0 { 0.0 } else { k as f64 / n as f64 };
+    Ok(VisibilityMetrics {
+        pixels: n,
+        mismatch: frac(band_miss + interior_miss),
+        edge_band_mismatch: frac(band_miss),
+        interior_mismatch: frac(interior_miss),
+        false_shadow: frac(fs),
+        false_light: frac(fl),
+        rmse: if n == 0 { 0.0 } else { (sq / n as f64).sqrt() },
+        mean_abs: if n == 0 { 0.0 } else { abs / n as f64 },
+    })
+}
+
+/// Mean FLIP error (NVIDIA's perceptual metric, as in wgpu's image tests) of two shaded images, averaged
+/// over `mask`. FLIP sees the whole image (its filters need the surroundings); only the average is masked.
+///
+/// # Errors
+/// When the images differ in size.
+pub fn flip_mean(test: &Image<Rgb8>, reference: &Image<Rgb8>, mask: &Image<bool>) -> Result<f64, SizeMismatch> {
+    check(test, reference)?;
+    check(test, mask)?;
+    let bytes = |img: &Image<Rgb8>| img.data().iter().flatten().copied().collect::<Vec<u8>>();
+    let (w, h) = (test.width(), test.height());
+    let r = nv_flip::FlipImageRgb8::with_data(w, h, &bytes(reference));
+    let t = nv_flip::FlipImageRgb8::with_data(w, h, &bytes(test));
+    let err = nv_flip::flip(r, t, nv_flip::DEFAULT_PIXELS_PER_DEGREE).to_vec();
+    let (sum, n) = err
+        .iter()
+        .zip(mask.data())
+        .filter(|(_, m)| **m)
+        .fold((0.0f64, 0u64), |(s, n), (e, _)| (s + f64::from(*e), n + 1));
+    Ok(if n == 0 { 0.0 } else { sum / n as f64 })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 20x20 reference, shadowed for x < 10; the test shadows x < 12 (two columns of false shadow) and
+    /// leaks one interior pixel.
+    #[test]
+    fn known_answers() {
+        let reference = Image::from_fn(20, 20, |x, _| if x < 10 { 0.0 } else { 1.0 });
+        let test = Image::from_fn(20, 20, |x, y| {
+            if (x, y) == (2, 5) {
+                1.0
+            } else if x < 12 {
+                0.0
+            } else {
+                1.0
+            }
+        });
+        let mask = Image::new(20, 20, true);
+        let m = compare_visibility(&test, &reference, &mask).unwrap();
+        assert_eq!(m.pixels, 400);
+        assert!((m.mismatch - 41.0 / 400.0).abs() < 1e-12);
+        assert!((m.false_shadow - 40.0 / 400.0).abs() < 1e-12);
+        assert!((m.false_light - 1.0 / 400.0).abs() < 1e-12);
+        // Columns 10 and 11 are within 2 px of the boundary (between columns 9 and 10); (2, 5) is not.
+        assert!((m.edge_band_mismatch - 40.0 / 400.0).abs() < 1e-12);
+        assert!((m.interior_mismatch - 1.0 / 400.0).abs() < 1e-12);
+        assert!((m.mean_abs - 41.0 / 400.0).abs() < 1e-12);
+        assert!((m.rmse - (41.0f64 / 400.0).sqrt()).abs() < 1e-12);
+    }
+
+    #[test]
+    fn band_is_two_pixels_wide_each_side() {
+        let reference = Image::from_fn(20, 1, |x, _| if x < 10 { 0.0 } else { 1.0 });
+        let band = edge_band(&reference, &Image::new(20, 1, true));
+        let cols: Vec<u32> = (0..20).filter(|&x| *band.get(x, 0)).collect();
+        assert_eq!(cols, vec![7, 8, 9, 10, 11, 12]);
+    }
+
+    #[test]
+    fn mask_excludes_pixels() {
+        let reference = Image::new(4, 4, 1.0f32);
+        let test = Image::new(4, 4, 0.0f32);
+        let mask = Image::from_fn(4, 4, |x, _| x == 0);
+        let m = compare_visibility(&test, &reference, &mask).unwrap();
+        assert_eq!(m.pixels, 4);
+        assert_eq!(m.mismatch, 1.0);
+        assert!(compare_visibility(&test, &Image::new(3, 4, 1.0), &mask).is_err());
+    }
+
+    #[test]
+    fn flip_is_zero_for_equal_and_positive_for_different() {
+        let a = Image::from_fn(32, 32, |x, y| [(x * 8) as u8, (y * 8) as u8, 128]);
+        let mask = Image::new(32, 32, true);
+        assert!(flip_mean(&a, &a, &mask).unwrap() < 1e-6);
+        let b = a.map(|p| [255 - p[0], p[1], p[2]]);
+        assert!(flip_mean(&b, &a, &mask).unwrap() > 0.1);
+    }
+}

@@ -1,0 +1,719 @@
+//! The scene graph: slotmap storage with typed keys, a node hierarchy with cached world transforms,
+//! materials, lights and cameras.
+//!
+//! Every mutation goes through a method that keeps the caches right: moving a node recomputes the world
+//! transforms of its subtree (and nothing else); replacing a mesh drops its cached adjacency and bumps its
+//! version so GPU uploads keyed by [`MeshKey`] know to refresh. Lights and cameras live in world space.
+
+use std::sync::{Arc, OnceLock};
+
+use glam::{Mat4, Vec3};
+use slotmap::SlotMap;
+
+use crate::bounds::Aabb;
+use crate::geometry::adjacency::Adjacency;
+use crate::mesh::Mesh;
+
+slotmap::new_key_type! {
+    /// A node of the hierarchy.
+    pub struct NodeKey;
+    /// A mesh, shared by any number of nodes.
+    pub struct MeshKey;
+    /// A material.
+    pub struct MaterialKey;
+    /// A light.
+    pub struct LightKey;
+    /// A camera.
+    pub struct CameraKey;
+}
+
+/// Why a scene edit was refused.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SceneError {
+    /// The key does not (or no longer) exist.
+    #[error("unknown {0} key")]
+    UnknownKey(&'static str),
+    /// A transform with NaN or infinite entries.
+    #[error("transform of node '{node}' is not finite")]
+    NonFiniteTransform {
+        /// The node's name.
+        node: String,
+    },
+    /// Reparenting would make a node its own ancestor.
+    #[error("making '{parent}' the parent of '{child}' would create a cycle")]
+    Cycle {
+        /// The would-be child.
+        child: String,
+        /// The would-be parent.
+        parent: String,
+    },
+    /// A light or camera with unusable parameters.
+    #[error("{0}")]
+    Invalid(String),
+}
+
+/// Surface appearance and shadow flags.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    /// Name, for reports.
+    pub name: String,
+    /// Linear-RGB albedo.
+    pub base_color: Vec3,
+    /// Lit from both sides (the shading normal faces the viewer).
+    pub two_sided: bool,
+    /// Whether surfaces with this material block light.
+    pub casts_shadow: bool,
+    /// Whether shadows are computed on surfaces with this material.
+    pub receives_shadow: bool,
+}
+
+impl Default for Material {
+    fn default() -> Self {
+        Self {
+            name: "default".into(),
+            base_color: Vec3::splat(0.8),
+            two_sided: false,
+            casts_shadow: true,
+            receives_shadow: true,
+        }
+    }
+}
+
+impl Material {
+    /// A default material of the given colour.
+    #[must_use]
+    pub fn colored(name: &str, base_color: Vec3) -> Self {
+        Self { name: name.into(), base_color, ..Self::default() }
+    }
+}
+
+/// What kind of light, with its placement in world space.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LightKind {
+    /// A point light with a cone: `cone_angle` is the full apex angle in radians.
+    Spot {
+        /// Position.
+        position: Vec3,
+        /// Unit direction the cone points along.
+        direction: Vec3,
+        /// Full cone angle in radians, in (0, pi).
+        cone_angle: f32,
+    },
+    /// Parallel light travelling along `direction` (unit).
+    Directional {
+        /// Direction the light travels.
+        direction: Vec3,
+    },
+    /// Omnidirectional point light.
+    Point {
+        /// Position.
+        position: Vec3,
+    },
+}
+
+/// A light source.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Light {
+    /// Type and placement.
+    pub kind: LightKind,
+    /// Linear-RGB colour.
+    pub color: Vec3,
+    /// Scale on `color`.
+    pub intensity: f32,
+    /// Radius of the emitting sphere, for soft shadows (hard-shadow techniques treat the light as a point).
+    pub radius: f32,
+}
+
+impl Light {
+    /// A white spot light at `position` aiming at `target`.
+    #[must_use]
+    pub fn spot(position: Vec3, target: Vec3, cone_angle_deg: f32) -> Self {
+        let direction = (target - position).normalize_or(Vec3::NEG_Y);
+        Self::white(LightKind::Spot { position, direction, cone_angle: cone_angle_deg.to_radians() })
+    }
+
+    /// A white directional light travelling along `direction`.
+    #[must_use]
+    pub fn directional(direction: Vec3) -> Self {
+        Self::white(LightKind::Directional { direction: direction.normalize_or(Vec3::NEG_Y) })
+    }
+
+    /// A white point light.
+    #[must_use]
+    pub fn point(position: Vec3) -> Self {
+        Self::white(LightKind::Point { position })
+    }
+
+    fn white(kind: LightKind) -> Self {
+        Self { kind, color: Vec3::ONE, intensity: 1.0, radius: 0.05 }
+    }
+
+    /// Position for spot and point lights, `None` for directional ones.
+    #[must_use]
+    pub fn position(&self) -> Option<Vec3> {
+        match self.kind {
+            LightKind::Spot { position, .. } | LightKind::Point { position } => Some(position),
+            LightKind::Directional { .. } => None,
+        }
+    }
+
+    /// The short name of the light type: "spot", "directional" or "point".
+    #[must_use]
+    pub fn type_name(&self) -> &'static str {
+        match self.kind {
+            LightKind::Spot { .. } => "spot",
+            LightKind::Directional { .. } => "directional",
+            LightKind::Point { .. } => "point",
+        }
+    }
+
+    /// Unit vector from `p` towards the light.
+    #[must_use]
+    pub fn to_light(&self, p: Vec3) -> Vec3 {
+        match self.kind {
+            LightKind::Spot { position, .. } | LightKind::Point { position } => (position - p).normalize_or_zero(),
+            LightKind::Directional { direction } => -direction,
+        }
+    }
+
+    /// Checks that the light can be used: finite, unit-able direction, cone in (0, 180) degrees.
+    ///
+    /// # Errors
+    /// [`SceneError::Invalid`] naming the bad parameter.
+    pub fn validate(&self) -> Result<(), SceneError> {
+        let bad = |what: &str| Err(SceneError::Invalid(format!("light {what}")));
+        match self.kind {
+            LightKind::Spot { position, direction, cone_angle } => {
+                if !position.is_finite() {
+                    return bad("position is not finite");
+                }
+                if !direction.is_finite() || direction.length_squared() < 1e-12 {
+                    return bad("direction is zero or not finite");
+                }
+                if !(cone_angle > 0.0 && cone_angle < std::f32::consts::PI) {
+                    return bad("cone angle must be between 0 and 180 degrees");
+                }
+            }
+            LightKind::Directional { direction } => {
+                if !direction.is_finite() || direction.length_squared() < 1e-12 {
+                    return bad("direction is zero or not finite");
+                }
+            }
+            LightKind::Point { position } => {
+                if !position.is_finite() {
+                    return bad("position is not finite");
+                }
+            }
+        }
+        if !(self.radius.is_finite() && self.radius >= 0.0 && self.color.is_finite() && self.intensity.is_finite()) {
+            return bad("colour, intensity or radius is not finite and non-negative");
+        }
+        Ok(())
+    }
+}
+
+/// A perspective camera with an infinite far plane (DESIGN 4).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera {
+    /// Eye position.
+    pub eye: Vec3,
+    /// Point looked at.
+    pub target: Vec3,
+    /// Up direction (need not be orthogonal to the view direction).
+    pub up: Vec3,
+    /// Vertical field of view in radians.
+    pub fov_y: f32,
+    /// Near plane distance.
+    pub near: f32,
+}
+
+impl Camera {
+    /// A camera at `eye` looking at `target` with a vertical field of view in degrees.
+    #[must_use]
+    pub fn look_at(eye: Vec3, target: Vec3, fov_y_deg: f32) -> Self {
+        Self { eye, target, up: Vec3::Y, fov_y: fov_y_deg.to_radians(), near: 0.05 }
+    }
+
+    /// World to view (right-handed, looking down -Z).
+    #[must_use]
+    pub fn view_from_world(&self) -> Mat4 {
+        let dir = (self.target - self.eye).normalize_or(Vec3::NEG_Z);
+        let up = if dir.cross(self.up).length_squared() < 1e-8 { Vec3::Z } else { self.up };
+        glam::camera::rh::view::look_to_mat4(self.eye, dir, up)
+    }
+
+    /// View to clip: an infinite right-handed perspective (NDC y up), depth 0 at the near plane and 1 at infinity.
+    #[must_use]
+    pub fn clip_from_view(&self, aspect: f32) -> Mat4 {
+        glam::camera::rh::proj::directx::perspective_infinite(self.fov_y, aspect, self.near)
+    }
+
+    /// World to clip for a view of the given aspect ratio (width / height).
+    #[must_use]
+    pub fn clip_from_world(&self, aspect: f32) -> Mat4 {
+        self.clip_from_view(aspect) * self.view_from_world()
+    }
+
+    /// Checks the camera can be used.
+    ///
+    /// # Errors
+    /// [`SceneError::Invalid`] naming the bad parameter.
+    pub fn validate(&self) -> Result<(), SceneError> {
+        if !(self.eye.is_finite() && self.target.is_finite() && self.up.is_finite()) {
+            return Err(SceneError::Invalid("camera eye, target or up is not finite".into()));
+        }
+        if (self.target - self.eye).length_squared() < 1e-12 {
+            return Err(SceneError::Invalid("camera eye and target coincide".into()));
+        }
+        if !(self.fov_y > 0.0 && self.fov_y < std::f32::consts::PI) {
+            return Err(SceneError::Invalid("camera field of view must be between 0 and 180 degrees".into()));
+        }
+        if !(self.near > 0.0 && self.near.is_finite()) {
+            return Err(SceneError::Invalid("camera near plane must be positive".into()));
+        }
+        Ok(())
+    }
+}
+
+/// A node: a local transform, optionally a mesh with a material, and shadow flags.
+#[derive(Clone, Debug)]
+pub struct Node {
+    name: String,
+    parent: Option<NodeKey>,
+    children: Vec<NodeKey>,
+    local: Mat4,
+    world: Mat4,
+    mesh: Option<(MeshKey, MaterialKey)>,
+    casts_shadow: bool,
+    receives_shadow: bool,
+}
+
+impl Node {
+    /// Name, for reports.
+    #[must_use]
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+    /// Parent node.
+    #[must_use]
+    pub fn parent(&self) -> Option<NodeKey> {
+        self.parent
+    }
+    /// Child nodes.
+    #[must_use]
+    pub fn children(&self) -> &[NodeKey] {
+        &self.children
+    }
+    /// Transform relative to the parent.
+    #[must_use]
+    pub fn local_transform(&self) -> Mat4 {
+        self.local
+    }
+    /// Cached world transform (always current).
+    #[must_use]
+    pub fn world_transform(&self) -> Mat4 {
+        self.world
+    }
+    /// The mesh this node draws and its material.
+    #[must_use]
+    pub fn mesh(&self) -> Option<(MeshKey, MaterialKey)> {
+        self.mesh
+    }
+    /// Whether this node blocks light (combined with its material's flag).
+    #[must_use]
+    pub fn casts_shadow(&self) -> bool {
+        self.casts_shadow
+    }
+    /// Whether this node shows shadows (combined with its material's flag).
+    #[must_use]
+    pub fn receives_shadow(&self) -> bool {
+        self.receives_shadow
+    }
+}
+
+struct MeshEntry {
+    mesh: Arc<Mesh>,
+    adjacency: OnceLock<Arc<Adjacency>>,
+    version: u64,
+}
+
+/// The scene: nodes, meshes, materials, lights and cameras.
+#[derive(Default)]
+pub struct Scene {
+    nodes: SlotMap<NodeKey, Node>,
+    roots: Vec<NodeKey>,
+    meshes: SlotMap<MeshKey, MeshEntry>,
+    materials: SlotMap<MaterialKey, Material>,
+    lights: SlotMap<LightKey, Light>,
+    cameras: SlotMap<CameraKey, Camera>,
+    next_mesh_version: u64,
+}
+
+impl Scene {
+    /// An empty scene.
+    #[must_use]
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    // ---- meshes ----
+
+    /// Adds a mesh; nodes refer to it by the returned key.
+    pub fn add_mesh(&mut self, mesh: Mesh) -> MeshKey {
+        self.next_mesh_version += 1;
+        self.meshes.insert(MeshEntry {
+            mesh: Arc::new(mesh),
+            adjacency: OnceLock::new(),
+            version: self.next_mesh_version,
+        })
+    }
+
+    /// The mesh behind a key.
+    #[must_use]
+    pub fn mesh(&self, key: MeshKey) -> Option<&Arc<Mesh>> {
+        self.meshes.get(key).map(|e| &e.mesh)
+    }
+
+    /// A number that changes whenever the mesh behind `key` is replaced.
+    #[must_use]
+    pub fn mesh_version(&self, key: MeshKey) -> Option<u64> {
+        self.meshes.get(key).map(|e| e.version)
+    }
+
+    /// Replaces a mesh's geometry for every node that uses it; drops its cached adjacency.
+    ///
+    /// # Errors
+    /// [`SceneError::UnknownKey`] for a removed or foreign key.
+    pub fn replace_mesh(&mut self, key: MeshKey, mesh: Mesh) -> Result<(), SceneError> {
+        self.next_mesh_version += 1;
+        let version = self.next_mesh_version;
+        let entry = self.meshes.get_mut(key).ok_or(SceneError::UnknownKey("mesh"))?;
+        *entry = MeshEntry { mesh: Arc::new(mesh), adjacency: OnceLock::new(), version };
+        Ok(())
+    }
+
+    /// The mesh's edge adjacency, built on first use and cached until the mesh is replaced.
+    #[must_use]
+    pub fn adjacency(&self, key: MeshKey) -> Option<Arc<Adjacency>> {
+        let e = self.meshes.get(key)?;
+        Some(e.adjacency.get_or_init(|| Arc::new(Adjacency::build(&e.mesh))).clone())
+    }
+
+    /// True when the mesh's adjacency is already cached.
+    #[must_use]
+    pub fn has_cached_adjacency(&self, key: MeshKey) -> bool {
+        self.meshes.get(key).is_some_and(|e| e.adjacency.get().is_some())
+    }
+
+    /// Every mesh.
+    pub fn meshes(&self) -> impl Iterator<Item = (MeshKey, &Arc<Mesh>)> {
+        self.meshes.iter().map(|(k, e)| (k, &e.mesh))
+    }
+
+    // ---- materials ----
+
+    /// Adds a material.
+    pub fn add_material(&mut self, material: Material) -> MaterialKey {
+        self.materials.insert(material)
+    }
+
+    /// A material.
+    #[must_use]
+    pub fn material(&self, key: MaterialKey) -> Option<&Material> {
+        self.materials.get(key)
+    }
+
+    /// A material, to edit (materials hold no cached state).
+    pub fn material_mut(&mut self, key: MaterialKey) -> Option<&mut Material> {
+        self.materials.get_mut(key)
+    }
+
+    // ---- nodes ----
+
+    /// Adds a node under `parent` (or as a root) with a local transform.
+    ///
+    /// # Errors
+    /// An unknown parent, or a non-finite transform.
+    pub fn add_node(&mut self, name: &str, parent: Option<NodeKey>, local: Mat4) -> Result<NodeKey, SceneError> {
+        if !local.is_finite() {
+            return Err(SceneError::NonFiniteTransform { node: name.into() });
+        }
+        let parent_world = match parent {
+            Some(p) => self.nodes.get(p).ok_or(SceneError::UnknownKey("node"))?.world,
+            None => Mat4::IDENTITY,
+        };
+        let key = self.nodes.insert(Node {
+            name: name.into(),
+            parent,
+            children: Vec::new(),
+            local,
+            world: parent_world * local,
+            mesh: None,
+            casts_shadow: true,
+            receives_shadow: true,
+        });
+        match parent {
+            Some(p) => self.nodes[p].children.push(key),
+            None => self.roots.push(key),
+        }
+        Ok(key)
+    }
+
+    /// Adds a root node drawing `mesh` with `material` at `transform`.
+    ///
+    /// # Errors
+    /// Unknown keys or a non-finite transform.
+    pub fn add_instance(
+        &mut self,
+        name: &str,
+        mesh: MeshKey,
+        material: MaterialKey,
+        transform: Mat4,
+    ) -> Result<NodeKey, SceneError> {
+        let node = self.add_node(name, None, transform)?;
+        self.set_mesh(node, Some((mesh, material)))?;
+        Ok(node)
+    }
+
+    /// A node.
+    #[must_use]
+    pub fn node(&self, key: NodeKey) -> Option<&Node> {
+        self.nodes.get(key)
+    }
+
+    /// Root nodes, in insertion order.
+    #[must_use]
+    pub fn roots(&self) -> &[NodeKey] {
+        &self.roots
+    }
+
+    /// Number of nodes.
+    #[must_use]
+    pub fn node_count(&self) -> usize {
+        self.nodes.len()
+    }
+
+    /// Sets what a node draws.
+    ///
+    /// # Errors
+    /// Unknown node, mesh or material key.
+    pub fn set_mesh(&mut self, node: NodeKey, mesh: Option<(MeshKey, MaterialKey)>) -> Result<(), SceneError> {
+        if let Some((m, mat)) = mesh {
+            self.meshes.get(m).ok_or(SceneError::UnknownKey("mesh"))?;
+            self.materials.get(mat).ok_or(SceneError::UnknownKey("material"))?;
+        }
+        self.nodes.get_mut(node).ok_or(SceneError::UnknownKey("node"))?.mesh = mesh;
+        Ok(())
+    }
+
+    /// Sets a node's shadow flags.
+    ///
+    /// # Errors
+    /// Unknown node key.
+    pub fn set_shadow_flags(&mut self, node: NodeKey, casts: bool, receives: bool) -> Result<(), SceneError> {
+        let n = self.nodes.get_mut(node).ok_or(SceneError::UnknownKey("node"))?;
+        n.casts_shadow = casts;
+        n.receives_shadow = receives;
+        Ok(())
+    }
+
+    /// Moves a node: sets its local transform and recomputes the world transforms of its subtree.
+    ///
+    /// # Errors
+    /// Unknown node, or a non-finite transform.
+    pub fn set_local_transform(&mut self, node: NodeKey, local: Mat4) -> Result<(), SceneError> {
+        let n = self.nodes.get_mut(node).ok_or(SceneError::UnknownKey("node"))?;
+        if !local.is_finite() {
+            return Err(SceneError::NonFiniteTransform { node: n.name.clone() });
+        }
+        n.local = local;
+        self.update_subtree(node);
+        Ok(())
+    }
+
+    /// Moves a node under a new parent (or to the roots), keeping its local transform.
+    ///
+    /// # Errors
+    /// Unknown keys, or a parent inside the node's own subtree.
+    pub fn set_parent(&mut self, node: NodeKey, parent: Option<NodeKey>) -> Result<(), SceneError> {
+        self.nodes.get(node).ok_or(SceneError::UnknownKey("node"))?;
+        if let Some(p) = parent {
+            self.nodes.get(p).ok_or(SceneError::UnknownKey("node"))?;
+            let mut a = Some(p);
+            while let Some(k) = a {
+                if k == node {
+                    return Err(SceneError::Cycle {
+                        child: self.nodes[node].name.clone(),
+                        parent: self.nodes[p].name.clone(),
+                    });
+                }
+                a = self.nodes[k].parent;
+            }
+        }
+        match self.nodes[node].parent {
+            Some(old) => self.nodes[old].children.retain(|&c| c != node),
+            None => self.roots.retain(|&c| c != node),
+        }
+        self.nodes[node].parent = parent;
+        match parent {
+            Some(p) => self.nodes[p].children.push(node),
+            None => self.roots.push(node),
+        }
+        self.update_subtree(node);
+        Ok(())
+    }
+
+    /// Removes a node and its whole subtree.
+    ///
+    /// # Errors
+    /// Unknown node key.
+    pub fn remove_node(&mut self, node: NodeKey) -> Result<(), SceneError> {
+        let parent = self.nodes.get(node).ok_or(SceneError::UnknownKey("node"))?.parent;
+        match parent {
+            Some(p) => self.nodes[p].children.retain(|&c| c != node),
+            None => self.roots.retain(|&c| c != node),
+        }
+        let mut stack = vec![node];
+        while let Some(k) = stack.pop() {
+            if let Some(n) = self.nodes.remove(k) {
+                stack.extend(n.children);
+            }
+        }
+        Ok(())
+    }
+
+    /// Recomputes world transforms below (and including) `node`; nothing else is touched.
+    fn update_subtree(&mut self, node: NodeKey) {
+        let mut stack = vec![node];
+        while let Some(k) = stack.pop() {
+            let parent_world = self.nodes[k].parent.map_or(Mat4::IDENTITY, |p| self.nodes[p].world);
+            let n = &mut self.nodes[k];
+            n.world = parent_world * n.local;
+            stack.extend(n.children.iter().copied());
+        }
+    }
+
+    /// Every node in depth-first order from the roots.
+    #[must_use]
+    pub fn depth_first(&self) -> Vec<NodeKey> {
+        let mut out = Vec::with_capacity(self.nodes.len());
+        let mut stack: Vec<NodeKey> = self.roots.iter().rev().copied().collect();
+        while let Some(k) = stack.pop() {
+            out.push(k);
+            stack.extend(self.nodes[k].children.iter().rev().copied());
+        }
+        out
+    }
+
+    /// Nodes that draw a mesh, depth-first, with the mesh and the material.
+    pub fn drawables(&self) -> impl Iterator<Item = (NodeKey, &Node, MeshKey, &Material)> {
+        self.depth_first().into_iter().filter_map(move |k| {
+            let n = &self.nodes[k];
+            let (m, mat) = n.mesh?;
+            Some((k, n, m, self.materials.get(mat)?))
+        })
+    }
+
+    /// World-space bounds of every drawn mesh.
+    #[must_use]
+    pub fn bounds(&self) -> Aabb {
+        self.drawables().fold(Aabb::EMPTY, |b, (_, n, m, _)| b.union(self.meshes[m].mesh.bounds().transformed(n.world)))
+    }
+
+    /// Total triangles drawn (instances counted each time).
+    #[must_use]
+    pub fn triangle_count(&self) -> usize {
+        self.drawables().map(|(_, _, m, _)| self.meshes[m].mesh.triangle_count()).sum()
+    }
+
+    // ---- lights and cameras ----
+
+    /// Adds a light.
+    pub fn add_light(&mut self, light: Light) -> LightKey {
+        self.lights.insert(light)
+    }
+
+    /// A light.
+    #[must_use]
+    pub fn light(&self, key: LightKey) -> Option<&Light> {
+        self.lights.get(key)
+    }
+
+    /// A light, to edit (lights hold no cached state; nothing depending on the light is cached).
+    pub fn light_mut(&mut self, key: LightKey) -> Option<&mut Light> {
+        self.lights.get_mut(key)
+    }
+
+    /// Every light.
+    pub fn lights(&self) -> impl Iterator<Item = (LightKey, &Light)> {
+        self.lights.iter()
+    }
+
+    /// Removes every light.
+    pub fn clear_lights(&mut self) {
+        self.lights.clear();
+    }
+
+    /// Adds a camera.
+    pub fn add_camera(&mut self, camera: Camera) -> CameraKey {
+        self.cameras.insert(camera)
+    }
+
+    /// A camera.
+    #[must_use]
+    pub fn camera(&self, key: CameraKey) -> Option<&Camera> {
+        self.cameras.get(key)
+    }
+
+    /// A camera, to edit.
+    pub fn camera_mut(&mut self, key: CameraKey) -> Option<&mut Camera> {
+        self.cameras.get_mut(key)
+    }
+
+    /// Every camera.
+    pub fn cameras(&self) -> impl Iterator<Item = (CameraKey, &Camera)> {
+        self.cameras.iter()
+    }
+
+    /// Removes every camera.
+    pub fn clear_cameras(&mut self) {
+        self.cameras.clear();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::procedural;
+
+    #[test]
+    fn moving_a_node_updates_its_subtree_only() {
+        let mut s = Scene::new();
+        let a = s.add_node("a", None, Mat4::from_translation(Vec3::X)).unwrap();
+        let b = s.add_node("b", Some(a), Mat4::from_translation(Vec3::Y)).unwrap();
+        let c = s.add_node("c", None, Mat4::from_translation(Vec3::Z)).unwrap();
+        assert_eq!(s.node(b).unwrap().world_transform().w_axis.truncate(), Vec3::new(1.0, 1.0, 0.0));
+        s.set_local_transform(a, Mat4::from_translation(Vec3::splat(2.0))).unwrap();
+        assert_eq!(s.node(b).unwrap().world_transform().w_axis.truncate(), Vec3::new(2.0, 3.0, 2.0));
+        assert_eq!(s.node(c).unwrap().world_transform().w_axis.truncate(), Vec3::Z);
+        s.set_parent(c, Some(b)).unwrap();
+        assert_eq!(s.node(c).unwrap().world_transform().w_axis.truncate(), Vec3::new(2.0, 3.0, 3.0));
+        assert!(matches!(s.set_parent(a, Some(c)), Err(SceneError::Cycle { .. })));
+        assert!(s.set_local_transform(a, Mat4::from_scale(Vec3::splat(f32::NAN))).is_err());
+        s.remove_node(a).unwrap();
+        assert_eq!(s.node_count(), 0);
+    }
+
+    #[test]
+    fn replacing_a_mesh_drops_its_adjacency() {
+        let mut s = Scene::new();
+        let m = s.add_mesh(procedural::cuboid(Vec3::ONE));
+        let v0 = s.mesh_version(m).unwrap();
+        assert!(s.adjacency(m).unwrap().closed());
+        assert!(s.has_cached_adjacency(m));
+        s.replace_mesh(m, procedural::plane(1.0, 1.0)).unwrap();
+        assert!(!s.has_cached_adjacency(m));
+        assert_ne!(s.mesh_version(m).unwrap(), v0);
+        assert!(!s.adjacency(m).unwrap().closed());
+    }
+}

@@ -1,0 +1,311 @@
+//! The geometry of each built-in scene. Sizes are in metres; every scene stands on y = 0.
+
+use glam::{Mat4, Quat, Vec2, Vec3};
+
+use super::{Rng, SceneParams};
+use crate::mesh::Mesh;
+use crate::procedural;
+use crate::scene::{Camera, Light, Material, Scene};
+
+/// A scene under construction.
+struct Stage {
+    scene: Scene,
+}
+
+impl Stage {
+    fn new() -> Self {
+        Self { scene: Scene::new() }
+    }
+
+    /// Adds a mesh instance with a colour. The builders only pass finite transforms of their own meshes.
+    fn add(&mut self, name: &str, mesh: Mesh, color: Vec3, transform: Mat4) {
+        let m = self.scene.add_mesh(mesh);
+        let mat = self.scene.add_material(Material::colored(name, color));
+        if let Err(e) = self.scene.add_instance(name, m, mat, transform) {
+            panic!("built-in scene: {e}");
+        }
+    }
+
+    fn ground(mut self, size: f32) -> Self {
+        self.add("ground", procedural::plane(size, size), Vec3::splat(0.75), Mat4::IDENTITY);
+        self
+    }
+
+    fn finish(mut self, camera: Camera, light: Light) -> Scene {
+        self.scene.add_camera(camera);
+        self.scene.add_light(light);
+        self.scene
+    }
+}
+
+const WARM: Vec3 = Vec3::new(0.85, 0.45, 0.25);
+const BLUE: Vec3 = Vec3::new(0.3, 0.45, 0.85);
+const GREEN: Vec3 = Vec3::new(0.35, 0.7, 0.35);
+const GOLD: Vec3 = Vec3::new(0.85, 0.7, 0.3);
+
+fn at(x: f32, y: f32, z: f32) -> Mat4 {
+    Mat4::from_translation(Vec3::new(x, y, z))
+}
+
+pub(super) fn cylinder(_: &SceneParams) -> Scene {
+    let mut s = Stage::new().ground(10.0);
+    s.add("cylinder", procedural::cylinder(0.3, 1.0, 64), WARM, Mat4::IDENTITY);
+    s.finish(
+        Camera::look_at(Vec3::new(1.2, 1.9, 3.2), Vec3::new(-0.4, 0.3, -0.5), 45.0),
+        Light::spot(Vec3::new(2.0, 4.0, 1.5), Vec3::new(0.0, 0.3, 0.0), 60.0),
+    )
+}
+
+pub(super) fn primitives(_: &SceneParams) -> Scene {
+    let mut s = Stage::new().ground(10.0);
+    s.add("box", procedural::cuboid(Vec3::splat(0.6)), WARM, at(-0.9, 0.3, 0.3) * Mat4::from_rotation_y(0.5));
+    s.add("cylinder", procedural::cylinder(0.25, 0.8, 128), BLUE, at(0.8, 0.0, 0.5));
+    s.add("sphere", procedural::sphere(0.35, 64, 40), GREEN, at(0.0, 0.35, -0.6));
+    s.add("torus", procedural::torus(0.35, 0.12, 80, 24), GOLD, at(0.9, 0.12, -0.7));
+    s.finish(
+        Camera::look_at(Vec3::new(0.3, 2.2, 3.4), Vec3::new(-0.2, 0.1, -0.4), 45.0),
+        Light::spot(Vec3::new(2.0, 4.0, 1.5), Vec3::new(-0.1, 0.0, -0.1), 60.0),
+    )
+}
+
+pub(super) fn stacked_boxes(_: &SceneParams) -> Scene {
+    let mut s = Stage::new().ground(10.0);
+    s.add("lower box", procedural::cuboid(Vec3::new(1.2, 0.5, 1.2)), BLUE, at(0.0, 0.25, 0.0));
+    s.add(
+        "upper box",
+        procedural::cuboid(Vec3::new(0.6, 0.08, 0.6)),
+        WARM,
+        at(0.55, 1.4, 0.35) * Mat4::from_rotation_y(0.3),
+    );
+    s.finish(
+        Camera::look_at(Vec3::new(0.8, 2.4, 3.0), Vec3::new(0.3, 0.3, 0.0), 45.0),
+        Light::spot(Vec3::new(1.0, 4.5, 0.6), Vec3::new(0.4, 0.0, 0.2), 60.0),
+    )
+}
+
+pub(super) fn l_shape(_: &SceneParams) -> Scene {
+    let mut s = Stage::new().ground(6.0);
+    let outline = [(0.0, 0.0), (1.2, 0.0), (1.2, -0.4), (0.4, -0.4), (0.4, -1.2), (0.0, -1.2)].map(Vec2::from);
+    s.add("l-shape", procedural::prism(&outline, 3, 0.3), WARM, at(-0.6, 0.5, 0.6));
+    s.finish(
+        Camera::look_at(Vec3::new(1.3, 2.3, 2.4), Vec3::new(-0.1, 0.2, -0.1), 45.0),
+        Light::directional(Vec3::new(0.25, -1.0, 0.15)),
+    )
+}
+
+/// Genus 2: the smooth union of two overlapping tori lying flat.
+fn double_torus_sdf(p: Vec3) -> f32 {
+    let torus = |q: Vec3| Vec2::new(Vec2::new(q.x, q.z).length() - 0.5, q.y).length() - 0.17;
+    let (a, b) = (torus(p - Vec3::new(-0.45, 0.0, 0.0)), torus(p - Vec3::new(0.45, 0.0, 0.0)));
+    let k = 0.08;
+    let h = (0.5 + 0.5 * (b - a) / k).clamp(0.0, 1.0);
+    b + (a - b) * h - k * h * (1.0 - h)
+}
+
+pub(super) fn double_torus(_: &SceneParams) -> Scene {
+    let mut s = Stage::new().ground(8.0);
+    let mesh = procedural::implicit(double_torus_sdf, Vec3::new(-1.2, -0.3, -0.75), Vec3::new(1.2, 0.3, 0.75), 48);
+    let mesh = mesh.unwrap_or_else(|| panic!("the double torus surface is empty"));
+    s.add("double torus", mesh, GOLD, at(0.0, 0.6, 0.0) * Mat4::from_rotation_x(0.25));
+    s.finish(
+        Camera::look_at(Vec3::new(0.6, 2.2, 2.8), Vec3::new(0.0, 0.3, 0.0), 45.0),
+        Light::spot(Vec3::new(0.8, 4.0, 0.9), Vec3::new(0.0, 0.0, -0.1), 60.0),
+    )
+}
+
+/// A bowling pin, 0.38 m tall, about 450 triangles.
+fn pin() -> Mesh {
+    let profile: Vec<Vec2> = [
+        (0.0, 0.0),
+        (0.026, 0.0),
+        (0.036, 0.02),
+        (0.05, 0.06),
+        (0.058, 0.1),
+        (0.06, 0.13),
+        (0.055, 0.17),
+        (0.042, 0.21),
+        (0.03, 0.245),
+        (0.023, 0.27),
+        (0.024, 0.3),
+        (0.03, 0.325),
+        (0.032, 0.345),
+        (0.028, 0.365),
+        (0.016, 0.378),
+        (0.0, 0.38),
+    ]
+    .map(Vec2::from)
+    .to_vec();
+    procedural::lathe(&profile, 16, false)
+}
+
+pub(super) fn strike(_: &SceneParams) -> Scene {
+    let mut s = Stage::new();
+    s.add("lane", procedural::plane(2.2, 8.0), Vec3::new(0.8, 0.65, 0.45), Mat4::IDENTITY);
+    let pin_mesh = pin();
+    let spacing = 0.305;
+    for row in 0..4 {
+        for k in 0..=row {
+            let x = (k as f32 - row as f32 * 0.5) * spacing;
+            let z = -1.5 - row as f32 * spacing * 0.866;
+            s.add(&format!("pin {row}.{k}"), pin_mesh.clone(), Vec3::splat(0.92), at(x, 0.0, z));
+        }
+    }
+    s.add("ball", procedural::sphere(0.11, 32, 20), Vec3::new(0.2, 0.25, 0.7), at(0.12, 0.11, -0.8));
+    s.finish(
+        Camera::look_at(Vec3::new(0.5, 0.9, 0.6), Vec3::new(-0.1, 0.1, -1.9), 45.0),
+        Light::spot(Vec3::new(-0.9, 2.6, 0.2), Vec3::new(0.0, 0.0, -1.7), 60.0),
+    )
+}
+
+/// A standing figure about 1.7 m tall from capsules and a sphere (about 620 triangles).
+fn figure(rng: &mut Rng) -> Mesh {
+    let limb = |r: f32, len: f32, from: Vec3, dir: Vec3| {
+        let rot = Quat::from_rotation_arc(Vec3::Y, dir.normalize());
+        procedural::capsule(r, len, 8, 3).transformed(Mat4::from_rotation_translation(rot, from))
+    };
+    let sway = rng.range(-0.15, 0.15);
+    let parts = [
+        limb(0.07, 0.85, Vec3::new(-0.1, 0.0, 0.0), Vec3::new(0.03, 1.0, 0.0)),
+        limb(0.07, 0.85, Vec3::new(0.1, 0.0, 0.0), Vec3::new(-0.03, 1.0, 0.0)),
+        limb(0.16, 0.7, Vec3::new(0.0, 0.78, 0.0), Vec3::Y),
+        limb(0.05, 0.65, Vec3::new(-0.2, 1.38, 0.0), Vec3::new(-0.3 + sway, -1.0, 0.1)),
+        limb(0.05, 0.65, Vec3::new(0.2, 1.38, 0.0), Vec3::new(0.3 + sway, -1.0, -0.1)),
+        procedural::sphere(0.11, 10, 8).transformed(at(0.0, 1.58, 0.0)),
+    ];
+    Mesh::merged(&parts).unwrap_or_else(|e| panic!("figure: {e}"))
+}
+
+pub(super) fn crowd(p: &SceneParams) -> Scene {
+    let mut rng = Rng::new(p.seed);
+    let mut s = Stage::new().ground(16.0);
+    s.add(
+        "wall",
+        procedural::plane(16.0, 6.0),
+        Vec3::splat(0.8),
+        at(0.0, 3.0, -6.0) * Mat4::from_rotation_x(std::f32::consts::FRAC_PI_2),
+    );
+    for row in 0..4 {
+        for col in 0..6 {
+            let x = (col as f32 - 2.5) * 0.9 + rng.range(-0.2, 0.2);
+            let z = -(row as f32) * 0.9 + rng.range(-0.2, 0.2);
+            let t = at(x, 0.0, z)
+                * Mat4::from_rotation_y(rng.range(-0.6, 0.6))
+                * Mat4::from_scale(Vec3::splat(rng.range(0.9, 1.1)));
+            let c = Vec3::new(rng.range(0.3, 0.9), rng.range(0.3, 0.9), rng.range(0.3, 0.9));
+            s.add(&format!("figure {row}.{col}"), figure(&mut rng), c, t);
+        }
+    }
+    s.finish(
+        Camera::look_at(Vec3::new(2.5, 3.0, 6.5), Vec3::new(-0.3, 1.0, -2.5), 45.0),
+        Light::spot(Vec3::new(-1.5, 4.5, 6.0), Vec3::new(0.0, 1.0, -3.0), 60.0),
+    )
+}
+
+pub(super) fn cubes(p: &SceneParams) -> Scene {
+    let mut rng = Rng::new(p.seed);
+    let mut s = Stage::new().ground(10.0);
+    let unit = procedural::cuboid(Vec3::splat(0.13));
+    let parts: Vec<Mesh> = (0..1000)
+        .map(|_| {
+            let pos = Vec3::new(rng.range(-1.3, 1.3), rng.range(0.2, 1.6), rng.range(-1.3, 1.3));
+            let rot =
+                Quat::from_euler(glam::EulerRot::XYZ, rng.range(0.0, 3.0), rng.range(0.0, 3.0), rng.range(0.0, 3.0));
+            unit.transformed(Mat4::from_rotation_translation(rot, pos))
+        })
+        .collect();
+    s.add("cubes", Mesh::merged(&parts).unwrap_or_else(|e| panic!("cubes: {e}")), WARM, Mat4::IDENTITY);
+    s.finish(
+        Camera::look_at(Vec3::new(2.6, 3.0, 4.2), Vec3::new(-0.3, 0.4, -0.3), 45.0),
+        Light::spot(Vec3::new(2.0, 4.5, 1.5), Vec3::new(0.0, 0.5, 0.0), 60.0),
+    )
+}
+
+/// A lumpy blob: a sphere displaced by a few seeded waves.
+fn blob(rng: &mut Rng) -> Mesh {
+    let waves: Vec<(Vec3, f32)> = (0..6)
+        .map(|_| {
+            (Vec3::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(-1.0, 1.0)) * 9.0, rng.range(0.0, 6.0))
+        })
+        .collect();
+    let f = move |q: Vec3| q.length() - 0.42 - waves.iter().map(|(k, ph)| 0.025 * (k.dot(q) + ph).sin()).sum::<f32>();
+    procedural::implicit(f, Vec3::splat(-0.6), Vec3::splat(0.6), 24).unwrap_or_else(|| panic!("blob surface is empty"))
+}
+
+pub(super) fn cage(p: &SceneParams) -> Scene {
+    let mut rng = Rng::new(p.seed);
+    let mut s = Stage::new().ground(10.0);
+    s.add("blob", blob(&mut rng), GREEN, at(0.0, 0.75, 0.0));
+    let bars = 16;
+    let mut parts = Vec::new();
+    for i in 0..bars {
+        let a = std::f32::consts::TAU * i as f32 / bars as f32;
+        parts.push(procedural::cylinder(0.025, 1.6, 10).transformed(at(0.85 * a.cos(), 0.0, 0.85 * a.sin())));
+    }
+    for y in [0.05, 1.55] {
+        parts.push(procedural::torus(0.85, 0.035, 64, 10).transformed(at(0.0, y, 0.0)));
+    }
+    s.add("cage", Mesh::merged(&parts).unwrap_or_else(|e| panic!("cage: {e}")), Vec3::splat(0.55), Mat4::IDENTITY);
+    s.finish(
+        Camera::look_at(Vec3::new(1.8, 2.4, 3.4), Vec3::new(-0.3, 0.5, -0.4), 45.0),
+        Light::spot(Vec3::new(1.6, 4.2, 1.2), Vec3::new(-0.2, 0.4, -0.2), 60.0),
+    )
+}
+
+fn branch(rng: &mut Rng, base: Vec3, dir: Vec3, length: f32, radius: f32, depth: u32, out: &mut Vec<Mesh>) {
+    let rot = Quat::from_rotation_arc(Vec3::Y, dir);
+    out.push(procedural::cylinder(radius, length, 9).transformed(Mat4::from_rotation_translation(rot, base)));
+    if depth == 0 {
+        return;
+    }
+    let tip = base + dir * length;
+    let spin = rng.range(0.0, std::f32::consts::TAU);
+    for k in 0..3 {
+        let around = spin + std::f32::consts::TAU * k as f32 / 3.0;
+        let tilt = rng.range(0.45, 0.8);
+        let side = (rot * Vec3::new(around.cos(), 0.0, around.sin())).normalize();
+        let child = (dir * tilt.cos() + side * tilt.sin() + Vec3::Y * 0.15).normalize();
+        let start = tip - dir * radius;
+        let child_length = length * rng.range(0.68, 0.8);
+        branch(rng, start, child, child_length, radius * 0.62, depth - 1, out);
+    }
+}
+
+pub(super) fn tree(p: &SceneParams) -> Scene {
+    let mut rng = Rng::new(p.seed);
+    let mut s = Stage::new().ground(12.0);
+    let mut parts = Vec::new();
+    branch(&mut rng, Vec3::ZERO, Vec3::Y, 0.9, 0.09, 6, &mut parts);
+    s.add(
+        "tree",
+        Mesh::merged(&parts).unwrap_or_else(|e| panic!("tree: {e}")),
+        Vec3::new(0.55, 0.4, 0.25),
+        Mat4::IDENTITY,
+    );
+    s.finish(
+        Camera::look_at(Vec3::new(2.2, 2.6, 4.6), Vec3::new(-0.6, 0.8, -0.8), 45.0),
+        Light::spot(Vec3::new(2.2, 5.0, 1.8), Vec3::new(-0.3, 0.6, -0.3), 70.0),
+    )
+}
+
+/// A room lit from inside near the ceiling. The camera stands in the shadow of a beam hung between it and
+/// the light (so every shadow volume that holds the eye crosses the near plane), and a post beside the
+/// eye is cut by the near plane itself.
+pub(super) fn room(_: &SceneParams) -> Scene {
+    use std::f32::consts::FRAC_PI_2;
+    let mut s = Stage::new();
+    let wall = Vec3::splat(0.8);
+    s.add("floor", procedural::plane(6.0, 7.0), Vec3::splat(0.7), at(0.0, 0.0, 0.5));
+    s.add("back wall", procedural::plane(6.0, 3.6), wall, at(0.0, 1.8, -3.0) * Mat4::from_rotation_x(FRAC_PI_2));
+    s.add("left wall", procedural::plane(3.6, 7.0), wall, at(-3.0, 1.8, 0.5) * Mat4::from_rotation_z(-FRAC_PI_2));
+    s.add("right wall", procedural::plane(3.6, 7.0), wall, at(3.0, 1.8, 0.5) * Mat4::from_rotation_z(FRAC_PI_2));
+    s.add("beam", procedural::cuboid(Vec3::new(1.4, 0.25, 1.0)), WARM, at(0.0, 2.35, 1.0));
+    s.add("table", procedural::cuboid(Vec3::new(1.2, 0.8, 0.8)), BLUE, at(1.0, 0.4, 0.0));
+    s.add("ball", procedural::sphere(0.3, 32, 16), GREEN, at(-1.2, 0.3, -0.8));
+    // The eye is at (0, 1.2, 3) with a near plane 0.05 ahead (z = 2.95), whose half-width is 0.0207:
+    // the post reaches 0.0195 to the eye's left and spans z 2.935..2.96, so the near plane cuts it.
+    s.add("post", procedural::cuboid(Vec3::new(0.18, 3.0, 0.025)), GOLD, at(-0.1095, 1.5, 2.9475));
+    s.finish(
+        Camera::look_at(Vec3::new(0.0, 1.2, 3.0), Vec3::new(0.0, 0.8, -2.0), 45.0),
+        Light::spot(Vec3::new(0.0, 3.5, -1.0), Vec3::new(0.0, 0.0, 1.5), 120.0),
+    )
+}

@@ -1,0 +1,305 @@
+//! The built-in scenes of DESIGN 7: the papers' test scenes, built procedurally so nothing is downloaded.
+//!
+//! Each has a default camera and light; [`SceneParams`] swaps the light type and seeds the random
+//! placement (the same seed always gives the same scene). [`stage_model`] puts a loaded model on a ground
+//! plane with the default spotlight and camera of DESIGN 11.
+
+mod builders;
+
+use glam::{Mat4, Vec3};
+
+use crate::mesh::Mesh;
+use crate::procedural;
+use crate::scene::{Camera, Light, LightKind, Material, Scene};
+
+/// Options for building a scene.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SceneParams {
+    /// Replace the default light with one of this type, placed where the default one is.
+    pub light: Option<LightType>,
+    /// Seed for random placement.
+    pub seed: u64,
+}
+
+impl Default for SceneParams {
+    fn default() -> Self {
+        Self { light: None, seed: 1 }
+    }
+}
+
+crate::named_enum! {
+    /// A light type, by name.
+    pub enum LightType {
+        /// A spot light.
+        Spot = "spot",
+        /// A directional light.
+        Directional = "directional",
+        /// A point light.
+        Point = "point",
+    }
+}
+
+/// A built-in scene.
+#[derive(Clone, Copy)]
+pub struct SceneInfo {
+    /// Its name.
+    pub name: &'static str,
+    /// After which paper figure.
+    pub after: &'static str,
+    /// What it holds and tests.
+    pub description: &'static str,
+    build: fn(&SceneParams) -> Scene,
+}
+
+/// Every built-in scene.
+pub const ALL: &[SceneInfo] = &[
+    SceneInfo {
+        name: "cylinder",
+        after: "Chan Fig. 3-4, 4-8",
+        description: "a cylinder standing on a ground plane, spotlight",
+        build: builders::cylinder,
+    },
+    SceneInfo {
+        name: "primitives",
+        after: "Chan Fig. 4-1d",
+        description: "box, cylinder, sphere and torus on a plane",
+        build: builders::primitives,
+    },
+    SceneInfo {
+        name: "stacked-boxes",
+        after: "Chan Fig. 4-10",
+        description: "a floating box over a box on the ground: one shadow across two receivers",
+        build: builders::stacked_boxes,
+    },
+    SceneInfo {
+        name: "l-shape",
+        after: "Weiskopf Fig. 5",
+        description: "an L-shaped solid above a surface, directional light from above",
+        build: builders::l_shape,
+    },
+    SceneInfo {
+        name: "double-torus",
+        after: "Weiskopf Fig. 6",
+        description: "a genus-2 solid over a plane",
+        build: builders::double_torus,
+    },
+    SceneInfo {
+        name: "strike",
+        after: "Sen Fig. 9",
+        description: "ten bowling pins and a ball on a lane",
+        build: builders::strike,
+    },
+    SceneInfo {
+        name: "crowd",
+        after: "Sen CROWD",
+        description: "24 figures in front of a distant wall",
+        build: builders::crowd,
+    },
+    SceneInfo {
+        name: "cubes",
+        after: "Chan Cubes",
+        description: "a thousand cubes casting heavily overlapping shadows",
+        build: builders::cubes,
+    },
+    SceneInfo {
+        name: "cage",
+        after: "Chan Dragon Cage",
+        description: "the bars of a cage around a dense blob",
+        build: builders::cage,
+    },
+    SceneInfo {
+        name: "tree",
+        after: "Chan Tree",
+        description: "a branching tree with thin branches",
+        build: builders::tree,
+    },
+    SceneInfo {
+        name: "room",
+        after: "Everitt-Kilgard, McCool 6.2",
+        description: "the camera inside a shadow, an occluder crossing the near plane",
+        build: builders::room,
+    },
+];
+
+/// Why a scene could not be built.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("unknown scene '{0}' (built-in scenes: {names})", names = names().join(", "))]
+pub struct UnknownScene(pub String);
+
+/// Names of every built-in scene.
+#[must_use]
+pub fn names() -> Vec<&'static str> {
+    ALL.iter().map(|s| s.name).collect()
+}
+
+/// The description of a built-in scene.
+#[must_use]
+pub fn info(name: &str) -> Option<&'static SceneInfo> {
+    ALL.iter().find(|s| s.name == name)
+}
+
+/// Builds a built-in scene: its meshes, one camera and one light.
+///
+/// # Errors
+/// [`UnknownScene`] for a name not in [`ALL`].
+pub fn build(name: &str, params: &SceneParams) -> Result<Scene, UnknownScene> {
+    let info = info(name).ok_or_else(|| UnknownScene(name.into()))?;
+    let mut scene = (info.build)(params);
+    if let Some(t) = params.light {
+        retype_lights(&mut scene, t);
+    }
+    Ok(scene)
+}
+
+/// Replaces every light with one of type `t` placed and aimed like it.
+pub fn retype_lights(scene: &mut Scene, t: LightType) {
+    let target = scene.bounds().center();
+    let lights: Vec<Light> = scene.lights().map(|(_, l)| *l).collect();
+    scene.clear_lights();
+    for l in lights {
+        let (position, direction) = match l.kind {
+            LightKind::Spot { position, direction, .. } => (position, direction),
+            LightKind::Point { position } => (position, (target - position).normalize_or(Vec3::NEG_Y)),
+            LightKind::Directional { direction } => {
+                (target - direction * scene.bounds().size().length().max(1.0) * 1.5, direction)
+            }
+        };
+        let cone_angle = match l.kind {
+            LightKind::Spot { cone_angle, .. } => cone_angle,
+            _ => 60f32.to_radians(),
+        };
+        let kind = match t {
+            LightType::Spot => LightKind::Spot { position, direction, cone_angle },
+            LightType::Directional => LightKind::Directional { direction },
+            LightType::Point => LightKind::Point { position },
+        };
+        scene.add_light(Light { kind, ..l });
+    }
+}
+
+/// The ground receiver of staged models: a 10 x 10 quad on y = 0.
+#[must_use]
+pub fn ground_quad() -> Mesh {
+    procedural::plane(10.0, 10.0)
+}
+
+/// Puts a loaded model on stage (DESIGN 11): scaled so the largest side of its bounds is 1, centred over
+/// the origin and set on y = 0, over a 10 x 10 ground quad (unless `ground` is false), with the default
+/// spotlight at (2, 4, 1.5) aiming at the origin with a 60 degree cone and the camera at (0, 1.1, 2.2)
+/// looking at (0, 0.35, 0) with a 45 degree vertical field of view. The model's own cameras and lights are
+/// replaced.
+pub fn stage_model(model: &mut Scene, ground: bool) {
+    let b = model.bounds();
+    let scale = 1.0 / b.size().max_element().max(1e-12);
+    let offset = Vec3::new(-b.center().x, -b.min.y, -b.center().z);
+    let place = Mat4::from_scale(Vec3::splat(scale)) * Mat4::from_translation(offset);
+    let roots: Vec<_> = model.roots().to_vec();
+    if let Ok(stage) = model.add_node("stage", None, place) {
+        for r in roots {
+            // Both keys exist and `stage` is a fresh root, so no cycle is possible.
+            let _ = model.set_parent(r, Some(stage));
+        }
+    }
+    if ground {
+        let mesh = model.add_mesh(ground_quad());
+        let mat = model.add_material(Material::colored("ground", Vec3::splat(0.75)));
+        let _ = model.add_instance("ground", mesh, mat, Mat4::IDENTITY);
+    }
+    model.clear_cameras();
+    model.clear_lights();
+    model.add_camera(Camera::look_at(Vec3::new(0.0, 1.1, 2.2), Vec3::new(0.0, 0.35, 0.0), 45.0));
+    model.add_light(Light::spot(Vec3::new(2.0, 4.0, 1.5), Vec3::ZERO, 60.0));
+}
+
+/// A small deterministic generator (SplitMix64) for scene placement.
+#[derive(Clone, Debug)]
+pub struct Rng(u64);
+
+impl Rng {
+    /// A generator from a seed.
+    #[must_use]
+    pub fn new(seed: u64) -> Self {
+        Self(seed ^ 0x5DEE_CE66_D1CE_4E5B)
+    }
+
+    /// The next 64 random bits.
+    pub fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+
+    /// Uniform in [0, 1).
+    pub fn unit(&mut self) -> f32 {
+        (self.next_u64() >> 40) as f32 / (1u64 << 24) as f32
+    }
+
+    /// Uniform in [lo, hi).
+    pub fn range(&mut self, lo: f32, hi: f32) -> f32 {
+        lo + (hi - lo) * self.unit()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_scene_builds_deterministically_with_a_camera_and_a_light() {
+        for info in ALL {
+            let a = build(info.name, &SceneParams::default()).unwrap();
+            let b = build(info.name, &SceneParams::default()).unwrap();
+            assert_eq!(a.triangle_count(), b.triangle_count(), "{}", info.name);
+            assert_eq!(a.bounds(), b.bounds(), "{}", info.name);
+            assert_eq!(a.cameras().count(), 1, "{}", info.name);
+            assert_eq!(a.lights().count(), 1, "{}", info.name);
+            for (_, l) in a.lights() {
+                l.validate().unwrap();
+            }
+        }
+        assert!(build("nope", &SceneParams::default()).is_err());
+    }
+
+    #[test]
+    fn triangle_counts_are_near_the_papers() {
+        let count = |n: &str| build(n, &SceneParams::default()).unwrap().triangle_count() as f64;
+        for (name, target) in
+            [("primitives", 9_400.0), ("crowd", 15_000.0), ("cubes", 12_000.0), ("cage", 12_000.0), ("tree", 40_000.0)]
+        {
+            let n = count(name);
+            assert!((n - target).abs() / target < 0.15, "{name}: {n} triangles, paper about {target}");
+        }
+        // Strike: ten pins of about 450 triangles each, a ball and a lane.
+        let strike = count("strike");
+        assert!(strike > 4_500.0 && strike < 6_500.0, "strike: {strike}");
+    }
+
+    #[test]
+    fn light_type_can_be_swapped() {
+        let p = SceneParams { light: Some(LightType::Point), seed: 1 };
+        let s = build("cylinder", &p).unwrap();
+        assert!(s.lights().all(|(_, l)| matches!(l.kind, LightKind::Point { .. })));
+        let p = SceneParams { light: Some(LightType::Spot), seed: 1 };
+        let s = build("l-shape", &p).unwrap();
+        assert!(s.lights().all(|(_, l)| matches!(l.kind, LightKind::Spot { .. }) && l.validate().is_ok()));
+    }
+
+    #[test]
+    fn staged_models_stand_on_the_ground() {
+        let mut s = Scene::new();
+        let m = s.add_mesh(procedural::sphere(3.0, 16, 8));
+        let mat = s.add_material(Material::default());
+        s.add_instance("ball", m, mat, Mat4::from_translation(Vec3::new(10.0, -5.0, 2.0))).unwrap();
+        stage_model(&mut s, true);
+        let ball = s
+            .drawables()
+            .find(|(_, n, _, _)| n.name() == "ball")
+            .map(|(_, n, m, _)| s.mesh(m).unwrap().bounds().transformed(n.world_transform()))
+            .unwrap();
+        assert!((ball.min.y).abs() < 1e-5);
+        assert!((ball.size().max_element() - 1.0).abs() < 1e-5);
+        assert!(ball.center().x.abs() < 1e-5 && ball.center().z.abs() < 1e-5);
+    }
+}

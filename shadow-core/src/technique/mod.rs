@@ -1,0 +1,248 @@
+//! The backend-neutral technique traits (DESIGN 3), settings parsing and the settings of the hard-shadow
+//! techniques.
+//!
+//! A technique is a plain settings struct (in [`settings`]). Each backend implements
+//! [`ShadowTechnique`] for it, which the orphan rule allows because the backend type is local to the
+//! backend crate. [`DynShadowTechnique`] is the one object-safe layer, for choosing at runtime.
+//!
+//! Refinements of the DESIGN 3 sketch, and why:
+//! - `build` and `query` both receive the frame and the light view: a query needs the light's projection
+//!   (shadow maps) or position (volumes), and passing it is simpler than every state keeping a copy.
+//! - Both receive `&mut FrameStats`, so techniques report counters and sub-phase times (a readback, say)
+//!   through one channel instead of a return value the frame driver has to merge.
+//! - `Backend::Error: From<TechniqueError>`, so the shared checks (unsupported light, bad settings) give
+//!   the same error on every backend.
+
+pub mod hard;
+pub mod settings;
+
+use crate::frame::FrameInputs;
+use crate::image::{Image, Rgb8};
+use crate::light::LightView;
+use crate::scene::Light;
+use crate::stats::{Counters, Timings};
+
+pub use settings::{SettingKey, SettingsError, TechniqueSettings, TechniqueSpec};
+
+/// A backend: a bundle of associated types (after wgpu-hal's `Api`).
+pub trait Backend: Sized + 'static {
+    /// Device, queues, caches, thread pool, counters.
+    type Context;
+    /// The camera view: depth, normal, position, receiver mask.
+    type GBuffer;
+    /// One light's visibility over the view, f32 in [0, 1].
+    type Visibility;
+    /// What can go wrong that a caller cannot foresee.
+    type Error: std::error::Error + Send + Sync + 'static + From<TechniqueError>;
+    /// Short name for reports ("cpu", "wgpu").
+    const NAME: &'static str;
+}
+
+/// Errors every backend shares.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum TechniqueError {
+    /// The technique cannot handle this kind of light.
+    #[error("technique '{technique}' does not support {light} lights")]
+    UnsupportedLight {
+        /// Technique name.
+        technique: String,
+        /// Light type name.
+        light: &'static str,
+    },
+    /// Settings that parse but cannot work together, or exceed a limit.
+    #[error("technique '{technique}': {message}")]
+    BadSettings {
+        /// Technique name.
+        technique: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// `build` was not called before `query`.
+    #[error("technique '{0}' was queried before it was built")]
+    NotBuilt(String),
+}
+
+/// Counters and timings a technique reports for one light in one frame.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct FrameStats {
+    /// Counters (DESIGN 8).
+    pub counters: Counters,
+    /// Phase times, filled by the frame driver; techniques add sub-phases to `timings.extra`.
+    pub timings: Timings,
+}
+
+/// A named picture of a technique's internals (a depth map, an edge map, a silhouette-point overlay).
+#[derive(Clone, Debug)]
+pub struct DebugView {
+    /// Short name, used in file names.
+    pub name: String,
+    /// The picture.
+    pub image: Image<Rgb8>,
+}
+
+/// A shadow technique on backend `B`: a build phase per light, then a query phase per view.
+pub trait ShadowTechnique<B: Backend>: Send + Sync {
+    /// What the technique keeps between frames: pipelines, maps, buffers.
+    type State: Send;
+
+    /// The registry name.
+    fn name(&self) -> &'static str;
+
+    /// Which lights the technique handles.
+    fn supports(&self, _light: &Light) -> bool {
+        true
+    }
+
+    /// Creates the state once; it is reused for every later frame.
+    ///
+    /// # Errors
+    /// Backend failures (pipeline creation, allocation).
+    fn create_state(&self, cx: &mut B::Context) -> Result<Self::State, B::Error>;
+
+    /// Build phase: the light-space representation (maps, volumes, smoothies) for one light.
+    ///
+    /// # Errors
+    /// Backend failures, or settings the backend cannot meet.
+    fn build(
+        &self,
+        cx: &mut B::Context,
+        state: &mut Self::State,
+        frame: &FrameInputs,
+        light: &LightView,
+        stats: &mut FrameStats,
+    ) -> Result<(), B::Error>;
+
+    /// Query phase: the light's visibility at every G-buffer pixel.
+    ///
+    /// # Errors
+    /// Backend failures, or a query before a build.
+    #[allow(clippy::too_many_arguments)]
+    fn query(
+        &self,
+        cx: &mut B::Context,
+        state: &mut Self::State,
+        frame: &FrameInputs,
+        light: &LightView,
+        gbuffer: &B::GBuffer,
+        out: &mut B::Visibility,
+        stats: &mut FrameStats,
+    ) -> Result<(), B::Error>;
+
+    /// Pictures of the internals after the last build (default: none).
+    ///
+    /// # Errors
+    /// Backend failures (a readback).
+    fn debug_views(&self, _cx: &mut B::Context, _state: &Self::State) -> Result<Vec<DebugView>, B::Error> {
+        Ok(Vec::new())
+    }
+}
+
+/// The object-safe face of a technique with its state, for choosing at runtime.
+pub trait DynShadowTechnique<B: Backend>: Send {
+    /// The registry name.
+    fn name(&self) -> &'static str;
+    /// The settings, as `key=value,...` (every key, defaults included).
+    fn settings(&self) -> String;
+    /// See [`ShadowTechnique::build`]; refuses lights the technique does not support.
+    ///
+    /// # Errors
+    /// As [`ShadowTechnique::build`], or [`TechniqueError::UnsupportedLight`].
+    fn build(
+        &mut self,
+        cx: &mut B::Context,
+        frame: &FrameInputs,
+        light: &LightView,
+        stats: &mut FrameStats,
+    ) -> Result<(), B::Error>;
+    /// See [`ShadowTechnique::query`].
+    ///
+    /// # Errors
+    /// As [`ShadowTechnique::query`], or [`TechniqueError::NotBuilt`].
+    fn query(
+        &mut self,
+        cx: &mut B::Context,
+        frame: &FrameInputs,
+        light: &LightView,
+        gbuffer: &B::GBuffer,
+        out: &mut B::Visibility,
+        stats: &mut FrameStats,
+    ) -> Result<(), B::Error>;
+    /// See [`ShadowTechnique::debug_views`].
+    ///
+    /// # Errors
+    /// As [`ShadowTechnique::debug_views`].
+    fn debug_views(&mut self, cx: &mut B::Context) -> Result<Vec<DebugView>, B::Error>;
+}
+
+/// A technique with its lazily created state: the standard [`DynShadowTechnique`].
+pub struct Stateful<B: Backend, T: ShadowTechnique<B>> {
+    technique: T,
+    settings: String,
+    state: Option<T::State>,
+}
+
+impl<B: Backend, T: ShadowTechnique<B>> Stateful<B, T> {
+    /// Wraps a technique; `settings` is its canonical settings string for reports.
+    pub fn new(technique: T, settings: String) -> Self {
+        Self { technique, settings, state: None }
+    }
+
+    /// Boxed, ready for a registry.
+    pub fn boxed(technique: T, settings: String) -> Box<dyn DynShadowTechnique<B>>
+    where
+        T: 'static,
+    {
+        Box::new(Self::new(technique, settings))
+    }
+}
+
+impl<B: Backend, T: ShadowTechnique<B>> DynShadowTechnique<B> for Stateful<B, T> {
+    fn name(&self) -> &'static str {
+        self.technique.name()
+    }
+
+    fn settings(&self) -> String {
+        self.settings.clone()
+    }
+
+    fn build(
+        &mut self,
+        cx: &mut B::Context,
+        frame: &FrameInputs,
+        light: &LightView,
+        stats: &mut FrameStats,
+    ) -> Result<(), B::Error> {
+        if !self.technique.supports(&light.light) {
+            return Err(TechniqueError::UnsupportedLight {
+                technique: self.technique.name().into(),
+                light: light.light.type_name(),
+            }
+            .into());
+        }
+        let state = match &mut self.state {
+            Some(s) => s,
+            slot => slot.insert(self.technique.create_state(cx)?),
+        };
+        self.technique.build(cx, state, frame, light, stats)
+    }
+
+    fn query(
+        &mut self,
+        cx: &mut B::Context,
+        frame: &FrameInputs,
+        light: &LightView,
+        gbuffer: &B::GBuffer,
+        out: &mut B::Visibility,
+        stats: &mut FrameStats,
+    ) -> Result<(), B::Error> {
+        let state = self.state.as_mut().ok_or_else(|| TechniqueError::NotBuilt(self.technique.name().into()))?;
+        self.technique.query(cx, state, frame, light, gbuffer, out, stats)
+    }
+
+    fn debug_views(&mut self, cx: &mut B::Context) -> Result<Vec<DebugView>, B::Error> {
+        match &self.state {
+            Some(s) => self.technique.debug_views(cx, s),
+            None => Ok(Vec::new()),
+        }
+    }
+}

@@ -1,0 +1,368 @@
+//! Technique settings: `name:key=value,...` parsing, typed settings structs, and their canonical strings.
+//!
+//! Every settings struct lists its keys with defaults and help ([`TechniqueSettings::keys`]); unknown
+//! keys and unparsable values are errors that name the technique, the key and what was expected.
+
+use std::collections::BTreeMap;
+use std::fmt;
+use std::str::FromStr;
+
+/// Largest shadow-map side any technique accepts: 16384^2 f32 texels is 1 GiB, refused before allocating
+/// anything bigger.
+pub const MAX_MAP_RESOLUTION: u32 = 16384;
+
+/// Why a technique specification was refused.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SettingsError {
+    /// Not of the form `name[:key=value,...]`.
+    #[error("bad technique specification '{spec}': {why}")]
+    Syntax {
+        /// The whole specification.
+        spec: String,
+        /// What is wrong.
+        why: String,
+    },
+    /// A key the technique does not have.
+    #[error("technique '{technique}' has no setting '{key}' (settings: {valid})")]
+    UnknownKey {
+        /// Technique name.
+        technique: String,
+        /// The unknown key.
+        key: String,
+        /// The keys it does have.
+        valid: String,
+    },
+    /// A value that does not parse or is out of range.
+    #[error("technique '{technique}': bad value '{value}' for '{key}': expected {expected}")]
+    BadValue {
+        /// Technique name.
+        technique: String,
+        /// The key.
+        key: String,
+        /// The value given.
+        value: String,
+        /// What would have been accepted.
+        expected: String,
+    },
+}
+
+/// A technique name with the settings given for it (not yet checked against the technique).
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct TechniqueSpec {
+    /// Registry name.
+    pub name: String,
+    /// Settings in the order given.
+    pub values: Vec<(String, String)>,
+}
+
+impl TechniqueSpec {
+    /// A specification with no settings.
+    #[must_use]
+    pub fn named(name: &str) -> Self {
+        Self { name: name.into(), values: Vec::new() }
+    }
+
+    /// Parses `name[:key=value,...]`. Values never contain commas.
+    ///
+    /// # Errors
+    /// [`SettingsError::Syntax`] for an empty name, a pair without `=`, an empty key or a repeated key.
+    pub fn parse(spec: &str) -> Result<Self, SettingsError> {
+        let bad = |why: &str| SettingsError::Syntax { spec: spec.into(), why: why.into() };
+        let (name, rest) = match spec.split_once(':') {
+            Some((n, r)) => (n.trim(), Some(r)),
+            None => (spec.trim(), None),
+        };
+        if name.is_empty() || !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_') {
+            return Err(bad("the name must be non-empty letters, digits and '-'"));
+        }
+        let mut values: Vec<(String, String)> = Vec::new();
+        for pair in rest.into_iter().flat_map(|r| r.split(',')).filter(|p| !p.trim().is_empty()) {
+            let (k, v) = pair.split_once('=').ok_or_else(|| bad(&format!("'{pair}' is not key=value")))?;
+            let (k, v) = (k.trim(), v.trim());
+            if k.is_empty() {
+                return Err(bad(&format!("'{pair}' has an empty key")));
+            }
+            if values.iter().any(|(seen, _)| seen == k) {
+                return Err(bad(&format!("'{k}' is given twice")));
+            }
+            values.push((k.into(), v.into()));
+        }
+        Ok(Self { name: name.into(), values })
+    }
+}
+
+impl fmt::Display for TechniqueSpec {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.name)?;
+        for (i, (k, v)) in self.values.iter().enumerate() {
+            write!(f, "{}{k}={v}", if i == 0 { ':' } else { ',' })?;
+        }
+        Ok(())
+    }
+}
+
+/// One setting: key, default value and help text.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SettingKey {
+    /// The key.
+    pub key: &'static str,
+    /// Its default, as text.
+    pub default: &'static str,
+    /// What it does.
+    pub help: &'static str,
+}
+
+/// The values given for a technique, with the defaults of its keys behind them.
+pub struct Values<'a> {
+    technique: &'a str,
+    given: BTreeMap<&'a str, &'a str>,
+    keys: &'static [SettingKey],
+}
+
+impl Values<'_> {
+    /// The value of `key` (given or default), parsed.
+    ///
+    /// # Errors
+    /// [`SettingsError::BadValue`] when it does not parse.
+    pub fn get<T: FromStr>(&self, key: &str) -> Result<T, SettingsError>
+    where
+        T::Err: fmt::Display,
+    {
+        let text = self.text(key);
+        text.parse().map_err(|e: T::Err| self.bad(key, &e.to_string()))
+    }
+
+    /// The text of `key`, given or default.
+    ///
+    /// # Panics
+    /// When `key` is not one of the technique's keys: that is a bug in the settings struct.
+    #[must_use]
+    pub fn text(&self, key: &str) -> &str {
+        match self.given.get(key) {
+            Some(v) => v,
+            None => match self.keys.iter().find(|k| k.key == key) {
+                Some(k) => k.default,
+                None => panic!("settings struct reads undeclared key '{key}'"),
+            },
+        }
+    }
+
+    /// A [`SettingsError::BadValue`] for `key` with its current text.
+    #[must_use]
+    pub fn bad(&self, key: &str, expected: &str) -> SettingsError {
+        SettingsError::BadValue {
+            technique: self.technique.into(),
+            key: key.into(),
+            value: self.text(key).into(),
+            expected: expected.into(),
+        }
+    }
+
+    /// The value of `key` as a number in `lo..=hi`.
+    ///
+    /// # Errors
+    /// [`SettingsError::BadValue`] when it does not parse or is out of range.
+    pub fn ranged<T: FromStr + PartialOrd + fmt::Display + Copy>(
+        &self,
+        key: &str,
+        lo: T,
+        hi: T,
+    ) -> Result<T, SettingsError>
+    where
+        T::Err: fmt::Display,
+    {
+        let v: T = self.get(key).map_err(|_| self.bad(key, &format!("a number from {lo} to {hi}")))?;
+        if v >= lo && v <= hi { Ok(v) } else { Err(self.bad(key, &format!("a number from {lo} to {hi}"))) }
+    }
+}
+
+/// A typed settings struct of a technique.
+pub trait TechniqueSettings: Sized + Clone + Send + Sync + 'static {
+    /// Every key, with its default and help.
+    fn keys() -> &'static [SettingKey];
+    /// Reads the struct from given-or-default values.
+    ///
+    /// # Errors
+    /// A value that does not parse or is out of range.
+    fn from_values(values: &Values<'_>) -> Result<Self, SettingsError>;
+    /// Every key with its current value, in [`TechniqueSettings::keys`] order.
+    fn to_values(&self) -> Vec<String>;
+
+    /// The settings of a spec for the technique named `technique`, unknown keys refused.
+    ///
+    /// # Errors
+    /// [`SettingsError::UnknownKey`] or [`SettingsError::BadValue`].
+    fn parse(technique: &str, given: &[(String, String)]) -> Result<Self, SettingsError> {
+        let keys = Self::keys();
+        for (k, _) in given {
+            if !keys.iter().any(|s| s.key == k) {
+                let valid = if keys.is_empty() {
+                    "none".to_string()
+                } else {
+                    keys.iter().map(|s| s.key).collect::<Vec<_>>().join(", ")
+                };
+                return Err(SettingsError::UnknownKey { technique: technique.into(), key: k.clone(), valid });
+            }
+        }
+        let values = Values { technique, given: given.iter().map(|(k, v)| (k.as_str(), v.as_str())).collect(), keys };
+        Self::from_values(&values)
+    }
+
+    /// The defaults.
+    ///
+    /// # Panics
+    /// When the declared defaults do not parse: a bug in the settings struct, caught by its tests.
+    #[must_use]
+    fn defaults() -> Self {
+        match Self::parse("defaults", &[]) {
+            Ok(s) => s,
+            Err(e) => panic!("declared defaults do not parse: {e}"),
+        }
+    }
+
+    /// Canonical `key=value,...` with every key, for reports.
+    #[must_use]
+    fn settings_string(&self) -> String {
+        Self::keys().iter().zip(self.to_values()).map(|(k, v)| format!("{}={v}", k.key)).collect::<Vec<_>>().join(",")
+    }
+}
+
+/// Declares a settings enum with its text names, `FromStr` (errors list the names) and `Display`.
+#[macro_export]
+macro_rules! named_enum {
+    ($(#[$m:meta])* pub enum $name:ident { $($(#[$vm:meta])* $variant:ident = $text:literal),+ $(,)? }) => {
+        $(#[$m])*
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+        pub enum $name { $($(#[$vm])* $variant),+ }
+
+        impl $name {
+            /// Every variant's name.
+            pub const NAMES: &'static [&'static str] = &[$($text),+];
+            /// The variant's name.
+            #[must_use]
+            pub fn as_str(self) -> &'static str {
+                match self { $(Self::$variant => $text),+ }
+            }
+        }
+
+        impl ::std::str::FromStr for $name {
+            type Err = String;
+            fn from_str(s: &str) -> Result<Self, String> {
+                match s { $($text => Ok(Self::$variant),)+ _ => Err(format!("one of {}", Self::NAMES.join(", "))) }
+            }
+        }
+
+        impl ::std::fmt::Display for $name {
+            fn fmt(&self, f: &mut ::std::fmt::Formatter<'_>) -> ::std::fmt::Result {
+                f.write_str(self.as_str())
+            }
+        }
+    };
+}
+
+named_enum! {
+    /// How a shadow map's depth is offset when the map is rendered (Vulkan's float depth bias, DESIGN 4).
+    pub enum BiasMode {
+        /// No bias.
+        None = "none",
+        /// The constant term only: `bias_constant * 2^(e - 23)`, e the exponent of the primitive's largest |z|.
+        Constant = "constant",
+        /// Constant plus `bias_slope * max(|dz/dx|, |dz/dy|)` in texels.
+        Slope = "slope",
+    }
+}
+
+named_enum! {
+    /// How a shadow-map lookup filters depth comparisons.
+    pub enum Filter {
+        /// One comparison against the nearest texel.
+        None = "none",
+        /// Bilinear percentage-closer filtering: the 2x2 comparisons around the sample, bilinearly
+        /// weighted (what hardware comparison samplers do).
+        Bilinear = "bilinear",
+        /// A 3x3 box of bilinear comparisons, one texel apart.
+        Pcf3x3 = "pcf3x3",
+        /// A 4x4 grid of comparisons, each jittered inside its cell by a per-pixel hash.
+        Pcf4x4Jitter = "pcf4x4-jitter",
+        /// 16 Poisson-disk comparisons, rotated per pixel.
+        Poisson16 = "poisson16",
+    }
+}
+
+/// The bias of a shadow-map render: Vulkan's depth-bias parameters.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DepthBias {
+    /// The constant factor, in units of the depth format's resolution at the primitive's depth.
+    pub constant: f32,
+    /// The slope factor, times the primitive's largest depth slope per texel.
+    pub slope: f32,
+    /// Largest bias applied (0 for no clamp).
+    pub clamp: f32,
+}
+
+impl DepthBias {
+    /// No bias at all.
+    pub const NONE: Self = Self { constant: 0.0, slope: 0.0, clamp: 0.0 };
+
+    /// The bias for a mode and its two factors.
+    #[must_use]
+    pub fn from_mode(mode: BiasMode, constant: f32, slope: f32) -> Self {
+        match mode {
+            BiasMode::None => Self::NONE,
+            BiasMode::Constant => Self { constant, slope: 0.0, clamp: 0.0 },
+            BiasMode::Slope => Self { constant, slope, clamp: 0.0 },
+        }
+    }
+
+    /// Vulkan's offset for a float depth buffer: `slope * max_slope + constant * 2^(e - 23)`, where `e` is
+    /// the exponent of `max_abs_z`, then clamped when `clamp` is not 0.
+    #[must_use]
+    pub fn offset(&self, max_slope: f32, max_abs_z: f32) -> f32 {
+        if self.constant == 0.0 && self.slope == 0.0 {
+            return 0.0;
+        }
+        let r = if max_abs_z > 0.0 {
+            // 2^(e - 23) with e = floor(log2 |z|): the spacing of f32 values at that magnitude.
+            let e = ((max_abs_z.to_bits() >> 23) & 0xff) as i32 - 127;
+            2f32.powi(e - 23)
+        } else {
+            2f32.powi(-149)
+        };
+        let o = self.slope * max_slope + self.constant * r;
+        if self.clamp > 0.0 {
+            o.min(self.clamp)
+        } else if self.clamp < 0.0 {
+            o.max(self.clamp)
+        } else {
+            o
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parses_specs() {
+        let s = TechniqueSpec::parse("shadow-map:res=1024,filter=pcf3x3").unwrap();
+        assert_eq!(s.name, "shadow-map");
+        assert_eq!(s.values, vec![("res".into(), "1024".into()), ("filter".into(), "pcf3x3".into())]);
+        assert_eq!(s.to_string(), "shadow-map:res=1024,filter=pcf3x3");
+        assert_eq!(TechniqueSpec::parse("ray-traced").unwrap().values, vec![]);
+        assert!(TechniqueSpec::parse("").is_err());
+        assert!(TechniqueSpec::parse("a:b").is_err());
+        assert!(TechniqueSpec::parse("a:=1").is_err());
+        assert!(TechniqueSpec::parse("a:b=1,b=2").is_err());
+        assert!(TechniqueSpec::parse("a b").is_err());
+    }
+
+    #[test]
+    fn vulkan_float_bias() {
+        let b = DepthBias::from_mode(BiasMode::Slope, 1.0, 2.0);
+        // z = 0.75 has exponent -1, so r = 2^-24.
+        assert_eq!(b.offset(0.0, 0.75), 2f32.powi(-24));
+        assert_eq!(b.offset(0.5, 0.75), 1.0 + 2f32.powi(-24));
+        assert_eq!(DepthBias::from_mode(BiasMode::None, 5.0, 5.0).offset(1.0, 1.0), 0.0);
+    }
+}
