@@ -4,12 +4,23 @@
 //! This crate is the facade: it re-exports the workspace crates and resolves what a user names on the
 //! command line (a built-in scene or a model file) into a scene.
 
+pub mod compare;
+mod error;
+pub mod registry;
+pub mod renderer;
+pub mod setup;
+pub mod sheet;
+
 use std::path::Path;
 
+pub use error::Error;
+pub use registry::{RegistryError, TechniqueEntry, TechniqueRegistry};
+pub use renderer::{BackendChoice, BackendKind, Renderer};
 pub use shadow_core as core;
 use shadow_core::Scene;
 use shadow_core::assets::{self, AssetError};
 use shadow_core::scenes::{self, SceneParams, UnknownScene};
+pub use shadow_cpu as cpu;
 
 /// Why a scene could not be had.
 #[derive(Debug, thiserror::Error)]

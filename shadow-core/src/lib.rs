@@ -15,6 +15,7 @@ pub mod geometry;
 pub mod image;
 pub mod inspect;
 pub mod light;
+pub mod lookup;
 pub mod mesh;
 pub mod metrics;
 pub mod procedural;
@@ -22,6 +23,7 @@ pub mod scene;
 pub mod scenes;
 pub mod stats;
 pub mod technique;
+pub mod text;
 
 pub use bounds::Aabb;
 pub use frame::{FrameInputs, Instance};

@@ -1,5 +1,11 @@
-//! Error metrics against a reference (DESIGN 8), over the pixels of a mask (receiver pixels inside the
-//! light's reach).
+//! Error metrics against a reference (DESIGN 8), over the pixels where a light's visibility shows in the
+//! picture: receiver pixels inside the light's reach whose seen side faces the light ([`measured_pixels`]).
+//!
+//! Surfaces turned away from a light get none of it whatever their visibility (Lambert's max(n.l, 0)), and
+//! there every technique's answer is a precision race: at a closed mesh's terminator, and on whole
+//! sub-pixel branches, the point lies within f32 depth resolution of its own silhouette's volume side or
+//! map texel. Measuring there would rank techniques by rounding, so those pixels are left out, as pixels
+//! showing no receiver are (DESIGN 4). The reference still calls them shadowed.
 //!
 //! Every fraction has the number of masked pixels as its denominator, so the parts add up:
 //! `mismatch = edge_band_mismatch + interior_mismatch = false_shadow + false_light`.
@@ -33,6 +39,21 @@ pub struct VisibilityMetrics {
     pub rmse: f64,
     /// Mean absolute visibility difference.
     pub mean_abs: f64,
+}
+
+/// The pixels every metric is taken over: receivers inside the light's reach whose seen side faces it.
+/// `position` and `normal` are the world position and the face normal turned towards the viewer.
+#[must_use]
+pub fn measured_pixels(
+    receiver: &Image<bool>,
+    position: &Image<glam::Vec3>,
+    normal: &Image<glam::Vec3>,
+    light: &crate::light::LightView,
+) -> Image<bool> {
+    Image::from_fn(receiver.width(), receiver.height(), |x, y| {
+        let p = *position.get(x, y);
+        *receiver.get(x, y) && light.in_domain(p) && normal.get(x, y).dot(light.light.to_light(p)) > 0.0
+    })
 }
 
 fn check<A, B>(a: &Image<A>, b: &Image<B>) -> Result<(), SizeMismatch> {

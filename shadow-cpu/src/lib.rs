@@ -1,1 +1,17 @@
-//! placeholder
+//! shadow-cpu: the CPU reference backend.
+//!
+//! A software rasterizer that follows DESIGN 4 exactly ([`raster`]), BVH ray casting for the exact
+//! reference ([`bvh`]), the G-buffer ([`gbuffer`]), shading ([`shade`]) and frame assembly ([`frame`]),
+//! and the CPU versions of the techniques ([`techniques`]).
+
+pub mod bvh;
+pub mod context;
+pub mod frame;
+pub mod gbuffer;
+pub mod raster;
+pub mod shade;
+pub mod techniques;
+
+pub use context::{CpuBackend, CpuContext, CpuError};
+pub use frame::{CpuFrame, render_frame};
+pub use gbuffer::GBuffer;

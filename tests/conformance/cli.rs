@@ -55,6 +55,6 @@ fn usage_errors_exit_2() {
     assert_eq!(shadowlab(&["inspect"]).0, 2);
     assert_eq!(shadowlab(&["frobnicate"]).0, 2);
     let (code, _, err) = shadowlab(&["inspect", "no-such-scene"]);
-    assert_eq!(code, 1);
+    assert_eq!(code, 2);
     assert!(err.contains("no-such-scene"), "{err}");
 }

@@ -79,7 +79,7 @@ pub(super) fn stacked_boxes(_: &SceneParams) -> Scene {
     );
     s.finish(
         Camera::look_at(Vec3::new(0.8, 2.4, 3.0), Vec3::new(0.3, 0.3, 0.0), 45.0),
-        Light::spot(Vec3::new(1.0, 4.5, 0.6), Vec3::new(0.4, 0.0, 0.2), 60.0),
+        Light::spot(Vec3::new(1.1, 4.5, 0.9), Vec3::new(0.4, 0.0, 0.2), 60.0),
     )
 }
 
@@ -298,14 +298,15 @@ pub(super) fn room(_: &SceneParams) -> Scene {
     s.add("back wall", procedural::plane(6.0, 3.6), wall, at(0.0, 1.8, -3.0) * Mat4::from_rotation_x(FRAC_PI_2));
     s.add("left wall", procedural::plane(3.6, 7.0), wall, at(-3.0, 1.8, 0.5) * Mat4::from_rotation_z(-FRAC_PI_2));
     s.add("right wall", procedural::plane(3.6, 7.0), wall, at(3.0, 1.8, 0.5) * Mat4::from_rotation_z(FRAC_PI_2));
-    s.add("beam", procedural::cuboid(Vec3::new(1.4, 0.25, 1.0)), WARM, at(0.0, 2.35, 1.0));
-    s.add("table", procedural::cuboid(Vec3::new(1.2, 0.8, 0.8)), BLUE, at(1.0, 0.4, 0.0));
-    s.add("ball", procedural::sphere(0.3, 32, 16), GREEN, at(-1.2, 0.3, -0.8));
-    // The eye is at (0, 1.2, 3) with a near plane 0.05 ahead (z = 2.95), whose half-width is 0.0207:
-    // the post reaches 0.0195 to the eye's left and spans z 2.935..2.96, so the near plane cuts it.
-    s.add("post", procedural::cuboid(Vec3::new(0.18, 3.0, 0.025)), GOLD, at(-0.1095, 1.5, 2.9475));
+    s.add("beam", procedural::cuboid(Vec3::new(1.4, 0.25, 0.9)), WARM, at(0.0, 2.5, 1.25));
+    s.add("table", procedural::cuboid(Vec3::new(1.2, 0.8, 0.8)), BLUE, at(1.0, 0.4, -0.3));
+    s.add("ball", procedural::sphere(0.3, 32, 16), GREEN, at(-1.1, 0.3, -1.0));
+    // The eye is at (0, 1.2, 3) with a near plane 0.05 ahead (z = 2.95), whose half-width is 0.026 at
+    // 55 degrees: the post reaches 0.025 to the eye's left and spans z 2.935..2.96, so the near plane cuts
+    // it. The segment from the eye to the light runs through the beam, so the eye is in its shadow.
+    s.add("post", procedural::cuboid(Vec3::new(0.18, 3.0, 0.025)), GOLD, at(-0.115, 1.5, 2.9475));
     s.finish(
-        Camera::look_at(Vec3::new(0.0, 1.2, 3.0), Vec3::new(0.0, 0.8, -2.0), 45.0),
-        Light::spot(Vec3::new(0.0, 3.5, -1.0), Vec3::new(0.0, 0.0, 1.5), 120.0),
+        Camera::look_at(Vec3::new(0.0, 1.2, 3.0), Vec3::new(0.0, 0.7, -2.0), 55.0),
+        Light::spot(Vec3::new(0.0, 3.4, 0.0), Vec3::new(0.0, 0.0, -1.0), 130.0),
     )
 }

@@ -8,7 +8,10 @@ use super::settings::{
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RayTraced {
     /// Shadow-ray origin offset along the geometric normal, as a fraction of the scene's bounding-box
-    /// diagonal (so the offset scales with the scene).
+    /// diagonal (so the offset scales with the scene). The default, 5e-7, is a few f32 ulps of the scene's
+    /// size: enough to clear the rounding of the surface position, small enough not to shift rays past
+    /// sub-centimetre occluders (at 2e-5 the tree's thin branch shadows moved by a pixel in 0.1% of the
+    /// image; from 2e-6 down the reference stops changing).
     pub epsilon: f32,
 }
 
@@ -16,7 +19,7 @@ impl TechniqueSettings for RayTraced {
     fn keys() -> &'static [SettingKey] {
         &[SettingKey {
             key: "epsilon",
-            default: "0.00002",
+            default: "0.0000005",
             help: "ray origin offset along the normal, as a fraction of the scene diagonal",
         }]
     }

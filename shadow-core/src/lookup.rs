@@ -1,0 +1,166 @@
+//! Shadow-map lookups and percentage-closer filters (DESIGN 4 and 6), written once and mirrored in WGSL
+//! (`shadow_lookup` in shadow-wgpu's common shader; each function below names its twin).
+//!
+//! A map is `N x N` depths, row-major from the top-left; texel `i` is centred at `(i + 0.5) / N`. A
+//! sample is lit when its depth is at most the stored depth. Samples outside the map are lit: the map has
+//! nothing to say there, and for a spot light the metrics leave those pixels out anyway. Filter taps
+//! clamp to the map's edge, as a clamp-to-edge sampler does.
+
+use glam::Vec2;
+
+use crate::image::Image;
+use crate::technique::settings::Filter;
+
+/// 16 points in the unit disk, spread by best-candidate sampling (minimum distance 0.41), centred.
+pub const POISSON16: [Vec2; 16] = [
+    Vec2::new(0.9306, 0.0506),
+    Vec2::new(-0.9488, 0.0122),
+    Vec2::new(-0.0356, 0.9994),
+    Vec2::new(-0.0246, -0.9163),
+    Vec2::new(0.0220, 0.0607),
+    Vec2::new(0.6663, -0.6365),
+    Vec2::new(0.6533, 0.7137),
+    Vec2::new(-0.6883, 0.6873),
+    Vec2::new(-0.6823, -0.6171),
+    Vec2::new(-0.1826, -0.4239),
+    Vec2::new(-0.4766, 0.2110),
+    Vec2::new(0.4581, -0.1665),
+    Vec2::new(0.1390, 0.5459),
+    Vec2::new(0.5258, 0.2807),
+    Vec2::new(-0.5932, -0.2138),
+    Vec2::new(0.2370, -0.5874),
+];
+
+/// An integer hash of a pixel, the same on both backends (WGSL twin: `pixel_hash`).
+#[must_use]
+pub fn pixel_hash(x: u32, y: u32) -> u32 {
+    let mut h = x.wrapping_mul(0x8da6_b343) ^ y.wrapping_mul(0xd816_3841);
+    h ^= h >> 16;
+    h = h.wrapping_mul(0x7feb_352d);
+    h ^= h >> 15;
+    h = h.wrapping_mul(0x846c_a68b);
+    h ^ (h >> 16)
+}
+
+/// A hash turned into [0, 1) (24 bits).
+#[must_use]
+pub fn hash_unit(h: u32) -> f32 {
+    (h >> 8) as f32 * (1.0 / 16_777_216.0)
+}
+
+/// One comparison against texel (x, y), clamped to the edge (WGSL twin: `compare_texel`).
+#[inline]
+fn compare_texel(map: &Image<f32>, x: i32, y: i32, depth: f32) -> f32 {
+    let n = map.width() as i32;
+    let v = *map.get(x.clamp(0, n - 1) as u32, y.clamp(0, n - 1) as u32);
+    if depth <= v { 1.0 } else { 0.0 }
+}
+
+/// Comparison against the texel holding `uv` (WGSL twin: `compare_nearest`).
+#[must_use]
+pub fn compare_nearest(map: &Image<f32>, uv: Vec2, depth: f32) -> f32 {
+    let n = map.width() as f32;
+    let t = (uv * n).floor();
+    compare_texel(map, t.x as i32, t.y as i32, depth)
+}
+
+/// Bilinearly weighted comparisons of the 2x2 texels around `uv - half a texel`: what a hardware
+/// comparison sampler with linear filtering returns (WGSL: `textureSampleCompareLevel`).
+#[must_use]
+pub fn compare_bilinear(map: &Image<f32>, uv: Vec2, depth: f32) -> f32 {
+    let n = map.width() as f32;
+    let st = uv * n - Vec2::splat(0.5);
+    let i = st.floor();
+    let f = st - i;
+    let (x, y) = (i.x as i32, i.y as i32);
+    let top = compare_texel(map, x, y, depth) * (1.0 - f.x) + compare_texel(map, x + 1, y, depth) * f.x;
+    let bottom = compare_texel(map, x, y + 1, depth) * (1.0 - f.x) + compare_texel(map, x + 1, y + 1, depth) * f.x;
+    top * (1.0 - f.y) + bottom * f.y
+}
+
+/// Visibility from a shadow map with a filter (WGSL twin: `shadow_lookup`). `radius` is the kernel radius
+/// in texels for the jittered and Poisson filters; `pixel` seeds their per-pixel rotation or jitter.
+#[must_use]
+pub fn shadow_lookup(map: &Image<f32>, uv: Vec2, depth: f32, filter: Filter, radius: f32, pixel: (u32, u32)) -> f32 {
+    if !(0.0..=1.0).contains(&uv.x) || !(0.0..=1.0).contains(&uv.y) {
+        return 1.0;
+    }
+    let texel = 1.0 / map.width() as f32;
+    match filter {
+        Filter::None => compare_nearest(map, uv, depth),
+        Filter::Bilinear => compare_bilinear(map, uv, depth),
+        Filter::Pcf3x3 => {
+            let mut sum = 0.0;
+            for dy in -1..=1 {
+                for dx in -1..=1 {
+                    sum += compare_bilinear(map, uv + Vec2::new(dx as f32, dy as f32) * texel, depth);
+                }
+            }
+            sum / 9.0
+        }
+        Filter::Pcf4x4Jitter => {
+            let mut h = pixel_hash(pixel.0, pixel.1);
+            let mut sum = 0.0;
+            for j in 0..4 {
+                for i in 0..4 {
+                    h = pixel_hash(h, (j * 4 + i) as u32);
+                    let jx = hash_unit(h);
+                    let jy = hash_unit(h.rotate_left(12));
+                    // Cell (i, j) of a 4x4 grid over [-radius, radius]^2, jittered inside the cell.
+                    let o = (Vec2::new(i as f32 + jx, j as f32 + jy) * 0.5 - Vec2::splat(1.0)) * radius;
+                    sum += compare_bilinear(map, uv + o * texel, depth);
+                }
+            }
+            sum / 16.0
+        }
+        Filter::Poisson16 => {
+            let angle = hash_unit(pixel_hash(pixel.0, pixel.1)) * std::f32::consts::TAU;
+            let (s, c) = angle.sin_cos();
+            let mut sum = 0.0;
+            for p in POISSON16 {
+                let o = Vec2::new(c * p.x - s * p.y, s * p.x + c * p.y) * radius;
+                sum += compare_bilinear(map, uv + o * texel, depth);
+            }
+            sum / 16.0
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 4x4 map: the left half at depth 0.2 (an occluder), the right half at 1.0.
+    fn half_map() -> Image<f32> {
+        Image::from_fn(4, 4, |x, _| if x < 2 { 0.2 } else { 1.0 })
+    }
+
+    #[test]
+    fn nearest_uses_the_texel_under_uv() {
+        let m = half_map();
+        assert_eq!(compare_nearest(&m, Vec2::new(0.49, 0.5), 0.5), 0.0);
+        assert_eq!(compare_nearest(&m, Vec2::new(0.51, 0.5), 0.5), 1.0);
+        assert_eq!(compare_nearest(&m, Vec2::new(0.1, 0.5), 0.2), 1.0, "equal depth is lit");
+        assert_eq!(shadow_lookup(&m, Vec2::new(-0.1, 0.5), 0.9, Filter::None, 1.0, (0, 0)), 1.0, "outside is lit");
+    }
+
+    #[test]
+    fn bilinear_weights_across_the_boundary() {
+        let m = half_map();
+        // Texel centres 1 and 2 are at u = 0.375 and 0.625; halfway between, half the weight is lit.
+        assert!((compare_bilinear(&m, Vec2::new(0.5, 0.5), 0.5) - 0.5).abs() < 1e-6);
+        assert!((compare_bilinear(&m, Vec2::new(0.4375, 0.5), 0.5) - 0.25).abs() < 1e-6);
+        assert_eq!(compare_bilinear(&m, Vec2::new(0.625, 0.5), 0.5), 1.0);
+    }
+
+    #[test]
+    fn wide_filters_are_averages_in_range() {
+        let m = half_map();
+        for f in [Filter::Pcf3x3, Filter::Pcf4x4Jitter, Filter::Poisson16] {
+            let edge = shadow_lookup(&m, Vec2::new(0.5, 0.5), 0.5, f, 1.5, (3, 7));
+            assert!(edge > 0.1 && edge < 0.9, "{f}: {edge}");
+            assert_eq!(shadow_lookup(&m, Vec2::new(0.5, 0.5), 0.1, f, 1.5, (3, 7)), 1.0, "{f}");
+        }
+        assert!(POISSON16.iter().all(|p| p.length() <= 1.0 + 1e-4));
+    }
+}

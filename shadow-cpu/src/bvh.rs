@@ -1,0 +1,80 @@
+//! Ray casting for the exact reference: a compressed wide BVH (obvhs' CWBVH, built with PLOC) over every
+//! casting triangle in world space, traversed for any hit.
+
+use std::hash::{Hash, Hasher};
+use std::time::Duration;
+
+use glam::{Vec3, Vec3A};
+use obvhs::BvhBuildParams;
+use obvhs::cwbvh::CwBvh;
+use obvhs::cwbvh::builder::build_cwbvh_from_tris;
+use obvhs::ray::Ray;
+use obvhs::triangle::Triangle;
+use rayon::prelude::*;
+use shadow_core::FrameInputs;
+
+/// The casters of a frame, ready for shadow rays.
+pub struct SceneBvh {
+    bvh: Option<CwBvh>,
+    /// Triangles in the BVH's primitive order, so leaves read them sequentially.
+    tris: Vec<Triangle>,
+}
+
+impl SceneBvh {
+    /// A key that changes when any caster's mesh or transform does.
+    #[must_use]
+    pub fn key(frame: &FrameInputs) -> u64 {
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        for inst in frame.instances.iter().filter(|i| i.casts_shadow) {
+            inst.mesh_version.hash(&mut h);
+            for v in inst.world_from_local.to_cols_array() {
+                v.to_bits().hash(&mut h);
+            }
+        }
+        h.finish()
+    }
+
+    /// Builds the BVH of every casting triangle in world space.
+    #[must_use]
+    pub fn build(frame: &FrameInputs) -> Self {
+        let tris: Vec<Triangle> = frame
+            .instances
+            .par_iter()
+            .filter(|i| i.casts_shadow)
+            .flat_map_iter(|inst| {
+                let m = inst.world_from_local;
+                let world: Vec<Vec3A> =
+                    inst.mesh.positions().iter().map(|&p| Vec3A::from(m.transform_point3(p))).collect();
+                inst.mesh
+                    .triangles()
+                    .iter()
+                    .map(move |t| Triangle {
+                        v0: world[t[0] as usize],
+                        v1: world[t[1] as usize],
+                        v2: world[t[2] as usize],
+                    })
+                    .collect::<Vec<_>>()
+            })
+            .collect();
+        if tris.is_empty() {
+            return Self { bvh: None, tris };
+        }
+        let bvh = build_cwbvh_from_tris(&tris, BvhBuildParams::medium_build(), &mut Duration::default());
+        let ordered = bvh.primitive_indices.iter().map(|&i| tris[i as usize]).collect();
+        Self { bvh: Some(bvh), tris: ordered }
+    }
+
+    /// Number of triangles.
+    #[must_use]
+    pub fn triangle_count(&self) -> usize {
+        self.tris.len()
+    }
+
+    /// True when some triangle blocks the segment from `origin` along unit `dir` for `tmax`.
+    #[must_use]
+    pub fn occluded(&self, origin: Vec3, dir: Vec3, tmax: f32) -> bool {
+        let Some(bvh) = &self.bvh else { return false };
+        let ray = Ray::new(origin.into(), dir.into(), 0.0, tmax);
+        !bvh.ray_traverse_miss(ray, |r, id| self.tris[id].intersect(r))
+    }
+}

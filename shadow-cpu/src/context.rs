@@ -1,0 +1,99 @@
+//! The CPU backend type, its context and its errors.
+
+use std::sync::Arc;
+
+use shadow_core::frame::FrameError;
+use shadow_core::light::LightViewError;
+use shadow_core::technique::{Backend, TechniqueError};
+use shadow_core::{FrameInputs, Image};
+
+use crate::bvh::SceneBvh;
+use crate::gbuffer::GBuffer;
+
+/// Largest view or map side the CPU backend renders.
+pub const MAX_TARGET_SIDE: u32 = 16384;
+/// Largest total of texels a single map-based build may allocate (2^30: 4 GiB of f32 depth).
+pub const MAX_MAP_TEXELS: u64 = 1 << 30;
+
+/// Errors of the CPU backend.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum CpuError {
+    /// A shared technique error (unsupported light, bad settings).
+    #[error(transparent)]
+    Technique(#[from] TechniqueError),
+    /// The frame could not be assembled (bad camera or light, empty scene).
+    #[error(transparent)]
+    Frame(#[from] FrameError),
+    /// No light view could be fitted.
+    #[error(transparent)]
+    LightView(#[from] LightViewError),
+    /// A view or map size that cannot be rendered.
+    #[error("{what} of {width}x{height} cannot be rendered: {why}")]
+    BadSize {
+        /// What was being sized.
+        what: &'static str,
+        /// Width asked for.
+        width: u64,
+        /// Height asked for.
+        height: u64,
+        /// Why not.
+        why: String,
+    },
+}
+
+/// Checks a target size before anything is allocated.
+///
+/// # Errors
+/// [`CpuError::BadSize`] for a zero side, a side over [`MAX_TARGET_SIDE`] or more than `max_texels`.
+pub fn check_size(what: &'static str, width: u64, height: u64, max_texels: u64) -> Result<(), CpuError> {
+    let why = if width == 0 || height == 0 {
+        "a side is zero".to_string()
+    } else if width > u64::from(MAX_TARGET_SIDE) || height > u64::from(MAX_TARGET_SIDE) {
+        format!("a side is over the limit of {MAX_TARGET_SIDE}")
+    } else if width * height > max_texels {
+        format!("{} texels is over the limit of {max_texels}", width * height)
+    } else {
+        return Ok(());
+    };
+    Err(CpuError::BadSize { what, width, height, why })
+}
+
+/// The CPU reference backend.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct CpuBackend;
+
+impl Backend for CpuBackend {
+    type Context = CpuContext;
+    type GBuffer = GBuffer;
+    type Visibility = Image<f32>;
+    type Error = CpuError;
+    const NAME: &'static str = "cpu";
+}
+
+/// What the CPU backend keeps between frames: the ray-casting BVH of the casters (it does not depend on
+/// the light, so it survives a moving light; it is rebuilt when a caster moves or changes).
+#[derive(Default)]
+pub struct CpuContext {
+    bvh: Option<(u64, Arc<SceneBvh>)>,
+}
+
+impl CpuContext {
+    /// A fresh context.
+    #[must_use]
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// The BVH of the frame's casters, built on first use and reused while they stay put.
+    pub fn bvh(&mut self, frame: &FrameInputs) -> Arc<SceneBvh> {
+        let key = SceneBvh::key(frame);
+        match &self.bvh {
+            Some((k, b)) if *k == key => b.clone(),
+            _ => {
+                let b = Arc::new(SceneBvh::build(frame));
+                self.bvh = Some((key, b.clone()));
+                b
+            }
+        }
+    }
+}

@@ -1,0 +1,545 @@
+//! A tile-binned, multi-threaded triangle rasterizer that follows DESIGN 4 to the letter: homogeneous
+//! clipping, 8 subpixel bits, the top-left fill rule, counter-clockwise front faces, perspective-correct
+//! barycentrics, f32 depth with Vulkan's float depth bias, depth clamp, culling, 8-bit two-sided stencil
+//! and a per-fragment closure writing a colour target of any type.
+//!
+//! Triangles are set up in parallel batches, binned in submission order into bands of [`BAND_ROWS`]
+//! rows, and the bands are rasterized in parallel. Every band owns its rows of every target and walks its
+//! triangles in submission order, so the output does not depend on the thread count.
+
+pub mod clip;
+pub mod state;
+
+use glam::Vec4;
+use rayon::prelude::*;
+use shadow_core::Image;
+
+pub use state::*;
+
+/// Rows per band of the binning grid.
+pub const BAND_ROWS: u32 = 16;
+/// Subpixel bits of the fixed-point screen coordinates.
+pub const SUBPIXEL_BITS: u32 = 8;
+const ONE: i64 = 1 << SUBPIXEL_BITS;
+const HALF: i64 = ONE / 2;
+/// Triangles set up at once: bounds the memory of a draw whatever its size.
+const BATCH: usize = 1 << 15;
+
+/// A depth buffer with an 8-bit stencil, row-major from the top-left.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DepthStencil {
+    width: u32,
+    height: u32,
+    /// Depth per pixel.
+    pub depth: Vec<f32>,
+    /// Stencil per pixel.
+    pub stencil: Vec<u8>,
+}
+
+impl DepthStencil {
+    /// A buffer cleared to `depth` and `stencil`.
+    #[must_use]
+    pub fn new(width: u32, height: u32, depth: f32, stencil: u8) -> Self {
+        let n = width as usize * height as usize;
+        Self { width, height, depth: vec![depth; n], stencil: vec![stencil; n] }
+    }
+
+    /// A buffer holding an existing depth image and a cleared stencil.
+    #[must_use]
+    pub fn from_depth(depth: &Image<f32>, stencil: u8) -> Self {
+        Self {
+            width: depth.width(),
+            height: depth.height(),
+            depth: depth.data().to_vec(),
+            stencil: vec![stencil; depth.data().len()],
+        }
+    }
+
+    /// Width in pixels.
+    #[must_use]
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+
+    /// Height in pixels.
+    #[must_use]
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+
+    /// The depth as an image.
+    #[must_use]
+    pub fn depth_image(&self) -> Image<f32> {
+        Image::from_vec(self.width, self.height, self.depth.clone())
+            .unwrap_or_else(|| unreachable!("sizes match by construction"))
+    }
+
+    /// The depth as an image, consuming the buffer.
+    #[must_use]
+    pub fn into_depth_image(self) -> Image<f32> {
+        let (w, h) = (self.width, self.height);
+        Image::from_vec(w, h, self.depth).unwrap_or_else(|| unreachable!("sizes match by construction"))
+    }
+}
+
+/// One triangle as a draw sees it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SourceTriangle {
+    /// Clip-space corners.
+    pub v: [Vec4; 3],
+    /// Primitive id handed to the fragment closure.
+    pub prim: u32,
+    /// Swap front and back for this triangle (a face drawn turned around).
+    pub flip: bool,
+}
+
+/// Anything that yields triangles by index.
+pub trait TriangleSource: Sync {
+    /// Number of triangles.
+    fn len(&self) -> usize;
+    /// Triangle `i`.
+    fn get(&self, i: usize) -> SourceTriangle;
+    /// True when there are none.
+    fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
+/// Indexed triangles over shared clip-space vertices.
+pub struct Indexed<'a> {
+    /// Clip-space vertices.
+    pub positions: &'a [Vec4],
+    /// Corner indices.
+    pub triangles: &'a [[u32; 3]],
+    /// Added to the triangle index to make the primitive id.
+    pub prim_base: u32,
+    /// Swap front and back for every triangle.
+    pub flip: bool,
+}
+
+impl TriangleSource for Indexed<'_> {
+    fn len(&self) -> usize {
+        self.triangles.len()
+    }
+    #[inline]
+    fn get(&self, i: usize) -> SourceTriangle {
+        let t = self.triangles[i];
+        SourceTriangle { v: t.map(|k| self.positions[k as usize]), prim: self.prim_base + i as u32, flip: self.flip }
+    }
+}
+
+/// Triangles given corner by corner.
+pub struct Soup<'a> {
+    /// Clip-space corners.
+    pub triangles: &'a [[Vec4; 3]],
+    /// Added to the triangle index to make the primitive id.
+    pub prim_base: u32,
+    /// Swap front and back for every triangle.
+    pub flip: bool,
+}
+
+impl TriangleSource for Soup<'_> {
+    fn len(&self) -> usize {
+        self.triangles.len()
+    }
+    #[inline]
+    fn get(&self, i: usize) -> SourceTriangle {
+        SourceTriangle { v: self.triangles[i], prim: self.prim_base + i as u32, flip: self.flip }
+    }
+}
+
+/// A fragment handed to the closure.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Fragment {
+    /// Pixel column.
+    pub x: u32,
+    /// Pixel row.
+    pub y: u32,
+    /// Depth after bias (and clamp).
+    pub depth: f32,
+    /// Primitive id of the source triangle.
+    pub prim: u32,
+    /// Front-facing (after the source's flip).
+    pub front_facing: bool,
+    /// Perspective-correct barycentrics in the source triangle (before clipping).
+    pub bary: [f32; 3],
+}
+
+/// A triangle after clipping, projection and setup.
+#[derive(Clone, Copy, Debug)]
+struct Setup {
+    /// Edge functions `E_k = a px + b py + c` (fixed point), positive inside; edge k faces corner k.
+    a: [i64; 3],
+    b: [i64; 3],
+    c: [i64; 3],
+    /// -1 for edges that are not top or left (a sample exactly on them is outside), else 0.
+    tl: [i64; 3],
+    min_x: i32,
+    max_x: i32,
+    min_y: i32,
+    max_y: i32,
+    /// Depth plane: z = z0 + dzdx (x - x0) + dzdy (y - y0), in pixels.
+    fx0: i64,
+    fy0: i64,
+    z0: f32,
+    dzdx: f32,
+    dzdy: f32,
+    offset: f32,
+    inv_area: f32,
+    inv_w: [f32; 3],
+    bary: [[f32; 3]; 3],
+    prim: u32,
+    front: bool,
+}
+
+fn floor_div(a: i64, b: i64) -> i64 {
+    if b > 0 { a.div_euclid(b) } else { (-a).div_euclid(-b) }
+}
+
+fn ceil_div(a: i64, b: i64) -> i64 {
+    -floor_div(-a, b)
+}
+
+/// Screen setup of one (clipped) triangle; `None` when it covers no sample or is culled.
+fn setup_one(v: [clip::ClipVertex; 3], src: &SourceTriangle, st: &RasterState, w: u32, h: u32) -> Option<Setup> {
+    // Screen space, top-left origin, y down (DESIGN 4), snapped to 8 subpixel bits.
+    let mut fx = [0i64; 3];
+    let mut fy = [0i64; 3];
+    let mut z = [0f32; 3];
+    let mut inv_w = [0f32; 3];
+    for k in 0..3 {
+        let p = v[k].pos;
+        if p.w <= 0.0 {
+            return None;
+        }
+        let iw = 1.0 / p.w;
+        let (nx, ny) = (p.x * iw, p.y * iw);
+        fx[k] = ((nx * 0.5 + 0.5) * w as f32 * ONE as f32).round() as i64;
+        fy[k] = ((0.5 - ny * 0.5) * h as f32 * ONE as f32).round() as i64;
+        z[k] = p.z * iw;
+        inv_w[k] = iw;
+    }
+    let area = (fx[1] - fx[0]) * (fy[2] - fy[0]) - (fx[2] - fx[0]) * (fy[1] - fy[0]);
+    if area == 0 {
+        return None;
+    }
+    // Counter-clockwise in NDC (y up) is clockwise on screen (y down): negative screen area.
+    let ccw = area < 0;
+    let front = (ccw == (st.front_face == FrontFace::Ccw)) != src.flip;
+    match st.cull {
+        CullMode::Back if !front => return None,
+        CullMode::Front if front => return None,
+        _ => {}
+    }
+    // Order the corners so the edge functions are positive inside.
+    let mut order = [0usize, 1, 2];
+    if area < 0 {
+        order = [0, 2, 1];
+    }
+    let (fx, fy, z, inv_w) = (order.map(|k| fx[k]), order.map(|k| fy[k]), order.map(|k| z[k]), order.map(|k| inv_w[k]));
+    let bary = order.map(|k| v[k].bary);
+    let area = area.abs();
+
+    let min_fx = fx.iter().min().copied().unwrap_or(0);
+    let max_fx = fx.iter().max().copied().unwrap_or(0);
+    let min_fy = fy.iter().min().copied().unwrap_or(0);
+    let max_fy = fy.iter().max().copied().unwrap_or(0);
+    // Pixels whose centres lie inside the bounding box.
+    let min_x = ceil_div(min_fx - HALF, ONE).max(0);
+    let max_x = floor_div(max_fx - HALF, ONE).min(i64::from(w) - 1);
+    let min_y = ceil_div(min_fy - HALF, ONE).max(0);
+    let max_y = floor_div(max_fy - HALF, ONE).min(i64::from(h) - 1);
+    if min_x > max_x || min_y > max_y {
+        return None;
+    }
+
+    let mut a = [0i64; 3];
+    let mut b = [0i64; 3];
+    let mut c = [0i64; 3];
+    let mut tl = [0i64; 3];
+    for k in 0..3 {
+        let (i, j) = ((k + 1) % 3, (k + 2) % 3);
+        let (dx, dy) = (fx[j] - fx[i], fy[j] - fy[i]);
+        a[k] = -dy;
+        b[k] = dx;
+        c[k] = dy * fx[i] - dx * fy[i];
+        // Inside is to the side of grad E = (-dy, dx): a left edge has the inside to its right
+        // (dy < 0), a top edge is horizontal with the inside below it (dy == 0, dx > 0).
+        let top_left = dy < 0 || (dy == 0 && dx > 0);
+        tl[k] = if top_left { 0 } else { -1 };
+    }
+
+    // Depth plane in pixel units, from the snapped corners.
+    let (x0, y0) = (fx[0] as f64 / ONE as f64, fy[0] as f64 / ONE as f64);
+    let (x1, y1) = (fx[1] as f64 / ONE as f64 - x0, fy[1] as f64 / ONE as f64 - y0);
+    let (x2, y2) = (fx[2] as f64 / ONE as f64 - x0, fy[2] as f64 / ONE as f64 - y0);
+    let det = x1 * y2 - x2 * y1;
+    let (z1, z2) = (f64::from(z[1]) - f64::from(z[0]), f64::from(z[2]) - f64::from(z[0]));
+    let dzdx = ((z1 * y2 - z2 * y1) / det) as f32;
+    let dzdy = ((z2 * x1 - z1 * x2) / det) as f32;
+    let offset = st.depth.map_or(0.0, |d| {
+        let max_z = z.iter().fold(0.0f32, |m, v| m.max(v.abs()));
+        d.bias.offset(dzdx.abs().max(dzdy.abs()), max_z)
+    });
+
+    Some(Setup {
+        a,
+        b,
+        c,
+        tl,
+        min_x: min_x as i32,
+        max_x: max_x as i32,
+        min_y: min_y as i32,
+        max_y: max_y as i32,
+        fx0: fx[0],
+        fy0: fy[0],
+        z0: z[0],
+        dzdx,
+        dzdy,
+        offset,
+        inv_area: 1.0 / area as f32,
+        inv_w,
+        bary,
+        prim: src.prim,
+        front,
+    })
+}
+
+/// Clips and sets up a source triangle into up to seven screen triangles.
+fn setup(src: SourceTriangle, st: &RasterState, w: u32, h: u32, guard: f32, out: &mut Vec<Setup>) {
+    let far = !st.depth.is_some_and(|d| d.clamp);
+    if clip::trivially_out(&src.v, guard, far) {
+        return;
+    }
+    let ident = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    if clip::inside_all(&src.v, guard, far) {
+        let v = [0, 1, 2].map(|k| clip::ClipVertex { pos: src.v[k], bary: ident[k] });
+        out.extend(setup_one(v, &src, st, w, h));
+        return;
+    }
+    let poly = clip::clip_triangle(&src.v, guard, far);
+    let p = poly.as_slice();
+    for k in 1..p.len().saturating_sub(1) {
+        out.extend(setup_one([p[0], p[k], p[k + 1]], &src, st, w, h));
+    }
+}
+
+/// Guard band: how far beyond the viewport (in viewport widths) geometry may reach before it is clipped,
+/// chosen so fixed-point coordinates stay far inside i32 range for any target up to 16384 pixels.
+fn guard_band(w: u32, h: u32) -> f32 {
+    let side = w.max(h).max(1) as f32;
+    ((1u32 << 22) as f32 / (side * ONE as f32)).clamp(1.0, 64.0)
+}
+
+/// Rasterizes `src` into `ds` and `color`. The closure gives the colour of a fragment or `None` to
+/// discard it; `blend` merges it into the stored colour.
+///
+/// # Panics
+/// When `color` is not the size of `ds`: a caller bug.
+pub fn draw<T, S, F, B>(
+    ds: &mut DepthStencil,
+    color: &mut Image<T>,
+    src: &S,
+    st: &RasterState,
+    shader: F,
+    blend: B,
+) -> RasterCounters
+where
+    T: Send,
+    S: TriangleSource + ?Sized,
+    F: Fn(&Fragment) -> Option<T> + Sync,
+    B: Fn(&mut T, T) + Sync,
+{
+    let (w, h) = (ds.width, ds.height);
+    assert!(
+        color.width() == w && color.height() == h,
+        "colour target {}x{} for a {w}x{h} depth buffer",
+        color.width(),
+        color.height()
+    );
+    let guard = guard_band(w, h);
+    let bands = h.div_ceil(BAND_ROWS) as usize;
+    let band_px = (BAND_ROWS * w) as usize;
+    let mut total = RasterCounters::default();
+    let mut bins: Vec<Vec<u32>> = vec![Vec::new(); bands];
+    for start in (0..src.len()).step_by(BATCH) {
+        let end = (start + BATCH).min(src.len());
+        let setups: Vec<Setup> = (start..end)
+            .into_par_iter()
+            .with_min_len(256)
+            .fold(Vec::new, |mut acc, i| {
+                setup(src.get(i), st, w, h, guard, &mut acc);
+                acc
+            })
+            .flatten()
+            .collect();
+        total.triangles += setups.len() as u64;
+        for b in &mut bins {
+            b.clear();
+        }
+        for (i, t) in setups.iter().enumerate() {
+            for band in (t.min_y as u32 / BAND_ROWS)..=(t.max_y as u32 / BAND_ROWS) {
+                bins[band as usize].push(i as u32);
+            }
+        }
+        let counters = ds
+            .depth
+            .par_chunks_mut(band_px)
+            .zip(ds.stencil.par_chunks_mut(band_px))
+            .zip(color.data_mut().par_chunks_mut(band_px))
+            .zip(bins.par_iter())
+            .enumerate()
+            .map(|(band, (((depth, stencil), col), bin))| {
+                let mut c = RasterCounters::default();
+                let y0 = band as i32 * BAND_ROWS as i32;
+                let mut rows = BandRows { depth, stencil, color: col, y0, width: w as usize };
+                for &t in bin {
+                    raster_band(&setups[t as usize], &mut rows, st, &shader, &blend, &mut c);
+                }
+                c
+            })
+            .reduce(RasterCounters::default, |mut a, b| {
+                a += b;
+                a
+            });
+        total.fragments += counters.fragments;
+        total.passed += counters.passed;
+        total.stencil_updates += counters.stencil_updates;
+    }
+    total
+}
+
+/// Depth (and stencil) only.
+pub fn draw_depth<S: TriangleSource + ?Sized>(ds: &mut DepthStencil, src: &S, st: &RasterState) -> RasterCounters {
+    let mut none = Image::new(ds.width, ds.height, ());
+    draw(ds, &mut none, src, st, |_| Some(()), |_, _| {})
+}
+
+struct BandRows<'a, T> {
+    depth: &'a mut [f32],
+    stencil: &'a mut [u8],
+    color: &'a mut [T],
+    y0: i32,
+    width: usize,
+}
+
+/// The columns of row `py` (fixed point) inside all three edges.
+#[inline(always)]
+fn span(t: &Setup, py: i64) -> Option<(i32, i32)> {
+    let (mut lo, mut hi) = (i64::from(t.min_x), i64::from(t.max_x));
+    for k in 0..3 {
+        // E_k(256 x + 128) + tl >= 0  <=>  256 a x >= -(b py + c + tl) - 128 a.
+        let kk = t.b[k] * py + t.c[k] + t.tl[k];
+        let num = -kk - HALF * t.a[k];
+        let den = ONE * t.a[k];
+        match den.signum() {
+            1 => lo = lo.max(ceil_div(num, den)),
+            -1 => hi = hi.min(floor_div(num, den)),
+            _ if kk < 0 => return None,
+            _ => {}
+        }
+    }
+    (lo <= hi).then_some((lo as i32, hi as i32))
+}
+
+#[inline(always)]
+fn raster_band<T, F, B>(
+    t: &Setup,
+    rows: &mut BandRows<'_, T>,
+    st: &RasterState,
+    shader: &F,
+    blend: &B,
+    c: &mut RasterCounters,
+) where
+    F: Fn(&Fragment) -> Option<T>,
+    B: Fn(&mut T, T),
+{
+    let band_rows = (rows.depth.len() / rows.width) as i32;
+    let y_lo = t.min_y.max(rows.y0);
+    let y_hi = t.max_y.min(rows.y0 + band_rows - 1);
+    let clamp = st.depth.is_some_and(|d| d.clamp);
+    for y in y_lo..=y_hi {
+        let py = i64::from(y) * ONE + HALF;
+        let Some((xs, xe)) = span(t, py) else { continue };
+        let px0 = i64::from(xs) * ONE + HALF;
+        let mut e: [i64; 3] = std::array::from_fn(|k| t.a[k] * px0 + t.b[k] * py + t.c[k]);
+        let step: [i64; 3] = t.a.map(|a| a * ONE);
+        let dy = (py - t.fy0) as f32 / ONE as f32;
+        let row = (y - rows.y0) as usize * rows.width;
+        for x in xs..=xe {
+            let dx = ((i64::from(x) * ONE + HALF) - t.fx0) as f32 / ONE as f32;
+            let mut depth = t.z0 + t.dzdx * dx + t.dzdy * dy + t.offset;
+            if clamp {
+                depth = depth.clamp(0.0, 1.0);
+            }
+            let lambda = [e[0] as f32 * t.inv_area, e[1] as f32 * t.inv_area, e[2] as f32 * t.inv_area];
+            for (e, s) in e.iter_mut().zip(step) {
+                *e += s;
+            }
+            c.fragments += 1;
+            let frag = || {
+                // Perspective-correct weights of the clipped corners, then of the source triangle.
+                let q = [lambda[0] * t.inv_w[0], lambda[1] * t.inv_w[1], lambda[2] * t.inv_w[2]];
+                let s = 1.0 / (q[0] + q[1] + q[2]);
+                let q = [q[0] * s, q[1] * s, q[2] * s];
+                let mut bary = [0.0f32; 3];
+                for (k, b) in bary.iter_mut().enumerate() {
+                    *b = q[0] * t.bary[0][k] + q[1] * t.bary[1][k] + q[2] * t.bary[2][k];
+                }
+                Fragment { x: x as u32, y: y as u32, depth, prim: t.prim, front_facing: t.front, bary }
+            };
+            let i = row + x as usize;
+            let mut value = None;
+            if !st.early_tests {
+                value = shader(&frag());
+                if value.is_none() {
+                    continue;
+                }
+            }
+            if let Some(s) = &st.stencil {
+                let face = if t.front { s.front } else { s.back };
+                let stored = rows.stencil[i];
+                let op = if !face.compare.test(s.reference & s.read_mask, stored & s.read_mask) {
+                    Some(face.fail)
+                } else if st.depth.is_some_and(|d| !d.compare.test(depth, rows.depth[i])) {
+                    Some(face.depth_fail)
+                } else {
+                    None
+                };
+                if let Some(op) = op {
+                    if op != StencilOp::Keep {
+                        rows.stencil[i] = (stored & !s.write_mask) | (op.apply(stored, s.reference) & s.write_mask);
+                        c.stencil_updates += 1;
+                    }
+                    continue;
+                }
+                if face.pass != StencilOp::Keep {
+                    rows.stencil[i] = (stored & !s.write_mask) | (face.pass.apply(stored, s.reference) & s.write_mask);
+                    c.stencil_updates += 1;
+                }
+            } else if let Some(d) = &st.depth
+                && !d.compare.test(depth, rows.depth[i])
+            {
+                continue;
+            }
+            if st.early_tests {
+                value = shader(&frag());
+                if value.is_none() {
+                    continue;
+                }
+            }
+            c.passed += 1;
+            if let Some(d) = &st.depth
+                && d.write
+            {
+                rows.depth[i] = depth;
+            }
+            if let Some(v) = value {
+                blend(&mut rows.color[i], v);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests;

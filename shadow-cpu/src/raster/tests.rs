@@ -1,0 +1,278 @@
+use glam::Vec4;
+
+use super::*;
+
+fn count_state() -> RasterState {
+    RasterState { depth: None, ..RasterState::default() }
+}
+
+/// A jittered grid of triangles spanning beyond the screen, in NDC with varying w (so perspective and
+/// clipping are exercised). Returns clip-space triangles.
+fn jittered_grid(n: usize, seed: u64, w_scale: f32) -> Vec<[Vec4; 3]> {
+    let mut rng = shadow_core::scenes::Rng::new(seed);
+    let mut pts = vec![vec![Vec4::ZERO; n + 1]; n + 1];
+    for (j, row) in pts.iter_mut().enumerate() {
+        for (i, p) in row.iter_mut().enumerate() {
+            let jit =
+                |r: &mut shadow_core::scenes::Rng, k: usize| if k == 0 || k == n { 0.0 } else { r.range(-0.3, 0.3) };
+            let x = -1.3 + 2.6 * (i as f32 + jit(&mut rng, i)) / n as f32;
+            let y = -1.3 + 2.6 * (j as f32 + jit(&mut rng, j)) / n as f32;
+            let w = 1.0 + w_scale * rng.unit();
+            *p = Vec4::new(x * w, y * w, 0.5 * w, w);
+        }
+    }
+    let mut tris = Vec::new();
+    for j in 0..n {
+        for i in 0..n {
+            let (a, b, c, d) = (pts[j][i], pts[j][i + 1], pts[j + 1][i + 1], pts[j + 1][i]);
+            tris.push([a, b, c]);
+            tris.push([a, c, d]);
+        }
+    }
+    tris
+}
+
+#[test]
+fn a_mesh_covers_every_pixel_exactly_once() {
+    for (seed, w_scale) in [(1, 0.0), (2, 3.0), (3, 0.5)] {
+        let tris = jittered_grid(13, seed, w_scale);
+        let mut ds = DepthStencil::new(97, 61, 1.0, 0);
+        let mut hits = Image::new(97, 61, 0u32);
+        let src = Soup { triangles: &tris, prim_base: 0, flip: false };
+        draw(&mut ds, &mut hits, &src, &count_state(), |_| Some(1), |d, s| *d += s);
+        assert!(
+            hits.data().iter().all(|&h| h == 1),
+            "seed {seed}: {:?}",
+            hits.data().iter().filter(|&&h| h != 1).count()
+        );
+    }
+}
+
+#[test]
+fn clipped_fans_stay_watertight() {
+    // A fan around a vertex behind the near plane: every triangle is clipped, and the clipped pieces must
+    // still tile the covered area exactly once.
+    let centre = Vec4::new(0.1, -0.05, -0.5, 0.2);
+    let ring: Vec<Vec4> = (0..11)
+        .map(|k| {
+            let a = std::f32::consts::TAU * k as f32 / 11.0;
+            Vec4::new(0.9 * a.cos(), 0.9 * a.sin(), 0.5, 1.0)
+        })
+        .collect();
+    let tris: Vec<[Vec4; 3]> = (0..11).map(|k| [centre, ring[k], ring[(k + 1) % 11]]).collect();
+    let mut ds = DepthStencil::new(64, 64, 1.0, 0);
+    let mut hits = Image::new(64, 64, 0u32);
+    draw(
+        &mut ds,
+        &mut hits,
+        &Soup { triangles: &tris, prim_base: 0, flip: false },
+        &count_state(),
+        |_| Some(1),
+        |d, s| *d += s,
+    );
+    assert!(hits.data().iter().all(|&h| h <= 1));
+    assert!(hits.data().iter().filter(|&&h| h == 1).count() > 100);
+}
+
+#[test]
+fn top_left_rule() {
+    // A 4x4 pixel square from two triangles whose edges pass exactly through pixel centres: the left and
+    // top edges own their samples, the right and bottom ones do not.
+    let ndc = |x: f32, y: f32| Vec4::new(x / 4.0 - 1.0, 1.0 - y / 4.0, 0.5, 1.0);
+    let (a, b, c, d) = (ndc(1.5, 1.5), ndc(5.5, 1.5), ndc(5.5, 5.5), ndc(1.5, 5.5));
+    let tris = [[a, d, c], [a, c, b]];
+    let mut ds = DepthStencil::new(8, 8, 1.0, 0);
+    let mut hits = Image::new(8, 8, 0u32);
+    draw(
+        &mut ds,
+        &mut hits,
+        &Soup { triangles: &tris, prim_base: 0, flip: false },
+        &count_state(),
+        |_| Some(1),
+        |d, s| *d += s,
+    );
+    for y in 0..8 {
+        for x in 0..8 {
+            let inside = (1..5).contains(&x) && (1..5).contains(&y);
+            assert_eq!(*hits.get(x, y), u32::from(inside), "pixel ({x}, {y})");
+        }
+    }
+}
+
+#[test]
+fn barycentrics_are_perspective_correct() {
+    // A triangle with very different w: the attribute at a pixel must equal the one found by casting the
+    // pixel's ray onto the triangle in clip space.
+    let v = [Vec4::new(-1.0, -1.0, 0.1, 1.0), Vec4::new(3.0, -3.0, 1.5, 3.0), Vec4::new(-0.5, 2.0, 1.0, 2.0)];
+    let mut ds = DepthStencil::new(32, 32, 1.0, 0);
+    let mut out = Image::new(32, 32, [f32::NAN; 3]);
+    let st = RasterState { depth: None, ..RasterState::default() };
+    draw(&mut ds, &mut out, &Soup { triangles: &[v], prim_base: 0, flip: false }, &st, |f| Some(f.bary), |d, s| *d = s);
+    let mut checked = 0;
+    for y in 0..32 {
+        for x in 0..32 {
+            let b = *out.get(x, y);
+            if b[0].is_nan() {
+                continue;
+            }
+            let p = v[0] * b[0] + v[1] * b[1] + v[2] * b[2];
+            let (nx, ny) = (p.x / p.w, p.y / p.w);
+            let (sx, sy) = ((nx * 0.5 + 0.5) * 32.0, (0.5 - ny * 0.5) * 32.0);
+            assert!(
+                (sx - (x as f32 + 0.5)).abs() < 2e-3 && (sy - (y as f32 + 0.5)).abs() < 2e-3,
+                "({x}, {y}) -> ({sx}, {sy})"
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked > 100);
+}
+
+#[test]
+fn depth_test_keeps_the_nearest_and_bias_follows_vulkan() {
+    let quad = |z: f32| [[Vec4::new(-1.0, -1.0, z, 1.0), Vec4::new(3.0, -1.0, z, 1.0), Vec4::new(-1.0, 3.0, z, 1.0)]];
+    let mut ds = DepthStencil::new(8, 8, 1.0, 0);
+    for z in [0.7, 0.25, 0.5] {
+        draw_depth(&mut ds, &Soup { triangles: &quad(z), prim_base: 0, flip: false }, &RasterState::default());
+    }
+    assert!(ds.depth.iter().all(|&d| d == 0.25));
+    // Constant bias of 4 at z = 0.75 (exponent -1): 4 * 2^-24.
+    let mut ds = DepthStencil::new(8, 8, 1.0, 0);
+    let bias = DepthBias { constant: 4.0, slope: 0.0, clamp: 0.0 };
+    let st = RasterState { depth: Some(DepthState { bias, ..DepthState::LESS_WRITE }), ..RasterState::default() };
+    draw_depth(&mut ds, &Soup { triangles: &quad(0.75), prim_base: 0, flip: false }, &st);
+    assert!(ds.depth.iter().all(|&d| d == 0.75 + 4.0 * 2f32.powi(-24)));
+    // Slope bias on a plane rising 0.1 per pixel in x: offset 2 * 0.1.
+    let tilted = [[Vec4::new(-1.0, -1.0, 0.2, 1.0), Vec4::new(1.0, -1.0, 1.0, 1.0), Vec4::new(-1.0, 1.0, 0.2, 1.0)]];
+    let mut plain = DepthStencil::new(8, 8, 1.0, 0);
+    draw_depth(&mut plain, &Soup { triangles: &tilted, prim_base: 0, flip: false }, &RasterState::default());
+    let mut biased = DepthStencil::new(8, 8, 1.0, 0);
+    let bias = DepthBias { constant: 0.0, slope: 2.0, clamp: 0.0 };
+    let st = RasterState { depth: Some(DepthState { bias, ..DepthState::LESS_WRITE }), ..RasterState::default() };
+    draw_depth(&mut biased, &Soup { triangles: &tilted, prim_base: 0, flip: false }, &st);
+    let (p, b) = (plain.depth[56], biased.depth[56]);
+    assert!((b - p - 0.2).abs() < 1e-5, "{p} {b}");
+}
+
+#[test]
+fn culling_and_facing() {
+    let ccw = [Vec4::new(-1.0, -1.0, 0.5, 1.0), Vec4::new(1.0, -1.0, 0.5, 1.0), Vec4::new(-1.0, 1.0, 0.5, 1.0)];
+    let cw = [ccw[0], ccw[2], ccw[1]];
+    for (tri, flip, front) in [(ccw, false, true), (cw, false, false), (cw, true, true)] {
+        let mut ds = DepthStencil::new(4, 4, 1.0, 0);
+        let mut out = Image::new(4, 4, 0u8);
+        let st = RasterState { depth: None, ..RasterState::default() };
+        draw(
+            &mut ds,
+            &mut out,
+            &Soup { triangles: &[tri], prim_base: 0, flip },
+            &st,
+            |f| Some(if f.front_facing { 1 } else { 2 }),
+            |d, s| *d = s,
+        );
+        assert_eq!(*out.get(0, 3), if front { 1 } else { 2 });
+        let st = RasterState { cull: CullMode::Back, depth: None, ..RasterState::default() };
+        let mut ds = DepthStencil::new(4, 4, 1.0, 0);
+        let n = draw_depth(&mut ds, &Soup { triangles: &[tri], prim_base: 0, flip }, &st).fragments;
+        assert_eq!(n > 0, front);
+    }
+}
+
+#[test]
+fn every_stencil_op() {
+    let cases = [
+        (StencilOp::Keep, 7, 7),
+        (StencilOp::Zero, 7, 0),
+        (StencilOp::Replace, 7, 42),
+        (StencilOp::IncrementClamp, 255, 255),
+        (StencilOp::DecrementClamp, 0, 0),
+        (StencilOp::Invert, 0b1010_0000, 0b0101_1111),
+        (StencilOp::IncrementWrap, 255, 0),
+        (StencilOp::DecrementWrap, 0, 255),
+    ];
+    let tri = [[Vec4::new(-1.0, -1.0, 0.5, 1.0), Vec4::new(3.0, -1.0, 0.5, 1.0), Vec4::new(-1.0, 3.0, 0.5, 1.0)]];
+    for (op, before, after) in cases {
+        let face =
+            StencilFace { compare: CompareFn::Always, fail: StencilOp::Keep, depth_fail: StencilOp::Keep, pass: op };
+        let st = RasterState {
+            depth: None,
+            stencil: Some(StencilState {
+                front: face,
+                back: StencilFace::KEEP,
+                read_mask: 0xff,
+                write_mask: 0xff,
+                reference: 42,
+            }),
+            ..RasterState::default()
+        };
+        let mut ds = DepthStencil::new(2, 2, 1.0, before);
+        draw_depth(&mut ds, &Soup { triangles: &tri, prim_base: 0, flip: false }, &st);
+        assert_eq!(ds.stencil[0], after, "{op:?}");
+    }
+    // Write mask keeps the other bits; depth-fail and fail ops; back-face state for back faces.
+    let face = StencilFace {
+        compare: CompareFn::Equal,
+        fail: StencilOp::Zero,
+        depth_fail: StencilOp::Invert,
+        pass: StencilOp::Keep,
+    };
+    let st = RasterState {
+        depth: Some(DepthState::LESS_READ),
+        stencil: Some(StencilState {
+            front: StencilFace::KEEP,
+            back: face,
+            read_mask: 0x0f,
+            write_mask: 0x01,
+            reference: 3,
+        }),
+        ..RasterState::default()
+    };
+    let back = [[tri[0][0], tri[0][2], tri[0][1]]];
+    let mut ds = DepthStencil::new(2, 2, 0.25, 0xf3); // reference 3 == 0xf3 & 0x0f; depth fails
+    draw_depth(&mut ds, &Soup { triangles: &back, prim_base: 0, flip: false }, &st);
+    assert_eq!(ds.stencil[0], 0xf2);
+    let mut ds = DepthStencil::new(2, 2, 0.25, 0xf1); // stencil test fails: Zero through write mask 1
+    draw_depth(&mut ds, &Soup { triangles: &back, prim_base: 0, flip: false }, &st);
+    assert_eq!(ds.stencil[0], 0xf0);
+}
+
+#[test]
+fn output_does_not_depend_on_the_thread_count() {
+    let tris = jittered_grid(40, 7, 2.0);
+    let mut rng = shadow_core::scenes::Rng::new(9);
+    // Overlapping layers at random depths, with stencil counting and a colour write.
+    let mut all = Vec::new();
+    for _ in 0..3 {
+        let dz = rng.range(-0.3, 0.3);
+        all.extend(tris.iter().map(|t| t.map(|v| Vec4::new(v.x, v.y, v.z + dz * v.w, v.w))));
+    }
+    let run = || {
+        let face = StencilFace {
+            compare: CompareFn::Always,
+            fail: StencilOp::Keep,
+            depth_fail: StencilOp::IncrementWrap,
+            pass: StencilOp::DecrementWrap,
+        };
+        let st = RasterState {
+            stencil: Some(StencilState { front: face, back: face, read_mask: 0xff, write_mask: 0xff, reference: 0 }),
+            ..RasterState::default()
+        };
+        let mut ds = DepthStencil::new(301, 207, 1.0, 0);
+        let mut col = Image::new(301, 207, 0u32);
+        let c = draw(
+            &mut ds,
+            &mut col,
+            &Soup { triangles: &all, prim_base: 0, flip: false },
+            &st,
+            |f| Some(f.prim),
+            |d, s| *d = s,
+        );
+        (ds, col, c)
+    };
+    let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap().install(run);
+    let many = rayon::ThreadPoolBuilder::new().num_threads(4).build().unwrap().install(run);
+    assert_eq!(one.0, many.0);
+    assert_eq!(one.1, many.1);
+    assert_eq!(one.2, many.2);
+    assert!(one.2.stencil_updates > 0);
+}

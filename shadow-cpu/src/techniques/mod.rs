@@ -1,0 +1,58 @@
+//! CPU versions of the techniques: each file is one technique, short enough to read next to its paper.
+//! Helpers two techniques share live here.
+
+pub mod ray_traced;
+pub mod shadow_map;
+pub mod shadow_volume;
+
+use rayon::prelude::*;
+use shadow_core::light::LightProjection;
+use shadow_core::technique::settings::DepthBias;
+use shadow_core::{FrameInputs, Image};
+
+use crate::context::{CpuError, MAX_MAP_TEXELS, check_size};
+use crate::gbuffer::{GBuffer, clip_vertices};
+use crate::raster::{CullMode, DepthState, DepthStencil, Indexed, RasterCounters, RasterState, draw_depth};
+
+/// Refuses a set of `count` square maps of side `res` before anything is allocated.
+///
+/// # Errors
+/// [`CpuError::BadSize`] over the limits.
+pub fn check_maps(res: u32, count: usize) -> Result<(), CpuError> {
+    check_size("shadow map", u64::from(res), u64::from(res) * count as u64, MAX_MAP_TEXELS)
+}
+
+/// Renders the depth of every casting instance from one light projection into a `res x res` map.
+#[must_use]
+pub fn render_depth_map(
+    frame: &FrameInputs,
+    proj: &LightProjection,
+    res: u32,
+    bias: DepthBias,
+    cull: CullMode,
+) -> (Image<f32>, RasterCounters) {
+    let mut ds = DepthStencil::new(res, res, 1.0, 0);
+    let state =
+        RasterState { cull, depth: Some(DepthState { bias, ..DepthState::LESS_WRITE }), ..RasterState::default() };
+    let mut counters = RasterCounters::default();
+    for inst in frame.instances.iter().filter(|i| i.casts_shadow) {
+        let clip = clip_vertices(inst.mesh.positions(), proj.clip_from_world * inst.world_from_local);
+        counters += draw_depth(
+            &mut ds,
+            &Indexed { positions: &clip, triangles: inst.mesh.triangles(), prim_base: 0, flip: inst.mirrored },
+            &state,
+        );
+    }
+    (ds.into_depth_image(), counters)
+}
+
+/// Fills `out` with `f(x, y, i)` at every receiver pixel (i the pixel index) and 1 elsewhere.
+pub fn per_receiver(g: &GBuffer, out: &mut Image<f32>, f: impl Fn(u32, u32, usize) -> f32 + Sync) {
+    let w = g.width() as usize;
+    out.data_mut().par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+        for (x, v) in row.iter_mut().enumerate() {
+            let i = y * w + x;
+            *v = if g.receiver.data()[i] { f(x as u32, y as u32, i) } else { 1.0 };
+        }
+    });
+}

@@ -1,0 +1,82 @@
+//! `ray-traced`: the exact reference. One shadow ray per receiver pixel, from the surface towards the
+//! light, against every caster.
+//!
+//! A surface whose seen side faces away from the light cannot see it: the surface itself is in the way
+//! (a closed mesh's own far side, or the back of a sheet). Those pixels are in shadow without a ray; a
+//! ray there would only graze the surface and, offset, could slip past the silhouette.
+//!
+//! Other rays start off the surface by `epsilon` times the scene's bounding-box diagonal, along the face
+//! normal turned towards the viewer (the side that is seen). The offset scales with the scene, so it is
+//! as many f32 ulps at any scene size (see [`RayTraced::epsilon`] for how the default was measured).
+
+use shadow_core::light::LightView;
+use shadow_core::scene::LightKind;
+use shadow_core::technique::hard::RayTraced;
+use shadow_core::technique::{FrameStats, ShadowTechnique};
+use shadow_core::{FrameInputs, Image};
+
+use super::per_receiver;
+use crate::bvh::SceneBvh;
+use crate::context::{CpuBackend, CpuContext, CpuError};
+use crate::gbuffer::GBuffer;
+
+/// What the reference keeps: the BVH of the last build.
+#[derive(Default)]
+pub struct State {
+    bvh: Option<std::sync::Arc<SceneBvh>>,
+}
+
+impl ShadowTechnique<CpuBackend> for RayTraced {
+    type State = State;
+
+    fn name(&self) -> &'static str {
+        "ray-traced"
+    }
+
+    fn create_state(&self, _: &mut CpuContext) -> Result<State, CpuError> {
+        Ok(State::default())
+    }
+
+    fn build(
+        &self,
+        cx: &mut CpuContext,
+        state: &mut State,
+        frame: &FrameInputs,
+        _: &LightView,
+        _: &mut FrameStats,
+    ) -> Result<(), CpuError> {
+        state.bvh = Some(cx.bvh(frame));
+        Ok(())
+    }
+
+    fn query(
+        &self,
+        _: &mut CpuContext,
+        state: &mut State,
+        frame: &FrameInputs,
+        light: &LightView,
+        g: &GBuffer,
+        out: &mut Image<f32>,
+        stats: &mut FrameStats,
+    ) -> Result<(), CpuError> {
+        let bvh =
+            state.bvh.as_ref().ok_or_else(|| shadow_core::technique::TechniqueError::NotBuilt(self.name().into()))?;
+        let eps = self.epsilon * frame.bounds.size().length();
+        per_receiver(g, out, |_, _, i| {
+            let n = g.geometric_normal.data()[i];
+            let origin = g.position.data()[i] + n * eps;
+            let (dir, tmax) = match light.light.kind {
+                LightKind::Spot { position, .. } | LightKind::Point { position } => {
+                    let d = position - origin;
+                    let len = d.length();
+                    (d / len, len)
+                }
+                LightKind::Directional { direction } => (-direction.normalize(), f32::INFINITY),
+            };
+            if n.dot(dir) <= 0.0 || bvh.occluded(origin, dir, tmax) { 0.0 } else { 1.0 }
+        });
+        stats.counters.covered_pixels = Some(g.covered_pixels());
+        stats.counters.extra.insert("shadow_rays".into(), g.covered_pixels() as f64);
+        Ok(())
+    }
+}

@@ -1,0 +1,148 @@
+//! `shadow-volume-zpass` (Crow 1977, Heidmann 1991) and `shadow-volume-zfail` (Everitt-Kilgard 2002,
+//! after Carmack): silhouettes from adjacency extruded to infinity, counted in an 8-bit stencil with
+//! two-sided wrapping ops against the G-buffer's depth. A pixel is lit when its count is zero.
+//!
+//! Z-pass counts the volume faces in front of the surface (front faces +1, back faces -1 where the depth
+//! test passes): right only while the eye is lit and no volume crosses the near plane. Z-fail counts the
+//! faces behind it (back faces +1, front faces -1 where the depth test fails) and closes every volume with
+//! a near and a far cap; with the camera's infinite far plane nothing is clipped behind, so it is right
+//! with the eye in shadow too. Open meshes cast with Bergeron's weights (shared geometry), so the
+//! counts stay right for the teapot and the Cornell box.
+
+use glam::{Mat4, Vec4};
+use shadow_core::frame::InstanceVolume;
+use shadow_core::geometry::volume::Caps;
+use shadow_core::light::LightView;
+use shadow_core::technique::hard::{ShadowVolume, VolumeCounting};
+use shadow_core::technique::{FrameStats, ShadowTechnique, TechniqueError};
+use shadow_core::{FrameInputs, Image};
+
+use super::per_receiver;
+use crate::context::{CpuBackend, CpuContext, CpuError};
+use crate::gbuffer::GBuffer;
+use crate::raster::{
+    CompareFn, DepthState, DepthStencil, Indexed, RasterCounters, RasterState, Soup, StencilFace, StencilOp,
+    StencilState, draw_depth,
+};
+
+/// The volumes of the last build.
+#[derive(Default)]
+pub struct State {
+    volumes: Option<Vec<InstanceVolume>>,
+}
+
+/// Two-sided stencil state of a counting.
+#[must_use]
+pub fn stencil_state(counting: VolumeCounting) -> StencilState {
+    let face = |pass, depth_fail| StencilFace { compare: CompareFn::Always, fail: StencilOp::Keep, depth_fail, pass };
+    let (front, back) = match counting {
+        VolumeCounting::ZPass => {
+            (face(StencilOp::IncrementWrap, StencilOp::Keep), face(StencilOp::DecrementWrap, StencilOp::Keep))
+        }
+        VolumeCounting::ZFail => {
+            (face(StencilOp::Keep, StencilOp::DecrementWrap), face(StencilOp::Keep, StencilOp::IncrementWrap))
+        }
+    };
+    StencilState { front, back, read_mask: 0xff, write_mask: 0xff, reference: 0 }
+}
+
+/// Rasterizes shadow volumes into the stencil of `ds` (which holds the G-buffer depth): sides, and for
+/// z-fail the near caps from the G-buffer's own clip-space vertices and the far caps at infinity.
+pub fn rasterize_volumes(
+    frame: &FrameInputs,
+    g: &GBuffer,
+    volumes: &[InstanceVolume],
+    counting: VolumeCounting,
+    ds: &mut DepthStencil,
+) -> RasterCounters {
+    let state = RasterState {
+        depth: Some(DepthState::LESS_READ),
+        stencil: Some(stencil_state(counting)),
+        ..RasterState::default()
+    };
+    let mut c = RasterCounters::default();
+    for iv in volumes {
+        let inst = &frame.instances[iv.instance];
+        let vol = &iv.volume;
+        let clip_from_local: Mat4 = g.clip_from_world * inst.world_from_local;
+        let sides: Vec<[Vec4; 3]> = vol.sides.iter().map(|t| t.map(|v| clip_from_local * v)).collect();
+        c += draw_depth(ds, &Soup { triangles: &sides, prim_base: 0, flip: inst.mirrored }, &state);
+        if counting == VolumeCounting::ZPass {
+            continue;
+        }
+        let tris = inst.mesh.triangles();
+        let pick = |ids: &[u32], reverse: bool| -> Vec<[u32; 3]> {
+            ids.iter().map(|&f| tris[f as usize]).map(|[a, b, c]| if reverse { [a, c, b] } else { [a, b, c] }).collect()
+        };
+        let (fwd, rev) = (pick(&vol.caps_forward, false), pick(&vol.caps_reversed, false));
+        // Near caps: the G-buffer's vertices, in the mesh's own winding; faces cast turned around are drawn
+        // with front and back swapped rather than re-wound, so their depths stay bit-identical.
+        let near = &g.clip_vertices[iv.instance];
+        c += draw_depth(ds, &Indexed { positions: near, triangles: &fwd, prim_base: 0, flip: inst.mirrored }, &state);
+        c += draw_depth(ds, &Indexed { positions: near, triangles: &rev, prim_base: 0, flip: !inst.mirrored }, &state);
+        // Far caps: the same faces projected to infinity, forward ones reversed.
+        let light = vol.light;
+        let far: Vec<Vec4> = inst.mesh.positions().iter().map(|&p| clip_from_local * light.extrude(p)).collect();
+        let far_fwd = pick(&vol.caps_forward, true);
+        c += draw_depth(
+            ds,
+            &Indexed { positions: &far, triangles: &far_fwd, prim_base: 0, flip: inst.mirrored },
+            &state,
+        );
+        c += draw_depth(ds, &Indexed { positions: &far, triangles: &rev, prim_base: 0, flip: inst.mirrored }, &state);
+    }
+    c
+}
+
+impl ShadowTechnique<CpuBackend> for ShadowVolume {
+    type State = State;
+
+    fn name(&self) -> &'static str {
+        match self.counting {
+            VolumeCounting::ZPass => "shadow-volume-zpass",
+            VolumeCounting::ZFail => "shadow-volume-zfail",
+        }
+    }
+
+    fn create_state(&self, _: &mut CpuContext) -> Result<State, CpuError> {
+        Ok(State::default())
+    }
+
+    fn build(
+        &self,
+        _: &mut CpuContext,
+        state: &mut State,
+        frame: &FrameInputs,
+        light: &LightView,
+        stats: &mut FrameStats,
+    ) -> Result<(), CpuError> {
+        let caps = if self.counting == VolumeCounting::ZFail { Caps::Both } else { Caps::None };
+        let volumes = frame.shadow_volumes(light, caps);
+        let c = &mut stats.counters;
+        c.silhouette_edges = Some(volumes.iter().map(|v| v.silhouette_edges as u64).sum());
+        c.volume_triangles = Some(volumes.iter().map(|v| v.volume.triangle_count() as u64).sum());
+        state.volumes = Some(volumes);
+        Ok(())
+    }
+
+    fn query(
+        &self,
+        _: &mut CpuContext,
+        state: &mut State,
+        frame: &FrameInputs,
+        _: &LightView,
+        g: &GBuffer,
+        out: &mut Image<f32>,
+        stats: &mut FrameStats,
+    ) -> Result<(), CpuError> {
+        let volumes = state.volumes.as_ref().ok_or_else(|| TechniqueError::NotBuilt(self.name().into()))?;
+        let mut ds = DepthStencil::from_depth(&g.depth, 0);
+        let c = rasterize_volumes(frame, g, volumes, self.counting, &mut ds);
+        per_receiver(g, out, |_, _, i| if ds.stencil[i] == 0 { 1.0 } else { 0.0 });
+        let counters = &mut stats.counters;
+        counters.covered_pixels = Some(g.covered_pixels());
+        counters.volume_fragments = Some(c.fragments);
+        counters.stencil_updates = Some(c.stencil_updates);
+        Ok(())
+    }
+}

@@ -1,0 +1,265 @@
+//! `compare`: every asked-for technique on every asked-for backend, measured against the ray-traced
+//! reference (DESIGN 8), with pictures and reports (DESIGN 11).
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use serde::Serialize;
+use shadow_core::image::{Rgb8, error_map, visibility_to_rgb};
+use shadow_core::metrics::{VisibilityMetrics, compare_visibility, flip_mean, measured_pixels};
+use shadow_core::stats::Phase;
+use shadow_core::technique::{FrameStats, TechniqueSpec};
+use shadow_core::{FrameInputs, Image};
+
+use crate::Error;
+use crate::renderer::{BackendKind, Renderer, RunOutput};
+use crate::sheet::contact_sheet;
+
+/// What to compare.
+pub struct CompareJob<'a> {
+    /// Scene name for the report.
+    pub scene: String,
+    /// The frame.
+    pub frame: &'a FrameInputs,
+    /// View size.
+    pub width: u32,
+    /// View size.
+    pub height: u32,
+    /// Techniques to measure (the reference is always run first).
+    pub techniques: Vec<TechniqueSpec>,
+    /// Backends to run them on.
+    pub backends: Vec<BackendKind>,
+    /// Where the files go (`None`: compute only).
+    pub out_dir: Option<PathBuf>,
+}
+
+/// `report.json`'s per-run entry.
+#[derive(Clone, Debug, Serialize)]
+pub struct ResultEntry {
+    /// Technique name.
+    pub technique: String,
+    /// Canonical settings.
+    pub settings: String,
+    /// Backend name.
+    pub backend: String,
+    /// Milliseconds per phase and in total.
+    pub timings_ms: BTreeMap<String, f64>,
+    /// Measured counters only.
+    pub counters: BTreeMap<String, f64>,
+    /// Errors against the reference.
+    pub vs_reference: BTreeMap<String, f64>,
+    /// File stem of its pictures.
+    #[serde(skip)]
+    pub file: String,
+    /// The metrics, typed.
+    #[serde(skip)]
+    pub metrics: VisibilityMetrics,
+    /// FLIP of the shaded image against the reference's.
+    #[serde(skip)]
+    pub flip: f64,
+}
+
+/// `report.json`'s cross-backend entry.
+#[derive(Clone, Debug, Serialize)]
+pub struct CrossEntry {
+    /// Technique name.
+    pub technique: String,
+    /// Canonical settings.
+    pub settings: String,
+    /// Fraction of masked pixels where the two backends disagree on lit/shadowed.
+    pub mismatch: f64,
+    /// RMS visibility difference.
+    pub rmse: f64,
+    /// FLIP between the two shaded images.
+    pub flip_mean: f64,
+}
+
+/// The whole `report.json`.
+#[derive(Clone, Debug, Serialize)]
+pub struct CompareReport {
+    /// Scene name.
+    pub scene: String,
+    /// View width.
+    pub width: u32,
+    /// View height.
+    pub height: u32,
+    /// One entry per technique and backend.
+    pub results: Vec<ResultEntry>,
+    /// One entry per technique run on both backends.
+    pub cross_backend: Vec<CrossEntry>,
+}
+
+/// Report keys of a frame's timings.
+#[must_use]
+pub fn timings_map(stats: &FrameStats) -> BTreeMap<String, f64> {
+    let mut m: BTreeMap<String, f64> =
+        Phase::ALL.iter().map(|p| (p.key().to_string(), stats.timings.get(*p))).collect();
+    m.insert("total".into(), stats.timings.total);
+    for (k, v) in &stats.timings.extra {
+        m.insert(k.clone(), *v);
+    }
+    m
+}
+
+fn metrics_map(m: &VisibilityMetrics, flip: f64) -> BTreeMap<String, f64> {
+    BTreeMap::from([
+        ("mismatch".into(), m.mismatch),
+        ("edge_band_mismatch".into(), m.edge_band_mismatch),
+        ("interior_mismatch".into(), m.interior_mismatch),
+        ("false_shadow".into(), m.false_shadow),
+        ("false_light".into(), m.false_light),
+        ("rmse".into(), m.rmse),
+        ("mean_abs".into(), m.mean_abs),
+        ("flip_mean".into(), flip),
+    ])
+}
+
+fn save(img: &Image<Rgb8>, dir: &Path, name: &str) -> Result<(), Error> {
+    img.save_png(dir.join(name)).map_err(Error::from)
+}
+
+/// Runs the job, writes its files, and returns the report.
+///
+/// # Errors
+/// Rendering failures or files that cannot be written.
+pub fn run_compare(
+    renderer: &mut Renderer,
+    job: &CompareJob<'_>,
+    mut progress: impl FnMut(&str),
+) -> Result<CompareReport, Error> {
+    if let Some(dir) = &job.out_dir {
+        std::fs::create_dir_all(dir).map_err(|e| Error::Write { path: dir.clone(), why: e.to_string() })?;
+    }
+    progress("reference: ray-traced on cpu");
+    let reference = TechniqueSpec::named("ray-traced");
+    let (ref_frame, _) = renderer.run_cpu_frame(job.frame, job.width, job.height, &reference)?;
+    let view = ref_frame.light_views.first().ok_or_else(|| Error::Usage("the scene has no light".into()))?;
+    let g = &ref_frame.gbuffer;
+    let mask = measured_pixels(&g.receiver, &g.position, &g.geometric_normal, view);
+    let ref_vis = &ref_frame.visibility[0];
+    let mut sheet: Vec<(String, Image<Rgb8>)> = vec![("ray-traced\nreference".into(), ref_frame.color.clone())];
+    if let Some(dir) = &job.out_dir {
+        save(&ref_frame.color, dir, "reference.png")?;
+        save(&visibility_to_rgb(ref_vis, &mask), dir, "reference.vis.png")?;
+    }
+
+    let mut results = Vec::new();
+    let mut runs: Vec<RunOutput> = Vec::new();
+    for (i, spec) in job.techniques.iter().enumerate() {
+        let same_name = job.techniques.iter().filter(|s| s.name == spec.name).count() > 1;
+        for &backend in &job.backends {
+            progress(&format!("{spec} on {}", backend.name()));
+            let run = renderer.run(backend, job.frame, job.width, job.height, spec)?;
+            let metrics = compare_visibility(&run.visibility[0], ref_vis, &mask)?;
+            let flip = flip_mean(&run.color, &ref_frame.color, &mask)?;
+            let file = if same_name {
+                format!("{}-{}-{}", spec.name, i + 1, backend.name())
+            } else {
+                format!("{}-{}", spec.name, backend.name())
+            };
+            if let Some(dir) = &job.out_dir {
+                save(&run.color, dir, &format!("{file}.png"))?;
+                save(&visibility_to_rgb(&run.visibility[0], &mask), dir, &format!("{file}.vis.png"))?;
+                save(&error_map(&run.visibility[0], ref_vis, &mask), dir, &format!("{file}.err.png"))?;
+                for v in &run.debug_views {
+                    save(&v.image, dir, &format!("{file}.{}.png", v.name))?;
+                }
+            }
+            let label = format!("{}\n{} {:.3}%", spec.name, backend.name(), metrics.mismatch * 100.0);
+            sheet.push((label, run.color.clone()));
+            results.push(ResultEntry {
+                technique: run.technique.clone(),
+                settings: run.settings.clone(),
+                backend: backend.name().into(),
+                timings_ms: timings_map(&run.stats),
+                counters: run.stats.counters.entries().into_iter().collect(),
+                vs_reference: metrics_map(&metrics, flip),
+                file,
+                metrics,
+                flip,
+            });
+            runs.push(run);
+        }
+    }
+
+    let mut cross_backend = Vec::new();
+    for (i, a) in runs.iter().enumerate() {
+        for b in &runs[i + 1..] {
+            if a.technique == b.technique && a.settings == b.settings && a.backend != b.backend {
+                let m = compare_visibility(&b.visibility[0], &a.visibility[0], &mask)?;
+                let flip = flip_mean(&b.color, &a.color, &mask)?;
+                cross_backend.push(CrossEntry {
+                    technique: a.technique.clone(),
+                    settings: a.settings.clone(),
+                    mismatch: m.mismatch,
+                    rmse: m.rmse,
+                    flip_mean: flip,
+                });
+            }
+        }
+    }
+
+    let report =
+        CompareReport { scene: job.scene.clone(), width: job.width, height: job.height, results, cross_backend };
+    if let Some(dir) = &job.out_dir {
+        save(&contact_sheet(&sheet, 320), dir, "contact.png")?;
+        let json = serde_json::to_string_pretty(&report).map_err(|e| Error::Usage(e.to_string()))?;
+        let write = |name: &str, text: &str| {
+            std::fs::write(dir.join(name), text).map_err(|e| Error::Write { path: dir.join(name), why: e.to_string() })
+        };
+        write("report.json", &json)?;
+        write("report.md", &report_markdown(&report))?;
+    }
+    Ok(report)
+}
+
+/// `report.md`: one table of errors, counters and times.
+#[must_use]
+pub fn report_markdown(r: &CompareReport) -> String {
+    let mut s = format!(
+        "# {} at {}x{}\n\nErrors against `ray-traced` over receiver pixels that face the light and lie in its reach.\n\n",
+        r.scene, r.width, r.height
+    );
+    s.push_str("| technique | backend | mismatch | edge band | interior | false shadow | false light | RMSE | FLIP | total ms | picture |\n");
+    s.push_str("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---|\n");
+    for e in &r.results {
+        let m = &e.metrics;
+        s.push_str(&format!(
+            "| `{}` | {} | {:.3}% | {:.3}% | {:.3}% | {:.3}% | {:.3}% | {:.4} | {:.4} | {:.1} | [png]({}.png) [errors]({}.err.png) |\n",
+            e.technique,
+            e.backend,
+            m.mismatch * 100.0,
+            m.edge_band_mismatch * 100.0,
+            m.interior_mismatch * 100.0,
+            m.false_shadow * 100.0,
+            m.false_light * 100.0,
+            m.rmse,
+            e.flip,
+            e.timings_ms.get("total").copied().unwrap_or(0.0),
+            e.file,
+            e.file
+        ));
+    }
+    s.push_str("\nSettings:\n\n");
+    for e in &r.results {
+        s.push_str(&format!("- `{}` ({}): `{}`\n", e.technique, e.backend, e.settings));
+    }
+    if !r.cross_backend.is_empty() {
+        s.push_str("\n| technique | cpu vs wgpu mismatch | RMSE | FLIP |\n|---|---:|---:|---:|\n");
+        for c in &r.cross_backend {
+            s.push_str(&format!(
+                "| `{}` | {:.3}% | {:.4} | {:.4} |\n",
+                c.technique,
+                c.mismatch * 100.0,
+                c.rmse,
+                c.flip_mean
+            ));
+        }
+    }
+    s.push_str("\nCounters:\n\n");
+    for e in &r.results {
+        let c: Vec<String> = e.counters.iter().map(|(k, v)| format!("{k} {v}")).collect();
+        s.push_str(&format!("- `{}` ({}): {}\n", e.technique, e.backend, c.join(", ")));
+    }
+    s
+}

@@ -1,0 +1,61 @@
+//! The error of every job in this crate. The CLI prints it as one line.
+
+use std::path::PathBuf;
+
+/// Why a job failed.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// Scene, model file or override.
+    #[error(transparent)]
+    Setup(#[from] crate::setup::SetupError),
+    /// Technique name or settings.
+    #[error(transparent)]
+    Registry(#[from] crate::registry::RegistryError),
+    /// A technique spec that does not parse.
+    #[error(transparent)]
+    Settings(#[from] shadow_core::technique::SettingsError),
+    /// The frame (camera, light, empty scene).
+    #[error(transparent)]
+    Frame(#[from] shadow_core::frame::FrameError),
+    /// The CPU backend.
+    #[error(transparent)]
+    Cpu(#[from] shadow_cpu::CpuError),
+    /// No GPU backend could be had.
+    #[error("no GPU backend: {0}")]
+    NoGpu(String),
+    /// A file could not be written.
+    #[error("cannot write {path}: {why}")]
+    Write {
+        /// The file.
+        path: PathBuf,
+        /// What went wrong.
+        why: String,
+    },
+    /// Images of different sizes compared.
+    #[error(transparent)]
+    Compare(#[from] shadow_core::metrics::SizeMismatch),
+    /// Anything else the user asked for that cannot be done.
+    #[error("{0}")]
+    Usage(String),
+}
+
+impl Error {
+    /// True for errors in what the user typed (exit status 2), false for failures of the work (1).
+    #[must_use]
+    pub fn is_usage(&self) -> bool {
+        use crate::setup::SetupError;
+        matches!(
+            self,
+            Self::Setup(SetupError::Option(_) | SetupError::Source(crate::SceneSourceError::Unknown(_)))
+                | Self::Registry(_)
+                | Self::Settings(_)
+                | Self::Usage(_)
+        )
+    }
+}
+
+impl From<shadow_core::image::ImageWriteError> for Error {
+    fn from(e: shadow_core::image::ImageWriteError) -> Self {
+        Self::Write { path: e.path.into(), why: e.source.to_string() }
+    }
+}

@@ -1,0 +1,166 @@
+//! The technique registry: name -> description, paper, settings keys with defaults, and a constructor per
+//! backend. Built-in, shadow-soft and user techniques register the same way; the CLI, the reports and the
+//! conformance tests enumerate it, so a new technique gets all of them for free.
+
+use shadow_core::technique::hard::{RayTraced, ShadowMap, ShadowVolume};
+use shadow_core::technique::settings::{SettingKey, SettingsError, TechniqueSettings, TechniqueSpec};
+use shadow_core::technique::{DynShadowTechnique, Stateful};
+use shadow_cpu::CpuBackend;
+
+/// Builds a technique for the CPU backend from a spec.
+pub type CpuConstructor = fn(&TechniqueSpec) -> Result<Box<dyn DynShadowTechnique<CpuBackend>>, SettingsError>;
+
+/// One registered technique.
+#[derive(Clone)]
+pub struct TechniqueEntry {
+    /// Registry name.
+    pub name: &'static str,
+    /// One line on what it does.
+    pub description: &'static str,
+    /// The paper it follows.
+    pub paper: &'static str,
+    /// Whether it is a reference (measured against, not measured).
+    pub reference: bool,
+    /// Settings keys with defaults.
+    pub keys: fn() -> &'static [SettingKey],
+    /// Canonical settings string of a spec (all keys, defaults filled in).
+    pub canonical: fn(&TechniqueSpec) -> Result<String, SettingsError>,
+    /// The CPU implementation, if any.
+    pub cpu: Option<CpuConstructor>,
+}
+
+/// Why a technique could not be made.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum RegistryError {
+    /// No technique of that name.
+    #[error("unknown technique '{name}' (techniques: {known})")]
+    Unknown {
+        /// The name asked for.
+        name: String,
+        /// The names registered.
+        known: String,
+    },
+    /// The technique has no implementation on that backend.
+    #[error("technique '{name}' is not implemented on the {backend} backend")]
+    NotOnBackend {
+        /// The technique.
+        name: String,
+        /// The backend.
+        backend: &'static str,
+    },
+    /// Bad settings.
+    #[error(transparent)]
+    Settings(#[from] SettingsError),
+}
+
+/// Every technique, by name.
+#[derive(Clone, Default)]
+pub struct TechniqueRegistry {
+    entries: Vec<TechniqueEntry>,
+}
+
+fn canonical<S: TechniqueSettings>(spec: &TechniqueSpec) -> Result<String, SettingsError> {
+    Ok(S::parse(&spec.name, &spec.values)?.settings_string())
+}
+
+/// A CPU constructor for a settings type whose value alone is the technique.
+fn cpu_plain<S>(spec: &TechniqueSpec) -> Result<Box<dyn DynShadowTechnique<CpuBackend>>, SettingsError>
+where
+    S: TechniqueSettings + shadow_core::technique::ShadowTechnique<CpuBackend>,
+{
+    let s = S::parse(&spec.name, &spec.values)?;
+    let text = s.settings_string();
+    Ok(Stateful::boxed(s, text))
+}
+
+fn cpu_volume(spec: &TechniqueSpec) -> Result<Box<dyn DynShadowTechnique<CpuBackend>>, SettingsError> {
+    ShadowVolume::parse(&spec.name, &spec.values)?;
+    let v = if spec.name == "shadow-volume-zpass" { ShadowVolume::ZPASS } else { ShadowVolume::ZFAIL };
+    Ok(Stateful::boxed(v, String::new()))
+}
+
+impl TechniqueRegistry {
+    /// The built-in techniques.
+    #[must_use]
+    pub fn builtin() -> Self {
+        let mut r = Self::default();
+        r.register(TechniqueEntry {
+            name: "ray-traced",
+            description: "exact hard shadows: one shadow ray per pixel through a BVH",
+            paper: "reference",
+            reference: true,
+            keys: RayTraced::keys,
+            canonical: canonical::<RayTraced>,
+            cpu: Some(cpu_plain::<RayTraced>),
+        });
+        r.register(TechniqueEntry {
+            name: "shadow-map",
+            description: "depth map from the light with Vulkan depth bias and percentage-closer filtering",
+            paper: "Williams 1978; Reeves et al. 1987 (survey: Nealen 2005)",
+            reference: false,
+            keys: ShadowMap::keys,
+            canonical: canonical::<ShadowMap>,
+            cpu: Some(cpu_plain::<ShadowMap>),
+        });
+        r.register(TechniqueEntry {
+            name: "shadow-volume-zpass",
+            description: "stencil shadow volumes counted from the eye: wrong when the eye is in shadow",
+            paper: "Crow 1977; Heidmann 1991",
+            reference: false,
+            keys: ShadowVolume::keys,
+            canonical: canonical::<ShadowVolume>,
+            cpu: Some(cpu_volume),
+        });
+        r.register(TechniqueEntry {
+            name: "shadow-volume-zfail",
+            description: "stencil shadow volumes counted from infinity, capped: right with the eye in shadow",
+            paper: "Everitt-Kilgard 2002",
+            reference: false,
+            keys: ShadowVolume::keys,
+            canonical: canonical::<ShadowVolume>,
+            cpu: Some(cpu_volume),
+        });
+        r
+    }
+
+    /// Adds (or replaces) a technique.
+    pub fn register(&mut self, entry: TechniqueEntry) {
+        self.entries.retain(|e| e.name != entry.name);
+        self.entries.push(entry);
+    }
+
+    /// Every entry, in registration order.
+    #[must_use]
+    pub fn entries(&self) -> &[TechniqueEntry] {
+        &self.entries
+    }
+
+    /// The entry for a name.
+    ///
+    /// # Errors
+    /// [`RegistryError::Unknown`].
+    pub fn get(&self, name: &str) -> Result<&TechniqueEntry, RegistryError> {
+        self.entries.iter().find(|e| e.name == name).ok_or_else(|| RegistryError::Unknown {
+            name: name.into(),
+            known: self.entries.iter().map(|e| e.name).collect::<Vec<_>>().join(", "),
+        })
+    }
+
+    /// Checks a spec (name and settings) and returns its canonical settings string.
+    ///
+    /// # Errors
+    /// Unknown name or bad settings.
+    pub fn canonical(&self, spec: &TechniqueSpec) -> Result<String, RegistryError> {
+        Ok((self.get(&spec.name)?.canonical)(spec)?)
+    }
+
+    /// The CPU implementation of a spec.
+    ///
+    /// # Errors
+    /// Unknown name, bad settings, or no CPU implementation.
+    pub fn cpu(&self, spec: &TechniqueSpec) -> Result<Box<dyn DynShadowTechnique<CpuBackend>>, RegistryError> {
+        let e = self.get(&spec.name)?;
+        let make = e.cpu.ok_or_else(|| RegistryError::NotOnBackend { name: spec.name.clone(), backend: "cpu" })?;
+        Ok(make(spec)?)
+    }
+}

@@ -1,0 +1,241 @@
+//! What a command renders: a scene (built-in or model file) with optional camera and light overrides
+//! (DESIGN 11 flag syntax), resolved into a [`Scene`].
+
+use glam::Vec3;
+use shadow_core::Scene;
+use shadow_core::scene::{Camera, Light, LightKind};
+use shadow_core::scenes::{LightType, SceneParams};
+
+use crate::{SceneSourceError, load_scene};
+
+/// A malformed `--camera`, `--light` or `--size` value.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("bad {flag} '{value}': {why}")]
+pub struct OptionError {
+    /// The flag.
+    pub flag: &'static str,
+    /// Its value.
+    pub value: String,
+    /// What is wrong.
+    pub why: String,
+}
+
+/// Splits `key=a,b,c,key2=d` into (key, value) pairs, where a piece without `=` continues the value
+/// before it (so vectors keep their commas).
+fn pairs(flag: &'static str, text: &str) -> Result<Vec<(String, String)>, OptionError> {
+    let mut out: Vec<(String, String)> = Vec::new();
+    for piece in text.split(',') {
+        match piece.split_once('=') {
+            Some((k, v)) => out.push((k.trim().to_string(), v.trim().to_string())),
+            None => match out.last_mut() {
+                Some((_, v)) => {
+                    v.push(',');
+                    v.push_str(piece.trim());
+                }
+                None => {
+                    return Err(OptionError { flag, value: text.into(), why: format!("'{piece}' is not key=value") });
+                }
+            },
+        }
+    }
+    Ok(out)
+}
+
+fn vec3(flag: &'static str, whole: &str, key: &str, v: &str) -> Result<Vec3, OptionError> {
+    let parts: Vec<f32> = v
+        .split(',')
+        .map(|p| p.trim().parse::<f32>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| OptionError { flag, value: whole.into(), why: format!("{key} must be three numbers X,Y,Z") })?;
+    match parts.as_slice() {
+        [x, y, z] if x.is_finite() && y.is_finite() && z.is_finite() => Ok(Vec3::new(*x, *y, *z)),
+        _ => Err(OptionError { flag, value: whole.into(), why: format!("{key} must be three finite numbers X,Y,Z") }),
+    }
+}
+
+fn number(flag: &'static str, whole: &str, key: &str, v: &str) -> Result<f32, OptionError> {
+    v.parse::<f32>().ok().filter(|x| x.is_finite()).ok_or_else(|| OptionError {
+        flag,
+        value: whole.into(),
+        why: format!("{key} must be a number"),
+    })
+}
+
+/// `--camera eye=X,Y,Z,target=X,Y,Z[,fov=DEG]`.
+///
+/// # Errors
+/// Unknown keys, missing eye or target, bad numbers, or an unusable camera.
+pub fn parse_camera(text: &str) -> Result<Camera, OptionError> {
+    const F: &str = "--camera";
+    let (mut eye, mut target, mut fov) = (None, None, 45.0);
+    for (k, v) in pairs(F, text)? {
+        match k.as_str() {
+            "eye" => eye = Some(vec3(F, text, "eye", &v)?),
+            "target" => target = Some(vec3(F, text, "target", &v)?),
+            "fov" => fov = number(F, text, "fov", &v)?,
+            other => {
+                return Err(OptionError {
+                    flag: F,
+                    value: text.into(),
+                    why: format!("unknown key '{other}' (eye, target, fov)"),
+                });
+            }
+        }
+    }
+    let missing = |what: &str| OptionError { flag: F, value: text.into(), why: format!("{what} is required") };
+    let cam = Camera::look_at(eye.ok_or_else(|| missing("eye"))?, target.ok_or_else(|| missing("target"))?, fov);
+    cam.validate().map_err(|e| OptionError { flag: F, value: text.into(), why: e.to_string() })?;
+    Ok(cam)
+}
+
+/// `--light spot|directional|point[,pos=X,Y,Z][,target=X,Y,Z][,fov=DEG][,radius=R]`, filling what is not
+/// given from `default` (the scene's own light).
+///
+/// # Errors
+/// An unknown type or key, bad numbers, or an unusable light.
+pub fn parse_light(text: &str, default: &Light, scene_center: Vec3) -> Result<Light, OptionError> {
+    const F: &str = "--light";
+    let (kind, rest) = text.split_once(',').unwrap_or((text, ""));
+    let t: LightType = kind.trim().parse().map_err(|e: String| OptionError {
+        flag: F,
+        value: text.into(),
+        why: format!("type must be {e}"),
+    })?;
+    let (mut pos, mut dir) = match default.kind {
+        LightKind::Spot { position, direction, .. } => (position, direction),
+        LightKind::Point { position } => (position, (scene_center - position).normalize_or(Vec3::NEG_Y)),
+        LightKind::Directional { direction } => (scene_center - direction * 5.0, direction),
+    };
+    let mut fov = match default.kind {
+        LightKind::Spot { cone_angle, .. } => cone_angle.to_degrees(),
+        _ => 60.0,
+    };
+    let mut radius = default.radius;
+    let mut target = None;
+    for (k, v) in if rest.is_empty() { Vec::new() } else { pairs(F, rest)? } {
+        match k.as_str() {
+            "pos" => pos = vec3(F, text, "pos", &v)?,
+            "target" => target = Some(vec3(F, text, "target", &v)?),
+            "fov" => fov = number(F, text, "fov", &v)?,
+            "radius" => radius = number(F, text, "radius", &v)?,
+            other => {
+                return Err(OptionError {
+                    flag: F,
+                    value: text.into(),
+                    why: format!("unknown key '{other}' (pos, target, fov, radius)"),
+                });
+            }
+        }
+    }
+    if let Some(tg) = target {
+        dir = (tg - pos).normalize_or(dir);
+    }
+    let kind = match t {
+        LightType::Spot => LightKind::Spot { position: pos, direction: dir, cone_angle: fov.to_radians() },
+        LightType::Directional => LightKind::Directional { direction: dir },
+        LightType::Point => LightKind::Point { position: pos },
+    };
+    let light = Light { kind, radius, ..*default };
+    light.validate().map_err(|e| OptionError { flag: F, value: text.into(), why: e.to_string() })?;
+    Ok(light)
+}
+
+/// `WxH`, both at least 1.
+///
+/// # Errors
+/// Anything else.
+pub fn parse_size(text: &str) -> Result<(u32, u32), OptionError> {
+    let bad = |why: &str| OptionError { flag: "--size", value: text.into(), why: why.into() };
+    let (w, h) = text.split_once(['x', 'X']).ok_or_else(|| bad("expected WxH, e.g. 512x512"))?;
+    let (w, h) = (
+        w.trim().parse::<u32>().map_err(|_| bad("width is not a whole number"))?,
+        h.trim().parse::<u32>().map_err(|_| bad("height is not a whole number"))?,
+    );
+    if w == 0 || h == 0 {
+        return Err(bad("width and height must be at least 1"));
+    }
+    Ok((w, h))
+}
+
+/// Which scene, and how it is set up.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SceneSetup {
+    /// Built-in scene name or model file.
+    pub source: String,
+    /// Give a model file its ground quad.
+    pub ground: bool,
+    /// Light type and seed.
+    pub params: SceneParams,
+    /// Replaces the scene's camera.
+    pub camera: Option<String>,
+    /// Replaces the scene's light.
+    pub light: Option<String>,
+}
+
+impl SceneSetup {
+    /// A built-in scene or model file with its own camera and light.
+    #[must_use]
+    pub fn new(source: &str) -> Self {
+        Self { source: source.into(), ground: true, params: SceneParams::default(), camera: None, light: None }
+    }
+
+    /// Loads the scene and applies the overrides.
+    ///
+    /// # Errors
+    /// Unknown scene, bad model file, or bad overrides.
+    pub fn build(&self) -> Result<Scene, SetupError> {
+        let mut scene = load_scene(&self.source, &self.params, self.ground)?;
+        if let Some(c) = &self.camera {
+            let cam = parse_camera(c)?;
+            scene.clear_cameras();
+            scene.add_camera(cam);
+        }
+        if let Some(l) = &self.light {
+            let default = scene
+                .lights()
+                .next()
+                .map(|(_, l)| *l)
+                .unwrap_or_else(|| Light::spot(Vec3::new(2.0, 4.0, 1.5), Vec3::ZERO, 60.0));
+            let light = parse_light(l, &default, scene.bounds().center())?;
+            scene.clear_lights();
+            scene.add_light(light);
+        }
+        Ok(scene)
+    }
+}
+
+/// Why a scene setup failed.
+#[derive(Debug, thiserror::Error)]
+pub enum SetupError {
+    /// The scene itself.
+    #[error(transparent)]
+    Source(#[from] SceneSourceError),
+    /// An override.
+    #[error(transparent)]
+    Option(#[from] OptionError),
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn camera_and_light_flags() {
+        let c = parse_camera("eye=1,2,3,target=0,0.5,0,fov=30").unwrap();
+        assert_eq!(c.eye, Vec3::new(1.0, 2.0, 3.0));
+        assert!((c.fov_y.to_degrees() - 30.0).abs() < 1e-4);
+        assert!(parse_camera("eye=1,2,target=0,0,0").is_err());
+        assert!(parse_camera("eye=1,2,3").is_err());
+        assert!(parse_camera("eye=1,2,3,target=1,2,3").is_err());
+        let d = Light::spot(Vec3::new(2.0, 4.0, 1.5), Vec3::ZERO, 60.0);
+        let l = parse_light("point,pos=0,5,0", &d, Vec3::ZERO).unwrap();
+        assert_eq!(l.kind, LightKind::Point { position: Vec3::new(0.0, 5.0, 0.0) });
+        let l = parse_light("directional", &d, Vec3::ZERO).unwrap();
+        assert!(matches!(l.kind, LightKind::Directional { .. }));
+        assert!(parse_light("laser", &d, Vec3::ZERO).is_err());
+        assert!(parse_light("spot,fov=200", &d, Vec3::ZERO).is_err());
+        assert_eq!(parse_size("640x480").unwrap(), (640, 480));
+        assert!(parse_size("0x480").is_err());
+        assert!(parse_size("640").is_err());
+    }
+}
