@@ -108,6 +108,7 @@ fn metrics_map(m: &VisibilityMetrics, flip: f64) -> BTreeMap<String, f64> {
         ("interior_mismatch".into(), m.interior_mismatch),
         ("false_shadow".into(), m.false_shadow),
         ("false_light".into(), m.false_light),
+        ("interior_false_shadow".into(), m.interior_false_shadow),
         ("rmse".into(), m.rmse),
         ("mean_abs".into(), m.mean_abs),
         ("flip_mean".into(), flip),

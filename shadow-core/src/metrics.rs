@@ -35,6 +35,8 @@ pub struct VisibilityMetrics {
     pub false_shadow: f64,
     /// Lit here, shadowed in the reference (leaks, peter-panning).
     pub false_light: f64,
+    /// False shadow away from reference shadow boundaries: surface acne.
+    pub interior_false_shadow: f64,
     /// Root mean square visibility difference.
     pub rmse: f64,
     /// Mean absolute visibility difference.
@@ -97,7 +99,7 @@ pub fn compare_visibility(
     check(test, reference)?;
     check(test, mask)?;
     let band = edge_band(reference, mask);
-    let (mut n, mut band_miss, mut interior_miss, mut fs, mut fl) = (0u64, 0u64, 0u64, 0u64, 0u64);
+    let (mut n, mut band_miss, mut interior_miss, mut fs, mut fl, mut acne) = (0u64, 0u64, 0u64, 0u64, 0u64, 0u64);
     let (mut sq, mut abs) = (0.0f64, 0.0f64);
     for i in 0..test.data().len() {
         if !mask.data()[i] {
@@ -114,6 +116,9 @@ pub fn compare_visibility(
                 band_miss += 1;
             } else {
                 interior_miss += 1;
+                if rl {
+                    acne += 1;
+                }
             }
             if rl {
                 fs += 1;
@@ -130,6 +135,7 @@ pub fn compare_visibility(
         interior_mismatch: frac(interior_miss),
         false_shadow: frac(fs),
         false_light: frac(fl),
+        interior_false_shadow: frac(acne),
         rmse: if n == 0 { 0.0 } else { (sq / n as f64).sqrt() },
         mean_abs: if n == 0 { 0.0 } else { abs / n as f64 },
     })
@@ -183,6 +189,8 @@ mod tests {
         // Columns 10 and 11 are within 2 px of the boundary (between columns 9 and 10); (2, 5) is not.
         assert!((m.edge_band_mismatch - 40.0 / 400.0).abs() < 1e-12);
         assert!((m.interior_mismatch - 1.0 / 400.0).abs() < 1e-12);
+        // The interior miss is a leak, not acne.
+        assert_eq!(m.interior_false_shadow, 0.0);
         assert!((m.mean_abs - 41.0 / 400.0).abs() < 1e-12);
         assert!((m.rmse - (41.0f64 / 400.0).sqrt()).abs() < 1e-12);
     }

@@ -43,8 +43,8 @@ pub fn direct(light: &Light, p: Vec3, n: Vec3) -> Vec3 {
 /// Linear radiance of a surface: albedo times (ambient plus the sum of each light's direct term times its
 /// visibility).
 #[must_use]
-pub fn shade(albedo: Vec3, p: Vec3, n: Vec3, lights: &[Light], visibility: &[f32]) -> Vec3 {
-    let direct: Vec3 = lights.iter().zip(visibility).map(|(l, &v)| direct(l, p, n) * v).sum();
+pub fn shade<'a>(albedo: Vec3, p: Vec3, n: Vec3, lit: impl IntoIterator<Item = (&'a Light, f32)>) -> Vec3 {
+    let direct: Vec3 = lit.into_iter().map(|(l, v)| direct(l, p, n) * v).sum();
     albedo * (Vec3::splat(AMBIENT) + direct)
 }
 

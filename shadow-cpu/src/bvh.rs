@@ -74,7 +74,34 @@ impl SceneBvh {
     #[must_use]
     pub fn occluded(&self, origin: Vec3, dir: Vec3, tmax: f32) -> bool {
         let Some(bvh) = &self.bvh else { return false };
+        // obvhs picks the traversal octant from the sign bits, so a -0.0 component sends the ray down the
+        // wrong children and it misses boxes it passes straight through: fold it into +0.0.
+        let dir = dir.map(|c| if c == 0.0 { 0.0 } else { c });
         let ray = Ray::new(origin.into(), dir.into(), 0.0, tmax);
         !bvh.ray_traverse_miss(ray, |r, id| self.tris[id].intersect(r))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+    use shadow_core::scenes::{self, LightType, SceneParams};
+
+    use super::*;
+
+    #[test]
+    fn negative_zero_directions_still_hit() {
+        let scene = scenes::build("room", &SceneParams { light: Some(LightType::Directional), seed: 1 }).unwrap();
+        let cam = scene.cameras().next().unwrap().0;
+        let frame = FrameInputs::from_scene(&scene, cam).unwrap();
+        let bvh = SceneBvh::build(&frame);
+        // Straight up through the beam hung at y 2.375..2.625 over x -0.7..0.7, z 0.8..1.7.
+        for (origin, dir) in [
+            (Vec3::new(0.0, 0.01, 1.25), Vec3::new(-0.0, 1.0, -0.0)),
+            (Vec3::new(0.0, 0.01, 1.25), Vec3::new(0.0, 1.0, 0.0)),
+            (Vec3::new(0.0, 0.01, 0.6), Vec3::new(-0.0, 0.96, 0.28).normalize()),
+        ] {
+            assert!(bvh.occluded(origin, dir, f32::INFINITY), "{origin} {dir}");
+        }
     }
 }

@@ -75,6 +75,7 @@ impl Backend for CpuBackend {
 #[derive(Default)]
 pub struct CpuContext {
     bvh: Option<(u64, Arc<SceneBvh>)>,
+    spare: Option<GBuffer>,
 }
 
 impl CpuContext {
@@ -82,6 +83,16 @@ impl CpuContext {
     #[must_use]
     pub fn new() -> Self {
         Self::default()
+    }
+
+    /// Hands a finished frame's G-buffer back, so the next frame reuses its storage.
+    pub fn recycle(&mut self, gbuffer: GBuffer) {
+        self.spare = Some(gbuffer);
+    }
+
+    /// The recycled G-buffer, if any.
+    pub(crate) fn take_spare(&mut self) -> Option<GBuffer> {
+        self.spare.take()
     }
 
     /// The BVH of the frame's casters, built on first use and reused while they stay put.

@@ -42,7 +42,7 @@ pub fn render_frame(
     let mut stats = FrameStats::default();
 
     let t = Instant::now();
-    let gbuffer = gbuffer::render(frame, width, height)?;
+    let gbuffer = gbuffer::render_reusing(frame, width, height, cx.take_spare())?;
     stats.timings.add(Phase::GBuffer, ms(t.elapsed()));
 
     let mut visibility = Vec::with_capacity(frame.lights.len());

@@ -1,6 +1,7 @@
-//! The camera G-buffer (DESIGN 5, step 2): one rasterization pass writing, per pixel, which triangle is
-//! visible and its perspective-correct barycentrics; then a resolve that turns those into world position,
-//! normals, albedo and the receiver mask.
+//! The camera G-buffer (DESIGN 5, step 2): a visibility buffer, then a resolve. The rasterization pass
+//! writes only which triangle is visible at each pixel; the resolve intersects the pixel's camera ray with
+//! that one triangle, which gives exact world position and perspective-correct barycentrics for the
+//! normal, once per pixel instead of once per overdrawn fragment.
 //!
 //! The clip-space vertices of every instance are kept: shadow-volume near caps are drawn from exactly
 //! these, so a lit surface and its cap have bit-identical depths.
@@ -39,6 +40,8 @@ pub struct GBuffer {
     pub receiver: Image<bool>,
     /// Clip-space vertices of every instance, exactly as rasterized.
     pub clip_vertices: Vec<Vec<Vec4>>,
+    /// The visibility buffer, kept so a recycled G-buffer reuses its storage.
+    samples: Vec<Sample>,
 }
 
 impl GBuffer {
@@ -59,11 +62,52 @@ impl GBuffer {
     }
 }
 
-#[derive(Clone, Copy)]
+/// The storage of a G-buffer, taken apart for reuse.
+#[derive(Default)]
+struct Storage {
+    vec3: [Option<Vec<Vec3>>; 4],
+    depth: Option<Vec<f32>>,
+    receiver: Option<Vec<bool>>,
+    samples: Option<Vec<Sample>>,
+}
+
+impl GBuffer {
+    fn into_storage(self) -> Storage {
+        Storage {
+            vec3: [
+                Some(self.position.into_vec()),
+                Some(self.normal.into_vec()),
+                Some(self.geometric_normal.into_vec()),
+                Some(self.albedo.into_vec()),
+            ],
+            depth: Some(self.depth.into_vec()),
+            receiver: Some(self.receiver.into_vec()),
+            samples: Some(self.samples),
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug)]
 struct Sample {
     instance: u32,
     triangle: u32,
-    bary: [f32; 3],
+}
+
+/// Where the ray `origin + t dir` meets the plane of triangle `c`, with that point's barycentrics. The
+/// ray is known to hit the triangle (the rasterizer found it at this pixel), so no bounds are checked;
+/// a ray parallel to the plane (a triangle seen edge-on) falls back to the centroid.
+fn ray_triangle(origin: Vec3, dir: Vec3, c: [Vec3; 3]) -> (Vec3, [f32; 3]) {
+    let (e1, e2) = (c[1] - c[0], c[2] - c[0]);
+    let h = dir.cross(e2);
+    let det = e1.dot(h);
+    if det.abs() <= f32::MIN_POSITIVE {
+        return ((c[0] + c[1] + c[2]) / 3.0, [1.0 / 3.0; 3]);
+    }
+    let s = origin - c[0];
+    let u = s.dot(h) / det;
+    let q = s.cross(e1);
+    let v = dir.dot(q) / det;
+    (c[0] + e1 * u + e2 * v, [1.0 - u - v, u, v])
 }
 
 /// Clip-space vertices of an instance under `clip_from_world`: the one transform every pass shares.
@@ -77,6 +121,28 @@ pub fn clip_vertices(positions: &[Vec3], clip_from_local: Mat4) -> Vec<Vec4> {
 /// # Errors
 /// A zero or oversized view.
 pub fn render(frame: &FrameInputs, width: u32, height: u32) -> Result<GBuffer, CpuError> {
+    render_reusing(frame, width, height, None)
+}
+
+/// A vector of `n` copies of `value`, in `old`'s storage when there is one: a recycled buffer's pages are
+/// already mapped, so a frame does not pay the kernel to fault fresh ones in.
+fn refill<T: Clone>(old: Option<Vec<T>>, n: usize, value: T) -> Vec<T> {
+    let mut v = old.unwrap_or_default();
+    v.clear();
+    v.resize(n, value);
+    v
+}
+
+/// [`render`], reusing the storage of a previous frame's G-buffer.
+///
+/// # Errors
+/// A zero or oversized view.
+pub fn render_reusing(
+    frame: &FrameInputs,
+    width: u32,
+    height: u32,
+    spare: Option<GBuffer>,
+) -> Result<GBuffer, CpuError> {
     check_size("view", u64::from(width), u64::from(height), u64::from(crate::context::MAX_TARGET_SIDE).pow(2))?;
     let camera = frame.camera;
     let clip_from_world = camera.clip_from_world(width as f32 / height as f32);
@@ -86,9 +152,21 @@ pub fn render(frame: &FrameInputs, width: u32, height: u32) -> Result<GBuffer, C
         .map(|inst| clip_vertices(inst.mesh.positions(), clip_from_world * inst.world_from_local))
         .collect();
 
-    let mut ds = DepthStencil::new(width, height, 1.0, 0);
-    let none = Sample { instance: NO_INSTANCE, triangle: 0, bary: [0.0; 3] };
-    let mut samples = Image::new(width, height, none);
+    let n = width as usize * height as usize;
+    let mut old = spare.map(GBuffer::into_storage);
+    let mut take = |k: usize| old.as_mut().and_then(|o: &mut Storage| o.vec3[k].take());
+    let (position, normal, geometric_normal, albedo) = (
+        refill(take(0), n, Vec3::ZERO),
+        refill(take(1), n, Vec3::Y),
+        refill(take(2), n, Vec3::Y),
+        refill(take(3), n, Vec3::ZERO),
+    );
+    let old = old.unwrap_or_default();
+    let mut ds = DepthStencil::from_parts(width, height, refill(old.depth, n, 1.0), vec![0; n]);
+    let none = Sample { instance: NO_INSTANCE, triangle: 0 };
+    let mut samples =
+        Image::from_vec(width, height, refill(old.samples, n, none)).unwrap_or_else(|| unreachable!("n pixels"));
+    let mut receiver = refill(old.receiver, n, false);
     let state = RasterState::default();
     for (i, inst) in frame.instances.iter().enumerate() {
         let src = Indexed { positions: &clip[i], triangles: inst.mesh.triangles(), prim_base: 0, flip: inst.mirrored };
@@ -97,62 +175,71 @@ pub fn render(frame: &FrameInputs, width: u32, height: u32) -> Result<GBuffer, C
             &mut samples,
             &src,
             &state,
-            |f| Some(Sample { instance: i as u32, triangle: f.prim, bary: f.bary }),
+            |f| Some(Sample { instance: i as u32, triangle: f.prim }),
             |d, s| *d = s,
         );
     }
 
-    // Resolve: one sample per pixel to the surface attributes.
+    // Resolve: each pixel's sample to the surface attributes, every image written in one pass.
     let normal_from_local: Vec<Mat3> =
         frame.instances.iter().map(|i| Mat3::from_mat4(i.world_from_local).inverse().transpose()).collect();
-    let resolved: Vec<(Vec3, Vec3, Vec3, Vec3, bool)> = samples
-        .data()
-        .par_iter()
-        .with_min_len(1024)
-        .map(|s| {
-            if s.instance == NO_INSTANCE {
-                return (Vec3::ZERO, Vec3::Y, Vec3::Y, Vec3::ZERO, false);
-            }
-            let inst = &frame.instances[s.instance as usize];
-            let t = inst.mesh.triangles()[s.triangle as usize];
-            let (p, n) = (inst.mesh.positions(), inst.mesh.normals());
-            let b = s.bary;
-            let local = p[t[0] as usize] * b[0] + p[t[1] as usize] * b[1] + p[t[2] as usize] * b[2];
-            let world = inst.world_from_local.transform_point3(local);
-            let nm = normal_from_local[s.instance as usize];
-            let mut shading = (nm * (n[t[0] as usize] * b[0] + n[t[1] as usize] * b[1] + n[t[2] as usize] * b[2]))
-                .normalize_or(Vec3::Y);
-            let face = shadow_core::mesh::face_normal(t.map(|k| p[k as usize]));
-            let mut geometric = (nm * face).normalize_or(shading);
-            if inst.mirrored {
-                geometric = -geometric;
-            }
-            let to_eye = camera.eye - world;
-            let seen_from_behind = geometric.dot(to_eye) < 0.0;
-            if seen_from_behind {
-                geometric = -geometric;
-                if inst.two_sided {
-                    shading = -shading;
+    let (mut position, mut normal, mut geometric_normal, mut albedo) = (position, normal, geometric_normal, albedo);
+    let w = width as usize;
+    let world_from_clip = clip_from_world.inverse();
+    position
+        .par_chunks_mut(w)
+        .zip(normal.par_chunks_mut(w))
+        .zip(geometric_normal.par_chunks_mut(w))
+        .zip(albedo.par_chunks_mut(w))
+        .zip(receiver.par_chunks_mut(w))
+        .zip(samples.data().par_chunks(w))
+        .enumerate()
+        .for_each(|(y, (((((pos, nrm), geo), alb), rec), smp))| {
+            for (x, s) in smp.iter().enumerate() {
+                if s.instance == NO_INSTANCE {
+                    continue;
                 }
+                let inst = &frame.instances[s.instance as usize];
+                let t = inst.mesh.triangles()[s.triangle as usize];
+                let (p, nn) = (inst.mesh.positions(), inst.mesh.normals());
+                let corners = t.map(|k| inst.world_from_local.transform_point3(p[k as usize]));
+                let ndc = glam::Vec2::new(
+                    (x as f32 + 0.5) / width as f32 * 2.0 - 1.0,
+                    1.0 - (y as f32 + 0.5) / height as f32 * 2.0,
+                );
+                let dir = world_from_clip.project_point3(ndc.extend(0.5)) - camera.eye;
+                let (world, b) = ray_triangle(camera.eye, dir, corners);
+                let nm = normal_from_local[s.instance as usize];
+                let interp = nn[t[0] as usize] * b[0] + nn[t[1] as usize] * b[1] + nn[t[2] as usize] * b[2];
+                let mut shading = (nm * interp).normalize_or(Vec3::Y);
+                let face = shadow_core::mesh::face_normal(t.map(|k| p[k as usize]));
+                let mut geometric = (nm * face).normalize_or(shading);
+                if inst.mirrored {
+                    geometric = -geometric;
+                }
+                // Turn the face normal to the side that is seen; shading normals too for two-sided materials.
+                if geometric.dot(camera.eye - world) < 0.0 {
+                    geometric = -geometric;
+                    if inst.two_sided {
+                        shading = -shading;
+                    }
+                }
+                (pos[x], nrm[x], geo[x], alb[x], rec[x]) =
+                    (world, shading, geometric, inst.base_color, inst.receives_shadow);
             }
-            (world, shading, geometric, inst.base_color, inst.receives_shadow)
-        })
-        .collect();
-    let take = |f: fn(&(Vec3, Vec3, Vec3, Vec3, bool)) -> Vec3| {
-        Image::from_vec(width, height, resolved.iter().map(f).collect())
-            .unwrap_or_else(|| unreachable!("one entry per pixel"))
-    };
+        });
+    let image = |data| Image::from_vec(width, height, data).unwrap_or_else(|| unreachable!("one entry per pixel"));
     Ok(GBuffer {
         camera,
         clip_from_world,
-        position: take(|r| r.0),
-        normal: take(|r| r.1),
-        geometric_normal: take(|r| r.2),
-        albedo: take(|r| r.3),
-        receiver: Image::from_vec(width, height, resolved.iter().map(|r| r.4).collect())
-            .unwrap_or_else(|| unreachable!("one entry per pixel")),
+        position: image(position),
+        normal: image(normal),
+        geometric_normal: image(geometric_normal),
+        albedo: image(albedo),
+        receiver: Image::from_vec(width, height, receiver).unwrap_or_else(|| unreachable!("one entry per pixel")),
         instance: samples.map(|s| s.instance),
         depth: ds.into_depth_image(),
         clip_vertices: clip,
+        samples: samples.into_vec(),
     })
 }

@@ -19,8 +19,8 @@ pub fn shade(g: &GBuffer, lights: &[Light], visibility: &[&Image<f32>]) -> Image
             if g.instance.data()[i] == NO_INSTANCE {
                 return to8(shading::BACKGROUND);
             }
-            let vis: Vec<f32> = visibility.iter().map(|v| v.data()[i]).collect();
-            to8(shading::shade(g.albedo.data()[i], g.position.data()[i], g.normal.data()[i], lights, &vis))
+            let lit = lights.iter().zip(visibility.iter().map(|v| v.data()[i]));
+            to8(shading::shade(g.albedo.data()[i], g.position.data()[i], g.normal.data()[i], lit))
         })
         .collect();
     Image::from_vec(g.width(), g.height(), data).unwrap_or_else(|| unreachable!("one entry per pixel"))

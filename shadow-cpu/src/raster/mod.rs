@@ -44,6 +44,17 @@ impl DepthStencil {
         Self { width, height, depth: vec![depth; n], stencil: vec![stencil; n] }
     }
 
+    /// A buffer over existing storage.
+    ///
+    /// # Panics
+    /// When either vector is not `width * height` long: a caller bug.
+    #[must_use]
+    pub fn from_parts(width: u32, height: u32, depth: Vec<f32>, stencil: Vec<u8>) -> Self {
+        let n = width as usize * height as usize;
+        assert!(depth.len() == n && stencil.len() == n, "depth-stencil storage of the wrong size");
+        Self { width, height, depth, stencil }
+    }
+
     /// A buffer holding an existing depth image and a cleared stencil.
     #[must_use]
     pub fn from_depth(depth: &Image<f32>, stencil: u8) -> Self {
@@ -350,6 +361,30 @@ where
     F: Fn(&Fragment) -> Option<T> + Sync,
     B: Fn(&mut T, T) + Sync,
 {
+    draw_with(ds, color, src, st, None, shader, blend)
+}
+
+/// Depth (and stencil) only: shadow-map renders and shadow-volume counting take branch-free inner loops.
+pub fn draw_depth<S: TriangleSource + ?Sized>(ds: &mut DepthStencil, src: &S, st: &RasterState) -> RasterCounters {
+    let mut none = Image::new(ds.width, ds.height, ());
+    draw_with(ds, &mut none, src, st, DepthKernel::for_state(st), |_| Some(()), |_, _| {})
+}
+
+fn draw_with<T, S, F, B>(
+    ds: &mut DepthStencil,
+    color: &mut Image<T>,
+    src: &S,
+    st: &RasterState,
+    fast: Option<DepthKernel>,
+    shader: F,
+    blend: B,
+) -> RasterCounters
+where
+    T: Send,
+    S: TriangleSource + ?Sized,
+    F: Fn(&Fragment) -> Option<T> + Sync,
+    B: Fn(&mut T, T) + Sync,
+{
     let (w, h) = (ds.width, ds.height);
     assert!(
         color.width() == w && color.height() == h,
@@ -394,7 +429,7 @@ where
                 let y0 = band as i32 * BAND_ROWS as i32;
                 let mut rows = BandRows { depth, stencil, color: col, y0, width: w as usize };
                 for &t in bin {
-                    raster_band(&setups[t as usize], &mut rows, st, &shader, &blend, &mut c);
+                    raster_band(&setups[t as usize], &mut rows, st, fast, &shader, &blend, &mut c);
                 }
                 c
             })
@@ -407,12 +442,6 @@ where
         total.stencil_updates += counters.stencil_updates;
     }
     total
-}
-
-/// Depth (and stencil) only.
-pub fn draw_depth<S: TriangleSource + ?Sized>(ds: &mut DepthStencil, src: &S, st: &RasterState) -> RasterCounters {
-    let mut none = Image::new(ds.width, ds.height, ());
-    draw(ds, &mut none, src, st, |_| Some(()), |_, _| {})
 }
 
 struct BandRows<'a, T> {
@@ -442,11 +471,126 @@ fn span(t: &Setup, py: i64) -> Option<(i32, i32)> {
     (lo <= hi).then_some((lo as i32, hi as i32))
 }
 
+/// Depth at pixel column `x` of a row whose depth at column 0's centre is `z_row` (clamped when asked).
+#[inline(always)]
+fn depth_at(t: &Setup, z_row: f32, x: i32, clamp: bool) -> f32 {
+    let z = z_row + t.dzdx * x as f32;
+    if clamp { z.clamp(0.0, 1.0) } else { z }
+}
+
+/// The depth of a row at the centre of column 0, bias included: the one place depth is interpolated, so
+/// every draw of a triangle gives it bit-identical depths.
+#[inline(always)]
+fn row_base(t: &Setup, py: i64) -> f32 {
+    let dx0 = (HALF - t.fx0) as f32 / ONE as f32;
+    let dy = (py - t.fy0) as f32 / ONE as f32;
+    t.z0 + t.dzdx * dx0 + t.dzdy * dy + t.offset
+}
+
+/// A stencil op as an 8-bit wrapping increment, when it is one (Keep, IncrementWrap, DecrementWrap).
+fn as_delta(op: StencilOp) -> Option<u8> {
+    match op {
+        StencilOp::Keep => Some(0),
+        StencilOp::IncrementWrap => Some(1),
+        StencilOp::DecrementWrap => Some(255),
+        _ => None,
+    }
+}
+
+/// The fast inner loops of depth-only draws: plain depth tests, or stencil counting where the op depends
+/// only on the depth test (shadow volumes). `None` when the state needs the general loop.
+#[derive(Clone, Copy)]
+enum DepthKernel {
+    Depth { compare: CompareFn, write: bool },
+    Count { compare: CompareFn, front: (u8, u8), back: (u8, u8) },
+}
+
+impl DepthKernel {
+    fn for_state(st: &RasterState) -> Option<Self> {
+        let d = st.depth?;
+        match &st.stencil {
+            None => Some(Self::Depth { compare: d.compare, write: d.write }),
+            Some(s) => {
+                let counting = |f: &StencilFace| {
+                    (f.compare == CompareFn::Always).then_some(())?;
+                    Some((as_delta(f.pass)?, as_delta(f.depth_fail)?))
+                };
+                (s.write_mask == 0xff && !d.write).then_some(())?;
+                Some(Self::Count { compare: d.compare, front: counting(&s.front)?, back: counting(&s.back)? })
+            }
+        }
+    }
+}
+
+/// Where a row's span starts: its depth base, the clamp flag and the first column.
+#[derive(Clone, Copy)]
+struct RowStart {
+    z_row: f32,
+    clamp: bool,
+    xs: i32,
+}
+
+/// One row of a depth-only draw with a fast kernel. Branch-free, so the compiler can vectorize it.
+#[inline(always)]
+fn row_fast(t: &Setup, k: DepthKernel, row: RowStart, depth: &mut [f32], stencil: &mut [u8], c: &mut RasterCounters) {
+    let RowStart { z_row, clamp, xs } = row;
+    #[inline(always)]
+    fn go(
+        t: &Setup,
+        z_row: f32,
+        clamp: bool,
+        xs: i32,
+        depth: &mut [f32],
+        mut f: impl FnMut(usize, f32, f32) -> bool,
+    ) -> u64 {
+        let mut passed = 0u64;
+        for (i, d) in depth.iter().enumerate() {
+            let z = depth_at(t, z_row, xs + i as i32, clamp);
+            passed += u64::from(f(i, z, *d));
+        }
+        passed
+    }
+    let n = depth.len() as u64;
+    c.fragments += n;
+    let passed = match k {
+        DepthKernel::Depth { compare, write: true } => {
+            let mut passed = 0u64;
+            for (i, d) in depth.iter_mut().enumerate() {
+                let z = depth_at(t, z_row, xs + i as i32, clamp);
+                let pass = compare.test(z, *d);
+                *d = if pass { z } else { *d };
+                passed += u64::from(pass);
+            }
+            passed
+        }
+        DepthKernel::Depth { compare, write: false } => go(t, z_row, clamp, xs, depth, |_, z, d| compare.test(z, d)),
+        DepthKernel::Count { compare, front, back } => {
+            let (dp, df) = if t.front { front } else { back };
+            let passed = match compare {
+                CompareFn::Less => go(t, z_row, clamp, xs, depth, |i, z, d| {
+                    let pass = z < d;
+                    stencil[i] = stencil[i].wrapping_add(if pass { dp } else { df });
+                    pass
+                }),
+                cmp => go(t, z_row, clamp, xs, depth, |i, z, d| {
+                    let pass = cmp.test(z, d);
+                    stencil[i] = stencil[i].wrapping_add(if pass { dp } else { df });
+                    pass
+                }),
+            };
+            c.stencil_updates += if dp != 0 { passed } else { 0 } + if df != 0 { n - passed } else { 0 };
+            passed
+        }
+    };
+    c.passed += passed;
+}
+
 #[inline(always)]
 fn raster_band<T, F, B>(
     t: &Setup,
     rows: &mut BandRows<'_, T>,
     st: &RasterState,
+    fast: Option<DepthKernel>,
     shader: &F,
     blend: &B,
     c: &mut RasterCounters,
@@ -461,31 +605,28 @@ fn raster_band<T, F, B>(
     for y in y_lo..=y_hi {
         let py = i64::from(y) * ONE + HALF;
         let Some((xs, xe)) = span(t, py) else { continue };
+        let z_row = row_base(t, py);
+        let row = (y - rows.y0) as usize * rows.width;
+        let (lo, hi) = (row + xs as usize, row + xe as usize + 1);
+        if let Some(k) = fast {
+            row_fast(t, k, RowStart { z_row, clamp, xs }, &mut rows.depth[lo..hi], &mut rows.stencil[lo..hi], c);
+            continue;
+        }
         let px0 = i64::from(xs) * ONE + HALF;
         let mut e: [i64; 3] = std::array::from_fn(|k| t.a[k] * px0 + t.b[k] * py + t.c[k]);
         let step: [i64; 3] = t.a.map(|a| a * ONE);
-        let dy = (py - t.fy0) as f32 / ONE as f32;
-        let row = (y - rows.y0) as usize * rows.width;
         for x in xs..=xe {
-            let dx = ((i64::from(x) * ONE + HALF) - t.fx0) as f32 / ONE as f32;
-            let mut depth = t.z0 + t.dzdx * dx + t.dzdy * dy + t.offset;
-            if clamp {
-                depth = depth.clamp(0.0, 1.0);
-            }
-            let lambda = [e[0] as f32 * t.inv_area, e[1] as f32 * t.inv_area, e[2] as f32 * t.inv_area];
+            let depth = depth_at(t, z_row, x, clamp);
+            let here = e;
             for (e, s) in e.iter_mut().zip(step) {
                 *e += s;
             }
             c.fragments += 1;
             let frag = || {
                 // Perspective-correct weights of the clipped corners, then of the source triangle.
-                let q = [lambda[0] * t.inv_w[0], lambda[1] * t.inv_w[1], lambda[2] * t.inv_w[2]];
+                let q = [0, 1, 2].map(|k| here[k] as f32 * t.inv_area * t.inv_w[k]);
                 let s = 1.0 / (q[0] + q[1] + q[2]);
-                let q = [q[0] * s, q[1] * s, q[2] * s];
-                let mut bary = [0.0f32; 3];
-                for (k, b) in bary.iter_mut().enumerate() {
-                    *b = q[0] * t.bary[0][k] + q[1] * t.bary[1][k] + q[2] * t.bary[2][k];
-                }
+                let bary = [0, 1, 2].map(|k| (q[0] * t.bary[0][k] + q[1] * t.bary[1][k] + q[2] * t.bary[2][k]) * s);
                 Fragment { x: x as u32, y: y as u32, depth, prim: t.prim, front_facing: t.front, bary }
             };
             let i = row + x as usize;

@@ -276,3 +276,48 @@ fn output_does_not_depend_on_the_thread_count() {
     assert_eq!(one.2, many.2);
     assert!(one.2.stencil_updates > 0);
 }
+
+#[test]
+fn fast_kernels_match_the_general_loop() {
+    let tris = jittered_grid(30, 11, 2.0);
+    let mut rng = shadow_core::scenes::Rng::new(5);
+    let mut all = Vec::new();
+    for k in 0..4 {
+        let dz = rng.range(-0.3, 0.3);
+        // Every other layer turned around, so both stencil faces are exercised.
+        all.extend(tris.iter().map(|t| {
+            let t = t.map(|v| Vec4::new(v.x, v.y, v.z + dz * v.w, v.w));
+            if k % 2 == 0 { t } else { [t[0], t[2], t[1]] }
+        }));
+    }
+    let src = Soup { triangles: &all, prim_base: 0, flip: false };
+    let volume = {
+        let face =
+            |pass, depth_fail| StencilFace { compare: CompareFn::Always, fail: StencilOp::Keep, depth_fail, pass };
+        StencilState {
+            front: face(StencilOp::IncrementWrap, StencilOp::Keep),
+            back: face(StencilOp::Keep, StencilOp::DecrementWrap),
+            read_mask: 0xff,
+            write_mask: 0xff,
+            reference: 0,
+        }
+    };
+    let bias = DepthBias { constant: 3.0, slope: 1.5, clamp: 0.0 };
+    for st in [
+        RasterState { depth: Some(DepthState { bias, ..DepthState::LESS_WRITE }), ..RasterState::default() },
+        RasterState { depth: Some(DepthState::LESS_READ), stencil: Some(volume), ..RasterState::default() },
+    ] {
+        let mut base = DepthStencil::new(123, 77, 1.0, 0);
+        // A non-trivial starting depth so tests go both ways.
+        for (i, d) in base.depth.iter_mut().enumerate() {
+            *d = 0.3 + 0.5 * ((i * 7919) % 101) as f32 / 101.0;
+        }
+        let (mut a, mut b) = (base.clone(), base);
+        assert!(DepthKernel::for_state(&st).is_some());
+        let fast = draw_depth(&mut a, &src, &st);
+        let mut none = Image::new(123, 77, ());
+        let general = draw(&mut b, &mut none, &src, &st, |_| Some(()), |_, _| {});
+        assert_eq!(a, b);
+        assert_eq!(fast, general);
+    }
+}

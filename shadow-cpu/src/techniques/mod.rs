@@ -22,7 +22,8 @@ pub fn check_maps(res: u32, count: usize) -> Result<(), CpuError> {
     check_size("shadow map", u64::from(res), u64::from(res) * count as u64, MAX_MAP_TEXELS)
 }
 
-/// Renders the depth of every casting instance from one light projection into a `res x res` map.
+/// Renders the depth of every casting instance from one light projection into a `res x res` map, in the
+/// storage of `reuse` when given (last frame's map: its pages are already mapped).
 #[must_use]
 pub fn render_depth_map(
     frame: &FrameInputs,
@@ -30,8 +31,13 @@ pub fn render_depth_map(
     res: u32,
     bias: DepthBias,
     cull: CullMode,
+    reuse: Option<Image<f32>>,
 ) -> (Image<f32>, RasterCounters) {
-    let mut ds = DepthStencil::new(res, res, 1.0, 0);
+    let n = res as usize * res as usize;
+    let mut depth = reuse.map(Image::into_vec).unwrap_or_default();
+    depth.clear();
+    depth.resize(n, 1.0);
+    let mut ds = DepthStencil::from_parts(res, res, depth, vec![0; n]);
     let state =
         RasterState { cull, depth: Some(DepthState { bias, ..DepthState::LESS_WRITE }), ..RasterState::default() };
     let mut counters = RasterCounters::default();

@@ -39,10 +39,11 @@ impl ShadowTechnique<CpuBackend> for ShadowMap {
         _: &mut FrameStats,
     ) -> Result<(), CpuError> {
         check_maps(self.resolution, light.projections.len())?;
+        let mut old = std::mem::take(&mut state.maps).into_iter();
         state.maps = light
             .projections
             .iter()
-            .map(|p| render_depth_map(frame, p, self.resolution, self.depth_bias(), CullMode::None).0)
+            .map(|p| render_depth_map(frame, p, self.resolution, self.depth_bias(), CullMode::None, old.next()).0)
             .collect();
         Ok(())
     }
