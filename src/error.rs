@@ -20,9 +20,9 @@ pub enum Error {
     /// The CPU backend.
     #[error(transparent)]
     Cpu(#[from] shadow_cpu::CpuError),
-    /// No GPU backend could be had.
-    #[error("no GPU backend: {0}")]
-    NoGpu(String),
+    /// The wgpu backend.
+    #[error(transparent)]
+    Gpu(#[from] shadow_wgpu::WgpuError),
     /// A file could not be written.
     #[error("cannot write {path}: {why}")]
     Write {

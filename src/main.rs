@@ -47,6 +47,10 @@ struct SceneArgs {
     /// View size, WxH.
     #[arg(long, default_value = "512x512")]
     size: String,
+    /// wgpu adapter by name substring (also SHADOWLAB_ADAPTER); software adapters such as lavapipe only
+    /// when named or with --backend wgpu.
+    #[arg(long)]
+    adapter: Option<String>,
 }
 
 impl SceneArgs {
@@ -186,6 +190,9 @@ fn list_techniques(json: bool) -> Result<(), Error> {
         if e.cpu.is_some() {
             b.push("cpu");
         }
+        if e.wgpu.is_some() {
+            b.push("wgpu");
+        }
         b
     };
     if json {
@@ -247,7 +254,7 @@ fn inspect(target: &str, json: bool) -> Result<(), Error> {
     Ok(())
 }
 
-fn backends(renderer: &Renderer, choice: &str) -> Result<Vec<shadowlab::BackendKind>, Error> {
+fn backends(renderer: &mut Renderer, choice: &str) -> Result<Vec<shadowlab::BackendKind>, Error> {
     let choice: BackendChoice =
         choice.parse().map_err(|e: String| Error::Usage(format!("bad --backend '{choice}': expected {e}")))?;
     let (kinds, note) = renderer.resolve(choice)?;
@@ -258,9 +265,9 @@ fn backends(renderer: &Renderer, choice: &str) -> Result<Vec<shadowlab::BackendK
 fn render(args: &SceneArgs, technique: &str, backend: &str, out: &Path) -> Result<(), Error> {
     let (frame, w, h) = args.frame()?;
     let spec = TechniqueSpec::parse(technique)?;
-    let mut renderer = Renderer::new(TechniqueRegistry::builtin());
+    let mut renderer = Renderer::new(TechniqueRegistry::builtin()).with_adapter(args.adapter.clone());
     renderer.registry().canonical(&spec)?;
-    for kind in backends(&renderer, backend)? {
+    for kind in backends(&mut renderer, backend)? {
         let run = renderer.run(kind, &frame, w, h, &spec)?;
         let path =
             if backend == "both" { out.with_extension(format!("{}.png", kind.name())) } else { out.to_path_buf() };
@@ -279,8 +286,8 @@ fn compare(
     backend: &str,
     out_dir: Option<PathBuf>,
 ) -> Result<(), Error> {
-    let mut renderer = Renderer::new(TechniqueRegistry::builtin());
-    let kinds = backends(&renderer, backend)?;
+    let mut renderer = Renderer::new(TechniqueRegistry::builtin()).with_adapter(args.adapter.clone());
+    let kinds = backends(&mut renderer, backend)?;
     let mut specs: Vec<TechniqueSpec> = technique.iter().map(|t| TechniqueSpec::parse(t)).collect::<Result<_, _>>()?;
     match techniques.as_deref() {
         Some("all") => specs.extend(

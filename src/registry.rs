@@ -6,9 +6,13 @@ use shadow_core::technique::hard::{RayTraced, ShadowMap, ShadowVolume};
 use shadow_core::technique::settings::{SettingKey, SettingsError, TechniqueSettings, TechniqueSpec};
 use shadow_core::technique::{DynShadowTechnique, Stateful};
 use shadow_cpu::CpuBackend;
+use shadow_wgpu::WgpuBackend;
 
 /// Builds a technique for the CPU backend from a spec.
 pub type CpuConstructor = fn(&TechniqueSpec) -> Result<Box<dyn DynShadowTechnique<CpuBackend>>, SettingsError>;
+
+/// Builds a technique for the wgpu backend from a spec.
+pub type WgpuConstructor = fn(&TechniqueSpec) -> Result<Box<dyn DynShadowTechnique<WgpuBackend>>, SettingsError>;
 
 /// One registered technique.
 #[derive(Clone)]
@@ -27,6 +31,8 @@ pub struct TechniqueEntry {
     pub canonical: fn(&TechniqueSpec) -> Result<String, SettingsError>,
     /// The CPU implementation, if any.
     pub cpu: Option<CpuConstructor>,
+    /// The wgpu implementation, if any.
+    pub wgpu: Option<WgpuConstructor>,
 }
 
 /// Why a technique could not be made.
@@ -63,17 +69,23 @@ fn canonical<S: TechniqueSettings>(spec: &TechniqueSpec) -> Result<String, Setti
     Ok(S::parse(&spec.name, &spec.values)?.settings_string())
 }
 
-/// A CPU constructor for a settings type whose value alone is the technique.
-fn cpu_plain<S>(spec: &TechniqueSpec) -> Result<Box<dyn DynShadowTechnique<CpuBackend>>, SettingsError>
+/// A constructor for a settings type whose value alone is the technique, on backend `B`.
+fn plain<B, S>(spec: &TechniqueSpec) -> Result<Box<dyn DynShadowTechnique<B>>, SettingsError>
 where
-    S: TechniqueSettings + shadow_core::technique::ShadowTechnique<CpuBackend>,
+    B: shadow_core::technique::Backend,
+    S: TechniqueSettings + shadow_core::technique::ShadowTechnique<B>,
 {
     let s = S::parse(&spec.name, &spec.values)?;
     let text = s.settings_string();
     Ok(Stateful::boxed(s, text))
 }
 
-fn cpu_volume(spec: &TechniqueSpec) -> Result<Box<dyn DynShadowTechnique<CpuBackend>>, SettingsError> {
+/// Shadow volumes: the name picks the counting.
+fn volume<B>(spec: &TechniqueSpec) -> Result<Box<dyn DynShadowTechnique<B>>, SettingsError>
+where
+    B: shadow_core::technique::Backend,
+    ShadowVolume: shadow_core::technique::ShadowTechnique<B>,
+{
     ShadowVolume::parse(&spec.name, &spec.values)?;
     let v = if spec.name == "shadow-volume-zpass" { ShadowVolume::ZPASS } else { ShadowVolume::ZFAIL };
     Ok(Stateful::boxed(v, String::new()))
@@ -91,7 +103,8 @@ impl TechniqueRegistry {
             reference: true,
             keys: RayTraced::keys,
             canonical: canonical::<RayTraced>,
-            cpu: Some(cpu_plain::<RayTraced>),
+            cpu: Some(plain::<CpuBackend, RayTraced>),
+            wgpu: None,
         });
         r.register(TechniqueEntry {
             name: "shadow-map",
@@ -100,7 +113,8 @@ impl TechniqueRegistry {
             reference: false,
             keys: ShadowMap::keys,
             canonical: canonical::<ShadowMap>,
-            cpu: Some(cpu_plain::<ShadowMap>),
+            cpu: Some(plain::<CpuBackend, ShadowMap>),
+            wgpu: Some(plain::<WgpuBackend, ShadowMap>),
         });
         r.register(TechniqueEntry {
             name: "shadow-volume-zpass",
@@ -109,7 +123,8 @@ impl TechniqueRegistry {
             reference: false,
             keys: ShadowVolume::keys,
             canonical: canonical::<ShadowVolume>,
-            cpu: Some(cpu_volume),
+            cpu: Some(volume::<CpuBackend>),
+            wgpu: Some(volume::<WgpuBackend>),
         });
         r.register(TechniqueEntry {
             name: "shadow-volume-zfail",
@@ -118,7 +133,8 @@ impl TechniqueRegistry {
             reference: false,
             keys: ShadowVolume::keys,
             canonical: canonical::<ShadowVolume>,
-            cpu: Some(cpu_volume),
+            cpu: Some(volume::<CpuBackend>),
+            wgpu: Some(volume::<WgpuBackend>),
         });
         r
     }
@@ -152,6 +168,16 @@ impl TechniqueRegistry {
     /// Unknown name or bad settings.
     pub fn canonical(&self, spec: &TechniqueSpec) -> Result<String, RegistryError> {
         Ok((self.get(&spec.name)?.canonical)(spec)?)
+    }
+
+    /// The wgpu implementation of a spec.
+    ///
+    /// # Errors
+    /// Unknown name, bad settings, or no wgpu implementation.
+    pub fn wgpu(&self, spec: &TechniqueSpec) -> Result<Box<dyn DynShadowTechnique<WgpuBackend>>, RegistryError> {
+        let e = self.get(&spec.name)?;
+        let make = e.wgpu.ok_or_else(|| RegistryError::NotOnBackend { name: spec.name.clone(), backend: "wgpu" })?;
+        Ok(make(spec)?)
     }
 
     /// The CPU implementation of a spec.

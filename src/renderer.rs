@@ -4,6 +4,7 @@ use shadow_core::image::Rgb8;
 use shadow_core::technique::{DebugView, FrameStats, TechniqueSpec};
 use shadow_core::{FrameInputs, Image};
 use shadow_cpu::{CpuContext, CpuFrame};
+use shadow_wgpu::{AdapterChoice, WgpuContext};
 
 use crate::Error;
 use crate::registry::TechniqueRegistry;
@@ -64,13 +65,41 @@ pub struct RunOutput {
 pub struct Renderer {
     registry: TechniqueRegistry,
     cpu: CpuContext,
+    adapter: AdapterChoice,
+    gpu: Option<WgpuContext>,
 }
 
 impl Renderer {
     /// A renderer over a registry.
     #[must_use]
     pub fn new(registry: TechniqueRegistry) -> Self {
-        Self { registry, cpu: CpuContext::new() }
+        Self { registry, cpu: CpuContext::new(), adapter: AdapterChoice::default(), gpu: None }
+    }
+
+    /// Picks the wgpu adapter by name substring (else `SHADOWLAB_ADAPTER`, else the first hardware one).
+    #[must_use]
+    pub fn with_adapter(mut self, name: Option<String>) -> Self {
+        self.adapter.name = name;
+        self
+    }
+
+    /// The wgpu context, opened on first use. A software adapter is accepted when `allow_software`.
+    fn gpu(&mut self, allow_software: bool) -> Result<&mut WgpuContext, Error> {
+        if self.gpu.is_none() {
+            let choice =
+                AdapterChoice { allow_software: allow_software || self.adapter.allow_software, ..self.adapter.clone() };
+            self.gpu = Some(WgpuContext::new(&choice)?);
+        }
+        match self.gpu.as_mut() {
+            Some(g) => Ok(g),
+            None => unreachable!("just opened"),
+        }
+    }
+
+    /// The adapter in use, once the wgpu backend has been opened.
+    #[must_use]
+    pub fn adapter(&self) -> Option<&shadow_wgpu::AdapterSummary> {
+        self.gpu.as_ref().map(|g| &g.adapter)
     }
 
     /// The registry.
@@ -79,17 +108,32 @@ impl Renderer {
         &self.registry
     }
 
-    /// The backends a choice resolves to, with a line saying why.
+    /// The backends a choice resolves to, with a line saying which adapter and why.
     ///
     /// # Errors
-    /// [`Error::NoGpu`] when wgpu is asked for and cannot be had.
-    pub fn resolve(&self, choice: BackendChoice) -> Result<(Vec<BackendKind>, String), Error> {
+    /// [`Error::Gpu`] when wgpu is asked for and cannot be had.
+    pub fn resolve(&mut self, choice: BackendChoice) -> Result<(Vec<BackendKind>, String), Error> {
+        let describe = |g: &WgpuContext| format!("{} ({}, {})", g.adapter.name, g.adapter.backend, g.adapter.kind);
         match choice {
             BackendChoice::Cpu => Ok((vec![BackendKind::Cpu], "backend: cpu".into())),
-            BackendChoice::Auto => {
-                Ok((vec![BackendKind::Cpu], "backend: cpu (auto: no GPU backend in this build)".into()))
+            BackendChoice::Auto => match self.gpu(false) {
+                Ok(g) => {
+                    let note = format!("backend: wgpu on {} (auto: a GPU adapter was found)", describe(g));
+                    Ok((vec![BackendKind::Wgpu], note))
+                }
+                Err(e) => {
+                    self.gpu = None;
+                    Ok((vec![BackendKind::Cpu], format!("backend: cpu (auto: {e})")))
+                }
+            },
+            BackendChoice::Wgpu => {
+                let g = self.gpu(true)?;
+                Ok((vec![BackendKind::Wgpu], format!("backend: wgpu on {}", describe(g))))
             }
-            BackendChoice::Wgpu | BackendChoice::Both => Err(Error::NoGpu("the wgpu backend is not built yet".into())),
+            BackendChoice::Both => {
+                let g = self.gpu(true)?;
+                Ok((vec![BackendKind::Cpu, BackendKind::Wgpu], format!("backends: cpu and wgpu on {}", describe(g))))
+            }
         }
     }
 
@@ -136,7 +180,21 @@ impl Renderer {
                     debug_views,
                 })
             }
-            BackendKind::Wgpu => Err(Error::NoGpu("the wgpu backend is not built yet".into())),
+            BackendKind::Wgpu => {
+                let mut t = self.registry.wgpu(spec)?;
+                let g = self.gpu(true)?;
+                let f = shadow_wgpu::render_frame(g, frame, width, height, t.as_mut())?;
+                let debug_views = t.debug_views(g)?;
+                Ok(RunOutput {
+                    technique: spec.name.clone(),
+                    settings,
+                    backend,
+                    color: f.color,
+                    visibility: f.visibility,
+                    stats: f.stats,
+                    debug_views,
+                })
+            }
         }
     }
 }

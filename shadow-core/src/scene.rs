@@ -5,6 +5,7 @@
 //! transforms of its subtree (and nothing else); replacing a mesh drops its cached adjacency and bumps its
 //! version so GPU uploads keyed by [`MeshKey`] know to refresh. Lights and cameras live in world space.
 
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, OnceLock};
 
 use glam::{Mat4, Vec3};
@@ -346,7 +347,13 @@ pub struct Scene {
     materials: SlotMap<MaterialKey, Material>,
     lights: SlotMap<LightKey, Light>,
     cameras: SlotMap<CameraKey, Camera>,
-    next_mesh_version: u64,
+}
+
+/// Mesh versions are unique in the process, not per scene: two scenes hand out the same [`MeshKey`]s,
+/// and a backend that caches uploads by key must still tell their meshes apart.
+fn next_mesh_version() -> u64 {
+    static NEXT: AtomicU64 = AtomicU64::new(1);
+    NEXT.fetch_add(1, Ordering::Relaxed)
 }
 
 impl Scene {
@@ -360,12 +367,7 @@ impl Scene {
 
     /// Adds a mesh; nodes refer to it by the returned key.
     pub fn add_mesh(&mut self, mesh: Mesh) -> MeshKey {
-        self.next_mesh_version += 1;
-        self.meshes.insert(MeshEntry {
-            mesh: Arc::new(mesh),
-            adjacency: OnceLock::new(),
-            version: self.next_mesh_version,
-        })
+        self.meshes.insert(MeshEntry { mesh: Arc::new(mesh), adjacency: OnceLock::new(), version: next_mesh_version() })
     }
 
     /// The mesh behind a key.
@@ -374,7 +376,7 @@ impl Scene {
         self.meshes.get(key).map(|e| &e.mesh)
     }
 
-    /// A number that changes whenever the mesh behind `key` is replaced.
+    /// A number that changes whenever the mesh behind `key` is replaced, unique across all scenes.
     #[must_use]
     pub fn mesh_version(&self, key: MeshKey) -> Option<u64> {
         self.meshes.get(key).map(|e| e.version)
@@ -385,8 +387,7 @@ impl Scene {
     /// # Errors
     /// [`SceneError::UnknownKey`] for a removed or foreign key.
     pub fn replace_mesh(&mut self, key: MeshKey, mesh: Mesh) -> Result<(), SceneError> {
-        self.next_mesh_version += 1;
-        let version = self.next_mesh_version;
+        let version = next_mesh_version();
         let entry = self.meshes.get_mut(key).ok_or(SceneError::UnknownKey("mesh"))?;
         *entry = MeshEntry { mesh: Arc::new(mesh), adjacency: OnceLock::new(), version };
         Ok(())
@@ -702,6 +703,16 @@ mod tests {
         assert!(s.set_local_transform(a, Mat4::from_scale(Vec3::splat(f32::NAN))).is_err());
         s.remove_node(a).unwrap();
         assert_eq!(s.node_count(), 0);
+    }
+
+    #[test]
+    fn mesh_versions_differ_across_scenes() {
+        // Two scenes give out the same first key; a GPU cache keyed by (key, version) must not mix them.
+        let (mut a, mut b) = (Scene::new(), Scene::new());
+        let ka = a.add_mesh(procedural::cuboid(Vec3::ONE));
+        let kb = b.add_mesh(procedural::plane(1.0, 1.0));
+        assert_eq!(ka, kb);
+        assert_ne!(a.mesh_version(ka), b.mesh_version(kb));
     }
 
     #[test]

@@ -2,3 +2,4 @@
 //! conformance.
 
 mod cli;
+mod suite;

@@ -1,0 +1,272 @@
+//! Headless wgpu: instance, adapter choice, device and queue, with errors for everything a caller cannot
+//! foresee (no adapter, a missing feature, a lost device, a validation failure).
+//!
+//! Adapter choice: a name substring (through [`AdapterChoice`], the CLI's `--adapter` or the
+//! `SHADOWLAB_ADAPTER` variable) picks that adapter; otherwise the first hardware adapter (discrete, then
+//! integrated, then virtual). Software adapters (lavapipe) are used only when asked for by name or when
+//! [`AdapterChoice::allow_software`] is set.
+
+use std::sync::{Arc, Mutex};
+
+use shadow_core::frame::FrameError;
+use shadow_core::light::LightViewError;
+use shadow_core::technique::{Backend, TechniqueError};
+
+/// Errors of the wgpu backend.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum WgpuError {
+    /// No adapter matches the request.
+    #[error("no suitable GPU adapter: {0}")]
+    NoAdapter(String),
+    /// The adapter lacks something the techniques need.
+    #[error("adapter '{adapter}' lacks {what}")]
+    MissingFeature {
+        /// The adapter.
+        adapter: String,
+        /// What is missing.
+        what: String,
+    },
+    /// The device could not be created.
+    #[error("cannot create a device on '{adapter}': {why}")]
+    Device {
+        /// The adapter.
+        adapter: String,
+        /// Why.
+        why: String,
+    },
+    /// The device was lost (driver reset, removal).
+    #[error("the GPU device was lost: {0}")]
+    DeviceLost(String),
+    /// A wgpu validation or out-of-memory error.
+    #[error("GPU error during {during}: {message}")]
+    Gpu {
+        /// What was being done.
+        during: String,
+        /// wgpu's message.
+        message: String,
+    },
+    /// A request over the adapter's limits or this backend's own.
+    #[error("{what} of {width}x{height} cannot be rendered: {why}")]
+    BadSize {
+        /// What was being sized.
+        what: &'static str,
+        /// Width.
+        width: u64,
+        /// Height.
+        height: u64,
+        /// Why not.
+        why: String,
+    },
+    /// A shared technique error.
+    #[error(transparent)]
+    Technique(#[from] TechniqueError),
+    /// The frame could not be assembled.
+    #[error(transparent)]
+    Frame(#[from] FrameError),
+    /// No light view could be fitted.
+    #[error(transparent)]
+    LightView(#[from] LightViewError),
+}
+
+/// The wgpu backend.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct WgpuBackend;
+
+impl Backend for WgpuBackend {
+    type Context = WgpuContext;
+    type GBuffer = crate::gbuffer::GpuGBuffer;
+    type Visibility = crate::frame::GpuVisibility;
+    type Error = WgpuError;
+    const NAME: &'static str = "wgpu";
+}
+
+/// Which adapter to use.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct AdapterChoice {
+    /// Case-insensitive substring of the adapter's name; `None` reads `SHADOWLAB_ADAPTER`.
+    pub name: Option<String>,
+    /// Accept a software adapter when no hardware one exists.
+    pub allow_software: bool,
+}
+
+/// What an adapter is.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct AdapterSummary {
+    /// Its name.
+    pub name: String,
+    /// Its backend (Vulkan, Metal, ...).
+    pub backend: String,
+    /// Discrete, integrated, virtual, CPU or other.
+    pub kind: String,
+    /// A software rasterizer (lavapipe, WARP, SwiftShader).
+    pub software: bool,
+}
+
+impl AdapterSummary {
+    fn of(info: &wgpu::AdapterInfo) -> Self {
+        Self {
+            name: info.name.clone(),
+            backend: format!("{:?}", info.backend),
+            kind: format!("{:?}", info.device_type),
+            software: info.device_type == wgpu::DeviceType::Cpu,
+        }
+    }
+}
+
+/// Device, queue and what the adapter can do.
+pub struct WgpuContext {
+    /// The adapter's description.
+    pub adapter: AdapterSummary,
+    /// The device.
+    pub device: wgpu::Device,
+    /// Its queue.
+    pub queue: wgpu::Queue,
+    /// Timestamp queries are available.
+    pub timestamps: bool,
+    lost: Arc<Mutex<Option<String>>>,
+    pub(crate) cache: crate::upload::SceneCache,
+    pub(crate) shared: crate::pipelines::Shared,
+}
+
+/// The instance. Set `XDG_RUNTIME_DIR` (CI does) to keep the Vulkan loader quiet on headless machines.
+fn instance() -> wgpu::Instance {
+    wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle())
+}
+
+/// Every adapter the instance sees.
+#[must_use]
+pub fn list_adapters() -> Vec<AdapterSummary> {
+    let inst = instance();
+    pollster::block_on(inst.enumerate_adapters(wgpu::Backends::all()))
+        .iter()
+        .map(|a| AdapterSummary::of(&a.get_info()))
+        .collect()
+}
+
+fn rank(info: &wgpu::AdapterInfo) -> u8 {
+    match info.device_type {
+        wgpu::DeviceType::DiscreteGpu => 0,
+        wgpu::DeviceType::IntegratedGpu => 1,
+        wgpu::DeviceType::VirtualGpu => 2,
+        wgpu::DeviceType::Other => 3,
+        wgpu::DeviceType::Cpu => 4,
+    }
+}
+
+impl WgpuContext {
+    /// Opens an adapter and a device.
+    ///
+    /// # Errors
+    /// No matching adapter, a missing feature, or a device that cannot be created.
+    pub fn new(choice: &AdapterChoice) -> Result<Self, WgpuError> {
+        let inst = instance();
+        let adapters = pollster::block_on(inst.enumerate_adapters(wgpu::Backends::all()));
+        let wanted = choice.name.clone().or_else(|| std::env::var("SHADOWLAB_ADAPTER").ok()).filter(|s| !s.is_empty());
+        let all: Vec<String> = adapters.iter().map(|a| a.get_info().name).collect();
+        let adapter = match &wanted {
+            Some(name) => {
+                let n = name.to_lowercase();
+                adapters.into_iter().find(|a| a.get_info().name.to_lowercase().contains(&n)).ok_or_else(|| {
+                    WgpuError::NoAdapter(format!(
+                        "none named like '{name}' (adapters: {})",
+                        if all.is_empty() { "none".into() } else { all.join(", ") }
+                    ))
+                })?
+            }
+            None => {
+                let mut candidates: Vec<wgpu::Adapter> = adapters
+                    .into_iter()
+                    .filter(|a| choice.allow_software || a.get_info().device_type != wgpu::DeviceType::Cpu)
+                    .collect();
+                candidates.sort_by_key(|a| rank(&a.get_info()));
+                candidates.into_iter().next().ok_or_else(|| {
+                    WgpuError::NoAdapter(if all.is_empty() {
+                        "no adapter at all (install a Vulkan driver; mesa-vulkan-drivers gives a software one)".into()
+                    } else {
+                        format!("no hardware adapter (software ones: {}; ask for one by name)", all.join(", "))
+                    })
+                })?
+            }
+        };
+        let info = adapter.get_info();
+        let summary = AdapterSummary::of(&info);
+        let features = adapter.features();
+        let needed = wgpu::Features::DEPTH32FLOAT_STENCIL8;
+        if !features.contains(needed) {
+            return Err(WgpuError::MissingFeature {
+                adapter: info.name,
+                what: "the Depth32FloatStencil8 format".into(),
+            });
+        }
+        let timestamps = features.contains(wgpu::Features::TIMESTAMP_QUERY);
+        let required_features =
+            needed | if timestamps { wgpu::Features::TIMESTAMP_QUERY } else { wgpu::Features::empty() };
+        let limits = adapter.limits();
+        let desc = wgpu::DeviceDescriptor {
+            label: Some("shadowlab"),
+            required_features,
+            required_limits: limits,
+            ..Default::default()
+        };
+        let (device, queue) = pollster::block_on(adapter.request_device(&desc))
+            .map_err(|e| WgpuError::Device { adapter: info.name.clone(), why: e.to_string() })?;
+        let lost = Arc::new(Mutex::new(None));
+        let flag = lost.clone();
+        device.set_device_lost_callback(move |reason, msg| {
+            if let Ok(mut l) = flag.lock() {
+                *l = Some(format!("{reason:?}: {msg}"));
+            }
+        });
+        let shared = crate::pipelines::Shared::new(&device);
+        Ok(Self {
+            adapter: summary,
+            device,
+            queue,
+            timestamps,
+            lost,
+            cache: crate::upload::SceneCache::default(),
+            shared,
+        })
+    }
+
+    /// Fails if the device was lost.
+    ///
+    /// # Errors
+    /// [`WgpuError::DeviceLost`].
+    pub fn check_lost(&self) -> Result<(), WgpuError> {
+        match self.lost.lock().ok().and_then(|l| l.clone()) {
+            Some(why) => Err(WgpuError::DeviceLost(why)),
+            None => Ok(()),
+        }
+    }
+
+    /// Runs `f` inside validation and out-of-memory error scopes and turns anything they catch into an
+    /// error naming `during`.
+    ///
+    /// # Errors
+    /// What the scopes caught, or a lost device.
+    pub fn scoped<R>(&self, during: &str, f: impl FnOnce(&Self) -> R) -> Result<R, WgpuError> {
+        self.check_lost()?;
+        let oom = self.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
+        let validation = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let r = f(self);
+        let v = pollster::block_on(validation.pop());
+        let o = pollster::block_on(oom.pop());
+        if let Some(e) = v.or(o) {
+            return Err(WgpuError::Gpu { during: during.into(), message: e.to_string() });
+        }
+        self.check_lost()?;
+        Ok(r)
+    }
+
+    /// Waits for all submitted work.
+    ///
+    /// # Errors
+    /// A lost device or a poll failure.
+    pub fn wait(&self) -> Result<(), WgpuError> {
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| WgpuError::Gpu { during: "wait".into(), message: e.to_string() })?;
+        self.check_lost()
+    }
+}

@@ -1,0 +1,215 @@
+//! One frame on the GPU (DESIGN 5): G-buffer, then per light a build and a query into a layer of the
+//! visibility array, then shading; results read back into images. Every phase ends with the queue
+//! drained, so its wall-clock time is the GPU's time for it.
+
+use std::time::Instant;
+
+use shadow_core::image::Rgb8;
+use shadow_core::light::LightView;
+use shadow_core::scene::LightKind;
+use shadow_core::stats::{Phase, ms};
+use shadow_core::technique::{DynShadowTechnique, FrameStats};
+use shadow_core::{FrameInputs, Image};
+use wgpu::util::DeviceExt;
+
+use crate::context::{WgpuBackend, WgpuContext, WgpuError};
+use crate::gbuffer::{self, GpuGBuffer};
+use crate::pipelines::{COLOR, VISIBILITY};
+use crate::readback;
+
+/// One light's visibility on the GPU: a render target layer (R32Float, 1 lit, 0 shadowed).
+pub struct GpuVisibility {
+    /// The layer to render into.
+    pub view: wgpu::TextureView,
+    /// Width.
+    pub width: u32,
+    /// Height.
+    pub height: u32,
+}
+
+/// Everything a GPU frame produced, read back.
+pub struct WgpuFrame {
+    /// The fitted view of each light.
+    pub light_views: Vec<LightView>,
+    /// Visibility per light.
+    pub visibility: Vec<Image<f32>>,
+    /// The shaded image.
+    pub color: Image<Rgb8>,
+    /// Counters (summed over lights) and phase times.
+    pub stats: FrameStats,
+}
+
+/// GPU twin of `Light` in common.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct LightRaw {
+    kind: [u32; 4],
+    position: [f32; 4],
+    direction: [f32; 4],
+    cone: [f32; 4],
+    color: [f32; 4],
+}
+
+impl LightRaw {
+    fn of(l: &shadow_core::scene::Light) -> Self {
+        let (kind, position, direction, cone) = match l.kind {
+            LightKind::Spot { position, direction, cone_angle } => {
+                let half = cone_angle * 0.5;
+                (
+                    0,
+                    position,
+                    direction.normalize(),
+                    [half.cos(), (half * (1.0 - shadow_core::shading::SPOT_SOFT_EDGE)).cos()],
+                )
+            }
+            LightKind::Directional { direction } => (1, glam::Vec3::ZERO, direction.normalize(), [0.0, 0.0]),
+            LightKind::Point { position } => (2, position, glam::Vec3::NEG_Y, [0.0, 0.0]),
+        };
+        Self {
+            kind: [kind, 0, 0, 0],
+            position: position.extend(1.0).to_array(),
+            direction: direction.extend(0.0).to_array(),
+            cone: [cone[0], cone[1], 0.0, 0.0],
+            color: (l.color * l.intensity).extend(1.0).to_array(),
+        }
+    }
+}
+
+fn layered(cx: &WgpuContext, label: &str, w: u32, h: u32, layers: u32, format: wgpu::TextureFormat) -> wgpu::Texture {
+    cx.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: layers },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+            | wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::COPY_SRC,
+        view_formats: &[],
+    })
+}
+
+/// A view of one layer of a 2D array texture.
+#[must_use]
+pub fn layer_view(tex: &wgpu::Texture, layer: u32) -> wgpu::TextureView {
+    tex.create_view(&wgpu::TextureViewDescriptor {
+        dimension: Some(wgpu::TextureViewDimension::D2),
+        base_array_layer: layer,
+        array_layer_count: Some(1),
+        ..Default::default()
+    })
+}
+
+/// Renders a frame with one technique for every light of the frame.
+///
+/// # Errors
+/// A bad view size, an unsupported light, or a GPU failure.
+pub fn render_frame(
+    cx: &mut WgpuContext,
+    frame: &FrameInputs,
+    width: u32,
+    height: u32,
+    technique: &mut dyn DynShadowTechnique<WgpuBackend>,
+) -> Result<WgpuFrame, WgpuError> {
+    let start = Instant::now();
+    let mut stats = FrameStats::default();
+
+    let t = Instant::now();
+    let g = gbuffer::render(cx, frame, width, height)?;
+    cx.wait()?;
+    stats.timings.add(Phase::GBuffer, ms(t.elapsed()));
+
+    let layers = frame.lights.len().max(1) as u32;
+    let vis_tex = layered(cx, "visibility", width, height, layers, VISIBILITY);
+    let mut light_views = Vec::new();
+    for (k, light) in frame.lights.iter().enumerate() {
+        let view = frame.light_view(light)?;
+        let mut light_stats = FrameStats::default();
+        let t = Instant::now();
+        technique.build(cx, frame, &view, &mut light_stats)?;
+        cx.wait()?;
+        stats.timings.add(Phase::Build, ms(t.elapsed()));
+        let mut out = GpuVisibility { view: layer_view(&vis_tex, k as u32), width, height };
+        let t = Instant::now();
+        technique.query(cx, frame, &view, &g, &mut out, &mut light_stats)?;
+        cx.wait()?;
+        stats.timings.add(Phase::Query, ms(t.elapsed()));
+        stats.counters.merge(&light_stats.counters);
+        for (key, v) in light_stats.timings.extra {
+            *stats.timings.extra.entry(key).or_insert(0.0) += v;
+        }
+        light_views.push(view);
+    }
+
+    let t = Instant::now();
+    let color_tex = shade(cx, frame, &g, &vis_tex)?;
+    cx.wait()?;
+    stats.timings.add(Phase::Shade, ms(t.elapsed()));
+    stats.timings.total = ms(start.elapsed());
+
+    let color = readback::read_rgb8(cx, &color_tex)?;
+    let visibility = (0..frame.lights.len() as u32)
+        .map(|k| readback::read_f32(cx, &vis_tex, k, wgpu::TextureAspect::All))
+        .collect::<Result<_, _>>()?;
+    Ok(WgpuFrame { light_views, visibility, color, stats })
+}
+
+fn shade(
+    cx: &WgpuContext,
+    frame: &FrameInputs,
+    g: &GpuGBuffer,
+    vis: &wgpu::Texture,
+) -> Result<wgpu::Texture, WgpuError> {
+    cx.scoped("the shading pass", |cx| {
+        let color = layered(cx, "color", g.width, g.height, 1, COLOR);
+        let lights: Vec<LightRaw> = frame.lights.iter().map(LightRaw::of).collect();
+        let lights = if lights.is_empty() { vec![bytemuck::Zeroable::zeroed()] } else { lights };
+        let lbuf = cx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("lights"),
+            contents: bytemuck::cast_slice(&lights),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        let vis_view = vis.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        });
+        let group = cx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("shade"),
+            layout: &cx.shared.shade_layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&g.position) },
+                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&g.normal) },
+                wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&g.albedo) },
+                wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&vis_view) },
+                wgpu::BindGroupEntry { binding: 4, resource: lbuf.as_entire_binding() },
+            ],
+        });
+        let view = color.create_view(&Default::default());
+        let mut enc = cx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("shade") });
+        {
+            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("shade"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: &view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                depth_stencil_attachment: None,
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_pipeline(&cx.shared.shade);
+            pass.set_bind_group(0, &g.frame_group, &[]);
+            pass.set_bind_group(1, &group, &[]);
+            pass.draw(0..3, 0..1);
+        }
+        cx.queue.submit([enc.finish()]);
+        color
+    })
+}

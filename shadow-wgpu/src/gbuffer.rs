@@ -1,0 +1,144 @@
+//! The camera G-buffer on the GPU: Depth32FloatStencil8 plus world position (w: receives shadow),
+//! shading normal and albedo (w: covered), all f32 so shading matches the CPU's.
+
+use shadow_core::FrameInputs;
+use shadow_core::scene::Camera;
+
+use crate::context::{WgpuContext, WgpuError};
+use crate::pipelines::{ATTRIBUTE, DEPTH_STENCIL, ViewRaw};
+
+/// The camera view of a frame, on the GPU.
+pub struct GpuGBuffer {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// The camera.
+    pub camera: Camera,
+    /// Depth and stencil.
+    pub depth: wgpu::Texture,
+    /// World position, w = receives shadow.
+    pub position: wgpu::TextureView,
+    /// Shading normal.
+    pub normal: wgpu::TextureView,
+    /// Albedo, w = covered.
+    pub albedo: wgpu::TextureView,
+    /// Group 0 for the camera view.
+    pub frame_group: wgpu::BindGroup,
+}
+
+impl GpuGBuffer {
+    /// A view of the depth-stencil texture.
+    #[must_use]
+    pub fn depth_view(&self) -> wgpu::TextureView {
+        self.depth.create_view(&wgpu::TextureViewDescriptor::default())
+    }
+}
+
+/// Largest view side, on top of the adapter's own limit.
+pub const MAX_VIEW_SIDE: u32 = 16384;
+
+/// Checks a view size against this backend's and the adapter's limits.
+///
+/// # Errors
+/// [`WgpuError::BadSize`].
+pub fn check_size(cx: &WgpuContext, what: &'static str, width: u32, height: u32) -> Result<(), WgpuError> {
+    let limit = cx.device.limits().max_texture_dimension_2d.min(MAX_VIEW_SIDE);
+    let why = if width == 0 || height == 0 {
+        "a side is zero".to_string()
+    } else if width > limit || height > limit {
+        format!("a side is over the limit of {limit}")
+    } else {
+        return Ok(());
+    };
+    Err(WgpuError::BadSize { what, width: u64::from(width), height: u64::from(height), why })
+}
+
+fn target(cx: &WgpuContext, label: &str, w: u32, h: u32, format: wgpu::TextureFormat) -> wgpu::Texture {
+    cx.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+            | wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::COPY_SRC,
+        view_formats: &[],
+    })
+}
+
+/// Renders the G-buffer of a frame.
+///
+/// # Errors
+/// A bad size or a GPU failure.
+pub fn render(cx: &mut WgpuContext, frame: &FrameInputs, width: u32, height: u32) -> Result<GpuGBuffer, WgpuError> {
+    check_size(cx, "view", width, height)?;
+    cx.cache.upload_meshes(&cx.device, frame);
+    let instances = cx.cache.instances(&cx.device, frame).clone();
+    cx.scoped("the G-buffer pass", |cx| {
+        let clip_from_world = frame.camera.clip_from_world(width as f32 / height as f32);
+        let frame_group = cx.shared.frame_group(
+            &cx.device,
+            &ViewRaw::new(clip_from_world, frame.camera.eye, width, height),
+            &instances,
+        );
+        let depth = target(cx, "depth", width, height, DEPTH_STENCIL);
+        let [position, normal, albedo] = ["position", "normal", "albedo"]
+            .map(|l| target(cx, l, width, height, ATTRIBUTE).create_view(&Default::default()));
+        let depth_view = depth.create_view(&Default::default());
+        let mut enc = cx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("gbuffer") });
+        {
+            let clear = |v| {
+                Some(wgpu::RenderPassColorAttachment {
+                    view: v,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })
+            };
+            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("gbuffer"),
+                color_attachments: &[clear(&position), clear(&normal), clear(&albedo)],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &depth_view,
+                    depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
+                    stencil_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(0), store: wgpu::StoreOp::Store }),
+                }),
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.push_debug_group("gbuffer");
+            pass.set_pipeline(&cx.shared.gbuffer);
+            pass.set_bind_group(0, &frame_group, &[]);
+            draw_instances(cx, &mut pass, frame, |_| true, true);
+            pass.pop_debug_group();
+        }
+        cx.queue.submit([enc.finish()]);
+        GpuGBuffer { width, height, camera: frame.camera, depth, position, normal, albedo, frame_group }
+    })
+}
+
+/// Draws every instance that passes `keep` with its own mesh (instance index = frame instance index).
+pub fn draw_instances(
+    cx: &WgpuContext,
+    pass: &mut wgpu::RenderPass<'_>,
+    frame: &FrameInputs,
+    keep: impl Fn(&shadow_core::Instance) -> bool,
+    normals: bool,
+) {
+    for (i, inst) in frame.instances.iter().enumerate().filter(|(_, i)| keep(i)) {
+        let Some(m) = cx.cache.mesh(inst.mesh_key) else { continue };
+        pass.set_vertex_buffer(0, m.positions.slice(..));
+        if normals {
+            pass.set_vertex_buffer(1, m.normals.slice(..));
+        }
+        pass.set_index_buffer(m.indices.slice(..), wgpu::IndexFormat::Uint32);
+        pass.draw_indexed(0..m.index_count, 0, i as u32..i as u32 + 1);
+    }
+}

@@ -1,0 +1,227 @@
+//! State every pass shares: the frame bind-group layout (view uniform and instance data), the
+//! G-buffer and shading pipelines, and the formats.
+
+use bytemuck::{Pod, Zeroable};
+use glam::{Mat4, Vec3};
+use wgpu::util::DeviceExt;
+
+use crate::shaders;
+
+/// The camera's depth and stencil.
+pub const DEPTH_STENCIL: wgpu::TextureFormat = wgpu::TextureFormat::Depth32FloatStencil8;
+/// Light-space depth maps.
+pub const MAP_DEPTH: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+/// G-buffer attributes.
+pub const ATTRIBUTE: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+/// Visibility.
+pub const VISIBILITY: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
+/// The shaded image (sRGB encoded by the shader).
+pub const COLOR: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+
+/// GPU twin of `View` in common.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+pub struct ViewRaw {
+    clip_from_world: [[f32; 4]; 4],
+    eye: [f32; 4],
+    size: [f32; 4],
+}
+
+impl ViewRaw {
+    /// A view of a `width x height` target.
+    #[must_use]
+    pub fn new(clip_from_world: Mat4, eye: Vec3, width: u32, height: u32) -> Self {
+        let (w, h) = (width as f32, height as f32);
+        Self {
+            clip_from_world: clip_from_world.to_cols_array_2d(),
+            eye: eye.extend(1.0).to_array(),
+            size: [w, h, 1.0 / w, 1.0 / h],
+        }
+    }
+}
+
+/// Vertex layout of homogeneous positions (location 0).
+pub const POSITION_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
+    array_stride: 16,
+    step_mode: wgpu::VertexStepMode::Vertex,
+    attributes: &wgpu::vertex_attr_array![0 => Float32x4],
+};
+
+/// Vertex layout of normals (location 1).
+pub const NORMAL_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
+    array_stride: 16,
+    step_mode: wgpu::VertexStepMode::Vertex,
+    attributes: &wgpu::vertex_attr_array![1 => Float32x4],
+};
+
+fn texture_entry(
+    binding: u32,
+    sample_type: wgpu::TextureSampleType,
+    dim: wgpu::TextureViewDimension,
+) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Texture { sample_type, view_dimension: dim, multisampled: false },
+        count: None,
+    }
+}
+
+/// An unfilterable float 2D texture binding (G-buffer attributes).
+#[must_use]
+pub fn attribute_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    texture_entry(binding, wgpu::TextureSampleType::Float { filterable: false }, wgpu::TextureViewDimension::D2)
+}
+
+/// A uniform or storage buffer binding.
+#[must_use]
+pub fn buffer_entry(
+    binding: u32,
+    ty: wgpu::BufferBindingType,
+    visibility: wgpu::ShaderStages,
+) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Buffer { ty, has_dynamic_offset: false, min_binding_size: None },
+        count: None,
+    }
+}
+
+/// Pipelines and layouts every frame uses.
+pub struct Shared {
+    /// Group 0: view uniform and instance data.
+    pub frame_layout: wgpu::BindGroupLayout,
+    /// The G-buffer pipeline.
+    pub gbuffer: wgpu::RenderPipeline,
+    /// Group 1 of the shading pass.
+    pub shade_layout: wgpu::BindGroupLayout,
+    /// The shading pipeline.
+    pub shade: wgpu::RenderPipeline,
+}
+
+impl Shared {
+    /// Creates the shared pipelines.
+    #[must_use]
+    pub fn new(device: &wgpu::Device) -> Self {
+        let all = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
+        let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("frame"),
+            entries: &[
+                buffer_entry(0, wgpu::BufferBindingType::Uniform, all),
+                buffer_entry(1, wgpu::BufferBindingType::Storage { read_only: true }, all),
+            ],
+        });
+        let gmod = shaders::module(device, "gbuffer", shaders::gbuffer());
+        let glayout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("gbuffer"),
+            bind_group_layouts: &[Some(&frame_layout)],
+            immediate_size: 0,
+        });
+        let target =
+            Some(wgpu::ColorTargetState { format: ATTRIBUTE, blend: None, write_mask: wgpu::ColorWrites::ALL });
+        let gbuffer = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("gbuffer"),
+            layout: Some(&glayout),
+            vertex: wgpu::VertexState {
+                module: &gmod,
+                entry_point: Some("vs_gbuffer"),
+                compilation_options: Default::default(),
+                buffers: &[Some(POSITION_LAYOUT), Some(NORMAL_LAYOUT)],
+            },
+            primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: DEPTH_STENCIL,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::Less),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &gmod,
+                entry_point: Some("fs_gbuffer"),
+                compilation_options: Default::default(),
+                targets: &[target.clone(), target.clone(), target],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        let shade_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("shade"),
+            entries: &[
+                attribute_entry(0),
+                attribute_entry(1),
+                attribute_entry(2),
+                texture_entry(
+                    3,
+                    wgpu::TextureSampleType::Float { filterable: false },
+                    wgpu::TextureViewDimension::D2Array,
+                ),
+                buffer_entry(4, wgpu::BufferBindingType::Storage { read_only: true }, wgpu::ShaderStages::FRAGMENT),
+            ],
+        });
+        let smod = shaders::module(device, "shade", shaders::shade());
+        let shade =
+            full_screen_pipeline(device, "shade", &smod, "fs_shade", &[&frame_layout, &shade_layout], COLOR, None);
+        Self { frame_layout, gbuffer, shade_layout, shade }
+    }
+
+    /// A group-0 bind group for a view (camera or light) over a frame's instances.
+    #[must_use]
+    pub fn frame_group(&self, device: &wgpu::Device, view: &ViewRaw, instances: &wgpu::Buffer) -> wgpu::BindGroup {
+        let ubuf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("view"),
+            contents: bytemuck::bytes_of(view),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("frame"),
+            layout: &self.frame_layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: ubuf.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: instances.as_entire_binding() },
+            ],
+        })
+    }
+}
+
+/// A pipeline drawing `vs_full_screen` into one colour target, optionally with a depth-stencil state.
+#[must_use]
+pub fn full_screen_pipeline(
+    device: &wgpu::Device,
+    label: &str,
+    module: &wgpu::ShaderModule,
+    fragment: &str,
+    groups: &[&wgpu::BindGroupLayout],
+    format: wgpu::TextureFormat,
+    depth_stencil: Option<wgpu::DepthStencilState>,
+) -> wgpu::RenderPipeline {
+    let groups: Vec<Option<&wgpu::BindGroupLayout>> = groups.iter().map(|g| Some(*g)).collect();
+    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(label),
+        bind_group_layouts: &groups,
+        immediate_size: 0,
+    });
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(label),
+        layout: Some(&layout),
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some("vs_full_screen"),
+            compilation_options: Default::default(),
+            buffers: &[],
+        },
+        primitive: Default::default(),
+        depth_stencil,
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module,
+            entry_point: Some(fragment),
+            compilation_options: Default::default(),
+            targets: &[Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL })],
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}

@@ -1,0 +1,77 @@
+//! WGSL sources. Each is `common.wgsl` followed by its own file; the shadow-map shader also gets the
+//! Poisson disk generated from shadow-core's constant, so the two backends share one table.
+
+use std::fmt::Write;
+
+const COMMON: &str = include_str!("shaders/common.wgsl");
+
+/// `common.wgsl` + `body`.
+fn with_common(body: &str) -> String {
+    format!("{COMMON}\n{body}")
+}
+
+/// The Poisson disk of `shadow_core::lookup::POISSON16` as a WGSL constant.
+fn poisson_constant() -> String {
+    let mut s = String::from("const POISSON16 = array<vec2<f32>, 16>(");
+    for (i, p) in shadow_core::lookup::POISSON16.iter().enumerate() {
+        let _ = write!(s, "{}vec2<f32>({:?}, {:?})", if i == 0 { "" } else { ", " }, p.x, p.y);
+    }
+    s.push_str(");\n");
+    s
+}
+
+/// G-buffer pass.
+#[must_use]
+pub fn gbuffer() -> String {
+    with_common(include_str!("shaders/gbuffer.wgsl"))
+}
+
+/// Shading pass.
+#[must_use]
+pub fn shade() -> String {
+    with_common(include_str!("shaders/shade.wgsl"))
+}
+
+/// Shadow-map light pass and query.
+#[must_use]
+pub fn shadow_map() -> String {
+    with_common(&format!("{}{}", poisson_constant(), include_str!("shaders/shadow_map.wgsl")))
+}
+
+/// Shadow-volume pass and resolve.
+#[must_use]
+pub fn shadow_volume() -> String {
+    with_common(include_str!("shaders/shadow_volume.wgsl"))
+}
+
+/// Every shader, by name, for validation.
+#[must_use]
+pub fn all() -> Vec<(&'static str, String)> {
+    vec![("gbuffer", gbuffer()), ("shade", shade()), ("shadow_map", shadow_map()), ("shadow_volume", shadow_volume())]
+}
+
+/// A shader module from WGSL text.
+#[must_use]
+pub fn module(device: &wgpu::Device, label: &str, source: String) -> wgpu::ShaderModule {
+    device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(label),
+        source: wgpu::ShaderSource::Wgsl(source.into()),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    /// Every WGSL source parses and validates with naga, so a shader error fails `cargo test`, not a user.
+    #[test]
+    fn every_shader_validates() {
+        for (name, src) in super::all() {
+            let module =
+                naga::front::wgsl::parse_str(&src).unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&src)));
+            let mut v =
+                naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all());
+            if let Err(e) = v.validate(&module) {
+                panic!("{name}: {}", e.emit_to_string(&src));
+            }
+        }
+    }
+}

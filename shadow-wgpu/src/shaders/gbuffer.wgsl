@@ -1,0 +1,42 @@
+// The camera G-buffer: world position (w: receives shadow), shading normal, albedo (w: covered).
+
+struct GOut {
+    @invariant @builtin(position) pos: vec4<f32>,
+    @location(0) world: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) @interpolate(flat) instance: u32,
+};
+
+@vertex
+fn vs_gbuffer(@location(0) p: vec4<f32>, @location(1) n: vec4<f32>, @builtin(instance_index) instance: u32) -> GOut {
+    var out: GOut;
+    let inst = instances[instance];
+    out.pos = clip_position(instance, p);
+    out.world = (inst.world_from_local * p).xyz;
+    out.normal = (inst.normal_from_local * vec4<f32>(n.xyz, 0.0)).xyz;
+    out.instance = instance;
+    return out;
+}
+
+struct GTargets {
+    @location(0) position: vec4<f32>,
+    @location(1) normal: vec4<f32>,
+    @location(2) albedo: vec4<f32>,
+};
+
+@fragment
+fn fs_gbuffer(in: GOut, @builtin(front_facing) front: bool) -> GTargets {
+    let inst = instances[in.instance];
+    var n = normalize(in.normal);
+    // Twin: shadow-cpu's G-buffer resolve turns a two-sided surface's normal to the side that is seen. A
+    // mirroring transform winds front faces clockwise, so its `front_facing` is reversed.
+    let seen_front = front != (inst.flags.y != 0u);
+    if (!seen_front && inst.color.w != 0.0) {
+        n = -n;
+    }
+    var out: GTargets;
+    out.position = vec4<f32>(in.world, f32(inst.flags.x));
+    out.normal = vec4<f32>(n, 0.0);
+    out.albedo = vec4<f32>(inst.color.xyz, 1.0);
+    return out;
+}

@@ -1,0 +1,28 @@
+// Shading and composition (twin: shadow-cpu's shade.rs): Lambert, ambient 0.15, cone falloff, sRGB.
+
+@group(1) @binding(0) var g_position: texture_2d<f32>;
+@group(1) @binding(1) var g_normal: texture_2d<f32>;
+@group(1) @binding(2) var g_albedo: texture_2d<f32>;
+@group(1) @binding(3) var visibility: texture_2d_array<f32>;
+@group(1) @binding(4) var<storage, read> lights: array<Light>;
+
+const AMBIENT: f32 = 0.15;
+const BACKGROUND: vec3<f32> = vec3<f32>(0.02, 0.025, 0.04);
+
+@fragment
+fn fs_shade(in: FullScreen) -> @location(0) vec4<f32> {
+    let px = vec2<i32>(in.pos.xy);
+    let albedo = textureLoad(g_albedo, px, 0);
+    var c = BACKGROUND;
+    if (albedo.w > 0.0) {
+        let p = textureLoad(g_position, px, 0).xyz;
+        let n = textureLoad(g_normal, px, 0).xyz;
+        var direct = vec3<f32>(0.0);
+        for (var i = 0u; i < arrayLength(&lights); i = i + 1u) {
+            let v = textureLoad(visibility, px, i32(i), 0).x;
+            direct = direct + direct_light(lights[i], p, n) * v;
+        }
+        c = albedo.xyz * (vec3<f32>(AMBIENT) + direct);
+    }
+    return vec4<f32>(linear_to_srgb(c.x), linear_to_srgb(c.y), linear_to_srgb(c.z), 1.0);
+}

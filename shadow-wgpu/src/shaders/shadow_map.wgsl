@@ -1,0 +1,120 @@
+// shadow-map: the light pass (depth only) and the query (twin: shadow_core::lookup).
+
+struct MapParams {
+    // One projection, or six cube faces (+X, -X, +Y, -Y, +Z, -Z).
+    proj: array<mat4x4<f32>, 6>,
+    // xyz: light position; w: 1 for a point light (cube faces), else 0
+    light: vec4<f32>,
+    // x: filter (0 none, 1 bilinear, 2 pcf3x3, 3 pcf4x4-jitter, 4 poisson16), y: radius in texels, z: map side
+    settings: vec4<f32>,
+};
+
+@group(1) @binding(0) var g_position: texture_2d<f32>;
+@group(1) @binding(1) var shadow_maps: texture_depth_2d_array;
+@group(1) @binding(2) var shadow_cmp: sampler_comparison;
+@group(1) @binding(3) var<uniform> map: MapParams;
+
+struct DepthOut {
+    @invariant @builtin(position) pos: vec4<f32>,
+};
+
+@vertex
+fn vs_light_depth(@location(0) p: vec4<f32>, @builtin(instance_index) instance: u32) -> DepthOut {
+    var out: DepthOut;
+    out.pos = clip_position(instance, p);
+    return out;
+}
+
+// Twin: shadow_core::light::cube_face.
+fn cube_face(d: vec3<f32>) -> i32 {
+    let a = abs(d);
+    if (a.x >= a.y && a.x >= a.z) {
+        return select(1, 0, d.x >= 0.0);
+    }
+    if (a.y >= a.z) {
+        return select(3, 2, d.y >= 0.0);
+    }
+    return select(5, 4, d.z >= 0.0);
+}
+
+// Twin: shadow_core::lookup::compare_texel.
+fn compare_texel(layer: i32, x: i32, y: i32, depth: f32) -> f32 {
+    let n = i32(map.settings.z);
+    let v = textureLoad(shadow_maps, vec2<i32>(clamp(x, 0, n - 1), clamp(y, 0, n - 1)), layer, 0);
+    return select(0.0, 1.0, depth <= v);
+}
+
+// Twin: shadow_core::lookup::compare_nearest.
+fn compare_nearest(layer: i32, uv: vec2<f32>, depth: f32) -> f32 {
+    let t = floor(uv * map.settings.z);
+    return compare_texel(layer, i32(t.x), i32(t.y), depth);
+}
+
+// Twin: shadow_core::lookup::compare_bilinear, done by the comparison sampler.
+fn compare_bilinear(layer: i32, uv: vec2<f32>, depth: f32) -> f32 {
+    return textureSampleCompareLevel(shadow_maps, shadow_cmp, uv, layer, depth);
+}
+
+// Twin: shadow_core::lookup::shadow_lookup.
+fn shadow_lookup(layer: i32, uv: vec2<f32>, depth: f32, pixel: vec2<u32>) -> f32 {
+    if (uv.x < 0.0 || uv.x > 1.0 || uv.y < 0.0 || uv.y > 1.0) {
+        return 1.0;
+    }
+    let kind = u32(map.settings.x);
+    let radius = map.settings.y;
+    let texel = 1.0 / map.settings.z;
+    if (kind == 0u) {
+        return compare_nearest(layer, uv, depth);
+    }
+    if (kind == 1u) {
+        return compare_bilinear(layer, uv, depth);
+    }
+    var sum = 0.0;
+    if (kind == 2u) {
+        for (var dy = -1; dy <= 1; dy = dy + 1) {
+            for (var dx = -1; dx <= 1; dx = dx + 1) {
+                sum = sum + compare_bilinear(layer, uv + vec2<f32>(f32(dx), f32(dy)) * texel, depth);
+            }
+        }
+        return sum / 9.0;
+    }
+    if (kind == 3u) {
+        var h = pixel_hash(pixel.x, pixel.y);
+        for (var j = 0u; j < 4u; j = j + 1u) {
+            for (var i = 0u; i < 4u; i = i + 1u) {
+                h = pixel_hash(h, j * 4u + i);
+                let jx = hash_unit(h);
+                let jy = hash_unit((h << 12u) | (h >> 20u));
+                let o = (vec2<f32>(f32(i) + jx, f32(j) + jy) * 0.5 - vec2<f32>(1.0)) * radius;
+                sum = sum + compare_bilinear(layer, uv + o * texel, depth);
+            }
+        }
+        return sum / 16.0;
+    }
+    let angle = hash_unit(pixel_hash(pixel.x, pixel.y)) * 6.2831855;
+    let s = sin(angle);
+    let c = cos(angle);
+    for (var k = 0; k < 16; k = k + 1) {
+        let p = POISSON16[k];
+        let o = vec2<f32>(c * p.x - s * p.y, s * p.x + c * p.y) * radius;
+        sum = sum + compare_bilinear(layer, uv + o * texel, depth);
+    }
+    return sum / 16.0;
+}
+
+@fragment
+fn fs_shadow_map_query(in: FullScreen) -> @location(0) vec4<f32> {
+    let px = vec2<i32>(in.pos.xy);
+    let g = textureLoad(g_position, px, 0);
+    if (g.w == 0.0) {
+        return vec4<f32>(1.0);
+    }
+    var layer = 0;
+    if (map.light.w != 0.0) {
+        layer = cube_face(g.xyz - map.light.xyz);
+    }
+    let c = map.proj[layer] * vec4<f32>(g.xyz, 1.0);
+    let ndc = c.xyz / c.w;
+    let v = shadow_lookup(layer, ndc_to_uv(ndc.xy), ndc.z, vec2<u32>(px));
+    return vec4<f32>(v);
+}

@@ -1,0 +1,291 @@
+//! `shadow-map` on the GPU (twin: shadow-cpu's techniques/shadow_map.rs): the light pass renders depth
+//! with the pipeline's depth bias into one layer per projection; the query runs `shadow_lookup` of
+//! shadow_map.wgsl over the G-buffer, with the hardware comparison sampler for bilinear taps.
+
+use bytemuck::{Pod, Zeroable};
+use shadow_core::FrameInputs;
+use shadow_core::light::LightView;
+use shadow_core::scene::LightKind;
+use shadow_core::technique::hard::ShadowMap;
+use shadow_core::technique::settings::{BiasMode, Filter};
+use shadow_core::technique::{FrameStats, ShadowTechnique, TechniqueError};
+use wgpu::util::DeviceExt;
+
+use crate::context::{WgpuBackend, WgpuContext, WgpuError};
+use crate::frame::{GpuVisibility, layer_view};
+use crate::gbuffer::{GpuGBuffer, check_size, draw_instances};
+use crate::pipelines::{
+    MAP_DEPTH, POSITION_LAYOUT, VISIBILITY, ViewRaw, attribute_entry, buffer_entry, full_screen_pipeline,
+};
+use crate::shaders;
+
+/// GPU twin of `MapParams` in shadow_map.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct MapParams {
+    proj: [[[f32; 4]; 4]; 6],
+    light: [f32; 4],
+    settings: [f32; 4],
+}
+
+/// Pipelines and the maps of the last build.
+pub struct State {
+    depth: wgpu::RenderPipeline,
+    query: wgpu::RenderPipeline,
+    query_layout: wgpu::BindGroupLayout,
+    sampler: wgpu::Sampler,
+    maps: Option<wgpu::Texture>,
+}
+
+/// The depth-bias state of a shadow-map's light pass. wgpu takes the constant factor as an integer (in
+/// units of the format's resolution, as Vulkan does), so it is rounded.
+#[must_use]
+pub fn depth_bias(s: &ShadowMap) -> wgpu::DepthBiasState {
+    match s.bias {
+        BiasMode::None => wgpu::DepthBiasState::default(),
+        BiasMode::Constant => {
+            wgpu::DepthBiasState { constant: s.bias_constant.round() as i32, slope_scale: 0.0, clamp: 0.0 }
+        }
+        BiasMode::Slope => {
+            wgpu::DepthBiasState { constant: s.bias_constant.round() as i32, slope_scale: s.bias_slope, clamp: 0.0 }
+        }
+    }
+}
+
+/// Depth-only pipeline of a light pass.
+#[must_use]
+pub fn light_pass_pipeline(
+    cx: &WgpuContext,
+    module: &wgpu::ShaderModule,
+    bias: wgpu::DepthBiasState,
+) -> wgpu::RenderPipeline {
+    let layout = cx.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("light pass"),
+        bind_group_layouts: &[Some(&cx.shared.frame_layout)],
+        immediate_size: 0,
+    });
+    cx.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("light pass"),
+        layout: Some(&layout),
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some("vs_light_depth"),
+            compilation_options: Default::default(),
+            buffers: &[Some(POSITION_LAYOUT)],
+        },
+        primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: MAP_DEPTH,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::Less),
+            stencil: Default::default(),
+            bias,
+        }),
+        multisample: Default::default(),
+        fragment: None,
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
+/// Renders the casters' depth from every projection of `light` into the layers of `maps` (meshes and
+/// `instances` already uploaded).
+pub fn render_maps(
+    cx: &WgpuContext,
+    pipeline: &wgpu::RenderPipeline,
+    frame: &FrameInputs,
+    light: &LightView,
+    maps: &wgpu::Texture,
+    instances: &wgpu::Buffer,
+) {
+    let res = maps.width();
+    let mut enc = cx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("light pass") });
+    for (k, p) in light.projections.iter().enumerate() {
+        let group =
+            cx.shared.frame_group(&cx.device, &ViewRaw::new(p.clip_from_world, glam::Vec3::ZERO, res, res), instances);
+        let view = layer_view(maps, k as u32);
+        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("light pass"),
+            color_attachments: &[],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &view,
+                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, &group, &[]);
+        draw_instances(cx, &mut pass, frame, |i| i.casts_shadow, false);
+    }
+    cx.queue.submit([enc.finish()]);
+}
+
+/// A depth array of `layers` square maps.
+#[must_use]
+pub fn map_texture(cx: &WgpuContext, res: u32, layers: u32) -> wgpu::Texture {
+    cx.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("shadow maps"),
+        size: wgpu::Extent3d { width: res, height: res, depth_or_array_layers: layers },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: MAP_DEPTH,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+            | wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::COPY_SRC,
+        view_formats: &[],
+    })
+}
+
+fn filter_code(f: Filter) -> f32 {
+    match f {
+        Filter::None => 0.0,
+        Filter::Bilinear => 1.0,
+        Filter::Pcf3x3 => 2.0,
+        Filter::Pcf4x4Jitter => 3.0,
+        Filter::Poisson16 => 4.0,
+    }
+}
+
+impl ShadowTechnique<WgpuBackend> for ShadowMap {
+    type State = State;
+
+    fn name(&self) -> &'static str {
+        "shadow-map"
+    }
+
+    fn create_state(&self, cx: &mut WgpuContext) -> Result<State, WgpuError> {
+        cx.scoped("creating the shadow-map pipelines", |cx| {
+            let module = shaders::module(&cx.device, "shadow_map", shaders::shadow_map());
+            let query_layout = cx.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("shadow map query"),
+                entries: &[
+                    attribute_entry(0),
+                    wgpu::BindGroupLayoutEntry {
+                        binding: 1,
+                        visibility: wgpu::ShaderStages::FRAGMENT,
+                        ty: wgpu::BindingType::Texture {
+                            sample_type: wgpu::TextureSampleType::Depth,
+                            view_dimension: wgpu::TextureViewDimension::D2Array,
+                            multisampled: false,
+                        },
+                        count: None,
+                    },
+                    wgpu::BindGroupLayoutEntry {
+                        binding: 2,
+                        visibility: wgpu::ShaderStages::FRAGMENT,
+                        ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
+                        count: None,
+                    },
+                    buffer_entry(3, wgpu::BufferBindingType::Uniform, wgpu::ShaderStages::FRAGMENT),
+                ],
+            });
+            let query = full_screen_pipeline(
+                &cx.device,
+                "shadow map query",
+                &module,
+                "fs_shadow_map_query",
+                &[&cx.shared.frame_layout, &query_layout],
+                VISIBILITY,
+                None,
+            );
+            let sampler = cx.device.create_sampler(&wgpu::SamplerDescriptor {
+                label: Some("shadow comparison"),
+                address_mode_u: wgpu::AddressMode::ClampToEdge,
+                address_mode_v: wgpu::AddressMode::ClampToEdge,
+                mag_filter: wgpu::FilterMode::Linear,
+                min_filter: wgpu::FilterMode::Linear,
+                compare: Some(wgpu::CompareFunction::LessEqual),
+                ..Default::default()
+            });
+            State {
+                depth: light_pass_pipeline(cx, &module, depth_bias(self)),
+                query,
+                query_layout,
+                sampler,
+                maps: None,
+            }
+        })
+    }
+
+    fn build(
+        &self,
+        cx: &mut WgpuContext,
+        state: &mut State,
+        frame: &FrameInputs,
+        light: &LightView,
+        _: &mut FrameStats,
+    ) -> Result<(), WgpuError> {
+        let layers = light.projections.len() as u32;
+        check_size(cx, "shadow map", self.resolution, self.resolution)?;
+        let fits =
+            state.maps.as_ref().is_some_and(|m| m.width() == self.resolution && m.depth_or_array_layers() == layers);
+        if !fits {
+            state.maps = Some(cx.scoped("allocating shadow maps", |cx| map_texture(cx, self.resolution, layers))?);
+        }
+        let maps = state.maps.clone().ok_or_else(|| TechniqueError::NotBuilt(self.name().into()))?;
+        cx.cache.upload_meshes(&cx.device, frame);
+        let instances = cx.cache.instances(&cx.device, frame).clone();
+        cx.scoped("the shadow-map light pass", |cx| render_maps(cx, &state.depth, frame, light, &maps, &instances))
+    }
+
+    fn query(
+        &self,
+        cx: &mut WgpuContext,
+        state: &mut State,
+        _: &FrameInputs,
+        light: &LightView,
+        g: &GpuGBuffer,
+        out: &mut GpuVisibility,
+        stats: &mut FrameStats,
+    ) -> Result<(), WgpuError> {
+        let maps = state.maps.as_ref().ok_or_else(|| TechniqueError::NotBuilt(self.name().into()))?;
+        let mut proj = [[[0.0f32; 4]; 4]; 6];
+        for (slot, p) in proj.iter_mut().zip(&light.projections) {
+            *slot = p.clip_from_world.to_cols_array_2d();
+        }
+        let (pos, point) = match light.light.kind {
+            LightKind::Point { position } => (position, 1.0),
+            _ => (glam::Vec3::ZERO, 0.0),
+        };
+        let params = MapParams {
+            proj,
+            light: pos.extend(point).to_array(),
+            settings: [filter_code(self.filter), self.filter_radius, maps.width() as f32, 0.0],
+        };
+        cx.scoped("the shadow-map query", |cx| {
+            let ubuf = cx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("map params"),
+                contents: bytemuck::bytes_of(&params),
+                usage: wgpu::BufferUsages::UNIFORM,
+            });
+            let maps_view = maps.create_view(&wgpu::TextureViewDescriptor {
+                dimension: Some(wgpu::TextureViewDimension::D2Array),
+                ..Default::default()
+            });
+            let group = cx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("shadow map query"),
+                layout: &state.query_layout,
+                entries: &[
+                    wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&g.position) },
+                    wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&maps_view) },
+                    wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&state.sampler) },
+                    wgpu::BindGroupEntry { binding: 3, resource: ubuf.as_entire_binding() },
+                ],
+            });
+            crate::techniques::full_screen(
+                cx,
+                "shadow map query",
+                &out.view,
+                &state.query,
+                &[&g.frame_group, &group],
+                None,
+            );
+        })?;
+        stats.counters.covered_pixels = None;
+        Ok(())
+    }
+}

@@ -1,0 +1,385 @@
+//! `shadow-volume-zpass` and `shadow-volume-zfail` on the GPU (twin: shadow-cpu's
+//! techniques/shadow_volume.rs). The volumes come from the shared CPU geometry, uploaded per frame;
+//! near caps are drawn from the mesh's own vertex buffer with the G-buffer's clip transform, so their
+//! depths match the G-buffer's exactly. Two-sided stencil with wrapping ops counts; a full-screen pass
+//! with the stencil test "count != 0" writes the shadowed receivers.
+//!
+//! Counters come from occlusion queries: samples passing the volume pass, and, in a separate pass with
+//! the depth test off, every rasterized volume fragment (outside the timed query phase).
+
+use shadow_core::FrameInputs;
+use shadow_core::frame::InstanceVolume;
+use shadow_core::geometry::volume::Caps;
+use shadow_core::light::LightView;
+use shadow_core::technique::hard::{ShadowVolume, VolumeCounting};
+use shadow_core::technique::{FrameStats, ShadowTechnique, TechniqueError};
+use wgpu::util::DeviceExt;
+
+use crate::context::{WgpuBackend, WgpuContext, WgpuError};
+use crate::frame::GpuVisibility;
+use crate::gbuffer::GpuGBuffer;
+use crate::pipelines::{DEPTH_STENCIL, POSITION_LAYOUT, VISIBILITY, attribute_entry, full_screen_pipeline};
+use crate::shaders;
+
+/// One draw of volume geometry: vertices, optional indices, instance, winding.
+struct VolumeDraw {
+    vertices: Option<wgpu::Buffer>,
+    indices: Option<(wgpu::Buffer, u32)>,
+    count: u32,
+    instance: u32,
+    /// Front faces wind clockwise (a mirrored instance, or faces cast turned around).
+    cw: bool,
+    /// Use the instance's mesh vertex buffer (near caps).
+    mesh_vertices: bool,
+}
+
+/// Pipelines and the uploaded volumes of the last build.
+pub struct State {
+    ccw: wgpu::RenderPipeline,
+    cw: wgpu::RenderPipeline,
+    count_all: wgpu::RenderPipeline,
+    resolve: wgpu::RenderPipeline,
+    resolve_layout: wgpu::BindGroupLayout,
+    draws: Vec<VolumeDraw>,
+}
+
+fn stencil_faces(counting: VolumeCounting) -> (wgpu::StencilFaceState, wgpu::StencilFaceState) {
+    use wgpu::StencilOperation as Op;
+    let face = |pass_op, depth_fail_op| wgpu::StencilFaceState {
+        compare: wgpu::CompareFunction::Always,
+        fail_op: Op::Keep,
+        depth_fail_op,
+        pass_op,
+    };
+    match counting {
+        VolumeCounting::ZPass => (face(Op::IncrementWrap, Op::Keep), face(Op::DecrementWrap, Op::Keep)),
+        VolumeCounting::ZFail => (face(Op::Keep, Op::DecrementWrap), face(Op::Keep, Op::IncrementWrap)),
+    }
+}
+
+fn volume_pipeline(
+    cx: &WgpuContext,
+    module: &wgpu::ShaderModule,
+    front_face: wgpu::FrontFace,
+    depth_stencil: wgpu::DepthStencilState,
+) -> wgpu::RenderPipeline {
+    let layout = cx.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("volume"),
+        bind_group_layouts: &[Some(&cx.shared.frame_layout)],
+        immediate_size: 0,
+    });
+    cx.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("volume"),
+        layout: Some(&layout),
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some("vs_volume"),
+            compilation_options: Default::default(),
+            buffers: &[Some(POSITION_LAYOUT)],
+        },
+        primitive: wgpu::PrimitiveState { front_face, cull_mode: None, ..Default::default() },
+        depth_stencil: Some(depth_stencil),
+        multisample: Default::default(),
+        fragment: None,
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
+impl ShadowTechnique<WgpuBackend> for ShadowVolume {
+    type State = State;
+
+    fn name(&self) -> &'static str {
+        match self.counting {
+            VolumeCounting::ZPass => "shadow-volume-zpass",
+            VolumeCounting::ZFail => "shadow-volume-zfail",
+        }
+    }
+
+    fn create_state(&self, cx: &mut WgpuContext) -> Result<State, WgpuError> {
+        let counting = self.counting;
+        cx.scoped("creating the shadow-volume pipelines", |cx| {
+            let module = shaders::module(&cx.device, "shadow_volume", shaders::shadow_volume());
+            let (front, back) = stencil_faces(counting);
+            let counting_state = wgpu::DepthStencilState {
+                format: DEPTH_STENCIL,
+                depth_write_enabled: Some(false),
+                depth_compare: Some(wgpu::CompareFunction::Less),
+                stencil: wgpu::StencilState { front, back, read_mask: 0xff, write_mask: 0xff },
+                bias: Default::default(),
+            };
+            let ccw = volume_pipeline(cx, &module, wgpu::FrontFace::Ccw, counting_state.clone());
+            let cw = volume_pipeline(cx, &module, wgpu::FrontFace::Cw, counting_state);
+            let all = wgpu::DepthStencilState {
+                format: DEPTH_STENCIL,
+                depth_write_enabled: Some(false),
+                depth_compare: Some(wgpu::CompareFunction::Always),
+                stencil: Default::default(),
+                bias: Default::default(),
+            };
+            let count_all = volume_pipeline(cx, &module, wgpu::FrontFace::Ccw, all);
+            let resolve_layout = cx.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("volume resolve"),
+                entries: &[attribute_entry(0)],
+            });
+            let test = wgpu::StencilFaceState { compare: wgpu::CompareFunction::NotEqual, ..Default::default() };
+            let resolve_state = wgpu::DepthStencilState {
+                format: DEPTH_STENCIL,
+                depth_write_enabled: Some(false),
+                depth_compare: Some(wgpu::CompareFunction::Always),
+                stencil: wgpu::StencilState { front: test, back: test, read_mask: 0xff, write_mask: 0 },
+                bias: Default::default(),
+            };
+            let resolve = full_screen_pipeline(
+                &cx.device,
+                "volume resolve",
+                &module,
+                "fs_volume_resolve",
+                &[&cx.shared.frame_layout, &resolve_layout],
+                VISIBILITY,
+                Some(resolve_state),
+            );
+            State { ccw, cw, count_all, resolve, resolve_layout, draws: Vec::new() }
+        })
+    }
+
+    fn build(
+        &self,
+        cx: &mut WgpuContext,
+        state: &mut State,
+        frame: &FrameInputs,
+        light: &LightView,
+        stats: &mut FrameStats,
+    ) -> Result<(), WgpuError> {
+        let caps = if self.counting == VolumeCounting::ZFail { Caps::Both } else { Caps::None };
+        let volumes = frame.shadow_volumes(light, caps);
+        let c = &mut stats.counters;
+        c.silhouette_edges = Some(volumes.iter().map(|v| v.silhouette_edges as u64).sum());
+        c.volume_triangles = Some(volumes.iter().map(|v| v.volume.triangle_count() as u64).sum());
+        cx.cache.upload_meshes(&cx.device, frame);
+        state.draws = cx.scoped("uploading shadow volumes", |cx| upload(cx, frame, &volumes))?;
+        Ok(())
+    }
+
+    fn query(
+        &self,
+        cx: &mut WgpuContext,
+        state: &mut State,
+        frame: &FrameInputs,
+        _: &LightView,
+        g: &GpuGBuffer,
+        out: &mut GpuVisibility,
+        stats: &mut FrameStats,
+    ) -> Result<(), WgpuError> {
+        if state.draws.is_empty() && stats.counters.volume_triangles.is_none() {
+            return Err(TechniqueError::NotBuilt(self.name().into()).into());
+        }
+        let depth = g.depth_view();
+        let passed = cx.scoped("the shadow-volume pass", |cx| {
+            let q = occlusion_pass(cx, state, frame, g, &depth, false);
+            let resolve_group = cx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("volume resolve"),
+                layout: &state.resolve_layout,
+                entries: &[wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::TextureView(&g.position),
+                }],
+            });
+            crate::techniques::full_screen(
+                cx,
+                "volume resolve",
+                &out.view,
+                &state.resolve,
+                &[&g.frame_group, &resolve_group],
+                Some((&depth, 0)),
+            );
+            q
+        })?;
+        let passed = read_query(cx, &passed)?;
+        // Every rasterized fragment, for Sen's overdraw: a second pass with the depth test off. It runs
+        // after the resolve, so it does not disturb the result; its time lands in a separate sub-phase.
+        let t = std::time::Instant::now();
+        let all = cx.scoped("the volume fragment count", |cx| occlusion_pass(cx, state, frame, g, &depth, true))?;
+        let all = read_query(cx, &all)?;
+        stats.timings.extra.insert("count_fragments".into(), shadow_core::stats::ms(t.elapsed()));
+        let c = &mut stats.counters;
+        c.volume_fragments = Some(all);
+        // Z-pass applies an op where the depth test passes, z-fail where it fails.
+        c.stencil_updates = Some(match self.counting {
+            VolumeCounting::ZPass => passed,
+            VolumeCounting::ZFail => all - passed.min(all),
+        });
+        Ok(())
+    }
+}
+
+/// Uploads the volumes: sides and far caps as homogeneous vertices, near caps as index lists into the
+/// mesh's own vertex buffer.
+fn upload(cx: &WgpuContext, frame: &FrameInputs, volumes: &[InstanceVolume]) -> Vec<VolumeDraw> {
+    let vbuf = |data: &[glam::Vec4]| {
+        cx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("volume"),
+            contents: bytemuck::cast_slice(data),
+            usage: wgpu::BufferUsages::VERTEX,
+        })
+    };
+    let ibuf = |data: &[u32]| {
+        (
+            cx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("caps"),
+                contents: bytemuck::cast_slice(data),
+                usage: wgpu::BufferUsages::INDEX,
+            }),
+            data.len() as u32,
+        )
+    };
+    let mut draws = Vec::new();
+    for iv in volumes {
+        let inst = &frame.instances[iv.instance];
+        let (instance, m) = (iv.instance as u32, inst.mirrored);
+        let vol = &iv.volume;
+        if !vol.sides.is_empty() {
+            let sides: Vec<glam::Vec4> = vol.sides.iter().flatten().copied().collect();
+            draws.push(VolumeDraw {
+                vertices: Some(vbuf(&sides)),
+                indices: None,
+                count: sides.len() as u32,
+                instance,
+                cw: m,
+                mesh_vertices: false,
+            });
+        }
+        let tris = inst.mesh.triangles();
+        let indices = |ids: &[u32], reverse: bool| -> Vec<u32> {
+            ids.iter()
+                .flat_map(|&f| {
+                    let [a, b, c] = tris[f as usize];
+                    if reverse { [a, c, b] } else { [a, b, c] }
+                })
+                .collect()
+        };
+        let far: Vec<glam::Vec4> = inst.mesh.positions().iter().map(|&p| vol.light.extrude(p)).collect();
+        let far_buf = (!vol.caps_forward.is_empty() || !vol.caps_reversed.is_empty()).then(|| vbuf(&far));
+        for (ids, near_cw, far_reverse) in [(&vol.caps_forward, m, true), (&vol.caps_reversed, !m, false)] {
+            if ids.is_empty() {
+                continue;
+            }
+            // Near caps in the mesh's own winding (turned-around faces drawn with clockwise fronts).
+            let near = ibuf(&indices(ids, false));
+            draws.push(VolumeDraw {
+                vertices: None,
+                count: near.1,
+                indices: Some(near),
+                instance,
+                cw: near_cw,
+                mesh_vertices: true,
+            });
+            // Far caps at infinity, forward faces reversed.
+            let farc = ibuf(&indices(ids, far_reverse));
+            draws.push(VolumeDraw {
+                vertices: far_buf.clone(),
+                count: farc.1,
+                indices: Some(farc),
+                instance,
+                cw: m,
+                mesh_vertices: false,
+            });
+        }
+    }
+    draws
+}
+
+/// One pass over every volume draw inside an occlusion query; `all` counts every fragment instead.
+fn occlusion_pass(
+    cx: &WgpuContext,
+    state: &State,
+    frame: &FrameInputs,
+    g: &GpuGBuffer,
+    depth: &wgpu::TextureView,
+    all: bool,
+) -> (wgpu::QuerySet, wgpu::Buffer) {
+    let set = cx.device.create_query_set(&wgpu::QuerySetDescriptor {
+        label: Some("volume fragments"),
+        ty: wgpu::QueryType::Occlusion,
+        count: 1,
+    });
+    let resolve = cx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("occlusion"),
+        size: 8,
+        usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    });
+    let mut enc = cx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("volumes") });
+    {
+        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("volumes"),
+            color_attachments: &[],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: depth,
+                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store }),
+                stencil_ops: Some(wgpu::Operations {
+                    load: if all { wgpu::LoadOp::Load } else { wgpu::LoadOp::Clear(0) },
+                    store: wgpu::StoreOp::Store,
+                }),
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: Some(&set),
+            multiview_mask: None,
+        });
+        pass.push_debug_group(if all { "count volume fragments" } else { "shadow volumes" });
+        pass.set_bind_group(0, &g.frame_group, &[]);
+        pass.begin_occlusion_query(0);
+        for d in &state.draws {
+            pass.set_pipeline(if all {
+                &state.count_all
+            } else if d.cw {
+                &state.cw
+            } else {
+                &state.ccw
+            });
+            let mesh = frame.instances.get(d.instance as usize).and_then(|i| cx.cache.mesh(i.mesh_key));
+            match (&d.vertices, d.mesh_vertices, mesh) {
+                (Some(v), _, _) => pass.set_vertex_buffer(0, v.slice(..)),
+                (None, true, Some(m)) => pass.set_vertex_buffer(0, m.positions.slice(..)),
+                _ => continue,
+            }
+            match &d.indices {
+                Some((ib, n)) => {
+                    pass.set_index_buffer(ib.slice(..), wgpu::IndexFormat::Uint32);
+                    pass.draw_indexed(0..*n, 0, d.instance..d.instance + 1);
+                }
+                None => pass.draw(0..d.count, d.instance..d.instance + 1),
+            }
+        }
+        pass.end_occlusion_query();
+        pass.pop_debug_group();
+    }
+    enc.resolve_query_set(&set, 0..1, &resolve, 0);
+    cx.queue.submit([enc.finish()]);
+    (set, resolve)
+}
+
+fn read_query(cx: &WgpuContext, q: &(wgpu::QuerySet, wgpu::Buffer)) -> Result<u64, WgpuError> {
+    let staging = cx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("occlusion readback"),
+        size: 8,
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    let mut enc = cx.device.create_command_encoder(&Default::default());
+    enc.copy_buffer_to_buffer(&q.1, 0, &staging, 0, 8);
+    cx.queue.submit([enc.finish()]);
+    let slice = staging.slice(..);
+    let (tx, rx) = std::sync::mpsc::channel();
+    slice.map_async(wgpu::MapMode::Read, move |r| {
+        let _ = tx.send(r);
+    });
+    cx.wait()?;
+    let gpu = |m: String| WgpuError::Gpu { during: "reading an occlusion query".into(), message: m };
+    rx.recv().map_err(|_| gpu("the map callback never ran".into()))?.map_err(|e| gpu(e.to_string()))?;
+    let data = slice.get_mapped_range().map_err(|e| gpu(e.to_string()))?;
+    let v = u64::from_le_bytes([data[0], data[1], data[2], data[3], data[4], data[5], data[6], data[7]]);
+    drop(data);
+    staging.unmap();
+    Ok(v)
+}
