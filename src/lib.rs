@@ -4,8 +4,10 @@
 //! This crate is the facade: it re-exports the workspace crates and resolves what a user names on the
 //! command line (a built-in scene or a model file) into a scene.
 
+pub mod bench;
 pub mod compare;
 mod error;
+pub mod plot;
 pub mod registry;
 pub mod renderer;
 pub mod setup;

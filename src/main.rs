@@ -113,6 +113,44 @@ enum Command {
         #[arg(long, short, default_value = "render.png")]
         out: PathBuf,
     },
+    /// Time techniques over frames with the light moving: per-phase median, min and max, and counters.
+    Bench {
+        #[command(flatten)]
+        scene: SceneArgs,
+        /// NAME[:key=value,...], repeatable.
+        #[arg(long)]
+        technique: Vec<String>,
+        /// all, or NAME,NAME with default settings.
+        #[arg(long)]
+        techniques: Option<String>,
+        /// Backend: auto, cpu, wgpu or both.
+        #[arg(long, default_value = "auto")]
+        backend: String,
+        /// Measured frames.
+        #[arg(long, default_value_t = 20)]
+        frames: u32,
+        /// Unmeasured frames first.
+        #[arg(long, default_value_t = 2)]
+        warmup: u32,
+        /// Print JSON.
+        #[arg(long)]
+        json: bool,
+        /// Repeat over a parameter: res=256,512,... (map side) or tris=10000,100000,... (a sphere of that
+        /// many triangles on the ground); writes sweep.csv and sweep.png.
+        #[arg(long)]
+        sweep: Option<String>,
+        /// Output folder for the sweep (default out/bench-SCENE).
+        #[arg(long)]
+        out_dir: Option<PathBuf>,
+    },
+    /// Write a scene (built-in or loaded) as .glb with its camera and lights.
+    Export {
+        #[command(flatten)]
+        scene: SceneArgs,
+        /// The .glb to write.
+        #[arg(long, short)]
+        out: PathBuf,
+    },
     /// Every asked-for technique against the ray-traced reference: pictures, error maps, a contact sheet,
     /// report.md and report.json.
     Compare {
@@ -153,6 +191,10 @@ fn run(cli: Cli) -> Result<(), Error> {
         Command::Compare { scene, technique, techniques, backend, out_dir } => {
             compare(&scene, technique, techniques, &backend, out_dir)
         }
+        Command::Bench { scene, technique, techniques, backend, frames, warmup, json, sweep, out_dir } => {
+            bench(&scene, BenchArgs { technique, techniques, backend, frames, warmup, json, sweep, out_dir })
+        }
+        Command::Export { scene, out } => export(&scene, &out),
     }
 }
 
@@ -254,6 +296,26 @@ fn inspect(target: &str, json: bool) -> Result<(), Error> {
     Ok(())
 }
 
+/// Checks that every technique exists on the backends `choice` names, before any backend is opened, so
+/// the error names the real cause on a machine without a GPU too.
+fn check_availability(renderer: &Renderer, specs: &[TechniqueSpec], choice: &str) -> Result<(), Error> {
+    let choice: BackendChoice =
+        choice.parse().map_err(|e: String| Error::Usage(format!("bad --backend '{choice}': expected {e}")))?;
+    for s in specs {
+        let e = renderer.registry().get(&s.name)?;
+        let missing = match choice {
+            BackendChoice::Cpu if e.cpu.is_none() => Some("cpu"),
+            BackendChoice::Wgpu | BackendChoice::Both if e.wgpu.is_none() => Some("wgpu"),
+            BackendChoice::Both if e.cpu.is_none() => Some("cpu"),
+            _ => None,
+        };
+        if let Some(backend) = missing {
+            return Err(shadowlab::RegistryError::NotOnBackend { name: s.name.clone(), backend }.into());
+        }
+    }
+    Ok(())
+}
+
 fn backends(renderer: &mut Renderer, choice: &str) -> Result<Vec<shadowlab::BackendKind>, Error> {
     let choice: BackendChoice =
         choice.parse().map_err(|e: String| Error::Usage(format!("bad --backend '{choice}': expected {e}")))?;
@@ -267,6 +329,7 @@ fn render(args: &SceneArgs, technique: &str, backend: &str, out: &Path) -> Resul
     let spec = TechniqueSpec::parse(technique)?;
     let mut renderer = Renderer::new(TechniqueRegistry::builtin()).with_adapter(args.adapter.clone());
     renderer.registry().canonical(&spec)?;
+    check_availability(&renderer, std::slice::from_ref(&spec), backend)?;
     for kind in backends(&mut renderer, backend)? {
         let run = renderer.run(kind, &frame, w, h, &spec)?;
         let path =
@@ -287,23 +350,9 @@ fn compare(
     out_dir: Option<PathBuf>,
 ) -> Result<(), Error> {
     let mut renderer = Renderer::new(TechniqueRegistry::builtin()).with_adapter(args.adapter.clone());
+    let specs = technique_specs(&renderer, &technique, techniques.as_deref())?;
+    check_availability(&renderer, &specs, backend)?;
     let kinds = backends(&mut renderer, backend)?;
-    let mut specs: Vec<TechniqueSpec> = technique.iter().map(|t| TechniqueSpec::parse(t)).collect::<Result<_, _>>()?;
-    match techniques.as_deref() {
-        Some("all") => specs.extend(
-            renderer.registry().entries().iter().filter(|e| !e.reference).map(|e| TechniqueSpec::named(e.name)),
-        ),
-        Some(list) => {
-            specs.extend(list.split(',').filter(|s| !s.trim().is_empty()).map(|s| TechniqueSpec::named(s.trim())))
-        }
-        None if specs.is_empty() => specs.extend(
-            renderer.registry().entries().iter().filter(|e| !e.reference).map(|e| TechniqueSpec::named(e.name)),
-        ),
-        None => {}
-    }
-    for s in &specs {
-        renderer.registry().canonical(s)?;
-    }
     let (frame, w, h) = args.frame()?;
     let out = out_dir.unwrap_or_else(|| PathBuf::from(format!("out/compare-{}", args.name())));
     let job = CompareJob {
@@ -315,22 +364,8 @@ fn compare(
         backends: kinds,
         out_dir: Some(out.clone()),
     };
-    let steps = (job.techniques.len() * job.backends.len() + 1) as u64;
-    let bar = std::io::stderr().is_terminal().then(|| {
-        let b = indicatif::ProgressBar::new(steps);
-        b.set_style(
-            indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} {msg}")
-                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-        );
-        b
-    });
-    let report = run_compare(&mut renderer, &job, |msg| match &bar {
-        Some(b) => {
-            b.set_message(msg.to_string());
-            b.inc(1);
-        }
-        None => eprintln!("{msg}"),
-    })?;
+    let bar = progress_bar((job.techniques.len() * job.backends.len() + 1) as u64);
+    let report = run_compare(&mut renderer, &job, |msg| report_progress(&bar, msg))?;
     if let Some(b) = bar {
         b.finish_and_clear();
     }
@@ -352,5 +387,185 @@ fn compare(
         );
     }
     println!("wrote {}/contact.png, report.md, report.json", out.display());
+    Ok(())
+}
+
+/// The technique specs of --technique and --techniques (every non-reference technique when neither).
+fn technique_specs(
+    renderer: &Renderer,
+    technique: &[String],
+    techniques: Option<&str>,
+) -> Result<Vec<TechniqueSpec>, Error> {
+    let mut specs: Vec<TechniqueSpec> = technique.iter().map(|t| TechniqueSpec::parse(t)).collect::<Result<_, _>>()?;
+    let all = || {
+        renderer
+            .registry()
+            .entries()
+            .iter()
+            .filter(|e| !e.reference)
+            .map(|e| TechniqueSpec::named(e.name))
+            .collect::<Vec<_>>()
+    };
+    match techniques {
+        Some("all") => specs.extend(all()),
+        Some(list) => {
+            specs.extend(list.split(',').filter(|s| !s.trim().is_empty()).map(|s| TechniqueSpec::named(s.trim())))
+        }
+        None if specs.is_empty() => specs.extend(all()),
+        None => {}
+    }
+    for s in &specs {
+        renderer.registry().canonical(s)?;
+    }
+    Ok(specs)
+}
+
+/// A progress bar when stderr is a terminal; plain lines otherwise.
+fn progress_bar(steps: u64) -> Option<indicatif::ProgressBar> {
+    std::io::stderr().is_terminal().then(|| {
+        let b = indicatif::ProgressBar::new(steps);
+        let style = indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} {msg}");
+        b.set_style(style.unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()));
+        b
+    })
+}
+
+fn report_progress(bar: &Option<indicatif::ProgressBar>, msg: &str) {
+    match bar {
+        Some(b) => {
+            b.set_message(msg.to_string());
+            b.inc(1);
+        }
+        None => eprintln!("{msg}"),
+    }
+}
+
+struct BenchArgs {
+    technique: Vec<String>,
+    techniques: Option<String>,
+    backend: String,
+    frames: u32,
+    warmup: u32,
+    json: bool,
+    sweep: Option<String>,
+    out_dir: Option<PathBuf>,
+}
+
+/// `--sweep KEY=V,V,...` as (key, values).
+fn parse_sweep(sweep: &str) -> Result<(&str, Vec<u32>), Error> {
+    let bad = |why: &str| Error::Usage(format!("bad --sweep '{sweep}': {why}"));
+    let (key, values) = sweep.split_once('=').ok_or_else(|| bad("expected res=N,N,... or tris=N,N,..."))?;
+    if key != "res" && key != "tris" {
+        return Err(bad("the parameter must be res or tris"));
+    }
+    let values: Vec<u32> = values
+        .split(',')
+        .map(|v| v.trim().parse::<u32>().ok().filter(|&v| v > 0))
+        .collect::<Option<_>>()
+        .ok_or_else(|| bad("values must be positive whole numbers"))?;
+    Ok((key, values))
+}
+
+fn bench(args: &SceneArgs, b: BenchArgs) -> Result<(), Error> {
+    use shadowlab::bench::{BenchJob, bench_table, run_bench, sweep_scene};
+    if b.frames == 0 {
+        return Err(Error::Usage("--frames must be at least 1".into()));
+    }
+    let sweep = b.sweep.as_deref().map(parse_sweep).transpose()?;
+    let mut renderer = Renderer::new(TechniqueRegistry::builtin()).with_adapter(args.adapter.clone());
+    let specs = technique_specs(&renderer, &b.technique, b.techniques.as_deref())?;
+    check_availability(&renderer, &specs, &b.backend)?;
+    let kinds = backends(&mut renderer, &b.backend)?;
+    let Some((key, values)) = sweep else {
+        let (frame, w, h) = args.frame()?;
+        let job = BenchJob {
+            scene: args.name(),
+            frame: &frame,
+            width: w,
+            height: h,
+            frames: b.frames,
+            warmup: b.warmup,
+            techniques: specs,
+            backends: kinds,
+        };
+        let bar = progress_bar((job.techniques.len() * job.backends.len()) as u64);
+        let r = run_bench(&mut renderer, &job, |m| report_progress(&bar, m))?;
+        if let Some(bar) = bar {
+            bar.finish_and_clear();
+        }
+        if b.json {
+            return print_json(&serde_json::to_value(&r).map_err(|e| Error::Usage(e.to_string()))?);
+        }
+        print!("{}", bench_table(&r));
+        return Ok(());
+    };
+    let has_res =
+        |s: &TechniqueSpec| renderer.registry().get(&s.name).is_ok_and(|e| (e.keys)().iter().any(|k| k.key == "res"));
+    let specs: Vec<TechniqueSpec> = if key == "res" { specs.into_iter().filter(has_res).collect() } else { specs };
+    if specs.is_empty() {
+        return Err(Error::Usage("--sweep res needs a technique with a res setting".into()));
+    }
+    let out = b.out_dir.clone().unwrap_or_else(|| PathBuf::from(format!("out/bench-{}", args.name())));
+    std::fs::create_dir_all(&out).map_err(|e| Error::Write { path: out.clone(), why: e.to_string() })?;
+    let mut csv = String::from("parameter,value,technique,backend,gbuffer_ms,build_ms,query_ms,shade_ms,total_ms\n");
+    let mut series: std::collections::BTreeMap<String, Vec<(f64, f64)>> = Default::default();
+    let bar = progress_bar((values.len() * specs.len() * kinds.len()) as u64);
+    for &v in &values {
+        let (frame, w, h) = if key == "res" {
+            args.frame()?
+        } else {
+            let (w, h) = parse_size(&args.size).map_err(|e| Error::Usage(e.to_string()))?;
+            let scene = sweep_scene(v);
+            let cam = scene.cameras().next().map(|(k, _)| k).ok_or_else(|| Error::Usage("no camera".into()))?;
+            (FrameInputs::from_scene(&scene, cam)?, w, h)
+        };
+        let with_value: Vec<TechniqueSpec> = specs
+            .iter()
+            .map(|s| {
+                let mut s = s.clone();
+                if key == "res" {
+                    s.values.retain(|(k, _)| k != "res");
+                    s.values.push(("res".into(), v.to_string()));
+                }
+                s
+            })
+            .collect();
+        let job = BenchJob {
+            scene: args.name(),
+            frame: &frame,
+            width: w,
+            height: h,
+            frames: b.frames,
+            warmup: b.warmup,
+            techniques: with_value,
+            backends: kinds.clone(),
+        };
+        let r = run_bench(&mut renderer, &job, |m| report_progress(&bar, &format!("{key}={v}: {m}")))?;
+        for e in &r.results {
+            let med = |k: &str| e.timings_ms.get(k).map_or(0.0, |t| t.median);
+            let phases = ["gbuffer", "build", "query", "shade", "total"].map(|k| format!("{:.3}", med(k))).join(",");
+            csv.push_str(&format!("{key},{v},{},{},{phases}\n", e.technique, e.backend));
+            series.entry(format!("{} {}", e.technique, e.backend)).or_default().push((f64::from(v), med("total")));
+        }
+    }
+    if let Some(bar) = bar {
+        bar.finish_and_clear();
+    }
+    std::fs::write(out.join("sweep.csv"), &csv)
+        .map_err(|e| Error::Write { path: out.join("sweep.csv"), why: e.to_string() })?;
+    let x_label = if key == "res" { "shadow map side (texels)" } else { "triangles" };
+    let series: Vec<(String, Vec<(f64, f64)>)> = series.into_iter().collect();
+    shadowlab::plot::line_plot(&format!("{} frame time", args.name()), x_label, "median ms per frame", &series)
+        .save_png(out.join("sweep.png"))?;
+    print!("{csv}");
+    println!("wrote {}/sweep.csv and sweep.png", out.display());
+    Ok(())
+}
+
+fn export(args: &SceneArgs, out: &Path) -> Result<(), Error> {
+    let scene = args.setup().build()?;
+    shadow_core::assets::export::export_glb(&scene, out)
+        .map_err(|e| Error::Write { path: out.to_path_buf(), why: e.source.to_string() })?;
+    println!("wrote {} ({} triangles)", out.display(), scene.triangle_count());
     Ok(())
 }

@@ -154,7 +154,56 @@ impl Renderer {
         Ok((f, views))
     }
 
-    /// Runs one technique on one backend.
+    /// A technique made for a backend, keeping its state (pipelines, maps) from frame to frame.
+    ///
+    /// # Errors
+    /// Unknown technique, bad settings, or a technique missing on that backend.
+    pub fn prepare(&self, backend: BackendKind, spec: &TechniqueSpec) -> Result<Prepared, Error> {
+        let settings = self.registry.canonical(spec)?;
+        let technique = match backend {
+            BackendKind::Cpu => PreparedKind::Cpu(self.registry.cpu(spec)?),
+            BackendKind::Wgpu => PreparedKind::Wgpu(self.registry.wgpu(spec)?),
+        };
+        Ok(Prepared { name: spec.name.clone(), settings, technique })
+    }
+
+    /// Renders one frame with a prepared technique.
+    ///
+    /// # Errors
+    /// A rendering failure, or no GPU for a wgpu technique.
+    pub fn run_prepared(
+        &mut self,
+        p: &mut Prepared,
+        frame: &FrameInputs,
+        width: u32,
+        height: u32,
+    ) -> Result<RunOutput, Error> {
+        let (backend, color, visibility, stats, debug_views) = match &mut p.technique {
+            PreparedKind::Cpu(t) => {
+                let f = shadow_cpu::render_frame(&mut self.cpu, frame, width, height, t.as_mut())?;
+                let views = t.debug_views(&mut self.cpu)?;
+                self.cpu.recycle(f.gbuffer);
+                (BackendKind::Cpu, f.color, f.visibility, f.stats, views)
+            }
+            PreparedKind::Wgpu(t) => {
+                let g = self.gpu(true)?;
+                let f = shadow_wgpu::render_frame(g, frame, width, height, t.as_mut())?;
+                let views = t.debug_views(g)?;
+                (BackendKind::Wgpu, f.color, f.visibility, f.stats, views)
+            }
+        };
+        Ok(RunOutput {
+            technique: p.name.clone(),
+            settings: p.settings.clone(),
+            backend,
+            color,
+            visibility,
+            stats,
+            debug_views,
+        })
+    }
+
+    /// Runs one technique on one backend, from a fresh state.
     ///
     /// # Errors
     /// Unknown technique, bad settings, a technique missing on that backend, or a rendering failure.
@@ -166,35 +215,40 @@ impl Renderer {
         height: u32,
         spec: &TechniqueSpec,
     ) -> Result<RunOutput, Error> {
-        let settings = self.registry.canonical(spec)?;
-        match backend {
-            BackendKind::Cpu => {
-                let (f, debug_views) = self.run_cpu_frame(frame, width, height, spec)?;
-                Ok(RunOutput {
-                    technique: spec.name.clone(),
-                    settings,
-                    backend,
-                    color: f.color,
-                    visibility: f.visibility,
-                    stats: f.stats,
-                    debug_views,
-                })
-            }
-            BackendKind::Wgpu => {
-                let mut t = self.registry.wgpu(spec)?;
-                let g = self.gpu(true)?;
-                let f = shadow_wgpu::render_frame(g, frame, width, height, t.as_mut())?;
-                let debug_views = t.debug_views(g)?;
-                Ok(RunOutput {
-                    technique: spec.name.clone(),
-                    settings,
-                    backend,
-                    color: f.color,
-                    visibility: f.visibility,
-                    stats: f.stats,
-                    debug_views,
-                })
-            }
+        let mut p = self.prepare(backend, spec)?;
+        self.run_prepared(&mut p, frame, width, height)
+    }
+}
+
+enum PreparedKind {
+    Cpu(Box<dyn shadow_core::technique::DynShadowTechnique<shadow_cpu::CpuBackend>>),
+    Wgpu(Box<dyn shadow_core::technique::DynShadowTechnique<shadow_wgpu::WgpuBackend>>),
+}
+
+/// A technique ready to run on one backend, with its state.
+pub struct Prepared {
+    name: String,
+    settings: String,
+    technique: PreparedKind,
+}
+
+impl Prepared {
+    /// Registry name.
+    #[must_use]
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+    /// Canonical settings.
+    #[must_use]
+    pub fn settings(&self) -> &str {
+        &self.settings
+    }
+    /// The backend it runs on.
+    #[must_use]
+    pub fn backend(&self) -> BackendKind {
+        match self.technique {
+            PreparedKind::Cpu(_) => BackendKind::Cpu,
+            PreparedKind::Wgpu(_) => BackendKind::Wgpu,
         }
     }
 }

@@ -58,3 +58,51 @@ fn usage_errors_exit_2() {
     assert_eq!(code, 2);
     assert!(err.contains("no-such-scene"), "{err}");
 }
+
+/// Every bad input gives exit status 2 (usage) or 1 (the work failed) and one line naming the cause.
+#[test]
+fn bad_inputs_give_one_line_and_the_right_status() {
+    let cycle = Path::new(env!("CARGO_MANIFEST_DIR")).join("shadow-core/tests/data/bad/node_cycle.gltf");
+    let cycle = cycle.to_str().unwrap();
+    let out = std::env::temp_dir().join(format!("shadowlab-cli-{}", std::process::id()));
+    let out = out.to_str().unwrap();
+    let cases: &[(&[&str], i32, &str)] = &[
+        (&["render", "--scene", "atlantis", "-o", out], 2, "unknown scene 'atlantis'"),
+        (&["render", "--technique", "shadow-mop", "-o", out], 2, "unknown technique 'shadow-mop'"),
+        (&["render", "--technique", "shadow-map:colour=red", "-o", out], 2, "has no setting 'colour'"),
+        (&["render", "--technique", "shadow-map:res=abc", "-o", out], 2, "bad value 'abc' for 'res'"),
+        (&["render", "--technique", "shadow-map:filter=gauss", "-o", out], 2, "pcf3x3"),
+        (&["render", "--technique", "shadow-map:res", "-o", out], 2, "is not key=value"),
+        (&["render", "--size", "512", "-o", out], 2, "expected WxH"),
+        (&["render", "--size", "0x512", "-o", out], 2, "at least 1"),
+        (&["render", "--size", "20000x20000", "--backend", "cpu", "-o", out], 1, "over the limit"),
+        (&["render", "--scene", "no/such/model.obj", "-o", out], 1, "file not found"),
+        (&["render", "--scene", cycle, "-o", out], 1, "own ancestor"),
+        (&["render", "--camera", "eye=1,2,target=0,0,0", "-o", out], 2, "eye must be three"),
+        (&["render", "--light", "laser", "-o", out], 2, "type must be one of spot, directional, point"),
+        (&["render", "--light", "spot,fov=250", "-o", out], 2, "cone angle"),
+        (&["compare", "--backend", "quantum", "--out-dir", out], 2, "bad --backend 'quantum'"),
+        (&["bench", "--frames", "0", "--backend", "cpu"], 2, "--frames must be at least 1"),
+        (&["bench", "--sweep", "speed=1,2", "--backend", "cpu"], 2, "must be res or tris"),
+        (&["bench", "--sweep", "res=256,-3", "--backend", "cpu"], 2, "positive whole numbers"),
+        (
+            &["render", "--technique", "ray-traced", "--backend", "wgpu", "-o", out],
+            2,
+            "not implemented on the wgpu backend",
+        ),
+        (&["export", "--scene", "cylinder", "-o", "/no/such/dir/x.glb"], 1, "cannot write /no/such/dir/x.glb"),
+    ];
+    for (args, status, words) in cases {
+        let (code, _, err) = shadowlab(args);
+        let lines: Vec<&str> =
+            err.lines().filter(|l| !l.starts_with("backend") && !l.contains("XDG_RUNTIME_DIR")).collect();
+        assert_eq!(code, *status, "{args:?}: status {code}, stderr: {err}");
+        assert_eq!(lines.len(), 1, "{args:?}: not one line: {err}");
+        assert!(
+            lines[0].starts_with("error: ") && lines[0].contains(words),
+            "{args:?}: '{}' lacks '{words}'",
+            lines[0]
+        );
+    }
+    let _ = std::fs::remove_file(out);
+}

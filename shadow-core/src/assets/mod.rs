@@ -6,6 +6,7 @@
 //! index is range-checked, and every position must be finite. Nothing panics on bad input, nothing loops
 //! on it, and nothing quietly drops what it cannot read if that would change the picture.
 
+pub mod export;
 mod gltf;
 mod obj;
 mod ply;

@@ -1,0 +1,186 @@
+//! `bench`: frames with the light moving every frame (nothing light-dependent can be cached), a warm-up,
+//! then per phase the median, minimum and maximum over the measured frames, with the counters of the
+//! last frame (DESIGN 11). `--sweep` repeats it over a parameter.
+
+use std::collections::BTreeMap;
+
+use glam::{Mat3, Vec3};
+use serde::Serialize;
+use shadow_core::FrameInputs;
+use shadow_core::scene::{Light, LightKind};
+use shadow_core::stats::{Phase, Summary};
+use shadow_core::technique::TechniqueSpec;
+
+use crate::Error;
+use crate::renderer::{BackendKind, Renderer};
+
+/// What to measure.
+pub struct BenchJob<'a> {
+    /// Scene name for the report.
+    pub scene: String,
+    /// The frame (its lights are moved frame by frame).
+    pub frame: &'a FrameInputs,
+    /// View size.
+    pub width: u32,
+    /// View size.
+    pub height: u32,
+    /// Measured frames.
+    pub frames: u32,
+    /// Frames run first and not measured (pipeline compilation, first allocations).
+    pub warmup: u32,
+    /// Techniques.
+    pub techniques: Vec<TechniqueSpec>,
+    /// Backends.
+    pub backends: Vec<BackendKind>,
+}
+
+/// Median, minimum and maximum, in milliseconds.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct Stat {
+    /// Median.
+    pub median: f64,
+    /// Minimum.
+    pub min: f64,
+    /// Maximum.
+    pub max: f64,
+}
+
+/// One technique on one backend.
+#[derive(Clone, Debug, Serialize)]
+pub struct BenchEntry {
+    /// Technique name.
+    pub technique: String,
+    /// Canonical settings.
+    pub settings: String,
+    /// Backend name.
+    pub backend: String,
+    /// Per phase (and total), over the measured frames.
+    pub timings_ms: BTreeMap<String, Stat>,
+    /// Counters of the last frame.
+    pub counters: BTreeMap<String, f64>,
+}
+
+/// The whole `bench --json` output.
+#[derive(Clone, Debug, Serialize)]
+pub struct BenchReport {
+    /// Scene name.
+    pub scene: String,
+    /// View width.
+    pub width: u32,
+    /// View height.
+    pub height: u32,
+    /// Measured frames.
+    pub frames: u32,
+    /// One entry per technique and backend.
+    pub results: Vec<BenchEntry>,
+}
+
+/// The light of frame `k`: turned about the vertical axis through `center`, a quarter turn over a run of
+/// `n` frames (position and direction for spot and point lights, direction for directional ones).
+#[must_use]
+pub fn moved_light(light: &Light, center: Vec3, k: u32, n: u32) -> Light {
+    let angle = std::f32::consts::FRAC_PI_2 * k as f32 / n.max(1) as f32;
+    let r = Mat3::from_rotation_y(angle);
+    let kind = match light.kind {
+        LightKind::Spot { position, direction, cone_angle } => {
+            LightKind::Spot { position: center + r * (position - center), direction: r * direction, cone_angle }
+        }
+        LightKind::Point { position } => LightKind::Point { position: center + r * (position - center) },
+        LightKind::Directional { direction } => LightKind::Directional { direction: r * direction },
+    };
+    Light { kind, ..*light }
+}
+
+/// Runs the job.
+///
+/// # Errors
+/// Rendering failures.
+pub fn run_bench(
+    renderer: &mut Renderer,
+    job: &BenchJob<'_>,
+    mut progress: impl FnMut(&str),
+) -> Result<BenchReport, Error> {
+    let center = job.frame.bounds.center();
+    let total = job.warmup + job.frames;
+    let mut results = Vec::new();
+    for spec in &job.techniques {
+        for &backend in &job.backends {
+            progress(&format!("{spec} on {}", backend.name()));
+            let mut p = renderer.prepare(backend, spec)?;
+            let mut samples: BTreeMap<String, Vec<f64>> = BTreeMap::new();
+            let mut counters = BTreeMap::new();
+            for k in 0..total {
+                let mut frame = job.frame.clone();
+                frame.lights = job.frame.lights.iter().map(|l| moved_light(l, center, k, total)).collect();
+                let run = renderer.run_prepared(&mut p, &frame, job.width, job.height)?;
+                if k < job.warmup {
+                    continue;
+                }
+                for phase in Phase::ALL {
+                    samples.entry(phase.key().into()).or_default().push(run.stats.timings.get(phase));
+                }
+                samples.entry("total".into()).or_default().push(run.stats.timings.total);
+                for (key, v) in &run.stats.timings.extra {
+                    samples.entry(key.clone()).or_default().push(*v);
+                }
+                counters = run.stats.counters.entries().into_iter().collect();
+            }
+            let timings_ms = samples
+                .into_iter()
+                .map(|(k, v)| {
+                    let s = Summary::of(&v);
+                    (k, Stat { median: s.median, min: s.min, max: s.max })
+                })
+                .collect();
+            results.push(BenchEntry {
+                technique: p.name().into(),
+                settings: p.settings().into(),
+                backend: backend.name().into(),
+                timings_ms,
+                counters,
+            });
+        }
+    }
+    Ok(BenchReport { scene: job.scene.clone(), width: job.width, height: job.height, frames: job.frames, results })
+}
+
+/// The bench table as text.
+#[must_use]
+pub fn bench_table(r: &BenchReport) -> String {
+    let mut s =
+        format!("{} at {}x{}, {} frames (median ms, min..max in brackets)\n", r.scene, r.width, r.height, r.frames);
+    s.push_str(&format!(
+        "{:<22} {:<5} {:>16} {:>16} {:>16} {:>16} {:>18}\n",
+        "technique", "", "gbuffer", "build", "query", "shade", "total"
+    ));
+    for e in &r.results {
+        let cell = |k: &str| {
+            e.timings_ms.get(k).map_or("-".to_string(), |t| format!("{:.1} [{:.1}..{:.1}]", t.median, t.min, t.max))
+        };
+        s.push_str(&format!(
+            "{:<22} {:<5} {:>16} {:>16} {:>16} {:>16} {:>18}\n",
+            e.technique,
+            e.backend,
+            cell("gbuffer"),
+            cell("build"),
+            cell("query"),
+            cell("shade"),
+            cell("total")
+        ));
+    }
+    s
+}
+
+/// The scene of a triangle-count sweep: a sphere of about `tris` triangles on the ground, staged like a
+/// model file (DESIGN 11).
+#[must_use]
+pub fn sweep_scene(tris: u32) -> shadow_core::Scene {
+    let segments = (tris as f32).sqrt().round().max(3.0) as u32;
+    let rings = (tris / segments).div_ceil(2).max(2) + 1;
+    let mut s = shadow_core::Scene::new();
+    let m = s.add_mesh(shadow_core::procedural::sphere(0.5, segments, rings));
+    let mat = s.add_material(shadow_core::Material::colored("sphere", Vec3::new(0.85, 0.45, 0.25)));
+    let _ = s.add_instance("sphere", m, mat, glam::Mat4::IDENTITY);
+    shadow_core::scenes::stage_model(&mut s, true);
+    s
+}
