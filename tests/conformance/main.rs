@@ -1,5 +1,9 @@
-//! The one integration-test binary (DESIGN 9): the command line, and (with the backends) cross-backend
-//! conformance.
+//! The one integration-test binary (DESIGN 9): the command line, and cross-backend conformance of every
+//! registered technique, the example's runtime-registered one included.
 
 mod cli;
+// The technique of examples/custom_technique.rs, registered at runtime like a user's would be.
+#[path = "../../examples/planar/mod.rs"]
+#[allow(dead_code)]
+mod planar;
 mod suite;
