@@ -70,5 +70,6 @@ pub fn render_frame(
     let color = shade(&gbuffer, &frame.lights, &refs);
     stats.timings.add(Phase::Shade, ms(t.elapsed()));
     stats.timings.total = ms(start.elapsed());
+    stats.counters.covered_pixels = Some(gbuffer.covered_pixels());
     Ok(CpuFrame { gbuffer, light_views, visibility, color, stats })
 }

@@ -12,6 +12,7 @@ use shadow_core::technique::{DynShadowTechnique, FrameStats};
 use shadow_core::{FrameInputs, Image};
 use wgpu::util::DeviceExt;
 
+use crate::clock::PhaseClock;
 use crate::context::{WgpuBackend, WgpuContext, WgpuError};
 use crate::gbuffer::{self, GpuGBuffer};
 use crate::pipelines::{COLOR, VISIBILITY};
@@ -114,9 +115,15 @@ pub fn render_frame(
 ) -> Result<WgpuFrame, WgpuError> {
     let start = Instant::now();
     let mut stats = FrameStats::default();
+    let mut clock = PhaseClock::new(cx);
+    // Marker indices of each phase's start and end, for GPU times.
+    let mut spans: Vec<(Phase, Option<u32>, Option<u32>)> = Vec::new();
+    let mark = |cx: &WgpuContext, clock: &mut Option<PhaseClock>| clock.as_mut().and_then(|c| c.mark(cx));
 
     let t = Instant::now();
+    let m0 = mark(cx, &mut clock);
     let g = gbuffer::render(cx, frame, width, height)?;
+    spans.push((Phase::GBuffer, m0, mark(cx, &mut clock)));
     cx.wait()?;
     stats.timings.add(Phase::GBuffer, ms(t.elapsed()));
 
@@ -127,12 +134,16 @@ pub fn render_frame(
         let view = frame.light_view(light)?;
         let mut light_stats = FrameStats::default();
         let t = Instant::now();
+        let m0 = mark(cx, &mut clock);
         technique.build(cx, frame, &view, &mut light_stats)?;
+        spans.push((Phase::Build, m0, mark(cx, &mut clock)));
         cx.wait()?;
         stats.timings.add(Phase::Build, ms(t.elapsed()));
         let mut out = GpuVisibility { view: layer_view(&vis_tex, k as u32), width, height };
         let t = Instant::now();
+        let m0 = mark(cx, &mut clock);
         technique.query(cx, frame, &view, &g, &mut out, &mut light_stats)?;
+        spans.push((Phase::Query, m0, mark(cx, &mut clock)));
         cx.wait()?;
         stats.timings.add(Phase::Query, ms(t.elapsed()));
         stats.counters.merge(&light_stats.counters);
@@ -143,10 +154,22 @@ pub fn render_frame(
     }
 
     let t = Instant::now();
-    let color_tex = shade(cx, frame, &g, &vis_tex)?;
+    let m0 = mark(cx, &mut clock);
+    let (color_tex, covered) = shade(cx, frame, &g, &vis_tex)?;
+    spans.push((Phase::Shade, m0, mark(cx, &mut clock)));
     cx.wait()?;
     stats.timings.add(Phase::Shade, ms(t.elapsed()));
     stats.timings.total = ms(start.elapsed());
+    stats.counters.covered_pixels = Some(read_count(cx, &covered)?);
+    if let Some(c) = &clock {
+        let at = c.read(cx)?;
+        for (phase, a, b) in spans {
+            if let (Some(a), Some(b)) = (a, b) {
+                *stats.timings.extra.entry(format!("gpu_{}", phase.key())).or_insert(0.0) +=
+                    at[b as usize] - at[a as usize];
+            }
+        }
+    }
 
     let color = readback::read_rgb8(cx, &color_tex)?;
     let visibility = (0..frame.lights.len() as u32)
@@ -155,12 +178,29 @@ pub fn render_frame(
     Ok(WgpuFrame { light_views, visibility, color, stats })
 }
 
+/// The receiver count of [`shade`]'s occlusion query.
+fn read_count(cx: &WgpuContext, q: &wgpu::Buffer) -> Result<u64, WgpuError> {
+    let staging = cx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("receivers readback"),
+        size: 8,
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    let mut enc = cx.device.create_command_encoder(&Default::default());
+    enc.copy_buffer_to_buffer(q, 0, &staging, 0, 8);
+    cx.queue.submit([enc.finish()]);
+    let d = readback::map_read(cx, &staging, "counting receivers")?;
+    Ok(u64::from_le_bytes([d[0], d[1], d[2], d[3], d[4], d[5], d[6], d[7]]))
+}
+
+/// Counts the receiver pixels (an occlusion query over a pass that discards everything else), then
+/// shades. Returns the shaded texture and the query's resolve buffer.
 fn shade(
     cx: &WgpuContext,
     frame: &FrameInputs,
     g: &GpuGBuffer,
     vis: &wgpu::Texture,
-) -> Result<wgpu::Texture, WgpuError> {
+) -> Result<(wgpu::Texture, wgpu::Buffer), WgpuError> {
     cx.scoped("the shading pass", |cx| {
         let color = layered(cx, "color", g.width, g.height, 1, COLOR);
         let lights: Vec<LightRaw> = frame.lights.iter().map(LightRaw::of).collect();
@@ -186,10 +226,21 @@ fn shade(
             ],
         });
         let view = color.create_view(&Default::default());
+        let query = cx.device.create_query_set(&wgpu::QuerySetDescriptor {
+            label: Some("receivers"),
+            ty: wgpu::QueryType::Occlusion,
+            count: 1,
+        });
+        let resolved = cx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("receivers"),
+            size: 8,
+            usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
         let mut enc = cx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("shade") });
-        {
+        for counting in [true, false] {
             let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("shade"),
+                label: Some(if counting { "count receivers" } else { "shade" }),
                 color_attachments: &[Some(wgpu::RenderPassColorAttachment {
                     view: &view,
                     depth_slice: None,
@@ -201,15 +252,22 @@ fn shade(
                 })],
                 depth_stencil_attachment: None,
                 timestamp_writes: None,
-                occlusion_query_set: None,
+                occlusion_query_set: counting.then_some(&query),
                 multiview_mask: None,
             });
-            pass.set_pipeline(&cx.shared.shade);
+            pass.set_pipeline(if counting { &cx.shared.receivers } else { &cx.shared.shade });
             pass.set_bind_group(0, &g.frame_group, &[]);
             pass.set_bind_group(1, &group, &[]);
+            if counting {
+                pass.begin_occlusion_query(0);
+            }
             pass.draw(0..3, 0..1);
+            if counting {
+                pass.end_occlusion_query();
+            }
         }
+        enc.resolve_query_set(&query, 0..1, &resolved, 0);
         cx.queue.submit([enc.finish()]);
-        color
+        (color, resolved)
     })
 }

@@ -4,6 +4,7 @@
 //! ([`gbuffer`]), the frame driver with shading and readback ([`frame`]), and the GPU versions of the
 //! techniques ([`techniques`]), each a folder-like module with its WGSL next to it in `shaders/`.
 
+pub mod clock;
 pub mod context;
 pub mod frame;
 pub mod gbuffer;

@@ -98,6 +98,8 @@ pub struct Shared {
     pub shade_layout: wgpu::BindGroupLayout,
     /// The shading pipeline.
     pub shade: wgpu::RenderPipeline,
+    /// Counts receiver pixels (same layout as shading).
+    pub receivers: wgpu::RenderPipeline,
 }
 
 impl Shared {
@@ -164,7 +166,16 @@ impl Shared {
         let smod = shaders::module(device, "shade", shaders::shade());
         let shade =
             full_screen_pipeline(device, "shade", &smod, "fs_shade", &[&frame_layout, &shade_layout], COLOR, None);
-        Self { frame_layout, gbuffer, shade_layout, shade }
+        let receivers = full_screen_pipeline(
+            device,
+            "receivers",
+            &smod,
+            "fs_receivers",
+            &[&frame_layout, &shade_layout],
+            COLOR,
+            None,
+        );
+        Self { frame_layout, gbuffer, shade_layout, shade, receivers }
     }
 
     /// A group-0 bind group for a view (camera or light) over a frame's instances.

@@ -38,24 +38,30 @@ fn read_layer(
         wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
     );
     cx.queue.submit([enc.finish()]);
+    let data = map_read(cx, &buffer, "readback")?;
+    let mut out = Vec::with_capacity((row * h) as usize);
+    for y in 0..h as usize {
+        out.extend_from_slice(&data[y * padded as usize..y * padded as usize + row as usize]);
+    }
+    Ok(out)
+}
+
+/// Maps a MAP_READ buffer (its copies already submitted) and returns its bytes.
+///
+/// # Errors
+/// A GPU failure.
+pub fn map_read(cx: &WgpuContext, buffer: &wgpu::Buffer, during: &str) -> Result<Vec<u8>, WgpuError> {
     let slice = buffer.slice(..);
     let (tx, rx) = std::sync::mpsc::channel();
     slice.map_async(wgpu::MapMode::Read, move |r| {
         let _ = tx.send(r);
     });
     cx.wait()?;
-    rx.recv()
-        .map_err(|_| WgpuError::Gpu { during: "readback".into(), message: "the map callback never ran".into() })?
-        .map_err(|e| WgpuError::Gpu { during: "readback".into(), message: e.to_string() })?;
-    let data =
-        slice.get_mapped_range().map_err(|e| WgpuError::Gpu { during: "readback".into(), message: e.to_string() })?;
-    let mut out = Vec::with_capacity((row * h) as usize);
-    for y in 0..h as usize {
-        out.extend_from_slice(&data[y * padded as usize..y * padded as usize + row as usize]);
-    }
-    drop(data);
+    let gpu = |m: String| WgpuError::Gpu { during: during.into(), message: m };
+    rx.recv().map_err(|_| gpu("the map callback never ran".into()))?.map_err(|e| gpu(e.to_string()))?;
+    let bytes = slice.get_mapped_range().map_err(|e| gpu(e.to_string()))?.to_vec();
     buffer.unmap();
-    Ok(out)
+    Ok(bytes)
 }
 
 /// A single-channel f32 texture (R32Float or Depth32Float) as an image.

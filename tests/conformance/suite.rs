@@ -25,7 +25,7 @@ const MAX_ERROR_GAP: f64 = 0.005;
 /// (z-pass with the eye in shadow is wrong by design; that failure is what z-fail exists for).
 fn reference_ceiling(technique: &str, scene: &str) -> Option<f64> {
     match (technique, scene) {
-        ("shadow-volume-zpass", "room") => None,
+        ("shadow-volume-zpass", "room" | "room-point") => None,
         // Fake shadows: right on the ground plane only, by construction.
         ("planar-shadow", "cylinder") => Some(0.001),
         ("planar-shadow", _) => None,
@@ -41,6 +41,15 @@ fn scenes() -> Vec<(String, Scene)> {
         .iter()
         .map(|n| (n.to_string(), scenes::build(n, &SceneParams::default()).expect("built-in scene")))
         .collect();
+    // The other light types: cube maps for point lights, orthographic maps and parallel extrusion.
+    for (n, t) in [
+        ("primitives", scenes::LightType::Point),
+        ("room", scenes::LightType::Point),
+        ("primitives", scenes::LightType::Directional),
+    ] {
+        let params = SceneParams { light: Some(t), ..SceneParams::default() };
+        v.push((format!("{n}-{t}"), scenes::build(n, &params).expect("built-in scene")));
+    }
     let spot = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/models/spot.obj");
     if spot.exists() {
         let mut s = shadow_core::assets::load(&spot).expect("spot.obj loads");
@@ -104,6 +113,19 @@ fn every_technique_agrees_across_backends_and_with_the_reference() {
             }
             if flip > MAX_CROSS_FLIP {
                 why.push(format!("cross-backend FLIP {flip:.4} > {MAX_CROSS_FLIP}"));
+            }
+            // The counters both backends report must agree (occlusion queries against CPU counts).
+            for (name, a, b) in [
+                ("covered_pixels", cpu.stats.counters.covered_pixels, gpu.stats.counters.covered_pixels),
+                ("volume_fragments", cpu.stats.counters.volume_fragments, gpu.stats.counters.volume_fragments),
+            ] {
+                if let (Some(a), Some(b)) = (a, b) {
+                    if (a as f64 - b as f64).abs() > 0.001 * a.max(b) as f64 + 2.0 {
+                        why.push(format!("{name}: cpu {a}, wgpu {b}"));
+                    }
+                } else if a.is_some() != b.is_some() && name == "covered_pixels" {
+                    why.push(format!("{name} reported by one backend only"));
+                }
             }
             if (gpu_err - cpu_err).abs() > MAX_ERROR_GAP {
                 why.push(format!("wgpu error {:.3}% vs cpu {:.3}%", gpu_err * 100.0, cpu_err * 100.0));

@@ -38,7 +38,11 @@ pub struct ShadowMap {
     pub resolution: u32,
     /// Bias mode.
     pub bias: BiasMode,
-    /// Vulkan constant depth-bias factor.
+    /// Vulkan constant depth-bias factor. The default, 4 (four f32 ulps at the primitive's depth), is the
+    /// smallest that settles ties on surfaces squarely facing the light: there the stored and the looked-up
+    /// depths are equal up to rounding, and at 1 the GPU's interpolated positions lost the tie on a
+    /// table top seen through a cube face (0.5% acne on lavapipe, none on the CPU); 4 to 64 changed no
+    /// other error.
     pub bias_constant: f32,
     /// Vulkan slope depth-bias factor.
     pub bias_slope: f32,
@@ -57,7 +61,7 @@ const MAP_KEYS: [SettingKey; 6] = [
     },
     SettingKey {
         key: "bias_constant",
-        default: "1",
+        default: "4",
         help: "constant bias factor, in units of the f32 depth resolution at the primitive",
     },
     SettingKey {
@@ -161,7 +165,7 @@ mod tests {
         let s = ShadowMap::defaults();
         assert_eq!(
             s.settings_string(),
-            "res=2048,bias=slope,bias_constant=1,bias_slope=2,filter=none,filter_radius=1.5"
+            "res=2048,bias=slope,bias_constant=4,bias_slope=2,filter=none,filter_radius=1.5"
         );
         let _ = RayTraced::defaults();
         let _ = ShadowVolume::defaults();

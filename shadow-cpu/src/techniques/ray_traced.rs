@@ -75,7 +75,6 @@ impl ShadowTechnique<CpuBackend> for RayTraced {
             };
             if n.dot(dir) <= 0.0 || bvh.occluded(origin, dir, tmax) { 0.0 } else { 1.0 }
         });
-        stats.counters.covered_pixels = Some(g.covered_pixels());
         stats.counters.extra.insert("shadow_rays".into(), g.covered_pixels() as f64);
         Ok(())
     }

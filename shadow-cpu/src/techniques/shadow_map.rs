@@ -56,7 +56,7 @@ impl ShadowTechnique<CpuBackend> for ShadowMap {
         light: &LightView,
         g: &GBuffer,
         out: &mut Image<f32>,
-        stats: &mut FrameStats,
+        _: &mut FrameStats,
     ) -> Result<(), CpuError> {
         if state.maps.len() != light.projections.len() {
             return Err(TechniqueError::NotBuilt(self.name().into()).into());
@@ -67,7 +67,6 @@ impl ShadowTechnique<CpuBackend> for ShadowMap {
             let (uv, depth) = light.projections[k].uv_depth(p);
             shadow_lookup(&state.maps[k], uv, depth, self.filter, self.filter_radius, (x, y))
         });
-        stats.counters.covered_pixels = Some(g.covered_pixels());
         Ok(())
     }
 

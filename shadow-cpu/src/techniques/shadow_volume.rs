@@ -140,7 +140,6 @@ impl ShadowTechnique<CpuBackend> for ShadowVolume {
         let c = rasterize_volumes(frame, g, volumes, self.counting, &mut ds);
         per_receiver(g, out, |_, _, i| if ds.stencil[i] == 0 { 1.0 } else { 0.0 });
         let counters = &mut stats.counters;
-        counters.covered_pixels = Some(g.covered_pixels());
         counters.volume_fragments = Some(c.fragments);
         counters.stencil_updates = Some(c.stencil_updates);
         Ok(())

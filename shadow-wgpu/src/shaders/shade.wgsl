@@ -26,3 +26,12 @@ fn fs_shade(in: FullScreen) -> @location(0) vec4<f32> {
     }
     return vec4<f32>(linear_to_srgb(c.x), linear_to_srgb(c.y), linear_to_srgb(c.z), 1.0);
 }
+
+// Counts receiver pixels (covered_pixels) through an occlusion query: only receivers survive.
+@fragment
+fn fs_receivers(in: FullScreen) -> @location(0) vec4<f32> {
+    if (textureLoad(g_position, vec2<i32>(in.pos.xy), 0).w == 0.0) {
+        discard;
+    }
+    return vec4<f32>(0.0);
+}

@@ -240,7 +240,7 @@ impl ShadowTechnique<WgpuBackend> for ShadowMap {
         light: &LightView,
         g: &GpuGBuffer,
         out: &mut GpuVisibility,
-        stats: &mut FrameStats,
+        _: &mut FrameStats,
     ) -> Result<(), WgpuError> {
         let maps = state.maps.as_ref().ok_or_else(|| TechniqueError::NotBuilt(self.name().into()))?;
         let mut proj = [[[0.0f32; 4]; 4]; 6];
@@ -285,7 +285,6 @@ impl ShadowTechnique<WgpuBackend> for ShadowMap {
                 None,
             );
         })?;
-        stats.counters.covered_pixels = None;
         Ok(())
     }
 }

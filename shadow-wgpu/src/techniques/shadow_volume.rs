@@ -369,17 +369,6 @@ fn read_query(cx: &WgpuContext, q: &(wgpu::QuerySet, wgpu::Buffer)) -> Result<u6
     let mut enc = cx.device.create_command_encoder(&Default::default());
     enc.copy_buffer_to_buffer(&q.1, 0, &staging, 0, 8);
     cx.queue.submit([enc.finish()]);
-    let slice = staging.slice(..);
-    let (tx, rx) = std::sync::mpsc::channel();
-    slice.map_async(wgpu::MapMode::Read, move |r| {
-        let _ = tx.send(r);
-    });
-    cx.wait()?;
-    let gpu = |m: String| WgpuError::Gpu { during: "reading an occlusion query".into(), message: m };
-    rx.recv().map_err(|_| gpu("the map callback never ran".into()))?.map_err(|e| gpu(e.to_string()))?;
-    let data = slice.get_mapped_range().map_err(|e| gpu(e.to_string()))?;
-    let v = u64::from_le_bytes([data[0], data[1], data[2], data[3], data[4], data[5], data[6], data[7]]);
-    drop(data);
-    staging.unmap();
-    Ok(v)
+    let d = crate::readback::map_read(cx, &staging, "reading an occlusion query")?;
+    Ok(u64::from_le_bytes([d[0], d[1], d[2], d[3], d[4], d[5], d[6], d[7]]))
 }

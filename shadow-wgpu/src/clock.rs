@@ -1,0 +1,83 @@
+//! GPU time per phase from timestamp queries, where the adapter has them: a marker (an empty compute
+//! pass that writes a timestamp) is submitted between phases; as the queue runs in order, the difference
+//! between two markers is the GPU's time for the work submitted between them.
+
+use crate::context::{WgpuContext, WgpuError};
+
+/// Markers of one frame.
+pub struct PhaseClock {
+    set: wgpu::QuerySet,
+    count: u32,
+}
+
+/// Most markers a frame writes.
+const CAPACITY: u32 = 64;
+
+impl PhaseClock {
+    /// A clock, or `None` on an adapter without timestamp queries.
+    #[must_use]
+    pub fn new(cx: &WgpuContext) -> Option<Self> {
+        cx.timestamps.then(|| Self {
+            set: cx.device.create_query_set(&wgpu::QuerySetDescriptor {
+                label: Some("phase clock"),
+                ty: wgpu::QueryType::Timestamp,
+                count: CAPACITY,
+            }),
+            count: 0,
+        })
+    }
+
+    /// Submits a marker; returns its index.
+    pub fn mark(&mut self, cx: &WgpuContext) -> Option<u32> {
+        if self.count >= CAPACITY {
+            return None;
+        }
+        let index = self.count;
+        let mut enc = cx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("phase marker") });
+        drop(enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("phase marker"),
+            timestamp_writes: Some(wgpu::ComputePassTimestampWrites {
+                query_set: &self.set,
+                beginning_of_pass_write_index: Some(index),
+                end_of_pass_write_index: None,
+            }),
+        }));
+        cx.queue.submit([enc.finish()]);
+        self.count += 1;
+        Some(index)
+    }
+
+    /// Every marker's time in milliseconds since the first.
+    ///
+    /// # Errors
+    /// A GPU failure while reading the queries back.
+    pub fn read(&self, cx: &WgpuContext) -> Result<Vec<f64>, WgpuError> {
+        if self.count == 0 {
+            return Ok(Vec::new());
+        }
+        let size = u64::from(self.count) * 8;
+        let resolve = cx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("timestamps"),
+            size,
+            usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let staging = cx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("timestamps readback"),
+            size,
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        });
+        let mut enc = cx.device.create_command_encoder(&Default::default());
+        enc.resolve_query_set(&self.set, 0..self.count, &resolve, 0);
+        enc.copy_buffer_to_buffer(&resolve, 0, &staging, 0, size);
+        cx.queue.submit([enc.finish()]);
+        let ticks = crate::readback::map_read(cx, &staging, "reading timestamps")?;
+        let period = f64::from(cx.queue.get_timestamp_period());
+        let ticks: Vec<u64> = ticks
+            .chunks_exact(8)
+            .map(|c| u64::from_le_bytes([c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7]]))
+            .collect();
+        Ok(ticks.iter().map(|&t| t.saturating_sub(ticks[0]) as f64 * period * 1e-6).collect())
+    }
+}
