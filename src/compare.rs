@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 use shadow_core::image::{Rgb8, error_map, visibility_to_rgb};
-use shadow_core::metrics::{VisibilityMetrics, compare_visibility, flip_mean, measured_pixels};
+use shadow_core::metrics::{VisibilityMetrics, back_false_light, compare_visibility, flip_mean, measured_pixels};
 use shadow_core::stats::Phase;
 use shadow_core::technique::{FrameStats, TechniqueSpec};
 use shadow_core::{FrameInputs, Image};
@@ -137,7 +137,18 @@ pub fn run_compare(
     let view = ref_frame.light_views.first().ok_or_else(|| Error::Usage("the scene has no light".into()))?;
     let g = &ref_frame.gbuffer;
     let mask = measured_pixels(&g.receiver, &g.position, &g.geometric_normal, view);
+    let reach =
+        Image::from_fn(job.width, job.height, |x, y| *g.receiver.get(x, y) && view.in_domain(*g.position.get(x, y)));
     let ref_vis = &ref_frame.visibility[0];
+    let bvh = renderer.bvh(job.frame);
+    let probe = shadow_cpu::acne::AcneProbe {
+        frame: job.frame,
+        light: view,
+        gbuffer: g,
+        bvh: &bvh,
+        reference: ref_vis,
+        mask: &mask,
+    };
     let mut sheet: Vec<(String, Image<Rgb8>)> = vec![("ray-traced\nreference".into(), ref_frame.color.clone())];
     if let Some(dir) = &job.out_dir {
         save(&ref_frame.color, dir, "reference.png")?;
@@ -161,11 +172,16 @@ pub fn run_compare(
             if let Some(dir) = &job.out_dir {
                 save(&run.color, dir, &format!("{file}.png"))?;
                 save(&visibility_to_rgb(&run.visibility[0], &mask), dir, &format!("{file}.vis.png"))?;
-                save(&error_map(&run.visibility[0], ref_vis, &mask), dir, &format!("{file}.err.png"))?;
+                save(&error_map(&run.visibility[0], ref_vis, &mask, &reach), dir, &format!("{file}.err.png"))?;
                 for v in &run.debug_views {
                     save(&v.image, dir, &format!("{file}.{}.png", v.name))?;
                 }
             }
+            // Map-based techniques (a `res` setting) also get acne told apart from undersampling.
+            let res =
+                run.settings.split(',').find_map(|kv| kv.strip_prefix("res=")).and_then(|v| v.parse::<u32>().ok());
+            let acne = res.map(|r| probe.texel_acne(&run.visibility[0], r));
+            let back = back_false_light(&run.visibility[0], ref_vis, &mask, &reach)?;
             let label = format!("{}\n{} {:.3}%", spec.name, backend.name(), metrics.mismatch * 100.0);
             sheet.push((label, run.color.clone()));
             results.push(ResultEntry {
@@ -174,7 +190,14 @@ pub fn run_compare(
                 backend: backend.name().into(),
                 timings_ms: timings_map(&run.stats),
                 counters: run.stats.counters.entries().into_iter().collect(),
-                vs_reference: metrics_map(&metrics, flip),
+                vs_reference: {
+                    let mut m = metrics_map(&metrics, flip);
+                    m.insert("back_false_light".into(), back);
+                    if let Some(a) = acne {
+                        m.insert("texel_acne".into(), a);
+                    }
+                    m
+                },
                 file,
                 metrics,
                 flip,

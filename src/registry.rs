@@ -2,7 +2,9 @@
 //! backend. Built-in, shadow-soft and user techniques register the same way; the CLI, the reports and the
 //! conformance tests enumerate it, so a new technique gets all of them for free.
 
-use shadow_core::technique::hard::{RayTraced, ShadowMap, ShadowVolume};
+use shadow_core::technique::hard::{
+    DepthLayers, DualShadowMap, MidpointShadowMap, RayTraced, SecondDepthShadowMap, ShadowMap, ShadowVolume,
+};
 use shadow_core::technique::settings::{SettingKey, SettingsError, TechniqueSettings, TechniqueSpec};
 use shadow_core::technique::{DynShadowTechnique, Stateful};
 use shadow_cpu::CpuBackend;
@@ -13,6 +15,13 @@ pub type CpuConstructor = fn(&TechniqueSpec) -> Result<Box<dyn DynShadowTechniqu
 
 /// Builds a technique for the wgpu backend from a spec.
 pub type WgpuConstructor = fn(&TechniqueSpec) -> Result<Box<dyn DynShadowTechnique<WgpuBackend>>, SettingsError>;
+
+type LayerFns = (
+    fn() -> &'static [SettingKey],
+    fn(&TechniqueSpec) -> Result<String, SettingsError>,
+    CpuConstructor,
+    WgpuConstructor,
+);
 
 /// One registered technique.
 #[derive(Clone)]
@@ -80,6 +89,18 @@ where
     Ok(Stateful::boxed(s, text))
 }
 
+/// A depth-layer map: the settings type (one per name, for its defaults) wraps the shared technique.
+fn layers<B, S>(spec: &TechniqueSpec) -> Result<Box<dyn DynShadowTechnique<B>>, SettingsError>
+where
+    B: shadow_core::technique::Backend,
+    S: TechniqueSettings + Into<DepthLayers>,
+    DepthLayers: shadow_core::technique::ShadowTechnique<B>,
+{
+    let s = S::parse(&spec.name, &spec.values)?;
+    let text = s.settings_string();
+    Ok(Stateful::boxed(s.into(), text))
+}
+
 /// Shadow volumes: the name picks the counting.
 fn volume<B>(spec: &TechniqueSpec) -> Result<Box<dyn DynShadowTechnique<B>>, SettingsError>
 where
@@ -136,6 +157,53 @@ impl TechniqueRegistry {
             cpu: Some(volume::<CpuBackend>),
             wgpu: Some(volume::<WgpuBackend>),
         });
+        let layer_entries: [(&'static str, &'static str, &'static str, LayerFns); 3] = [
+            (
+                "midpoint-shadow-map",
+                "a map of the midpoint between the two layers nearest the light (depth peeling)",
+                "Woo 1992 (in Weiskopf-Ertl 2003, section 3)",
+                (
+                    MidpointShadowMap::keys,
+                    canonical::<MidpointShadowMap>,
+                    layers::<CpuBackend, MidpointShadowMap>,
+                    layers::<WgpuBackend, MidpointShadowMap>,
+                ),
+            ),
+            (
+                "second-depth-shadow-map",
+                "a map of the second-nearest layer; meant for closed meshes",
+                "Wang-Molnar 1994 (in Weiskopf-Ertl 2003, section 2)",
+                (
+                    SecondDepthShadowMap::keys,
+                    canonical::<SecondDepthShadowMap>,
+                    layers::<CpuBackend, SecondDepthShadowMap>,
+                    layers::<WgpuBackend, SecondDepthShadowMap>,
+                ),
+            ),
+            (
+                "dual-shadow-map",
+                "nearest layer plus min(half the gap to the second, z_offset): an adaptive bias",
+                "Weiskopf-Ertl 2003",
+                (
+                    DualShadowMap::keys,
+                    canonical::<DualShadowMap>,
+                    layers::<CpuBackend, DualShadowMap>,
+                    layers::<WgpuBackend, DualShadowMap>,
+                ),
+            ),
+        ];
+        for (name, description, paper, (keys, canonical, cpu, wgpu)) in layer_entries {
+            r.register(TechniqueEntry {
+                name,
+                description,
+                paper,
+                reference: false,
+                keys,
+                canonical,
+                cpu: Some(cpu),
+                wgpu: Some(wgpu),
+            });
+        }
         r
     }
 

@@ -154,6 +154,11 @@ impl Renderer {
         Ok((f, views))
     }
 
+    /// The BVH of a frame's casters (for measurements against the reference).
+    pub fn bvh(&mut self, frame: &FrameInputs) -> std::sync::Arc<shadow_cpu::bvh::SceneBvh> {
+        self.cpu.bvh(frame)
+    }
+
     /// A technique made for a backend, keeping its state (pipelines, maps) from frame to frame.
     ///
     /// # Errors

@@ -184,20 +184,28 @@ pub fn visibility_to_rgb(vis: &Image<f32>, mask: &Image<bool>) -> Image<Rgb8> {
 }
 
 /// The error heat map of DESIGN 11: false shadow red, false light blue, agreement grey (lit light, shadowed
-/// dark), no receiver black.
+/// dark) over the measured pixels; over `shown` pixels that are not measured (receivers turned away from
+/// the light) the same colours, dimmed; everything else black.
 #[must_use]
-pub fn error_map(test: &Image<f32>, reference: &Image<f32>, mask: &Image<bool>) -> Image<Rgb8> {
+pub fn error_map(
+    test: &Image<f32>,
+    reference: &Image<f32>,
+    measured: &Image<bool>,
+    shown: &Image<bool>,
+) -> Image<Rgb8> {
     Image::from_fn(test.width(), test.height(), |x, y| {
-        if !*mask.get(x, y) {
+        let (m, s) = (*measured.get(x, y), *shown.get(x, y));
+        if !m && !s {
             return [0, 0, 0];
         }
         let (t, r) = (*test.get(x, y) >= 0.5, *reference.get(x, y) >= 0.5);
-        match (t, r) {
+        let c: Rgb8 = match (t, r) {
             (false, true) => [230, 40, 40],
             (true, false) => [40, 90, 240],
             (true, true) => [150, 150, 150],
             (false, false) => [70, 70, 70],
-        }
+        };
+        if m { c } else { c.map(|v| v / 3 + 20) }
     })
 }
 

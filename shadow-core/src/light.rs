@@ -76,6 +76,16 @@ impl LightProjection {
         self.clip_from_world.inverse().project_point3(ndc)
     }
 
+    /// NDC depth of a distance along the view axis (the inverse of [`LightProjection::linear_depth`]).
+    #[must_use]
+    pub fn ndc_depth(&self, linear: f32) -> f32 {
+        if self.orthographic {
+            (linear - self.near) / (self.far - self.near)
+        } else {
+            self.far * (linear - self.near) / (linear * (self.far - self.near))
+        }
+    }
+
     /// Distance along the view axis for an NDC depth.
     #[must_use]
     pub fn linear_depth(&self, depth: f32) -> f32 {
@@ -145,13 +155,23 @@ fn safe_up(dir: Vec3) -> Vec3 {
     if dir.cross(Vec3::Y).length_squared() < 1e-6 { Vec3::Z } else { Vec3::Y }
 }
 
-/// Fitted near and far for a perspective view from `eye`: far is the deepest box corner along `dir`, near
-/// the distance to the closest box (never more than any depth inside it), at least far / 2000.
+/// Fitted near and far for a perspective view from `eye` along `dir`: far is the deepest box corner; near the
+/// shallowest (depth along the axis is linear over a box, so its extremes are at corners), at least
+/// far / 2000, and that floor wherever a box reaches behind the eye's plane. A near plane set from the
+/// Euclidean distance to the closest box instead clips geometry seen off-axis, since depth is distance
+/// times the cosine of the angle off the axis: on `room`, the beam near a point light vanished from a cube
+/// face that way.
 fn perspective_range(eye: Vec3, dir: Vec3, boxes: &[Aabb]) -> (f32, f32) {
-    let far = boxes.iter().flat_map(|b| b.corners()).map(|c| (c - eye).dot(dir)).fold(0.0f32, f32::max);
+    let depths = |b: &Aabb| b.corners().map(|c| (c - eye).dot(dir));
+    let far = boxes.iter().flat_map(depths).fold(0.0f32, f32::max);
     let far = (far * 1.01).max(1e-3);
-    let closest = boxes.iter().map(|b| (eye.clamp(b.min, b.max) - eye).length()).fold(f32::INFINITY, f32::min);
-    let near = (closest * 0.95).clamp(far / 2000.0, far * 0.5);
+    let floor = far / 2000.0;
+    let shallowest = boxes
+        .iter()
+        .map(|b| depths(b).into_iter().fold(f32::INFINITY, f32::min))
+        .filter(|&d| d < far)
+        .fold(f32::INFINITY, f32::min);
+    let near = (shallowest * 0.99).clamp(floor, far * 0.5);
     (near, far)
 }
 
@@ -259,6 +279,7 @@ mod tests {
         assert!(back.length() < 1e-3);
         let p = &v.projections[0];
         assert!((p.linear_depth(depth) - Vec3::new(2.0, 4.0, 1.5).length()).abs() < 1e-3);
+        assert!((p.ndc_depth(p.linear_depth(0.37)) - 0.37).abs() < 1e-5);
     }
 
     #[test]
@@ -267,6 +288,21 @@ mod tests {
         for c in boxes().iter().flat_map(|b| b.corners()) {
             let ndc = v.projections[0].ndc(c);
             assert!(ndc.x.abs() <= 1.0 && ndc.y.abs() <= 1.0 && (0.0..=1.0).contains(&ndc.z), "{c} -> {ndc}");
+        }
+    }
+
+    #[test]
+    fn near_planes_keep_off_axis_geometry() {
+        // A box close to the light but well off the +Z axis: its shallowest depth along +Z is 0.8, less
+        // than its distance to the light (1.11). The near plane must not clip it.
+        let boxes = [
+            Aabb::new(Vec3::new(-0.7, 2.375, 0.8), Vec3::new(0.7, 2.625, 1.7)),
+            Aabb::new(Vec3::new(-3.0, 0.0, -3.0), Vec3::new(3.0, 0.0, 4.0)),
+        ];
+        let v = LightView::fit(&Light::point(Vec3::new(0.0, 3.4, 0.0)), &boxes).unwrap();
+        for c in boxes[0].corners() {
+            let p = &v.projections[v.projection_index(c)];
+            assert!(p.ndc(c).z >= 0.0, "corner {c} clipped by the near plane of its face");
         }
     }
 

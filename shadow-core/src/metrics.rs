@@ -43,6 +43,32 @@ pub struct VisibilityMetrics {
     pub mean_abs: f64,
 }
 
+/// False light on receiver pixels turned away from the light (the self-unshadowing of Weiskopf-Ertl
+/// Fig. 2a and 4), as a fraction of `reach` (receivers in the light's reach); `measured` marks the pixels
+/// facing the light, which are left out.
+///
+/// # Errors
+/// When the images differ in size.
+pub fn back_false_light(
+    test: &Image<f32>,
+    reference: &Image<f32>,
+    measured: &Image<bool>,
+    reach: &Image<bool>,
+) -> Result<f64, SizeMismatch> {
+    check(test, reference)?;
+    check(test, measured)?;
+    check(test, reach)?;
+    let (mut n, mut k) = (0u64, 0u64);
+    for i in 0..test.data().len() {
+        if !reach.data()[i] {
+            continue;
+        }
+        n += 1;
+        k += u64::from(!measured.data()[i] && test.data()[i] >= 0.5 && reference.data()[i] < 0.5);
+    }
+    Ok(if n == 0 { 0.0 } else { k as f64 / n as f64 })
+}
+
 /// The pixels every metric is taken over: receivers inside the light's reach whose seen side faces it.
 /// `position` and `normal` are the world position and the face normal turned towards the viewer.
 #[must_use]

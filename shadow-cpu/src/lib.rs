@@ -4,6 +4,7 @@
 //! reference ([`bvh`]), the G-buffer ([`gbuffer`]), shading ([`shade`]) and frame assembly ([`frame`]),
 //! and the CPU versions of the techniques ([`techniques`]).
 
+pub mod acne;
 pub mod bvh;
 pub mod context;
 pub mod frame;

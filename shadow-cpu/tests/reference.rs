@@ -115,7 +115,7 @@ fn bad_requests_are_refused_before_allocating() {
     let mut huge =
         Stateful::<CpuBackend, _>::new(ShadowMap { resolution: 16384, ..ShadowMap::defaults() }, String::new());
     let err = render_frame(&mut cx, &f, 64, 64, &mut huge).err().expect("refused");
-    assert!(err.to_string().contains("shadow map"), "{err}");
+    assert!(err.to_string().contains("shadow maps") && err.to_string().contains("over the limit"), "{err}");
     // A NaN transform never reaches a frame: the scene refuses it.
     let mut s = Scene::new();
     let n = s.add_node("n", None, glam::Mat4::IDENTITY).expect("node");

@@ -38,6 +38,12 @@ pub fn shadow_map() -> String {
     with_common(&format!("{}{}", poisson_constant(), include_str!("shaders/shadow_map.wgsl")))
 }
 
+/// Depth-layer passes (peeling and combination).
+#[must_use]
+pub fn depth_layers() -> String {
+    with_common(include_str!("shaders/depth_layers.wgsl"))
+}
+
 /// Shadow-volume pass and resolve.
 #[must_use]
 pub fn shadow_volume() -> String {
@@ -47,7 +53,13 @@ pub fn shadow_volume() -> String {
 /// Every shader, by name, for validation.
 #[must_use]
 pub fn all() -> Vec<(&'static str, String)> {
-    vec![("gbuffer", gbuffer()), ("shade", shade()), ("shadow_map", shadow_map()), ("shadow_volume", shadow_volume())]
+    vec![
+        ("gbuffer", gbuffer()),
+        ("shade", shade()),
+        ("shadow_map", shadow_map()),
+        ("shadow_volume", shadow_volume()),
+        ("depth_layers", depth_layers()),
+    ]
 }
 
 /// A shader module from WGSL text.

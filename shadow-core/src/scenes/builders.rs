@@ -1,4 +1,7 @@
 //! The geometry of each built-in scene. Sizes are in metres; every scene stands on y = 0.
+//!
+//! The builders work on fixed data, so a failure here (an empty implicit surface, a bad transform) is a bug
+//! in this file, not bad input: they panic, and the scene tests build every scene to prove they do not.
 
 use glam::{Mat4, Quat, Vec2, Vec3};
 

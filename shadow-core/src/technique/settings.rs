@@ -269,6 +269,9 @@ named_enum! {
         Constant = "constant",
         /// Constant plus `bias_slope * max(|dz/dx|, |dz/dy|)` in texels.
         Slope = "slope",
+        /// No bias in the map; each receiver is moved `bias_world` towards the light before the lookup (a
+        /// constant offset in scene units, the classic constant bias of Weiskopf-Ertl Fig. 3).
+        World = "world",
     }
 }
 
@@ -308,7 +311,7 @@ impl DepthBias {
     #[must_use]
     pub fn from_mode(mode: BiasMode, constant: f32, slope: f32) -> Self {
         match mode {
-            BiasMode::None => Self::NONE,
+            BiasMode::None | BiasMode::World => Self::NONE,
             BiasMode::Constant => Self { constant, slope: 0.0, clamp: 0.0 },
             BiasMode::Slope => Self { constant, slope, clamp: 0.0 },
         }

@@ -1,6 +1,7 @@
 //! CPU versions of the techniques: each file is one technique, short enough to read next to its paper.
 //! Helpers two techniques share live here.
 
+pub mod depth_layers;
 pub mod ray_traced;
 pub mod shadow_map;
 pub mod shadow_volume;
@@ -19,7 +20,17 @@ use crate::raster::{CullMode, DepthState, DepthStencil, Indexed, RasterCounters,
 /// # Errors
 /// [`CpuError::BadSize`] over the limits.
 pub fn check_maps(res: u32, count: usize) -> Result<(), CpuError> {
-    check_size("shadow map", u64::from(res), u64::from(res) * count as u64, MAX_MAP_TEXELS)
+    check_size("shadow map", u64::from(res), u64::from(res), u64::MAX)?;
+    let total = u64::from(res) * u64::from(res) * count as u64;
+    if total > MAX_MAP_TEXELS {
+        return Err(CpuError::BadSize {
+            what: "shadow maps",
+            width: u64::from(res),
+            height: u64::from(res),
+            why: format!("{count} maps of this size are {total} texels, over the limit of {MAX_MAP_TEXELS}"),
+        });
+    }
+    Ok(())
 }
 
 /// Renders the depth of every casting instance from one light projection into a `res x res` map, in the

@@ -5,6 +5,7 @@
 use shadow_core::light::LightView;
 use shadow_core::lookup::shadow_lookup;
 use shadow_core::technique::hard::ShadowMap;
+use shadow_core::technique::settings::Filter;
 use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
 use shadow_core::{FrameInputs, Image};
 
@@ -17,6 +18,40 @@ use crate::raster::CullMode;
 #[derive(Default)]
 pub struct State {
     maps: Vec<Image<f32>>,
+}
+
+/// The lookup every map-based technique shares: each receiver (moved `receiver_offset` towards the light)
+/// projected into its map and compared through `filter`.
+pub fn query_maps(
+    maps: &[Image<f32>],
+    light: &LightView,
+    g: &GBuffer,
+    out: &mut Image<f32>,
+    filter: Filter,
+    radius: f32,
+    receiver_offset: f32,
+) {
+    per_receiver(g, out, |x, y, i| {
+        let mut p = g.position.data()[i];
+        if receiver_offset != 0.0 {
+            p += light.light.to_light(p) * receiver_offset;
+        }
+        let k = light.projection_index(p);
+        let (uv, depth) = light.projections[k].uv_depth(p);
+        shadow_lookup(&maps[k], uv, depth, filter, radius, (x, y))
+    });
+}
+
+/// False-colour pictures of depth maps, named `{prefix}{k}`.
+#[must_use]
+pub fn depth_views(prefix: &str, maps: &[Image<f32>]) -> Vec<DebugView> {
+    maps.iter()
+        .enumerate()
+        .map(|(k, m)| {
+            let lo = m.data().iter().copied().fold(1.0f32, f32::min);
+            DebugView { name: format!("{prefix}{k}"), image: shadow_core::image::false_colour(m, lo, 1.0) }
+        })
+        .collect()
 }
 
 impl ShadowTechnique<CpuBackend> for ShadowMap {
@@ -61,24 +96,11 @@ impl ShadowTechnique<CpuBackend> for ShadowMap {
         if state.maps.len() != light.projections.len() {
             return Err(TechniqueError::NotBuilt(self.name().into()).into());
         }
-        per_receiver(g, out, |x, y, i| {
-            let p = g.position.data()[i];
-            let k = light.projection_index(p);
-            let (uv, depth) = light.projections[k].uv_depth(p);
-            shadow_lookup(&state.maps[k], uv, depth, self.filter, self.filter_radius, (x, y))
-        });
+        query_maps(&state.maps, light, g, out, self.filter, self.filter_radius, self.receiver_offset());
         Ok(())
     }
 
     fn debug_views(&self, _: &mut CpuContext, state: &State) -> Result<Vec<DebugView>, CpuError> {
-        Ok(state
-            .maps
-            .iter()
-            .enumerate()
-            .map(|(k, m)| {
-                let lo = m.data().iter().copied().fold(1.0f32, f32::min);
-                DebugView { name: format!("depth{k}"), image: shadow_core::image::false_colour(m, lo, 1.0) }
-            })
-            .collect())
+        Ok(depth_views("depth", &state.maps))
     }
 }

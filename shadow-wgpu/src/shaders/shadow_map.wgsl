@@ -3,9 +3,12 @@
 struct MapParams {
     // One projection, or six cube faces (+X, -X, +Y, -Y, +Z, -Z).
     proj: array<mat4x4<f32>, 6>,
-    // xyz: light position; w: 1 for a point light (cube faces), else 0
+    // xyz: light position; w: kind (0 spot, 1 directional, 2 point: cube faces)
     light: vec4<f32>,
-    // x: filter (0 none, 1 bilinear, 2 pcf3x3, 3 pcf4x4-jitter, 4 poisson16), y: radius in texels, z: map side
+    // xyz: the direction the light travels (spot axis, directional light)
+    direction: vec4<f32>,
+    // x: filter (0 none, 1 bilinear, 2 pcf3x3, 3 pcf4x4-jitter, 4 poisson16), y: radius in texels,
+    // z: map side, w: receiver offset towards the light (bias=world)
     settings: vec4<f32>,
 };
 
@@ -109,11 +112,20 @@ fn fs_shadow_map_query(in: FullScreen) -> @location(0) vec4<f32> {
     if (g.w == 0.0) {
         return vec4<f32>(1.0);
     }
-    var layer = 0;
-    if (map.light.w != 0.0) {
-        layer = cube_face(g.xyz - map.light.xyz);
+    var p = g.xyz;
+    if (map.settings.w != 0.0) {
+        // Twin: query_maps in shadow-cpu (Light::to_light times the offset).
+        var to_light = -map.direction.xyz;
+        if (map.light.w != 1.0) {
+            to_light = normalize(map.light.xyz - p);
+        }
+        p = p + to_light * map.settings.w;
     }
-    let c = map.proj[layer] * vec4<f32>(g.xyz, 1.0);
+    var layer = 0;
+    if (map.light.w == 2.0) {
+        layer = cube_face(p - map.light.xyz);
+    }
+    let c = map.proj[layer] * vec4<f32>(p, 1.0);
     let ndc = c.xyz / c.w;
     let v = shadow_lookup(layer, ndc_to_uv(ndc.xy), ndc.z, vec2<u32>(px));
     return vec4<f32>(v);

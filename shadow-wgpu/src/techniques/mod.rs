@@ -1,5 +1,6 @@
 //! GPU versions of the techniques, each next to its WGSL in `shaders/`; helpers they share.
 
+pub mod depth_layers;
 pub mod shadow_map;
 pub mod shadow_volume;
 

@@ -25,15 +25,133 @@ use crate::shaders;
 struct MapParams {
     proj: [[[f32; 4]; 4]; 6],
     light: [f32; 4],
+    direction: [f32; 4],
     settings: [f32; 4],
+}
+
+/// The lookup every map-based technique shares (twin: `query_maps` in shadow-cpu): a full-screen pass
+/// running `shadow_lookup` of shadow_map.wgsl over the G-buffer.
+pub struct MapQuery {
+    pipeline: wgpu::RenderPipeline,
+    layout: wgpu::BindGroupLayout,
+    sampler: wgpu::Sampler,
+}
+
+impl MapQuery {
+    /// Creates the query pipeline from the shadow-map module.
+    #[must_use]
+    pub fn new(cx: &WgpuContext, module: &wgpu::ShaderModule) -> Self {
+        let layout = cx.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("shadow map query"),
+            entries: &[
+                attribute_entry(0),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Depth,
+                        view_dimension: wgpu::TextureViewDimension::D2Array,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 2,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
+                    count: None,
+                },
+                buffer_entry(3, wgpu::BufferBindingType::Uniform, wgpu::ShaderStages::FRAGMENT),
+            ],
+        });
+        let pipeline = full_screen_pipeline(
+            &cx.device,
+            "shadow map query",
+            module,
+            "fs_shadow_map_query",
+            &[&cx.shared.frame_layout, &layout],
+            VISIBILITY,
+            None,
+        );
+        let sampler = cx.device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("shadow comparison"),
+            address_mode_u: wgpu::AddressMode::ClampToEdge,
+            address_mode_v: wgpu::AddressMode::ClampToEdge,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            compare: Some(wgpu::CompareFunction::LessEqual),
+            ..Default::default()
+        });
+        Self { pipeline, layout, sampler }
+    }
+
+    /// Writes the visibility of every receiver through the maps (one layer per light projection).
+    ///
+    /// # Errors
+    /// A GPU failure.
+    #[allow(clippy::too_many_arguments)]
+    pub fn run(
+        &self,
+        cx: &WgpuContext,
+        maps: &wgpu::Texture,
+        light: &LightView,
+        g: &GpuGBuffer,
+        out: &GpuVisibility,
+        filter: Filter,
+        radius: f32,
+        receiver_offset: f32,
+    ) -> Result<(), WgpuError> {
+        let mut proj = [[[0.0f32; 4]; 4]; 6];
+        for (slot, p) in proj.iter_mut().zip(&light.projections) {
+            *slot = p.clip_from_world.to_cols_array_2d();
+        }
+        let (pos, dir, kind) = match light.light.kind {
+            LightKind::Spot { position, direction, .. } => (position, direction, 0.0),
+            LightKind::Directional { direction } => (glam::Vec3::ZERO, direction, 1.0),
+            LightKind::Point { position } => (position, glam::Vec3::NEG_Y, 2.0),
+        };
+        let params = MapParams {
+            proj,
+            light: pos.extend(kind).to_array(),
+            direction: dir.normalize().extend(0.0).to_array(),
+            settings: [filter_code(filter), radius, maps.width() as f32, receiver_offset],
+        };
+        cx.scoped("the shadow-map query", |cx| {
+            let ubuf = cx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("map params"),
+                contents: bytemuck::bytes_of(&params),
+                usage: wgpu::BufferUsages::UNIFORM,
+            });
+            let maps_view = maps.create_view(&wgpu::TextureViewDescriptor {
+                dimension: Some(wgpu::TextureViewDimension::D2Array),
+                ..Default::default()
+            });
+            let group = cx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("shadow map query"),
+                layout: &self.layout,
+                entries: &[
+                    wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&g.position) },
+                    wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&maps_view) },
+                    wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&self.sampler) },
+                    wgpu::BindGroupEntry { binding: 3, resource: ubuf.as_entire_binding() },
+                ],
+            });
+            crate::techniques::full_screen(
+                cx,
+                "shadow map query",
+                &out.view,
+                &self.pipeline,
+                &[&g.frame_group, &group],
+                None,
+            );
+        })
+    }
 }
 
 /// Pipelines and the maps of the last build.
 pub struct State {
     depth: wgpu::RenderPipeline,
-    query: wgpu::RenderPipeline,
-    query_layout: wgpu::BindGroupLayout,
-    sampler: wgpu::Sampler,
+    query: MapQuery,
     maps: Option<wgpu::Texture>,
 }
 
@@ -42,7 +160,7 @@ pub struct State {
 #[must_use]
 pub fn depth_bias(s: &ShadowMap) -> wgpu::DepthBiasState {
     match s.bias {
-        BiasMode::None => wgpu::DepthBiasState::default(),
+        BiasMode::None | BiasMode::World => wgpu::DepthBiasState::default(),
         BiasMode::Constant => {
             wgpu::DepthBiasState { constant: s.bias_constant.round() as i32, slope_scale: 0.0, clamp: 0.0 }
         }
@@ -160,52 +278,9 @@ impl ShadowTechnique<WgpuBackend> for ShadowMap {
     fn create_state(&self, cx: &mut WgpuContext) -> Result<State, WgpuError> {
         cx.scoped("creating the shadow-map pipelines", |cx| {
             let module = shaders::module(&cx.device, "shadow_map", shaders::shadow_map());
-            let query_layout = cx.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("shadow map query"),
-                entries: &[
-                    attribute_entry(0),
-                    wgpu::BindGroupLayoutEntry {
-                        binding: 1,
-                        visibility: wgpu::ShaderStages::FRAGMENT,
-                        ty: wgpu::BindingType::Texture {
-                            sample_type: wgpu::TextureSampleType::Depth,
-                            view_dimension: wgpu::TextureViewDimension::D2Array,
-                            multisampled: false,
-                        },
-                        count: None,
-                    },
-                    wgpu::BindGroupLayoutEntry {
-                        binding: 2,
-                        visibility: wgpu::ShaderStages::FRAGMENT,
-                        ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
-                        count: None,
-                    },
-                    buffer_entry(3, wgpu::BufferBindingType::Uniform, wgpu::ShaderStages::FRAGMENT),
-                ],
-            });
-            let query = full_screen_pipeline(
-                &cx.device,
-                "shadow map query",
-                &module,
-                "fs_shadow_map_query",
-                &[&cx.shared.frame_layout, &query_layout],
-                VISIBILITY,
-                None,
-            );
-            let sampler = cx.device.create_sampler(&wgpu::SamplerDescriptor {
-                label: Some("shadow comparison"),
-                address_mode_u: wgpu::AddressMode::ClampToEdge,
-                address_mode_v: wgpu::AddressMode::ClampToEdge,
-                mag_filter: wgpu::FilterMode::Linear,
-                min_filter: wgpu::FilterMode::Linear,
-                compare: Some(wgpu::CompareFunction::LessEqual),
-                ..Default::default()
-            });
             State {
                 depth: light_pass_pipeline(cx, &module, depth_bias(self)),
-                query,
-                query_layout,
-                sampler,
+                query: MapQuery::new(cx, &module),
                 maps: None,
             }
         })
@@ -243,48 +318,6 @@ impl ShadowTechnique<WgpuBackend> for ShadowMap {
         _: &mut FrameStats,
     ) -> Result<(), WgpuError> {
         let maps = state.maps.as_ref().ok_or_else(|| TechniqueError::NotBuilt(self.name().into()))?;
-        let mut proj = [[[0.0f32; 4]; 4]; 6];
-        for (slot, p) in proj.iter_mut().zip(&light.projections) {
-            *slot = p.clip_from_world.to_cols_array_2d();
-        }
-        let (pos, point) = match light.light.kind {
-            LightKind::Point { position } => (position, 1.0),
-            _ => (glam::Vec3::ZERO, 0.0),
-        };
-        let params = MapParams {
-            proj,
-            light: pos.extend(point).to_array(),
-            settings: [filter_code(self.filter), self.filter_radius, maps.width() as f32, 0.0],
-        };
-        cx.scoped("the shadow-map query", |cx| {
-            let ubuf = cx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("map params"),
-                contents: bytemuck::bytes_of(&params),
-                usage: wgpu::BufferUsages::UNIFORM,
-            });
-            let maps_view = maps.create_view(&wgpu::TextureViewDescriptor {
-                dimension: Some(wgpu::TextureViewDimension::D2Array),
-                ..Default::default()
-            });
-            let group = cx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("shadow map query"),
-                layout: &state.query_layout,
-                entries: &[
-                    wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&g.position) },
-                    wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&maps_view) },
-                    wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&state.sampler) },
-                    wgpu::BindGroupEntry { binding: 3, resource: ubuf.as_entire_binding() },
-                ],
-            });
-            crate::techniques::full_screen(
-                cx,
-                "shadow map query",
-                &out.view,
-                &state.query,
-                &[&g.frame_group, &group],
-                None,
-            );
-        })?;
-        Ok(())
+        state.query.run(cx, maps, light, g, out, self.filter, self.filter_radius, self.receiver_offset())
     }
 }
