@@ -2,6 +2,7 @@
 //! registered technique, the example's runtime-registered one included.
 
 mod cli;
+mod depth_layers;
 // The technique of examples/custom_technique.rs, registered at runtime like a user's would be.
 #[path = "../../examples/planar/mod.rs"]
 #[allow(dead_code)]
