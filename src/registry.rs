@@ -4,6 +4,7 @@
 
 use shadow_core::technique::hard::{
     DepthLayers, DualShadowMap, MidpointShadowMap, RayTraced, SecondDepthShadowMap, ShadowMap, ShadowVolume,
+    SilhouetteMap,
 };
 use shadow_core::technique::settings::{SettingKey, SettingsError, TechniqueSettings, TechniqueSpec};
 use shadow_core::technique::{DynShadowTechnique, Stateful};
@@ -136,6 +137,16 @@ impl TechniqueRegistry {
             canonical: canonical::<ShadowMap>,
             cpu: Some(plain::<CpuBackend, ShadowMap>),
             wgpu: Some(plain::<WgpuBackend, ShadowMap>),
+        });
+        r.register(TechniqueEntry {
+            name: "silhouette-map",
+            description: "a shadow map plus silhouette points half a texel off: piecewise-linear shadow edges",
+            paper: "Sen, Cammarano, Hanrahan 2003",
+            reference: false,
+            keys: SilhouetteMap::keys,
+            canonical: canonical::<SilhouetteMap>,
+            cpu: Some(plain::<CpuBackend, SilhouetteMap>),
+            wgpu: None,
         });
         r.register(TechniqueEntry {
             name: "shadow-volume-zpass",

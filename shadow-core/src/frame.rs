@@ -10,8 +10,9 @@ use glam::{Mat4, Vec3};
 use rayon::prelude::*;
 
 use crate::bounds::Aabb;
+use crate::geometry::LightSource;
 use crate::geometry::adjacency::Adjacency;
-use crate::geometry::silhouette::{CastMode, silhouette};
+use crate::geometry::silhouette::{CastMode, Silhouette, silhouette};
 use crate::geometry::volume::{Caps, ShadowVolume, extrude};
 use crate::light::{LightView, LightViewError};
 use crate::mesh::Mesh;
@@ -149,24 +150,45 @@ impl FrameInputs {
         LightView::fit(light, &boxes)
     }
 
+    /// The silhouette of every casting instance for the light, found afresh (in parallel over instances),
+    /// with the light in the instance's mesh space.
+    fn silhouettes(&self, light: &LightView) -> impl IndexedParallelIterator<Item = (usize, LightSource, Silhouette)> {
+        let world_light = light.source();
+        self.instances.par_iter().enumerate().map(move |(i, inst)| {
+            if !inst.casts_shadow {
+                return (i, world_light, Silhouette::default());
+            }
+            let local_light = world_light.transformed(inst.local_from_world);
+            let adj = &inst.adjacency;
+            (i, local_light, silhouette(adj, local_light, CastMode::for_mesh(adj)))
+        })
+    }
+
     /// Shadow volumes of every casting instance for the light, found afresh (in parallel over instances).
     #[must_use]
     pub fn shadow_volumes(&self, light: &LightView, caps: Caps) -> Vec<InstanceVolume> {
-        let world_light = light.source();
-        self.instances
-            .par_iter()
-            .enumerate()
-            .filter(|(_, inst)| inst.casts_shadow)
-            .map(|(i, inst)| {
-                let local_light = world_light.transformed(inst.local_from_world);
-                let adj = &inst.adjacency;
-                let sil = silhouette(adj, local_light, CastMode::for_mesh(adj));
-                InstanceVolume {
-                    instance: i,
-                    silhouette_edges: sil.edges.len(),
-                    volume: extrude(adj, &sil, local_light, caps),
-                }
+        self.silhouettes(light)
+            .filter(|(i, ..)| self.instances[*i].casts_shadow)
+            .map(|(i, local_light, sil)| InstanceVolume {
+                instance: i,
+                silhouette_edges: sil.edges.len(),
+                volume: extrude(&self.instances[i].adjacency, &sil, local_light, caps),
             })
             .collect()
+    }
+
+    /// The silhouette edges of every casting instance for the light, in world space, in instance order
+    /// (what silhouette maps rasterize; the edges' weights do not matter there).
+    #[must_use]
+    pub fn silhouette_segments(&self, light: &LightView) -> Vec<[Vec3; 2]> {
+        let per_instance: Vec<Vec<[Vec3; 2]>> = self
+            .silhouettes(light)
+            .map(|(i, _, sil)| {
+                let inst = &self.instances[i];
+                let at = |v: u32| inst.world_from_local.transform_point3(inst.adjacency.positions()[v as usize]);
+                sil.edges.iter().map(|e| [at(e.a), at(e.b)]).collect()
+            })
+            .collect();
+        per_instance.concat()
     }
 }

@@ -33,3 +33,4 @@ pub use light::{LightView, LightViewKind};
 pub use mesh::{Mesh, MeshError};
 pub use scene::{Camera, CameraKey, Light, LightKey, LightKind, Material, MaterialKey, MeshKey, Node, NodeKey, Scene};
 pub mod shading;
+pub mod silhouette_map;

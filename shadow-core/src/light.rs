@@ -35,6 +35,9 @@ pub struct LightProjection {
     pub clip_from_view: Mat4,
     /// World to clip.
     pub clip_from_world: Mat4,
+    /// Takes a world-space plane `(n, d)` to the same plane in clip space (the inverse transpose of
+    /// `clip_from_world`), for [`LightProjection::depth_gradient`].
+    pub clip_plane_from_world_plane: Mat4,
     /// Near plane distance.
     pub near: f32,
     /// Far plane distance.
@@ -49,6 +52,7 @@ impl LightProjection {
             view_from_world,
             clip_from_view,
             clip_from_world: clip_from_view * view_from_world,
+            clip_plane_from_world_plane: (clip_from_view * view_from_world).inverse().transpose(),
             near,
             far,
             orthographic,
@@ -67,6 +71,22 @@ impl LightProjection {
         let c = self.clip_from_world * p.extend(1.0);
         let ndc = c.xyz() / c.w;
         (ndc_to_uv(ndc.xy()), ndc.z)
+    }
+
+    /// How the NDC depth of the plane through `p` with normal `n` changes with map coordinates: the
+    /// receiver plane's `(dz/du, dz/dv)`. NDC depth is affine in `uv` over a plane (that is why
+    /// rasterizers interpolate it linearly), so `depth + gradient . (uv' - uv)` is the plane's depth at
+    /// `uv'` exactly. Zero for a plane seen edge-on from the light (a gradient over about 1e6 per unit of
+    /// uv, where rounding decides the sign: such a plane's depth says nothing about its neighbours).
+    /// WGSL twin: `depth_gradient` in shadow_map.wgsl.
+    #[must_use]
+    pub fn depth_gradient(&self, p: Vec3, n: Vec3) -> Vec2 {
+        // The plane a x + b y + c z + d = 0 in NDC: z = -(a x + b y + d) / c, with x = 2u - 1, y = 1 - 2v.
+        let c = self.clip_plane_from_world_plane * n.extend(-n.dot(p));
+        if c.z.abs() <= 1e-6 * (c.x.abs() + c.y.abs()) {
+            return Vec2::ZERO;
+        }
+        Vec2::new(-2.0 * c.x / c.z, 2.0 * c.y / c.z)
     }
 
     /// The world point at map coordinates `uv` and NDC depth `depth` (McCool's back-projection).
@@ -280,6 +300,28 @@ mod tests {
         let p = &v.projections[0];
         assert!((p.linear_depth(depth) - Vec3::new(2.0, 4.0, 1.5).length()).abs() < 1e-3);
         assert!((p.ndc_depth(p.linear_depth(0.37)) - 0.37).abs() < 1e-5);
+    }
+
+    #[test]
+    fn depth_gradient_extrapolates_along_the_plane() {
+        for light in
+            [Light::spot(Vec3::new(2.0, 4.0, 1.5), Vec3::ZERO, 60.0), Light::directional(Vec3::new(0.3, -1.0, 0.2))]
+        {
+            let v = LightView::fit(&light, &boxes()).unwrap();
+            let proj = &v.projections[0];
+            let (p, n) = (Vec3::new(0.1, 0.2, -0.3), Vec3::new(0.3, 0.9, -0.2).normalize());
+            let t = n.cross(Vec3::X).normalize();
+            let q = p + t * 0.05 + n.cross(t) * 0.03;
+            let ((up, zp), (uq, zq)) = (proj.uv_depth(p), proj.uv_depth(q));
+            let g = proj.depth_gradient(p, n);
+            assert!((zp + g.dot(uq - up) - zq).abs() < 1e-5, "{light:?}: {} vs {zq}", zp + g.dot(uq - up));
+            // A plane seen edge-on has no gradient.
+            let along = match light.kind {
+                LightKind::Directional { direction } => direction,
+                _ => p - Vec3::new(2.0, 4.0, 1.5),
+            };
+            assert_eq!(proj.depth_gradient(p, along.cross(Vec3::Y).normalize()), Vec2::ZERO);
+        }
     }
 
     #[test]

@@ -1,5 +1,7 @@
 //! Settings of the hard-shadow techniques (DESIGN 6).
 
+use crate::silhouette_map::{CornerDepth, Keep};
+
 use super::settings::{
     BiasMode, DepthBias, Filter, MAX_MAP_RESOLUTION, SettingKey, SettingsError, TechniqueSettings, Values,
 };
@@ -104,6 +106,19 @@ impl ShadowMap {
     pub fn receiver_offset(&self) -> f32 {
         if self.bias == BiasMode::World { self.bias_world } else { 0.0 }
     }
+
+    /// The depth-map keys (`res` and the bias keys), with no filter.
+    fn read_depth(v: &Values<'_>) -> Result<Self, SettingsError> {
+        Ok(Self {
+            resolution: read_resolution(v)?,
+            bias: v.get("bias")?,
+            bias_constant: v.ranged("bias_constant", 0.0, 1e9)?,
+            bias_slope: v.ranged("bias_slope", 0.0, 1e4)?,
+            filter: Filter::None,
+            filter_radius: 0.0,
+            bias_world: v.ranged("bias_world", 0.0, 1e6)?,
+        })
+    }
 }
 
 impl TechniqueSettings for ShadowMap {
@@ -112,13 +127,9 @@ impl TechniqueSettings for ShadowMap {
     }
     fn from_values(v: &Values<'_>) -> Result<Self, SettingsError> {
         Ok(Self {
-            resolution: read_resolution(v)?,
-            bias: v.get("bias")?,
-            bias_constant: v.ranged("bias_constant", 0.0, 1e9)?,
-            bias_slope: v.ranged("bias_slope", 0.0, 1e4)?,
             filter: v.get("filter")?,
             filter_radius: v.ranged("filter_radius", 0.0, 64.0)?,
-            bias_world: v.ranged("bias_world", 0.0, 1e6)?,
+            ..Self::read_depth(v)?
         })
     }
     fn to_values(&self) -> Vec<String> {
@@ -130,6 +141,77 @@ impl TechniqueSettings for ShadowMap {
             self.filter.to_string(),
             self.filter_radius.to_string(),
             self.bias_world.to_string(),
+        ]
+    }
+}
+
+/// `silhouette-map` (Sen, Cammarano, Hanrahan 2003): a shadow map plus a map of points on the
+/// silhouettes, shifted half a texel; the lookup reconstructs a piecewise-linear shadow edge.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SilhouetteMap {
+    /// The depth map: resolution and bias as `shadow-map` has them (its filter is unused: the
+    /// reconstruction replaces it).
+    pub depth: ShadowMap,
+    /// The corner rule's enlargement of the clip square, in texels (section 3.1: "within limits of
+    /// precision"). At 0.01 a segment within a hundredth of a texel of a corner is stored in all four texels
+    /// around it, far above the rounding of texel coordinates (about 1e-4 at 4096 texels).
+    pub corner_margin: f32,
+    /// What each corner sample is compared with.
+    pub corner_depth: CornerDepth,
+    /// Which point a texel crossed by several silhouettes keeps.
+    pub keep: Keep,
+}
+
+const SILHOUETTE_KEYS: [SettingKey; 8] = [
+    SettingKey {
+        key: "res",
+        default: "1024",
+        help: "depth-map side in texels (16 to 16384); the silhouette map has one texel fewer",
+    },
+    MAP_KEYS[1],
+    MAP_KEYS[2],
+    MAP_KEYS[3],
+    MAP_KEYS[6],
+    SettingKey {
+        key: "corner_margin",
+        default: "0.01",
+        help: "corner rule: how far outside a texel, in texels, a segment still counts as crossing it",
+    },
+    SettingKey {
+        key: "corner_depth",
+        default: "receiver-plane",
+        help: "compare corner samples with the receiver plane's depth there, or the fragment's own (the paper)",
+    },
+    SettingKey {
+        key: "keep",
+        default: "nearest",
+        help: "the point a texel crossed by several silhouettes keeps: nearest the light, or last drawn (the paper)",
+    },
+];
+
+impl TechniqueSettings for SilhouetteMap {
+    fn keys() -> &'static [SettingKey] {
+        &SILHOUETTE_KEYS
+    }
+    fn from_values(v: &Values<'_>) -> Result<Self, SettingsError> {
+        Ok(Self {
+            depth: ShadowMap::read_depth(v)?,
+            corner_margin: v.ranged("corner_margin", 0.0, 0.25)?,
+            corner_depth: v.get("corner_depth")?,
+            keep: v.get("keep")?,
+        })
+    }
+    fn to_values(&self) -> Vec<String> {
+        let d = &self.depth;
+        vec![
+            d.resolution.to_string(),
+            d.bias.to_string(),
+            d.bias_constant.to_string(),
+            d.bias_slope.to_string(),
+            d.bias_world.to_string(),
+            self.corner_margin.to_string(),
+            self.corner_depth.to_string(),
+            self.keep.to_string(),
         ]
     }
 }
@@ -183,6 +265,11 @@ mod tests {
             "res=2048,bias=slope,bias_constant=4,bias_slope=2,filter=none,filter_radius=1.5,bias_world=0.05"
         );
         let _ = RayTraced::defaults();
+        assert_eq!(
+            SilhouetteMap::defaults().settings_string(),
+            "res=1024,bias=slope,bias_constant=4,bias_slope=2,bias_world=0.05,corner_margin=0.01,\
+             corner_depth=receiver-plane,keep=nearest"
+        );
         let _ = ShadowVolume::defaults();
     }
 

@@ -5,9 +5,11 @@ pub mod depth_layers;
 pub mod ray_traced;
 pub mod shadow_map;
 pub mod shadow_volume;
+pub mod silhouette_map;
 
 use rayon::prelude::*;
-use shadow_core::light::LightProjection;
+use shadow_core::glam::{Vec2, Vec3};
+use shadow_core::light::{LightProjection, LightView};
 use shadow_core::technique::settings::DepthBias;
 use shadow_core::{FrameInputs, Image};
 
@@ -61,6 +63,50 @@ pub fn render_depth_map(
         );
     }
     (ds.into_depth_image(), counters)
+}
+
+/// Renders one depth map per projection of `light` (after checking their size), each in the storage of the
+/// map it replaces in `maps`.
+///
+/// # Errors
+/// [`CpuError::BadSize`] over the limits.
+pub fn render_depth_maps(
+    frame: &FrameInputs,
+    light: &LightView,
+    res: u32,
+    bias: DepthBias,
+    maps: &mut Vec<Image<f32>>,
+) -> Result<(), CpuError> {
+    check_maps(res, light.projections.len())?;
+    let mut old = std::mem::take(maps).into_iter();
+    *maps =
+        light.projections.iter().map(|p| render_depth_map(frame, p, res, bias, CullMode::None, old.next()).0).collect();
+    Ok(())
+}
+
+/// Where a receiver looks into a light's maps.
+#[derive(Clone, Copy, Debug)]
+pub struct MapPosition {
+    /// The projection (cube face) it falls in.
+    pub projection: usize,
+    /// Map coordinates.
+    pub uv: Vec2,
+    /// NDC depth.
+    pub depth: f32,
+    /// The world point looked up (moved towards the light under `bias=world`).
+    pub world: Vec3,
+}
+
+/// Where a receiver at `p` looks into the light's maps, after moving it `receiver_offset` towards the
+/// light (`bias=world`).
+#[must_use]
+pub fn map_position(light: &LightView, mut p: Vec3, receiver_offset: f32) -> MapPosition {
+    if receiver_offset != 0.0 {
+        p += light.light.to_light(p) * receiver_offset;
+    }
+    let k = light.projection_index(p);
+    let (uv, depth) = light.projections[k].uv_depth(p);
+    MapPosition { projection: k, uv, depth, world: p }
 }
 
 /// Fills `out` with `f(x, y, i)` at every receiver pixel (i the pixel index) and 1 elsewhere.

@@ -9,10 +9,9 @@ use shadow_core::technique::settings::Filter;
 use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
 use shadow_core::{FrameInputs, Image};
 
-use super::{check_maps, per_receiver, render_depth_map};
+use super::{map_position, per_receiver, render_depth_maps};
 use crate::context::{CpuBackend, CpuContext, CpuError};
 use crate::gbuffer::GBuffer;
-use crate::raster::CullMode;
 
 /// The maps of the last build, one per light projection.
 #[derive(Default)]
@@ -32,13 +31,8 @@ pub fn query_maps(
     receiver_offset: f32,
 ) {
     per_receiver(g, out, |x, y, i| {
-        let mut p = g.position.data()[i];
-        if receiver_offset != 0.0 {
-            p += light.light.to_light(p) * receiver_offset;
-        }
-        let k = light.projection_index(p);
-        let (uv, depth) = light.projections[k].uv_depth(p);
-        shadow_lookup(&maps[k], uv, depth, filter, radius, (x, y))
+        let m = map_position(light, g.position.data()[i], receiver_offset);
+        shadow_lookup(&maps[m.projection], m.uv, m.depth, filter, radius, (x, y))
     });
 }
 
@@ -73,14 +67,7 @@ impl ShadowTechnique<CpuBackend> for ShadowMap {
         light: &LightView,
         _: &mut FrameStats,
     ) -> Result<(), CpuError> {
-        check_maps(self.resolution, light.projections.len())?;
-        let mut old = std::mem::take(&mut state.maps).into_iter();
-        state.maps = light
-            .projections
-            .iter()
-            .map(|p| render_depth_map(frame, p, self.resolution, self.depth_bias(), CullMode::None, old.next()).0)
-            .collect();
-        Ok(())
+        render_depth_maps(frame, light, self.resolution, self.depth_bias(), &mut state.maps)
     }
 
     fn query(
