@@ -146,7 +146,7 @@ impl TechniqueRegistry {
             keys: SilhouetteMap::keys,
             canonical: canonical::<SilhouetteMap>,
             cpu: Some(plain::<CpuBackend, SilhouetteMap>),
-            wgpu: None,
+            wgpu: Some(plain::<WgpuBackend, SilhouetteMap>),
         });
         r.register(TechniqueEntry {
             name: "shadow-volume-zpass",

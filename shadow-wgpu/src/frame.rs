@@ -76,7 +76,16 @@ impl LightRaw {
     }
 }
 
-fn layered(cx: &WgpuContext, label: &str, w: u32, h: u32, layers: u32, format: wgpu::TextureFormat) -> wgpu::Texture {
+/// A 2D array texture to render into, sample and copy from.
+#[must_use]
+pub fn layered(
+    cx: &WgpuContext,
+    label: &str,
+    w: u32,
+    h: u32,
+    layers: u32,
+    format: wgpu::TextureFormat,
+) -> wgpu::Texture {
     cx.device.create_texture(&wgpu::TextureDescriptor {
         label: Some(label),
         size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: layers },

@@ -21,6 +21,8 @@ pub struct GpuGBuffer {
     pub position: wgpu::TextureView,
     /// Shading normal.
     pub normal: wgpu::TextureView,
+    /// Unit face normal, turned towards the viewer.
+    pub geometric_normal: wgpu::TextureView,
     /// Albedo, w = covered.
     pub albedo: wgpu::TextureView,
     /// Group 0 for the camera view.
@@ -85,7 +87,7 @@ pub fn render(cx: &mut WgpuContext, frame: &FrameInputs, width: u32, height: u32
             &instances,
         );
         let depth = target(cx, "depth", width, height, DEPTH_STENCIL);
-        let [position, normal, albedo] = ["position", "normal", "albedo"]
+        let [position, normal, albedo, geometric_normal] = ["position", "normal", "albedo", "geometric normal"]
             .map(|l| target(cx, l, width, height, ATTRIBUTE).create_view(&Default::default()));
         let depth_view = depth.create_view(&Default::default());
         let mut enc = cx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("gbuffer") });
@@ -103,7 +105,7 @@ pub fn render(cx: &mut WgpuContext, frame: &FrameInputs, width: u32, height: u32
             };
             let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("gbuffer"),
-                color_attachments: &[clear(&position), clear(&normal), clear(&albedo)],
+                color_attachments: &[clear(&position), clear(&normal), clear(&albedo), clear(&geometric_normal)],
                 depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                     view: &depth_view,
                     depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
@@ -120,7 +122,17 @@ pub fn render(cx: &mut WgpuContext, frame: &FrameInputs, width: u32, height: u32
             pass.pop_debug_group();
         }
         cx.queue.submit([enc.finish()]);
-        GpuGBuffer { width, height, camera: frame.camera, depth, position, normal, albedo, frame_group }
+        GpuGBuffer {
+            width,
+            height,
+            camera: frame.camera,
+            depth,
+            position,
+            normal,
+            albedo,
+            geometric_normal,
+            frame_group,
+        }
     })
 }
 

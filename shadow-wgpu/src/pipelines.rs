@@ -73,6 +73,13 @@ pub fn attribute_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
     texture_entry(binding, wgpu::TextureSampleType::Float { filterable: false }, wgpu::TextureViewDimension::D2)
 }
 
+/// A depth 2D-array texture binding (the light projections' maps), read with `textureLoad` or a
+/// comparison sampler.
+#[must_use]
+pub fn depth_array_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    texture_entry(binding, wgpu::TextureSampleType::Depth, wgpu::TextureViewDimension::D2Array)
+}
+
 /// A uniform or storage buffer binding.
 #[must_use]
 pub fn buffer_entry(
@@ -144,7 +151,7 @@ impl Shared {
                 module: &gmod,
                 entry_point: Some("fs_gbuffer"),
                 compilation_options: Default::default(),
-                targets: &[target.clone(), target.clone(), target],
+                targets: &[target.clone(), target.clone(), target.clone(), target],
             }),
             multiview_mask: None,
             cache: None,

@@ -90,3 +90,15 @@ pub fn read_rgb8(cx: &WgpuContext, tex: &wgpu::Texture) -> Result<Image<Rgb8>, W
     Image::from_vec(tex.width(), tex.height(), data)
         .ok_or_else(|| WgpuError::Gpu { during: "readback".into(), message: "size mismatch".into() })
 }
+
+/// One layer of an Rg32Float texture as an image of pairs.
+///
+/// # Errors
+/// A GPU failure.
+pub fn read_rg32(cx: &WgpuContext, tex: &wgpu::Texture, layer: u32) -> Result<Image<[f32; 2]>, WgpuError> {
+    let bytes = read_layer(cx, tex, layer, 8, wgpu::TextureAspect::All)?;
+    let f = |c: &[u8]| f32::from_le_bytes([c[0], c[1], c[2], c[3]]);
+    let data = bytes.chunks_exact(8).map(|c| [f(&c[..4]), f(&c[4..])]).collect();
+    Image::from_vec(tex.width(), tex.height(), data)
+        .ok_or_else(|| WgpuError::Gpu { during: "readback".into(), message: "size mismatch".into() })
+}

@@ -1,5 +1,6 @@
-//! WGSL sources. Each is `common.wgsl` followed by its own file; the shadow-map shader also gets the
-//! Poisson disk generated from shadow-core's constant, so the two backends share one table.
+//! WGSL sources. Each is `common.wgsl` followed by its own file (the silhouette-map build pass, which
+//! reads no camera state, stands alone); the shadow-map shader also gets the Poisson disk generated from
+//! shadow-core's constant, so the two backends share one table.
 
 use std::fmt::Write;
 
@@ -38,6 +39,18 @@ pub fn shadow_map() -> String {
     with_common(&format!("{}{}", poisson_constant(), include_str!("shaders/shadow_map.wgsl")))
 }
 
+/// Silhouette-map pass 2 (the points) and the texel count.
+#[must_use]
+pub fn silhouette_build() -> String {
+    include_str!("shaders/silhouette_build.wgsl").to_string()
+}
+
+/// Silhouette-map query: the shadow-map shader and the reconstruction.
+#[must_use]
+pub fn silhouette_query() -> String {
+    format!("{}\n{}", shadow_map(), include_str!("shaders/silhouette_query.wgsl"))
+}
+
 /// Depth-layer passes (peeling and combination).
 #[must_use]
 pub fn depth_layers() -> String {
@@ -59,6 +72,8 @@ pub fn all() -> Vec<(&'static str, String)> {
         ("shadow_map", shadow_map()),
         ("shadow_volume", shadow_volume()),
         ("depth_layers", depth_layers()),
+        ("silhouette_build", silhouette_build()),
+        ("silhouette_query", silhouette_query()),
     ]
 }
 

@@ -1,4 +1,5 @@
-// The camera G-buffer: world position (w: receives shadow), shading normal, albedo (w: covered).
+// The camera G-buffer: world position (w: receives shadow), shading normal, albedo (w: covered), face
+// normal.
 
 struct GOut {
     @invariant @builtin(position) pos: vec4<f32>,
@@ -22,10 +23,18 @@ struct GTargets {
     @location(0) position: vec4<f32>,
     @location(1) normal: vec4<f32>,
     @location(2) albedo: vec4<f32>,
+    @location(3) geometric_normal: vec4<f32>,
 };
 
 @fragment
 fn fs_gbuffer(in: GOut, @builtin(front_facing) front: bool) -> GTargets {
+    // The face normal from the position's screen derivatives (in uniform control flow, before any
+    // branch): both differences lie in the triangle's plane, helper lanes included. Twin: the CPU
+    // G-buffer's `geometric_normal`, turned towards the viewer likewise.
+    var face = normalize(cross(dpdx(in.world), dpdy(in.world)));
+    if (dot(face, view.eye.xyz - in.world) < 0.0) {
+        face = -face;
+    }
     let inst = instances[in.instance];
     var n = normalize(in.normal);
     // Twin: shadow-cpu's G-buffer resolve turns a two-sided surface's normal to the side that is seen. A
@@ -38,5 +47,6 @@ fn fs_gbuffer(in: GOut, @builtin(front_facing) front: bool) -> GTargets {
     out.position = vec4<f32>(in.world, f32(inst.flags.x));
     out.normal = vec4<f32>(n, 0.0);
     out.albedo = vec4<f32>(inst.color.xyz, 1.0);
+    out.geometric_normal = vec4<f32>(face, 0.0);
     return out;
 }

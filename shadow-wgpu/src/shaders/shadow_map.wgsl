@@ -10,6 +10,10 @@ struct MapParams {
     // x: filter (0 none, 1 bilinear, 2 pcf3x3, 3 pcf4x4-jitter, 4 poisson16), y: radius in texels,
     // z: map side, w: receiver offset towards the light (bias=world)
     settings: vec4<f32>,
+    // Per projection: world planes to clip planes (inverse transpose of proj), for depth_gradient.
+    planes: array<mat4x4<f32>, 6>,
+    // Technique-specific (silhouette-map: x = 1 for receiver-plane corner depths).
+    extra: vec4<f32>,
 };
 
 @group(1) @binding(0) var g_position: texture_2d<f32>;
@@ -105,16 +109,19 @@ fn shadow_lookup(layer: i32, uv: vec2<f32>, depth: f32, pixel: vec2<u32>) -> f32
     return sum / 16.0;
 }
 
-@fragment
-fn fs_shadow_map_query(in: FullScreen) -> @location(0) vec4<f32> {
-    let px = vec2<i32>(in.pos.xy);
-    let g = textureLoad(g_position, px, 0);
-    if (g.w == 0.0) {
-        return vec4<f32>(1.0);
-    }
-    var p = g.xyz;
+// Where a receiver looks into the maps. Twin: shadow-cpu's `MapPosition`.
+struct MapPoint {
+    layer: i32,
+    uv: vec2<f32>,
+    depth: f32,
+    // The world point looked up (moved towards the light under bias=world).
+    world: vec3<f32>,
+};
+
+// Twin: shadow-cpu's `map_position` (Light::to_light times the offset, then the projection).
+fn map_point(receiver: vec3<f32>) -> MapPoint {
+    var p = receiver;
     if (map.settings.w != 0.0) {
-        // Twin: query_maps in shadow-cpu (Light::to_light times the offset).
         var to_light = -map.direction.xyz;
         if (map.light.w != 1.0) {
             to_light = normalize(map.light.xyz - p);
@@ -127,6 +134,25 @@ fn fs_shadow_map_query(in: FullScreen) -> @location(0) vec4<f32> {
     }
     let c = map.proj[layer] * vec4<f32>(p, 1.0);
     let ndc = c.xyz / c.w;
-    let v = shadow_lookup(layer, ndc_to_uv(ndc.xy), ndc.z, vec2<u32>(px));
-    return vec4<f32>(v);
+    return MapPoint(layer, ndc_to_uv(ndc.xy), ndc.z, p);
+}
+
+// Twin: shadow_core::light::LightProjection::depth_gradient.
+fn depth_gradient(layer: i32, p: vec3<f32>, n: vec3<f32>) -> vec2<f32> {
+    let c = map.planes[layer] * vec4<f32>(n, -dot(n, p));
+    if (abs(c.z) <= 1e-6 * (abs(c.x) + abs(c.y))) {
+        return vec2<f32>(0.0);
+    }
+    return vec2<f32>(-2.0 * c.x / c.z, 2.0 * c.y / c.z);
+}
+
+@fragment
+fn fs_shadow_map_query(in: FullScreen) -> @location(0) vec4<f32> {
+    let px = vec2<i32>(in.pos.xy);
+    let g = textureLoad(g_position, px, 0);
+    if (g.w == 0.0) {
+        return vec4<f32>(1.0);
+    }
+    let m = map_point(g.xyz);
+    return vec4<f32>(shadow_lookup(m.layer, m.uv, m.depth, vec2<u32>(px)));
 }

@@ -12,7 +12,7 @@ use shadow_core::technique::hard::{DepthLayers, LayerCulling, LayerKind};
 use shadow_core::technique::{FrameStats, ShadowTechnique, TechniqueError};
 use wgpu::util::DeviceExt;
 
-use super::shadow_map::{MapQuery, map_texture};
+use super::shadow_map::{MapQuery, QueryExtras, map_texture};
 use crate::context::{WgpuBackend, WgpuContext, WgpuError};
 use crate::frame::{GpuVisibility, layer_view};
 use crate::gbuffer::{GpuGBuffer, check_size};
@@ -279,6 +279,6 @@ impl ShadowTechnique<WgpuBackend> for DepthLayers {
         _: &mut FrameStats,
     ) -> Result<(), WgpuError> {
         let maps = state.maps.as_ref().ok_or_else(|| TechniqueError::NotBuilt(self.name().into()))?;
-        state.query.run(cx, maps, light, g, out, self.filter, self.filter_radius, 0.0)
+        state.query.run(cx, maps, light, g, out, self.filter, self.filter_radius, 0.0, &QueryExtras::NONE)
     }
 }

@@ -12,10 +12,11 @@ use shadow_core::technique::{FrameStats, ShadowTechnique, TechniqueError};
 use wgpu::util::DeviceExt;
 
 use crate::context::{WgpuBackend, WgpuContext, WgpuError};
-use crate::frame::{GpuVisibility, layer_view};
+use crate::frame::{GpuVisibility, layer_view, layered};
 use crate::gbuffer::{GpuGBuffer, check_size, draw_instances};
 use crate::pipelines::{
-    MAP_DEPTH, POSITION_LAYOUT, VISIBILITY, ViewRaw, attribute_entry, buffer_entry, full_screen_pipeline,
+    MAP_DEPTH, POSITION_LAYOUT, VISIBILITY, ViewRaw, attribute_entry, buffer_entry, depth_array_entry,
+    full_screen_pipeline,
 };
 use crate::shaders;
 
@@ -27,6 +28,8 @@ struct MapParams {
     light: [f32; 4],
     direction: [f32; 4],
     settings: [f32; 4],
+    planes: [[[f32; 4]; 4]; 6],
+    extra: [f32; 4],
 }
 
 /// The lookup every map-based technique shares (twin: `query_maps` in shadow-cpu): a full-screen pass
@@ -37,38 +40,55 @@ pub struct MapQuery {
     sampler: wgpu::Sampler,
 }
 
+/// What a map query adds to the shared bindings (0 to 3): settings and resources.
+pub struct QueryExtras<'a> {
+    /// Technique-specific settings (`MapParams.extra`).
+    pub settings: [f32; 4],
+    /// Bindings from 4 on.
+    pub entries: &'a [wgpu::BindGroupEntry<'a>],
+}
+
+impl QueryExtras<'_> {
+    /// None: the plain shadow-map query.
+    pub const NONE: QueryExtras<'static> = QueryExtras { settings: [0.0; 4], entries: &[] };
+}
+
 impl MapQuery {
     /// Creates the query pipeline from the shadow-map module.
     #[must_use]
     pub fn new(cx: &WgpuContext, module: &wgpu::ShaderModule) -> Self {
-        let layout = cx.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("shadow map query"),
-            entries: &[
-                attribute_entry(0),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Depth,
-                        view_dimension: wgpu::TextureViewDimension::D2Array,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 2,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
-                    count: None,
-                },
-                buffer_entry(3, wgpu::BufferBindingType::Uniform, wgpu::ShaderStages::FRAGMENT),
-            ],
-        });
+        Self::with_entry(cx, module, "fs_shadow_map_query", &[])
+    }
+
+    /// A query pipeline running `entry` of `module` (the shadow-map shader with more after it), with the
+    /// shared bindings 0 to 3 and `extra` from 4 on.
+    #[must_use]
+    pub fn with_entry(
+        cx: &WgpuContext,
+        module: &wgpu::ShaderModule,
+        entry: &str,
+        extra: &[wgpu::BindGroupLayoutEntry],
+    ) -> Self {
+        let mut entries = vec![
+            attribute_entry(0),
+            depth_array_entry(1),
+            wgpu::BindGroupLayoutEntry {
+                binding: 2,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
+                count: None,
+            },
+            buffer_entry(3, wgpu::BufferBindingType::Uniform, wgpu::ShaderStages::FRAGMENT),
+        ];
+        entries.extend_from_slice(extra);
+        let layout = cx
+            .device
+            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("map query"), entries: &entries });
         let pipeline = full_screen_pipeline(
             &cx.device,
-            "shadow map query",
+            "map query",
             module,
-            "fs_shadow_map_query",
+            entry,
             &[&cx.shared.frame_layout, &layout],
             VISIBILITY,
             None,
@@ -100,10 +120,12 @@ impl MapQuery {
         filter: Filter,
         radius: f32,
         receiver_offset: f32,
+        extras: &QueryExtras<'_>,
     ) -> Result<(), WgpuError> {
-        let mut proj = [[[0.0f32; 4]; 4]; 6];
-        for (slot, p) in proj.iter_mut().zip(&light.projections) {
+        let (mut proj, mut planes) = ([[[0.0f32; 4]; 4]; 6], [[[0.0f32; 4]; 4]; 6]);
+        for ((slot, plane), p) in proj.iter_mut().zip(&mut planes).zip(&light.projections) {
             *slot = p.clip_from_world.to_cols_array_2d();
+            *plane = p.clip_plane_from_world_plane.to_cols_array_2d();
         }
         let (pos, dir, kind) = match light.light.kind {
             LightKind::Spot { position, direction, .. } => (position, direction, 0.0),
@@ -115,6 +137,8 @@ impl MapQuery {
             light: pos.extend(kind).to_array(),
             direction: dir.normalize().extend(0.0).to_array(),
             settings: [filter_code(filter), radius, maps.width() as f32, receiver_offset],
+            planes,
+            extra: extras.settings,
         };
         cx.scoped("the shadow-map query", |cx| {
             let ubuf = cx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -126,24 +150,19 @@ impl MapQuery {
                 dimension: Some(wgpu::TextureViewDimension::D2Array),
                 ..Default::default()
             });
+            let mut entries = vec![
+                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&g.position) },
+                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&maps_view) },
+                wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&self.sampler) },
+                wgpu::BindGroupEntry { binding: 3, resource: ubuf.as_entire_binding() },
+            ];
+            entries.extend_from_slice(extras.entries);
             let group = cx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("shadow map query"),
+                label: Some("map query"),
                 layout: &self.layout,
-                entries: &[
-                    wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&g.position) },
-                    wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&maps_view) },
-                    wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&self.sampler) },
-                    wgpu::BindGroupEntry { binding: 3, resource: ubuf.as_entire_binding() },
-                ],
+                entries: &entries,
             });
-            crate::techniques::full_screen(
-                cx,
-                "shadow map query",
-                &out.view,
-                &self.pipeline,
-                &[&g.frame_group, &group],
-                None,
-            );
+            crate::techniques::full_screen(cx, "map query", &out.view, &self.pipeline, &[&g.frame_group, &group], None);
         })
     }
 }
@@ -244,18 +263,7 @@ pub fn render_maps(
 /// A depth array of `layers` square maps.
 #[must_use]
 pub fn map_texture(cx: &WgpuContext, res: u32, layers: u32) -> wgpu::Texture {
-    cx.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("shadow maps"),
-        size: wgpu::Extent3d { width: res, height: res, depth_or_array_layers: layers },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: MAP_DEPTH,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-            | wgpu::TextureUsages::TEXTURE_BINDING
-            | wgpu::TextureUsages::COPY_SRC,
-        view_formats: &[],
-    })
+    layered(cx, "shadow maps", res, res, layers, MAP_DEPTH)
 }
 
 fn filter_code(f: Filter) -> f32 {
@@ -318,6 +326,16 @@ impl ShadowTechnique<WgpuBackend> for ShadowMap {
         _: &mut FrameStats,
     ) -> Result<(), WgpuError> {
         let maps = state.maps.as_ref().ok_or_else(|| TechniqueError::NotBuilt(self.name().into()))?;
-        state.query.run(cx, maps, light, g, out, self.filter, self.filter_radius, self.receiver_offset())
+        state.query.run(
+            cx,
+            maps,
+            light,
+            g,
+            out,
+            self.filter,
+            self.filter_radius,
+            self.receiver_offset(),
+            &QueryExtras::NONE,
+        )
     }
 }
