@@ -204,18 +204,34 @@ impl Shared {
     }
 }
 
+/// A fragment entry point with the values of its pipeline-overridable constants.
+#[derive(Clone, Copy, Debug)]
+pub struct FragmentEntry<'a> {
+    /// The entry point.
+    pub name: &'a str,
+    /// `override` constants by name.
+    pub constants: &'a [(&'a str, f64)],
+}
+
+impl<'a> From<&'a str> for FragmentEntry<'a> {
+    fn from(name: &'a str) -> Self {
+        Self { name, constants: &[] }
+    }
+}
+
 /// A pipeline drawing `vs_full_screen` into one colour target, optionally with a depth-stencil state.
 #[must_use]
-pub fn full_screen_pipeline(
+pub fn full_screen_pipeline<'a>(
     device: &wgpu::Device,
     label: &str,
     module: &wgpu::ShaderModule,
-    fragment: &str,
+    fragment: impl Into<FragmentEntry<'a>>,
     groups: &[&wgpu::BindGroupLayout],
     format: wgpu::TextureFormat,
     depth_stencil: Option<wgpu::DepthStencilState>,
 ) -> wgpu::RenderPipeline {
     let groups: Vec<Option<&wgpu::BindGroupLayout>> = groups.iter().map(|g| Some(*g)).collect();
+    let fragment = fragment.into();
     let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some(label),
         bind_group_layouts: &groups,
@@ -235,8 +251,11 @@ pub fn full_screen_pipeline(
         multisample: Default::default(),
         fragment: Some(wgpu::FragmentState {
             module,
-            entry_point: Some(fragment),
-            compilation_options: Default::default(),
+            entry_point: Some(fragment.name),
+            compilation_options: wgpu::PipelineCompilationOptions {
+                constants: fragment.constants,
+                ..Default::default()
+            },
             targets: &[Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL })],
         }),
         multiview_mask: None,

@@ -5,6 +5,8 @@
 @group(1) @binding(5) var g_geometric_normal: texture_2d<f32>;
 // Pixels whose corner tests disagreed (the silhouette_pixels counter).
 @group(1) @binding(6) var<storage, read_write> silhouette_pixels: atomic<u32>;
+// Nearest, clamp to edge: textureGather's four texels are a silhouette texel's four corners.
+@group(1) @binding(7) var corner_sampler: sampler;
 
 // Twin: shadow_core::silhouette_map::CORNERS (cyclic: (0, 0), (1, 0), (1, 1), (0, 1)).
 const CORNERS = array<vec2<f32>, 4>(vec2<f32>(0.0, 0.0), vec2<f32>(1.0, 0.0), vec2<f32>(1.0, 1.0), vec2<f32>(0.0, 1.0));
@@ -60,14 +62,15 @@ fn silhouette_lookup(layer: i32, uv: vec2<f32>, depth: f32, gradient: vec2<f32>)
     let t = floor(s);
     let f = s - t;
     let ij = vec2<i32>(t);
-    var lit: array<bool, 4>;
-    for (var k = 0; k < 4; k = k + 1) {
-        let c = CORNERS[k];
-        let stored = textureLoad(shadow_maps, ij + vec2<i32>(c), layer, 0);
-        lit[k] = depth + dot(gradient, (c - f) / n) <= stored;
-    }
-    if (lit[0] == lit[1] && lit[1] == lit[2] && lit[2] == lit[3]) {
-        return vec2<f32>(select(0.0, 1.0, lit[0]), 0.0);
+    // One gather fetches the four corners, sampled at the point between their centres. Its components
+    // are (i, j + 1), (i + 1, j + 1), (i + 1, j), (i, j) (the WGSL order): .wzyx is CORNERS order.
+    let stored = textureGather(shadow_maps, corner_sampler, (t + vec2<f32>(1.0)) / n, layer).wzyx;
+    // The receiver plane's depth at the four corners, in CORNERS order, as one vector.
+    let cx = vec4<f32>(0.0, 1.0, 1.0, 0.0);
+    let cy = vec4<f32>(0.0, 0.0, 1.0, 1.0);
+    let lit = vec4<f32>(depth) + (gradient.x * (cx - f.x) + gradient.y * (cy - f.y)) / n <= stored;
+    if (all(lit) || !any(lit)) {
+        return vec2<f32>(select(0.0, 1.0, lit.x), 0.0);
     }
     let o = point_or_centre(layer, ij.x, ij.y);
     var nb: array<vec2<f32>, 4>;

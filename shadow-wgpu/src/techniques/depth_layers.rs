@@ -9,6 +9,7 @@ use bytemuck::{Pod, Zeroable};
 use shadow_core::FrameInputs;
 use shadow_core::light::{LightProjection, LightView};
 use shadow_core::technique::hard::{DepthLayers, LayerCulling, LayerKind};
+use shadow_core::technique::settings::Filter;
 use shadow_core::technique::{FrameStats, ShadowTechnique, TechniqueError};
 use wgpu::util::DeviceExt;
 
@@ -63,7 +64,7 @@ fn kind_code(k: LayerKind) -> f32 {
 }
 
 impl State {
-    fn new(cx: &WgpuContext) -> Self {
+    fn new(cx: &WgpuContext, filter: Filter) -> Self {
         let module = shaders::module(&cx.device, "depth_layers", shaders::depth_layers());
         let map_module = shaders::module(&cx.device, "shadow_map", shaders::shadow_map());
         let layout = cx.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -141,7 +142,7 @@ impl State {
             multiview_mask: None,
             cache: None,
         });
-        Self { passes, combine, layout, query: MapQuery::new(cx, &map_module), maps: None, scratch: None }
+        Self { passes, combine, layout, query: MapQuery::new(cx, &map_module, filter), maps: None, scratch: None }
     }
 }
 
@@ -238,7 +239,7 @@ impl ShadowTechnique<WgpuBackend> for DepthLayers {
     }
 
     fn create_state(&self, cx: &mut WgpuContext) -> Result<State, WgpuError> {
-        cx.scoped("creating the depth-layer pipelines", State::new)
+        cx.scoped("creating the depth-layer pipelines", |cx| State::new(cx, self.filter))
     }
 
     fn build(
@@ -279,6 +280,6 @@ impl ShadowTechnique<WgpuBackend> for DepthLayers {
         _: &mut FrameStats,
     ) -> Result<(), WgpuError> {
         let maps = state.maps.as_ref().ok_or_else(|| TechniqueError::NotBuilt(self.name().into()))?;
-        state.query.run(cx, maps, light, g, out, self.filter, self.filter_radius, 0.0, &QueryExtras::NONE)
+        state.query.run(cx, maps, light, g, out, self.filter_radius, 0.0, &QueryExtras::NONE)
     }
 }

@@ -15,7 +15,7 @@ use crate::context::{WgpuBackend, WgpuContext, WgpuError};
 use crate::frame::{GpuVisibility, layer_view, layered};
 use crate::gbuffer::{GpuGBuffer, check_size, draw_instances};
 use crate::pipelines::{
-    MAP_DEPTH, POSITION_LAYOUT, VISIBILITY, ViewRaw, attribute_entry, buffer_entry, depth_array_entry,
+    FragmentEntry, MAP_DEPTH, POSITION_LAYOUT, VISIBILITY, ViewRaw, attribute_entry, buffer_entry, depth_array_entry,
     full_screen_pipeline,
 };
 use crate::shaders;
@@ -54,10 +54,11 @@ impl QueryExtras<'_> {
 }
 
 impl MapQuery {
-    /// Creates the query pipeline from the shadow-map module.
+    /// Creates the query pipeline from the shadow-map module, specialized for `filter`.
     #[must_use]
-    pub fn new(cx: &WgpuContext, module: &wgpu::ShaderModule) -> Self {
-        Self::with_entry(cx, module, "fs_shadow_map_query", &[])
+    pub fn new(cx: &WgpuContext, module: &wgpu::ShaderModule, filter: Filter) -> Self {
+        let constants = [("FILTER", filter_code(filter))];
+        Self::with_entry(cx, module, FragmentEntry { name: "fs_shadow_map_query", constants: &constants }, &[])
     }
 
     /// A query pipeline running `entry` of `module` (the shadow-map shader with more after it), with the
@@ -66,7 +67,7 @@ impl MapQuery {
     pub fn with_entry(
         cx: &WgpuContext,
         module: &wgpu::ShaderModule,
-        entry: &str,
+        entry: FragmentEntry<'_>,
         extra: &[wgpu::BindGroupLayoutEntry],
     ) -> Self {
         let mut entries = vec![
@@ -117,7 +118,6 @@ impl MapQuery {
         light: &LightView,
         g: &GpuGBuffer,
         out: &GpuVisibility,
-        filter: Filter,
         radius: f32,
         receiver_offset: f32,
         extras: &QueryExtras<'_>,
@@ -136,7 +136,7 @@ impl MapQuery {
             proj,
             light: pos.extend(kind).to_array(),
             direction: dir.normalize().extend(0.0).to_array(),
-            settings: [filter_code(filter), radius, maps.width() as f32, receiver_offset],
+            settings: [0.0, radius, maps.width() as f32, receiver_offset],
             planes,
             extra: extras.settings,
         };
@@ -266,7 +266,8 @@ pub fn map_texture(cx: &WgpuContext, res: u32, layers: u32) -> wgpu::Texture {
     layered(cx, "shadow maps", res, res, layers, MAP_DEPTH)
 }
 
-fn filter_code(f: Filter) -> f32 {
+/// The value of the shader's `FILTER` constant.
+fn filter_code(f: Filter) -> f64 {
     match f {
         Filter::None => 0.0,
         Filter::Bilinear => 1.0,
@@ -288,7 +289,7 @@ impl ShadowTechnique<WgpuBackend> for ShadowMap {
             let module = shaders::module(&cx.device, "shadow_map", shaders::shadow_map());
             State {
                 depth: light_pass_pipeline(cx, &module, depth_bias(self)),
-                query: MapQuery::new(cx, &module),
+                query: MapQuery::new(cx, &module, self.filter),
                 maps: None,
             }
         })
@@ -326,16 +327,6 @@ impl ShadowTechnique<WgpuBackend> for ShadowMap {
         _: &mut FrameStats,
     ) -> Result<(), WgpuError> {
         let maps = state.maps.as_ref().ok_or_else(|| TechniqueError::NotBuilt(self.name().into()))?;
-        state.query.run(
-            cx,
-            maps,
-            light,
-            g,
-            out,
-            self.filter,
-            self.filter_radius,
-            self.receiver_offset(),
-            &QueryExtras::NONE,
-        )
+        state.query.run(cx, maps, light, g, out, self.filter_radius, self.receiver_offset(), &QueryExtras::NONE)
     }
 }

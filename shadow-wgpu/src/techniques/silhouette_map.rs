@@ -6,16 +6,15 @@
 //! draws with the test off, so rasterization order keeps the last). The query runs
 //! `fs_silhouette_query` of silhouette_query.wgsl over the G-buffer.
 //!
-//! Counters: a compute pass counts non-empty texels (`silhouette_texels`) and the query counts the
-//! pixels whose corner tests disagree (`silhouette_pixels`) with an atomic; both are read back once,
-//! after the query, in the `count_readback` sub-phase.
+//! Counters: the query counts the pixels whose corner tests disagree (`silhouette_pixels`) with an
+//! atomic; after it, a compute pass counts the non-empty texels (`silhouette_texels`) and both are read
+//! back, timed as the `count_silhouette` sub-phase of the query.
 
 use bytemuck::{Pod, Zeroable};
 use shadow_core::FrameInputs;
 use shadow_core::light::LightView;
 use shadow_core::silhouette_map::{CornerDepth, Keep, MapSegment, overlay, project_segments};
 use shadow_core::technique::hard::SilhouetteMap;
-use shadow_core::technique::settings::Filter;
 use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
 use wgpu::util::DeviceExt;
 
@@ -51,6 +50,8 @@ pub struct State {
     points_layout: wgpu::BindGroupLayout,
     count: wgpu::ComputePipeline,
     query: MapQuery,
+    /// Nearest-texel sampler for the query's corner gather.
+    corners: wgpu::Sampler,
     maps: Option<Maps>,
     /// Non-empty texels, then silhouette pixels: one u32 each, 256 bytes apart (storage offset alignment).
     counters: wgpu::Buffer,
@@ -126,7 +127,7 @@ impl State {
         let query = MapQuery::with_entry(
             cx,
             &map_module,
-            "fs_silhouette_query",
+            "fs_silhouette_query".into(),
             &[
                 wgpu::BindGroupLayoutEntry {
                     binding: 4,
@@ -140,6 +141,12 @@ impl State {
                 },
                 attribute_entry(5),
                 storage_entry(6, false, wgpu::ShaderStages::FRAGMENT),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 7,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::NonFiltering),
+                    count: None,
+                },
             ],
         );
         let counters = cx.device.create_buffer(&wgpu::BufferDescriptor {
@@ -154,6 +161,14 @@ impl State {
             points_layout,
             count,
             query,
+            corners: cx.device.create_sampler(&wgpu::SamplerDescriptor {
+                label: Some("silhouette corners"),
+                address_mode_u: wgpu::AddressMode::ClampToEdge,
+                address_mode_v: wgpu::AddressMode::ClampToEdge,
+                mag_filter: wgpu::FilterMode::Nearest,
+                min_filter: wgpu::FilterMode::Nearest,
+                ..Default::default()
+            }),
             maps: None,
             counters,
         }
@@ -199,7 +214,7 @@ fn upload_segments(
     (buffer, ranges)
 }
 
-/// Pass 2 for every projection, then the texel count of each layer (into the first counter).
+/// Pass 2 for every projection, after zeroing both counters.
 fn draw_points(
     cx: &WgpuContext,
     state: &State,
@@ -261,7 +276,18 @@ fn draw_points(
                 pass.draw(0..6, range.clone());
             }
         }
-        let count_group = cx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+    }
+    cx.queue.submit([enc.finish()]);
+}
+
+/// Counts the non-empty texels of every layer into the first counter, then reads both counters:
+/// (non-empty texels, silhouette pixels).
+fn count(cx: &WgpuContext, state: &State, maps: &Maps) -> Result<(u64, u64), WgpuError> {
+    let side = maps.points.width();
+    let mut enc = cx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("count texels") });
+    for k in 0..maps.points.depth_or_array_layers() {
+        let layer = layer_view(&maps.points, k);
+        let group = cx.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("count silhouette texels"),
             layout: &state.count.get_bind_group_layout(0),
             entries: &[
@@ -281,10 +307,11 @@ fn draw_points(
             timestamp_writes: None,
         });
         pass.set_pipeline(&state.count);
-        pass.set_bind_group(0, &count_group, &[]);
+        pass.set_bind_group(0, &group, &[]);
         pass.dispatch_workgroups(side.div_ceil(8), side.div_ceil(8), 1);
     }
     cx.queue.submit([enc.finish()]);
+    read_counters(cx, &state.counters)
 }
 
 /// Reads both counters: (non-empty texels, silhouette pixels).
@@ -364,15 +391,18 @@ impl ShadowTechnique<WgpuBackend> for SilhouetteMap {
                     size: wgpu::BufferSize::new(4),
                 }),
             },
+            wgpu::BindGroupEntry { binding: 7, resource: wgpu::BindingResource::Sampler(&state.corners) },
         ];
         let receiver_plane = if self.corner_depth == CornerDepth::ReceiverPlane { 1.0 } else { 0.0 };
         let extras = QueryExtras { settings: [receiver_plane, 0.0, 0.0, 0.0], entries: &entries };
         let offset = self.depth.receiver_offset();
-        state.query.run(cx, &maps.depth, light, g, out, Filter::None, 0.0, offset, &extras)?;
+        state.query.run(cx, &maps.depth, light, g, out, 0.0, offset, &extras)?;
+        // The counters cost a compute pass and a readback that the technique itself does not need: a
+        // sub-phase of their own, after the query's work is done, so they can be told apart.
         cx.wait()?;
         let t = std::time::Instant::now();
-        let (texels, pixels) = read_counters(cx, &state.counters)?;
-        stats.timings.extra.insert("count_readback".into(), shadow_core::stats::ms(t.elapsed()));
+        let (texels, pixels) = cx.scoped("the silhouette counters", |cx| count(cx, state, maps))??;
+        stats.timings.extra.insert("count_silhouette".into(), shadow_core::stats::ms(t.elapsed()));
         stats.counters.extra.insert("silhouette_texels".into(), texels as f64);
         stats.counters.silhouette_pixels = Some(pixels);
         Ok(())
