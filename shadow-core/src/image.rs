@@ -15,6 +15,13 @@ pub struct Image<T> {
     data: Vec<T>,
 }
 
+impl<T> Default for Image<T> {
+    /// The empty 0 x 0 image.
+    fn default() -> Self {
+        Self { width: 0, height: 0, data: Vec::new() }
+    }
+}
+
 /// Why an image could not be written.
 #[derive(Debug, thiserror::Error)]
 #[error("cannot write {path}: {source}")]

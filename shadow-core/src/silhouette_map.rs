@@ -9,7 +9,7 @@
 //! outermost half texel of the depth map has no four corners around it, and there the lookup is the plain
 //! shadow map's.
 //!
-//! **Build** ([`store_points`]): every silhouette edge, projected into texel space ([`project_segments`]), is
+//! **Build** ([`PointMap::store`]): every silhouette edge, projected into texel space ([`project_segments`]), is
 //! offered to every texel whose slightly enlarged square it may touch; [`choose_point`] picks the stored
 //! point as Fig. 4 does (an endpoint inside the texel; else the diagonal intersections, one or the midpoint
 //! of two; else nothing), with the corner rule of section 3.1; a point farther from the light than all four
@@ -201,34 +201,76 @@ crate::named_enum! {
     }
 }
 
-/// Pass 2 on the CPU: the silhouette map of `depth` (an `N x N` depth map) for `segments` in texel space.
-/// Returns the `(N - 1)`-texel map ([`EMPTY`] where no point was stored) and the number of non-empty
-/// texels. GPU twin: `fs_silhouette_point`, drawn with a depth test for [`Keep::Nearest`].
-#[must_use]
-pub fn store_points(segments: &[MapSegment], depth: &Image<f32>, margin: f32, keep: Keep) -> (Image<[f32; 2]>, u64) {
-    let side = depth.width().saturating_sub(1);
-    let mut points = Image::new(side, side, EMPTY);
-    // The depth of each stored point, for Keep::Nearest (a less-or-equal depth test).
-    let mut stored = Image::new(side, side, f32::INFINITY);
-    for seg in segments {
-        for (i, j) in candidate_texels(seg, margin, side) {
-            let Some((p, z)) = choose_point(seg, Vec2::new(i as f32, j as f32), margin) else { continue };
-            // Section 3.1: a point farther from the light than all four corner samples is hidden.
-            let corners = [(i, j), (i + 1, j), (i, j + 1), (i + 1, j + 1)].map(|(x, y)| *depth.get(x, y));
-            if z > corners.into_iter().fold(f32::MIN, f32::max) {
-                continue;
+/// A silhouette map on the CPU, kept from frame to frame: only the texels the last build wrote are reset,
+/// so a build costs its silhouette texels, not the map's area (a 2047^2 map is 33 MB to clear).
+#[derive(Clone, Debug, Default)]
+pub struct PointMap {
+    points: Image<[f32; 2]>,
+    /// The depth of each stored point, for [`Keep::Nearest`] (a less-or-equal depth test).
+    depth: Image<f32>,
+    /// Indices of the non-empty texels, each once.
+    written: Vec<u32>,
+}
+
+impl PointMap {
+    /// The points, [`EMPTY`] where none was stored.
+    #[must_use]
+    pub fn points(&self) -> &Image<[f32; 2]> {
+        &self.points
+    }
+
+    /// How many texels hold a point.
+    #[must_use]
+    pub fn texels(&self) -> u64 {
+        self.written.len() as u64
+    }
+
+    /// Pass 2 on the CPU: the silhouette map of `depth` (an `N x N` depth map) for `segments` in texel space,
+    /// `N - 1` texels a side. GPU twin: `fs_silhouette_point`, drawn with a depth test for
+    /// [`Keep::Nearest`].
+    pub fn store(&mut self, segments: &[MapSegment], depth: &Image<f32>, margin: f32, keep: Keep) {
+        let side = depth.width().saturating_sub(1);
+        if self.points.width() == side {
+            for &i in &self.written {
+                self.points.data_mut()[i as usize] = EMPTY;
+                self.depth.data_mut()[i as usize] = f32::INFINITY;
             }
-            if keep == Keep::Nearest {
-                if z > *stored.get(i, j) {
+        } else {
+            self.points = Image::new(side, side, EMPTY);
+            self.depth = Image::new(side, side, f32::INFINITY);
+        }
+        self.written.clear();
+        for seg in segments {
+            for (i, j) in candidate_texels(seg, margin, side) {
+                let Some((p, z)) = choose_point(seg, Vec2::new(i as f32, j as f32), margin) else { continue };
+                // Section 3.1: a point farther from the light than all four corner samples is hidden.
+                let corners = [(i, j), (i + 1, j), (i, j + 1), (i + 1, j + 1)].map(|(x, y)| *depth.get(x, y));
+                if z > corners.into_iter().fold(f32::MIN, f32::max) {
                     continue;
                 }
-                *stored.get_mut(i, j) = z;
+                let at = self.points.index(i, j);
+                if keep == Keep::Nearest {
+                    if z > self.depth.data()[at] {
+                        continue;
+                    }
+                    self.depth.data_mut()[at] = z;
+                }
+                if self.points.data()[at][0] < 0.0 {
+                    self.written.push(at as u32);
+                }
+                self.points.data_mut()[at] = p.to_array();
             }
-            *points.get_mut(i, j) = p.to_array();
         }
     }
-    let texels = points.data().iter().filter(|p| p[0] >= 0.0).count() as u64;
-    (points, texels)
+}
+
+/// [`PointMap::store`] into a new map: the points and the number of non-empty texels.
+#[must_use]
+pub fn store_points(segments: &[MapSegment], depth: &Image<f32>, margin: f32, keep: Keep) -> (Image<[f32; 2]>, u64) {
+    let mut map = PointMap::default();
+    map.store(segments, depth, margin, keep);
+    let texels = map.texels();
+    (map.points, texels)
 }
 
 /// Corners of a texel in its own frame, in the cyclic order the quadrants use: (0, 0), (1, 0), (1, 1),

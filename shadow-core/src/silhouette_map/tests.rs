@@ -126,6 +126,19 @@ fn a_shared_texel_keeps_the_nearest_or_the_last_point() {
 }
 
 #[test]
+fn a_reused_map_equals_a_fresh_one() {
+    let depth = Image::new(16, 16, 1.0);
+    let (a, b) = (seg((2.5, 2.5), (9.5, 4.5)), seg((3.2, 11.0), (12.5, 6.1)));
+    let mut map = PointMap::default();
+    map.store(&[a, b], &depth, 0.01, Keep::Nearest);
+    map.store(&[b], &depth, 0.01, Keep::Nearest);
+    let (fresh, texels) = store_points(&[b], &depth, 0.01, Keep::Nearest);
+    assert_eq!(map.points().data(), fresh.data());
+    assert_eq!(map.texels(), texels);
+    assert_eq!(texels, fresh.data().iter().filter(|p| p[0] >= 0.0).count() as u64);
+}
+
+#[test]
 fn straight_edges_are_reconstructed_exactly() {
     // A half-plane below the line y = 3.37 + 0.41 x: the polyline through the stored points is the line
     // itself, so every position off it is right, where the shadow map is wrong along the whole edge. (In

@@ -1,6 +1,6 @@
 //! `silhouette-map` (Sen, Cammarano, Hanrahan 2003). Pass 1 renders the depth map as `shadow-map` does
 //! (same bias); pass 2 stores one silhouette point per texel of a map shifted half a texel
-//! (`shadow_core::silhouette_map::store_points`, the reference both backends follow); the query runs the
+//! (`shadow_core::silhouette_map::PointMap::store`, the reference both backends follow); the query runs the
 //! four corner tests and, where they disagree, the skewed-quadrant reconstruction of Fig. 5. With
 //! `corner_depth=receiver-plane` (the default) each corner is compared with the receiver plane's depth
 //! there, from the G-buffer's face normal.
@@ -16,7 +16,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use shadow_core::glam::Vec2;
 use shadow_core::light::LightView;
 use shadow_core::silhouette_map::CornerDepth;
-use shadow_core::silhouette_map::{overlay, project_segments, silhouette_lookup, store_points};
+use shadow_core::silhouette_map::{PointMap, overlay, project_segments, silhouette_lookup};
 use shadow_core::technique::hard::SilhouetteMap;
 use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
 use shadow_core::{FrameInputs, Image};
@@ -30,7 +30,7 @@ use crate::gbuffer::GBuffer;
 #[derive(Default)]
 pub struct State {
     maps: Vec<Image<f32>>,
-    points: Vec<Image<[f32; 2]>>,
+    points: Vec<PointMap>,
 }
 
 impl ShadowTechnique<CpuBackend> for SilhouetteMap {
@@ -55,17 +55,12 @@ impl ShadowTechnique<CpuBackend> for SilhouetteMap {
         let res = self.depth.resolution;
         render_depth_maps(frame, light, res, self.depth.depth_bias(), &mut state.maps)?;
         let edges = frame.silhouette_segments(light);
+        state.points.resize_with(light.projections.len(), PointMap::default);
         let mut texels = 0;
-        state.points = light
-            .projections
-            .iter()
-            .zip(&state.maps)
-            .map(|(p, map)| {
-                let (points, n) = store_points(&project_segments(&edges, p, res), map, self.corner_margin, self.keep);
-                texels += n;
-                points
-            })
-            .collect();
+        for ((p, map), points) in light.projections.iter().zip(&state.maps).zip(&mut state.points) {
+            points.store(&project_segments(&edges, p, res), map, self.corner_margin, self.keep);
+            texels += points.texels();
+        }
         let c = &mut stats.counters;
         c.silhouette_edges = Some(edges.len() as u64);
         c.extra.insert("silhouette_texels".into(), texels as f64);
@@ -96,7 +91,7 @@ impl ShadowTechnique<CpuBackend> for SilhouetteMap {
                 }
                 CornerDepth::Fragment => Vec2::ZERO,
             };
-            let r = silhouette_lookup(&state.maps[k], &state.points[k], m.uv, m.depth, gradient);
+            let r = silhouette_lookup(&state.maps[k], state.points[k].points(), m.uv, m.depth, gradient);
             if r.silhouette {
                 silhouette_pixels.fetch_add(1, Ordering::Relaxed);
             }
@@ -114,7 +109,7 @@ impl ShadowTechnique<CpuBackend> for SilhouetteMap {
                 .iter()
                 .zip(&state.points)
                 .enumerate()
-                .map(|(k, (m, p))| DebugView { name: format!("silhouette{k}"), image: overlay(m, p) }),
+                .map(|(k, (m, p))| DebugView { name: format!("silhouette{k}"), image: overlay(m, p.points()) }),
         );
         Ok(views)
     }
