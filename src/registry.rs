@@ -4,7 +4,7 @@
 
 use shadow_core::technique::hard::{
     DepthLayers, DualShadowMap, MidpointShadowMap, RayTraced, SecondDepthShadowMap, ShadowMap, ShadowVolume,
-    SilhouetteMap,
+    SilhouetteMap, VolumeReconstruction,
 };
 use shadow_core::technique::settings::{SettingKey, SettingsError, TechniqueSettings, TechniqueSpec};
 use shadow_core::technique::{DynShadowTechnique, Stateful};
@@ -147,6 +147,16 @@ impl TechniqueRegistry {
             canonical: canonical::<SilhouetteMap>,
             cpu: Some(plain::<CpuBackend, SilhouetteMap>),
             wgpu: Some(plain::<WgpuBackend, SilhouetteMap>),
+        });
+        r.register(TechniqueEntry {
+            name: "volume-reconstruction",
+            description: "a shadow volume rebuilt from the light's depth map, resolved with one stencil bit",
+            paper: "McCool 2000",
+            reference: false,
+            keys: VolumeReconstruction::keys,
+            canonical: canonical::<VolumeReconstruction>,
+            cpu: Some(plain::<CpuBackend, VolumeReconstruction>),
+            wgpu: None,
         });
         r.register(TechniqueEntry {
             name: "shadow-volume-zpass",

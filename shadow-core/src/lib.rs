@@ -19,6 +19,7 @@ pub mod lookup;
 pub mod mesh;
 pub mod metrics;
 pub mod procedural;
+pub mod reconstruction;
 pub mod scene;
 pub mod scenes;
 pub mod stats;

@@ -246,6 +246,26 @@ impl LightView {
         Ok(Self { light: *light, kind, projections })
     }
 
+    /// The same view with a point light's six cube faces widened so that an `n x n` map's outermost
+    /// sample centres lie exactly on the 90-degree face boundaries: neighbouring faces then sample the
+    /// same rays along their shared edge, and surfaces reconstructed from their maps meet there without
+    /// cracks (McCool section 5, Fig. 6: overlapping partitions). Other lights are returned unchanged.
+    #[must_use]
+    pub fn with_seamless_faces(&self, n: u32) -> Self {
+        let LightKind::Point { position } = self.light.kind else { return self.clone() };
+        // Sample i sits at NDC -1 + (2i + 1) / n; the outermost ones at tan(half fov) (1 - 1/n) = 1.
+        let fov = 2.0 * (n as f32 / (n.max(2) - 1) as f32).atan();
+        let projections = CUBE_FACES
+            .iter()
+            .zip(&self.projections)
+            .map(|(&(dir, up), p)| {
+                let view = look_to_mat4(position, dir, up);
+                LightProjection::new(view, directx::perspective(fov, 1.0, p.near, p.far), p.near, p.far, false)
+            })
+            .collect();
+        Self { projections, ..self.clone() }
+    }
+
     /// The light as the geometry kernels take it, in world space.
     #[must_use]
     pub fn source(&self) -> LightSource {

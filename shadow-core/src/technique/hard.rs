@@ -216,6 +216,164 @@ impl TechniqueSettings for SilhouetteMap {
     }
 }
 
+crate::named_enum! {
+    /// Whether the near-plane cap of `volume-reconstruction` is drawn.
+    pub enum Capping {
+        /// Software caps (McCool section 6.2).
+        On = "on",
+        /// None: where the eye's near plane cuts the volume, parity inverts (Fig. 7).
+        Off = "off",
+    }
+}
+
+crate::named_enum! {
+    /// The edge detector of `volume-reconstruction`.
+    pub enum EdgeTest {
+        /// First differences over theta_L thinned by the second-derivative test, sure edges over theta_H
+        /// (section 3.3).
+        SecondDerivative = "second-derivative",
+        /// First differences over theta_L alone (section 3.1).
+        FirstDifference = "first-difference",
+    }
+}
+
+crate::named_enum! {
+    /// Where the mesh of `volume-reconstruction` has its vertices.
+    pub enum MeshVertices {
+        /// At texel centres, edge midpoints and corners, a border sample taking the far side: shadows the
+        /// size of the shadow map's (see `reconstruction::texel_square_grid`).
+        Texel = "texel",
+        /// At the texel centres, as the paper has them: every shadow half a texel larger.
+        Centre = "centre",
+    }
+}
+
+/// `volume-reconstruction` (McCool 2000): a shadow volume rebuilt from the light's depth map, resolved
+/// with a one-bit parity stencil.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VolumeReconstruction {
+    /// The depth map: resolution and bias as `shadow-map` has them (the filter is unused). The bias
+    /// moves the reconstructed boundary away from the light, as the paper's bias translation of the light
+    /// depths does; `bias=world` moves each vertex `bias_world` along its light ray.
+    pub depth: ShadowMap,
+    /// Where the mesh's vertices are.
+    pub vertices: MeshVertices,
+    /// The detector.
+    pub edges: EdgeTest,
+    /// theta_L, theta_H, theta_S and the dangling-edge threshold, as fractions of the fitted light depth
+    /// range (far minus near), applied to linear depths.
+    pub theta_low: f32,
+    /// See `theta_low`.
+    pub theta_high: f32,
+    /// See `theta_low`.
+    pub theta_second: f32,
+    /// See `theta_low`.
+    pub theta_dangling: f32,
+    /// How many cells a dangling edge is followed under the lowered thresholds.
+    pub dangling_steps: u32,
+    /// The near-plane cap.
+    pub capping: Capping,
+}
+
+const RECONSTRUCTION_KEYS: [SettingKey; 13] = [
+    SettingKey { key: "res", default: "1024", help: "depth-map side in texels (16 to 16384)" },
+    MAP_KEYS[1],
+    MAP_KEYS[2],
+    // An eighth of shadow-map's: the mesh is drawn only across discontinuities, where its slopes fall
+    // away from the occluder, so the bias is needed only against false-positive cells lying on a surface,
+    // and a receiver's bias sinks the slopes' far ends behind it and erodes the shadow (cubes, map 512:
+    // slope 2 gives 1.22%, 0.25 gives 0.95%, shadow-map 0.92%; none leaves false-positive rows on strike).
+    SettingKey {
+        key: "bias_slope",
+        default: "0.25",
+        help: "slope bias factor, times the primitive's largest depth change per texel",
+    },
+    MAP_KEYS[6],
+    SettingKey {
+        key: "vertices",
+        default: "texel",
+        help: "texel (centres, midpoints and corners: shadow-map-sized shadows) or centre (the paper's)",
+    },
+    SettingKey {
+        key: "edges",
+        default: "second-derivative",
+        help: "second-derivative (thinned, section 3.3) or first-difference (section 3.1)",
+    },
+    SettingKey {
+        key: "theta_low",
+        default: "0.001",
+        help: "candidate edge threshold, fraction of the light depth range",
+    },
+    SettingKey { key: "theta_high", default: "0.01", help: "sure edge threshold, fraction of the light depth range" },
+    SettingKey {
+        key: "theta_second",
+        default: "0.0005",
+        help: "second-derivative zero-crossing strength, fraction of the light depth range",
+    },
+    SettingKey {
+        key: "theta_dangling",
+        default: "0.0001",
+        help: "lowered threshold along dangling edges, fraction of the light depth range",
+    },
+    SettingKey { key: "dangling_steps", default: "8", help: "cells a dangling edge is followed (0 to 64)" },
+    SettingKey { key: "capping", default: "on", help: "near-plane caps: on, or off to see the inversion" },
+];
+
+impl TechniqueSettings for VolumeReconstruction {
+    fn keys() -> &'static [SettingKey] {
+        &RECONSTRUCTION_KEYS
+    }
+    fn from_values(v: &Values<'_>) -> Result<Self, SettingsError> {
+        let r = Self {
+            depth: ShadowMap::read_depth(v)?,
+            vertices: v.get("vertices")?,
+            edges: v.get("edges")?,
+            theta_low: v.ranged("theta_low", 0.0, 1.0)?,
+            theta_high: v.ranged("theta_high", 0.0, 1.0)?,
+            theta_second: v.ranged("theta_second", 0.0, 1.0)?,
+            theta_dangling: v.ranged("theta_dangling", 0.0, 1.0)?,
+            dangling_steps: v.ranged("dangling_steps", 0, 64)?,
+            capping: v.get("capping")?,
+        };
+        if r.theta_high < r.theta_low {
+            return Err(v.bad("theta_high", &format!("at least theta_low ({})", r.theta_low)));
+        }
+        Ok(r)
+    }
+    fn to_values(&self) -> Vec<String> {
+        let d = &self.depth;
+        vec![
+            d.resolution.to_string(),
+            d.bias.to_string(),
+            d.bias_constant.to_string(),
+            d.bias_slope.to_string(),
+            d.bias_world.to_string(),
+            self.vertices.to_string(),
+            self.edges.to_string(),
+            self.theta_low.to_string(),
+            self.theta_high.to_string(),
+            self.theta_second.to_string(),
+            self.theta_dangling.to_string(),
+            self.dangling_steps.to_string(),
+            self.capping.to_string(),
+        ]
+    }
+}
+
+impl VolumeReconstruction {
+    /// The detector's thresholds in scene units for a light depth range of `range`.
+    #[must_use]
+    pub fn edge_settings(&self, range: f32) -> crate::reconstruction::edges::EdgeSettings {
+        crate::reconstruction::edges::EdgeSettings {
+            low: self.theta_low * range,
+            high: self.theta_high * range,
+            second: (self.edges == EdgeTest::SecondDerivative).then_some(self.theta_second * range),
+            dangling: self.theta_dangling * range,
+            dangling_steps: self.dangling_steps,
+        }
+    }
+}
+
 /// How stencil shadow volumes count (the technique name picks it).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum VolumeCounting {

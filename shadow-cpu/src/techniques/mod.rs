@@ -6,6 +6,7 @@ pub mod ray_traced;
 pub mod shadow_map;
 pub mod shadow_volume;
 pub mod silhouette_map;
+pub mod volume_reconstruction;
 
 use rayon::prelude::*;
 use shadow_core::glam::{Vec2, Vec3};

@@ -1,0 +1,273 @@
+//! `volume-reconstruction` (McCool 2000): the light's depth map becomes a polygonal shadow-volume boundary
+//! (`shadow_core::reconstruction`, shared with the GPU backend), resolved with one stencil bit.
+//!
+//! Build: depth maps as `shadow-map` renders them (same bias; a point light's cube faces widened so their
+//! maps meet, see `LightView::with_seamless_faces`), then per map the edge flags and the reconstructed
+//! triangles. Query: the near-plane cap for this view, then every triangle drawn with its stencil bit
+//! inverted wherever it is in front of the G-buffer (front and back faces alike, one pass), the caps
+//! inverted without a depth test, and the bit read: set means shadowed.
+
+use shadow_core::glam::{Mat4, Vec4};
+use shadow_core::image::{Rgb8, false_colour};
+use shadow_core::light::LightView;
+use shadow_core::reconstruction::caps::near_plane_cap;
+use shadow_core::reconstruction::edges::{EdgeMap, depth_edges};
+use shadow_core::reconstruction::mesh::{border_walls, reconstruct};
+use shadow_core::reconstruction::{HomTriangle, SampleGrid, texel_square_grid};
+use shadow_core::scene::LightKind;
+use shadow_core::technique::hard::{Capping, MeshVertices, VolumeReconstruction};
+use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
+use shadow_core::{FrameInputs, Image};
+
+use super::{per_receiver, render_depth_maps};
+use crate::context::{CpuBackend, CpuContext, CpuError};
+use crate::gbuffer::GBuffer;
+use crate::raster::{
+    CompareFn, DepthState, DepthStencil, RasterCounters, RasterState, Soup, StencilFace, StencilOp, StencilState,
+    draw_depth,
+};
+
+/// One light projection's map, edges and boundary.
+pub struct Projection {
+    /// The projection the map was rendered with.
+    pub view: shadow_core::light::LightProjection,
+    /// Where the mesh's samples are.
+    pub grid: SampleGrid,
+    /// NDC depths at the grid's samples, bias included.
+    pub samples: Vec<f32>,
+    /// Linear depths at the samples (what the edge detector and the split rule compare).
+    pub linear: Vec<f32>,
+    /// The map's edge flags.
+    pub edges: EdgeMap,
+    /// The flags between the grid's samples (the map's own for the paper's grid).
+    pub mesh_edges: EdgeMap,
+    /// The reconstructed boundary.
+    pub triangles: Vec<HomTriangle>,
+}
+
+/// The projections of the last build, and what the last query drew (for the debug views).
+#[derive(Default)]
+pub struct State {
+    maps: Vec<Image<f32>>,
+    projections: Vec<Projection>,
+    last_view: Option<(Mat4, u32, u32, Vec<HomTriangle>)>,
+}
+
+/// Where the light's rays start, as the mesh's `bias=world` offset needs it.
+#[must_use]
+pub fn light_origin(view: &LightView) -> Vec4 {
+    match view.light.kind {
+        LightKind::Spot { position, .. } | LightKind::Point { position } => position.extend(1.0),
+        LightKind::Directional { direction } => direction.extend(0.0),
+    }
+}
+
+/// Edges and boundary of one rendered map (shared by both backends: the GPU reads its maps back first).
+#[must_use]
+pub fn reconstruct_projection(
+    s: &VolumeReconstruction,
+    view: &LightView,
+    proj: shadow_core::light::LightProjection,
+    map: &Image<f32>,
+) -> Projection {
+    let n = map.width();
+    let point = matches!(view.light.kind, LightKind::Point { .. });
+    let texels: Vec<f32> = map.data().iter().map(|&z| proj.linear_depth(z.min(1.0))).collect();
+    let edges = depth_edges(&texels, n, n, &s.edge_settings(proj.far - proj.near));
+    let (grid, samples, linear, mesh_edges) = match s.vertices {
+        MeshVertices::Texel => {
+            let ring = u32::from(point);
+            let (linear, flags) = texel_square_grid(&texels, n, &edges, ring);
+            let ndc = linear.iter().map(|&d| proj.ndc_depth(d)).collect();
+            (SampleGrid::texel_squares(&proj, n, ring), ndc, linear, flags)
+        }
+        MeshVertices::Centre => (SampleGrid::centres(&proj, n), map.data().to_vec(), texels, edges.clone()),
+    };
+    let offset = s.depth.receiver_offset();
+    let origin = light_origin(view);
+    let mut triangles = reconstruct(&samples, &linear, &mesh_edges, &grid, offset, origin).triangles;
+    if !point {
+        triangles.extend(border_walls(&samples, &grid, offset, origin));
+    }
+    Projection { view: proj, grid, samples, linear, edges, mesh_edges, triangles }
+}
+
+/// The caps of every projection for a view: the stencil's starting bit (global inversions) and the cap
+/// triangles.
+#[must_use]
+pub fn caps_for_view(projections: &[Projection], eye_clip_from_world: Mat4) -> (bool, Vec<HomTriangle>) {
+    let mut invert = false;
+    let mut triangles = Vec::new();
+    for p in projections {
+        let cap = near_plane_cap(eye_clip_from_world, &p.view, &p.grid, &p.samples, &p.linear);
+        invert ^= cap.invert_all;
+        triangles.extend(cap.triangles);
+    }
+    (invert, triangles)
+}
+
+/// The one-bit parity state: invert bit 0 on every fragment that passes `depth`, both faces.
+fn parity_state(depth: DepthState) -> RasterState {
+    let face = StencilFace {
+        compare: CompareFn::Always,
+        fail: StencilOp::Keep,
+        depth_fail: StencilOp::Keep,
+        pass: StencilOp::Invert,
+    };
+    RasterState {
+        depth: Some(depth),
+        stencil: Some(StencilState { front: face, back: face, read_mask: 1, write_mask: 1, reference: 0 }),
+        ..RasterState::default()
+    }
+}
+
+/// Caps drawn at mid depth with the depth test off: they lie on the near plane, which would clip them, and
+/// every visible surface is behind it anyway.
+#[must_use]
+pub fn cap_clip(eye: Mat4, t: &HomTriangle) -> [Vec4; 3] {
+    t.map(|p| {
+        let c = eye * p;
+        Vec4::new(c.x, c.y, 0.5 * c.w, c.w)
+    })
+}
+
+impl ShadowTechnique<CpuBackend> for VolumeReconstruction {
+    type State = State;
+
+    fn name(&self) -> &'static str {
+        "volume-reconstruction"
+    }
+
+    fn create_state(&self, _: &mut CpuContext) -> Result<State, CpuError> {
+        Ok(State::default())
+    }
+
+    fn build(
+        &self,
+        _: &mut CpuContext,
+        state: &mut State,
+        frame: &FrameInputs,
+        light: &LightView,
+        stats: &mut FrameStats,
+    ) -> Result<(), CpuError> {
+        let res = self.depth.resolution;
+        let view = light.with_seamless_faces(res);
+        render_depth_maps(frame, &view, res, self.depth.depth_bias(), &mut state.maps)?;
+        state.projections = view
+            .projections
+            .iter()
+            .zip(&state.maps)
+            .map(|(&p, map)| reconstruct_projection(self, &view, p, map))
+            .collect();
+        record_build(&state.projections, stats);
+        Ok(())
+    }
+
+    fn query(
+        &self,
+        _: &mut CpuContext,
+        state: &mut State,
+        _: &FrameInputs,
+        _: &LightView,
+        g: &GBuffer,
+        out: &mut Image<f32>,
+        stats: &mut FrameStats,
+    ) -> Result<(), CpuError> {
+        if state.projections.is_empty() {
+            return Err(TechniqueError::NotBuilt(self.name().into()).into());
+        }
+        let eye = g.clip_from_world;
+        let (invert, caps) =
+            if self.capping == Capping::On { caps_for_view(&state.projections, eye) } else { (false, Vec::new()) };
+        let mut ds = DepthStencil::from_depth(&g.depth, u8::from(invert));
+        let sides: Vec<[Vec4; 3]> =
+            state.projections.iter().flat_map(|p| &p.triangles).map(|t| t.map(|v| eye * v)).collect();
+        let mut c: RasterCounters = draw_depth(
+            &mut ds,
+            &Soup { triangles: &sides, prim_base: 0, flip: false },
+            &parity_state(DepthState::LESS_READ),
+        );
+        let capped: Vec<[Vec4; 3]> = caps.iter().map(|t| cap_clip(eye, t)).collect();
+        let always = DepthState { compare: CompareFn::Always, ..DepthState::LESS_READ };
+        c += draw_depth(&mut ds, &Soup { triangles: &capped, prim_base: 0, flip: false }, &parity_state(always));
+        per_receiver(g, out, |_, _, i| if ds.stencil[i] & 1 == 0 { 1.0 } else { 0.0 });
+        let counters = &mut stats.counters;
+        counters.volume_triangles = Some((sides.len() + capped.len()) as u64);
+        counters.volume_fragments = Some(c.fragments);
+        counters.stencil_updates = Some(c.stencil_updates);
+        counters.extra.insert("cap_triangles".into(), capped.len() as f64);
+        counters.extra.insert("cap_inverted".into(), f64::from(u8::from(invert)));
+        let mut all = state.projections.iter().flat_map(|p| p.triangles.iter().copied()).collect::<Vec<_>>();
+        all.extend(caps);
+        state.last_view = Some((eye, g.width(), g.height(), all));
+        Ok(())
+    }
+
+    fn debug_views(&self, _: &mut CpuContext, state: &State) -> Result<Vec<DebugView>, CpuError> {
+        let mut views: Vec<DebugView> = state
+            .projections
+            .iter()
+            .enumerate()
+            .map(|(k, p)| DebugView { name: format!("edges{k}"), image: edge_view(&p.samples, &p.mesh_edges) })
+            .collect();
+        if let Some((eye, w, h, tris)) = &state.last_view {
+            views.push(DebugView { name: "volume".into(), image: volume_view(*eye, *w, *h, tris) });
+        }
+        Ok(views)
+    }
+}
+
+/// The build's counters: the edge-flag fraction (mean over the maps) and the boundary's triangles.
+pub fn record_build(projections: &[Projection], stats: &mut FrameStats) {
+    let fraction = projections.iter().map(|p| p.edges.flag_fraction()).sum::<f64>() / projections.len().max(1) as f64;
+    stats.counters.extra.insert("edge_flag_fraction".into(), fraction);
+    stats
+        .counters
+        .extra
+        .insert("boundary_triangles".into(), projections.iter().map(|p| p.triangles.len()).sum::<usize>() as f64);
+}
+
+/// The edge map over the mesh's sample depths (light view): samples with a flagged side red.
+#[must_use]
+pub fn edge_view(samples: &[f32], edges: &EdgeMap) -> Image<Rgb8> {
+    let (w, h) = edges.size();
+    let depths = Image::from_fn(w, h, |x, y| samples[(y * w + x) as usize]);
+    let lo = samples.iter().copied().fold(1.0f32, f32::min);
+    let mut img = false_colour(&depths, lo, 1.0);
+    for y in 0..h {
+        for x in 0..w {
+            let flagged = (x + 1 < w && edges.u(x, y))
+                || (x > 0 && edges.u(x - 1, y))
+                || (y + 1 < h && edges.v(x, y))
+                || (y > 0 && edges.v(x, y - 1));
+            if flagged {
+                *img.get_mut(x, y) = [235, 30, 30];
+            }
+        }
+    }
+    img
+}
+
+/// The reconstructed volume in the eye's view: how many boundary and cap triangles cover each pixel, with
+/// no depth test, as a false-colour ramp (black: none).
+#[must_use]
+pub fn volume_view(eye: Mat4, w: u32, h: u32, triangles: &[HomTriangle]) -> Image<Rgb8> {
+    let mut ds = DepthStencil::new(w, h, 1.0, 0);
+    let count = StencilFace {
+        compare: CompareFn::Always,
+        fail: StencilOp::Keep,
+        depth_fail: StencilOp::Keep,
+        pass: StencilOp::IncrementClamp,
+    };
+    let state = RasterState {
+        depth: Some(DepthState { compare: CompareFn::Always, ..DepthState::LESS_READ }),
+        stencil: Some(StencilState { front: count, back: count, read_mask: 0xff, write_mask: 0xff, reference: 0 }),
+        ..RasterState::default()
+    };
+    let clip: Vec<[Vec4; 3]> = triangles.iter().map(|t| t.map(|v| eye * v)).collect();
+    let _ = draw_depth(&mut ds, &Soup { triangles: &clip, prim_base: 0, flip: false }, &state);
+    let top = ds.stencil.iter().copied().max().unwrap_or(0).max(1);
+    let counts = Image::from_fn(w, h, |x, y| f32::from(ds.stencil[(y * w + x) as usize]));
+    let img = false_colour(&counts, 0.0, f32::from(top));
+    Image::from_fn(w, h, |x, y| if *counts.get(x, y) == 0.0 { [0, 0, 0] } else { *img.get(x, y) })
+}
