@@ -182,7 +182,13 @@ pub fn run_compare(
                 run.settings.split(',').find_map(|kv| kv.strip_prefix("res=")).and_then(|v| v.parse::<u32>().ok());
             let acne = res.map(|r| probe.texel_acne(&run.visibility[0], r));
             let back = back_false_light(&run.visibility[0], ref_vis, &mask, &reach)?;
-            let label = format!("{}\n{} {:.3}%", spec.name, backend.name(), metrics.mismatch * 100.0);
+            // A technique asked for more than once is told apart by the settings it was given.
+            let given = if same_name {
+                spec.values.iter().map(|(k, v)| format!("{k}={v} ")).collect::<String>()
+            } else {
+                String::new()
+            };
+            let label = format!("{}\n{given}{} {:.3}%", spec.name, backend.name(), metrics.mismatch * 100.0);
             sheet.push((label, run.color.clone()));
             results.push(ResultEntry {
                 technique: run.technique.clone(),

@@ -156,7 +156,7 @@ impl TechniqueRegistry {
             keys: VolumeReconstruction::keys,
             canonical: canonical::<VolumeReconstruction>,
             cpu: Some(plain::<CpuBackend, VolumeReconstruction>),
-            wgpu: None,
+            wgpu: Some(plain::<WgpuBackend, VolumeReconstruction>),
         });
         r.register(TechniqueEntry {
             name: "shadow-volume-zpass",

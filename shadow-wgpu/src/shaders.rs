@@ -63,6 +63,12 @@ pub fn shadow_volume() -> String {
     with_common(include_str!("shaders/shadow_volume.wgsl"))
 }
 
+/// Shadow volume reconstruction: the boundary and cap passes, after the shadow-volume shader (its resolve).
+#[must_use]
+pub fn volume_reconstruction() -> String {
+    format!("{}\n{}", shadow_volume(), include_str!("shaders/volume_reconstruction.wgsl"))
+}
+
 /// Every shader, by name, for validation.
 #[must_use]
 pub fn all() -> Vec<(&'static str, String)> {
@@ -71,6 +77,7 @@ pub fn all() -> Vec<(&'static str, String)> {
         ("shade", shade()),
         ("shadow_map", shadow_map()),
         ("shadow_volume", shadow_volume()),
+        ("volume_reconstruction", volume_reconstruction()),
         ("depth_layers", depth_layers()),
         ("silhouette_build", silhouette_build()),
         ("silhouette_query", silhouette_query()),

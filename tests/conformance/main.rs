@@ -9,3 +9,4 @@ mod silhouette_map;
 #[allow(dead_code)]
 mod planar;
 mod suite;
+mod volume_reconstruction;

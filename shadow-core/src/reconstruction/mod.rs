@@ -27,6 +27,7 @@
 pub mod caps;
 pub mod edges;
 pub mod mesh;
+pub mod projection;
 
 #[cfg(test)]
 mod tests;

@@ -1,21 +1,20 @@
 //! `volume-reconstruction` (McCool 2000): the light's depth map becomes a polygonal shadow-volume boundary
 //! (`shadow_core::reconstruction`, shared with the GPU backend), resolved with one stencil bit.
 //!
-//! Build: depth maps as `shadow-map` renders them (same bias; a point light's cube faces widened so their
-//! maps meet, see `LightView::with_seamless_faces`), then per map the edge flags and the reconstructed
-//! triangles. Query: the near-plane cap for this view, then every triangle drawn with its stencil bit
+//! Build: depth maps as `shadow-map` renders them (its bias settings, with a smaller default slope; a point
+//! light's cube faces widened so their maps meet, see `LightView::with_seamless_faces`), then per map the
+//! edge flags and the reconstructed triangles (`shadow_core::reconstruction::projection`). Query: the near-plane cap for this view, then every triangle drawn with its stencil bit
 //! inverted wherever it is in front of the G-buffer (front and back faces alike, one pass), the caps
 //! inverted without a depth test, and the bit read: set means shadowed.
 
 use shadow_core::glam::{Mat4, Vec4};
 use shadow_core::image::{Rgb8, false_colour};
 use shadow_core::light::LightView;
-use shadow_core::reconstruction::caps::near_plane_cap;
-use shadow_core::reconstruction::edges::{EdgeMap, depth_edges};
-use shadow_core::reconstruction::mesh::{border_walls, reconstruct};
-use shadow_core::reconstruction::{HomTriangle, SampleGrid, texel_square_grid};
-use shadow_core::scene::LightKind;
-use shadow_core::technique::hard::{Capping, MeshVertices, VolumeReconstruction};
+use shadow_core::reconstruction::HomTriangle;
+use shadow_core::reconstruction::projection::{
+    Projection, caps_for_view, edge_view, reconstruct_projection, record_build,
+};
+use shadow_core::technique::hard::{Capping, VolumeReconstruction};
 use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
 use shadow_core::{FrameInputs, Image};
 
@@ -27,83 +26,12 @@ use crate::raster::{
     draw_depth,
 };
 
-/// One light projection's map, edges and boundary.
-pub struct Projection {
-    /// The projection the map was rendered with.
-    pub view: shadow_core::light::LightProjection,
-    /// Where the mesh's samples are.
-    pub grid: SampleGrid,
-    /// NDC depths at the grid's samples, bias included.
-    pub samples: Vec<f32>,
-    /// Linear depths at the samples (what the edge detector and the split rule compare).
-    pub linear: Vec<f32>,
-    /// The map's edge flags.
-    pub edges: EdgeMap,
-    /// The flags between the grid's samples (the map's own for the paper's grid).
-    pub mesh_edges: EdgeMap,
-    /// The reconstructed boundary.
-    pub triangles: Vec<HomTriangle>,
-}
-
 /// The projections of the last build, and what the last query drew (for the debug views).
 #[derive(Default)]
 pub struct State {
     maps: Vec<Image<f32>>,
     projections: Vec<Projection>,
     last_view: Option<(Mat4, u32, u32, Vec<HomTriangle>)>,
-}
-
-/// Where the light's rays start, as the mesh's `bias=world` offset needs it.
-#[must_use]
-pub fn light_origin(view: &LightView) -> Vec4 {
-    match view.light.kind {
-        LightKind::Spot { position, .. } | LightKind::Point { position } => position.extend(1.0),
-        LightKind::Directional { direction } => direction.extend(0.0),
-    }
-}
-
-/// Edges and boundary of one rendered map (shared by both backends: the GPU reads its maps back first).
-#[must_use]
-pub fn reconstruct_projection(
-    s: &VolumeReconstruction,
-    view: &LightView,
-    proj: shadow_core::light::LightProjection,
-    map: &Image<f32>,
-) -> Projection {
-    let n = map.width();
-    let point = matches!(view.light.kind, LightKind::Point { .. });
-    let texels: Vec<f32> = map.data().iter().map(|&z| proj.linear_depth(z.min(1.0))).collect();
-    let edges = depth_edges(&texels, n, n, &s.edge_settings(proj.far - proj.near));
-    let (grid, samples, linear, mesh_edges) = match s.vertices {
-        MeshVertices::Texel => {
-            let ring = u32::from(point);
-            let (linear, flags) = texel_square_grid(&texels, n, &edges, ring);
-            let ndc = linear.iter().map(|&d| proj.ndc_depth(d)).collect();
-            (SampleGrid::texel_squares(&proj, n, ring), ndc, linear, flags)
-        }
-        MeshVertices::Centre => (SampleGrid::centres(&proj, n), map.data().to_vec(), texels, edges.clone()),
-    };
-    let offset = s.depth.receiver_offset();
-    let origin = light_origin(view);
-    let mut triangles = reconstruct(&samples, &linear, &mesh_edges, &grid, offset, origin).triangles;
-    if !point {
-        triangles.extend(border_walls(&samples, &grid, offset, origin));
-    }
-    Projection { view: proj, grid, samples, linear, edges, mesh_edges, triangles }
-}
-
-/// The caps of every projection for a view: the stencil's starting bit (global inversions) and the cap
-/// triangles.
-#[must_use]
-pub fn caps_for_view(projections: &[Projection], eye_clip_from_world: Mat4) -> (bool, Vec<HomTriangle>) {
-    let mut invert = false;
-    let mut triangles = Vec::new();
-    for p in projections {
-        let cap = near_plane_cap(eye_clip_from_world, &p.view, &p.grid, &p.samples, &p.linear);
-        invert ^= cap.invert_all;
-        triangles.extend(cap.triangles);
-    }
-    (invert, triangles)
 }
 
 /// The one-bit parity state: invert bit 0 on every fragment that passes `depth`, both faces.
@@ -215,37 +143,6 @@ impl ShadowTechnique<CpuBackend> for VolumeReconstruction {
         }
         Ok(views)
     }
-}
-
-/// The build's counters: the edge-flag fraction (mean over the maps) and the boundary's triangles.
-pub fn record_build(projections: &[Projection], stats: &mut FrameStats) {
-    let fraction = projections.iter().map(|p| p.edges.flag_fraction()).sum::<f64>() / projections.len().max(1) as f64;
-    stats.counters.extra.insert("edge_flag_fraction".into(), fraction);
-    stats
-        .counters
-        .extra
-        .insert("boundary_triangles".into(), projections.iter().map(|p| p.triangles.len()).sum::<usize>() as f64);
-}
-
-/// The edge map over the mesh's sample depths (light view): samples with a flagged side red.
-#[must_use]
-pub fn edge_view(samples: &[f32], edges: &EdgeMap) -> Image<Rgb8> {
-    let (w, h) = edges.size();
-    let depths = Image::from_fn(w, h, |x, y| samples[(y * w + x) as usize]);
-    let lo = samples.iter().copied().fold(1.0f32, f32::min);
-    let mut img = false_colour(&depths, lo, 1.0);
-    for y in 0..h {
-        for x in 0..w {
-            let flagged = (x + 1 < w && edges.u(x, y))
-                || (x > 0 && edges.u(x - 1, y))
-                || (y + 1 < h && edges.v(x, y))
-                || (y > 0 && edges.v(x, y - 1));
-            if flagged {
-                *img.get_mut(x, y) = [235, 30, 30];
-            }
-        }
-    }
-    img
 }
 
 /// The reconstructed volume in the eye's view: how many boundary and cap triangles cover each pixel, with

@@ -4,6 +4,7 @@ pub mod depth_layers;
 pub mod shadow_map;
 pub mod shadow_volume;
 pub mod silhouette_map;
+pub mod volume_reconstruction;
 
 /// Runs a full-screen pipeline into `target` (cleared to 1: lit), with an optional depth-stencil
 /// attachment whose contents are kept.

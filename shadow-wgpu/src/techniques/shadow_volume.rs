@@ -38,8 +38,7 @@ pub struct State {
     ccw: wgpu::RenderPipeline,
     cw: wgpu::RenderPipeline,
     count_all: wgpu::RenderPipeline,
-    resolve: wgpu::RenderPipeline,
-    resolve_layout: wgpu::BindGroupLayout,
+    resolve: StencilResolve,
     draws: Vec<VolumeDraw>,
 }
 
@@ -57,9 +56,11 @@ fn stencil_faces(counting: VolumeCounting) -> (wgpu::StencilFaceState, wgpu::Ste
     }
 }
 
-fn volume_pipeline(
+/// A stencil-only pipeline drawing homogeneous points through `entry` (both faces).
+pub(crate) fn volume_pipeline(
     cx: &WgpuContext,
     module: &wgpu::ShaderModule,
+    entry: &str,
     front_face: wgpu::FrontFace,
     depth_stencil: wgpu::DepthStencilState,
 ) -> wgpu::RenderPipeline {
@@ -73,7 +74,7 @@ fn volume_pipeline(
         layout: Some(&layout),
         vertex: wgpu::VertexState {
             module,
-            entry_point: Some("vs_volume"),
+            entry_point: Some(entry),
             compilation_options: Default::default(),
             buffers: &[Some(POSITION_LAYOUT)],
         },
@@ -108,8 +109,8 @@ impl ShadowTechnique<WgpuBackend> for ShadowVolume {
                 stencil: wgpu::StencilState { front, back, read_mask: 0xff, write_mask: 0xff },
                 bias: Default::default(),
             };
-            let ccw = volume_pipeline(cx, &module, wgpu::FrontFace::Ccw, counting_state.clone());
-            let cw = volume_pipeline(cx, &module, wgpu::FrontFace::Cw, counting_state);
+            let ccw = volume_pipeline(cx, &module, "vs_volume", wgpu::FrontFace::Ccw, counting_state.clone());
+            let cw = volume_pipeline(cx, &module, "vs_volume", wgpu::FrontFace::Cw, counting_state);
             let all = wgpu::DepthStencilState {
                 format: DEPTH_STENCIL,
                 depth_write_enabled: Some(false),
@@ -117,29 +118,9 @@ impl ShadowTechnique<WgpuBackend> for ShadowVolume {
                 stencil: Default::default(),
                 bias: Default::default(),
             };
-            let count_all = volume_pipeline(cx, &module, wgpu::FrontFace::Ccw, all);
-            let resolve_layout = cx.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("volume resolve"),
-                entries: &[attribute_entry(0)],
-            });
-            let test = wgpu::StencilFaceState { compare: wgpu::CompareFunction::NotEqual, ..Default::default() };
-            let resolve_state = wgpu::DepthStencilState {
-                format: DEPTH_STENCIL,
-                depth_write_enabled: Some(false),
-                depth_compare: Some(wgpu::CompareFunction::Always),
-                stencil: wgpu::StencilState { front: test, back: test, read_mask: 0xff, write_mask: 0 },
-                bias: Default::default(),
-            };
-            let resolve = full_screen_pipeline(
-                &cx.device,
-                "volume resolve",
-                &module,
-                "fs_volume_resolve",
-                &[&cx.shared.frame_layout, &resolve_layout],
-                VISIBILITY,
-                Some(resolve_state),
-            );
-            State { ccw, cw, count_all, resolve, resolve_layout, draws: Vec::new() }
+            let count_all = volume_pipeline(cx, &module, "vs_volume", wgpu::FrontFace::Ccw, all);
+            let resolve = StencilResolve::new(cx, &module, 0xff);
+            State { ccw, cw, count_all, resolve, draws: Vec::new() }
         })
     }
 
@@ -177,22 +158,7 @@ impl ShadowTechnique<WgpuBackend> for ShadowVolume {
         let depth = g.depth_view();
         let passed = cx.scoped("the shadow-volume pass", |cx| {
             let q = occlusion_pass(cx, state, frame, g, &depth, false);
-            let resolve_group = cx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("volume resolve"),
-                layout: &state.resolve_layout,
-                entries: &[wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::TextureView(&g.position),
-                }],
-            });
-            crate::techniques::full_screen(
-                cx,
-                "volume resolve",
-                &out.view,
-                &state.resolve,
-                &[&g.frame_group, &resolve_group],
-                Some((&depth, 0)),
-            );
+            state.resolve.run(cx, g, out, &depth);
             q
         })?;
         let passed = read_query(cx, &passed)?;
@@ -211,6 +177,68 @@ impl ShadowTechnique<WgpuBackend> for ShadowVolume {
         });
         Ok(())
     }
+}
+
+/// The resolve both stencil techniques share: a full-screen pass that writes 0 (shadowed) to the receivers
+/// whose stencil, under `read_mask`, is not 0.
+pub(crate) struct StencilResolve {
+    pipeline: wgpu::RenderPipeline,
+    layout: wgpu::BindGroupLayout,
+}
+
+impl StencilResolve {
+    /// The pipeline, from a module holding shadow_volume.wgsl's `fs_volume_resolve`.
+    pub(crate) fn new(cx: &WgpuContext, module: &wgpu::ShaderModule, read_mask: u32) -> Self {
+        let layout = cx.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("stencil resolve"),
+            entries: &[attribute_entry(0)],
+        });
+        let test = wgpu::StencilFaceState { compare: wgpu::CompareFunction::NotEqual, ..Default::default() };
+        let state = wgpu::DepthStencilState {
+            format: DEPTH_STENCIL,
+            depth_write_enabled: Some(false),
+            depth_compare: Some(wgpu::CompareFunction::Always),
+            stencil: wgpu::StencilState { front: test, back: test, read_mask, write_mask: 0 },
+            bias: Default::default(),
+        };
+        let pipeline = full_screen_pipeline(
+            &cx.device,
+            "stencil resolve",
+            module,
+            "fs_volume_resolve",
+            &[&cx.shared.frame_layout, &layout],
+            VISIBILITY,
+            Some(state),
+        );
+        Self { pipeline, layout }
+    }
+
+    /// Writes the visibility from the stencil of `depth` (G-buffer `g`'s depth-stencil).
+    pub(crate) fn run(&self, cx: &WgpuContext, g: &GpuGBuffer, out: &GpuVisibility, depth: &wgpu::TextureView) {
+        let group = cx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("stencil resolve"),
+            layout: &self.layout,
+            entries: &[wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&g.position) }],
+        });
+        let groups = [&g.frame_group, &group];
+        crate::techniques::full_screen(cx, "stencil resolve", &out.view, &self.pipeline, &groups, Some((depth, 0)));
+    }
+}
+
+/// A one-query occlusion set and the buffer it resolves into.
+pub(crate) fn occlusion_query(cx: &WgpuContext) -> (wgpu::QuerySet, wgpu::Buffer) {
+    let set = cx.device.create_query_set(&wgpu::QuerySetDescriptor {
+        label: Some("fragments"),
+        ty: wgpu::QueryType::Occlusion,
+        count: 1,
+    });
+    let resolve = cx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("occlusion"),
+        size: 8,
+        usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    });
+    (set, resolve)
 }
 
 /// Uploads the volumes: sides and far caps as homogeneous vertices, near caps as index lists into the
@@ -298,17 +326,7 @@ fn occlusion_pass(
     depth: &wgpu::TextureView,
     all: bool,
 ) -> (wgpu::QuerySet, wgpu::Buffer) {
-    let set = cx.device.create_query_set(&wgpu::QuerySetDescriptor {
-        label: Some("volume fragments"),
-        ty: wgpu::QueryType::Occlusion,
-        count: 1,
-    });
-    let resolve = cx.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("occlusion"),
-        size: 8,
-        usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
-        mapped_at_creation: false,
-    });
+    let (set, resolve) = occlusion_query(cx);
     let mut enc = cx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("volumes") });
     {
         let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -359,7 +377,8 @@ fn occlusion_pass(
     (set, resolve)
 }
 
-fn read_query(cx: &WgpuContext, q: &(wgpu::QuerySet, wgpu::Buffer)) -> Result<u64, WgpuError> {
+/// Reads an occlusion query's resolved count.
+pub(crate) fn read_query(cx: &WgpuContext, q: &(wgpu::QuerySet, wgpu::Buffer)) -> Result<u64, WgpuError> {
     let staging = cx.device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("occlusion readback"),
         size: 8,

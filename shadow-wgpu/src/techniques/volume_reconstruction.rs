@@ -1,0 +1,241 @@
+//! `volume-reconstruction` on the GPU (twin: shadow-cpu's techniques/volume_reconstruction.rs). As in the
+//! paper (section 2): the light pass renders the depth maps, they are read back (timed as the build's
+//! `depth_readback`), shadow-core reconstructs the boundary on the CPU, and it is uploaded as homogeneous
+//! world triangles. The query draws them with the stencil's bit 0 inverted wherever a fragment is in front
+//! of the G-buffer (both faces, one pass), then the near-plane caps with the depth test off, the stencil
+//! starting at 1 where the cap inverts the whole view; the resolve marks pixels whose bit is set.
+//!
+//! Counters come from occlusion queries: samples passing the parity pass (stencil updates), and, in a
+//! second pass with the depth test off, every rasterized fragment (outside the timed query phase).
+
+use shadow_core::FrameInputs;
+use shadow_core::glam::Vec4;
+use shadow_core::light::LightView;
+use shadow_core::reconstruction::HomTriangle;
+use shadow_core::reconstruction::projection::{
+    Projection, caps_for_view, edge_view, reconstruct_projection, record_build,
+};
+use shadow_core::technique::hard::{Capping, VolumeReconstruction};
+use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
+use wgpu::util::DeviceExt;
+
+use super::shadow_map::{depth_bias, light_pass_pipeline, map_texture, render_maps};
+use super::shadow_volume::{StencilResolve, occlusion_query, read_query, volume_pipeline};
+use crate::context::{WgpuBackend, WgpuContext, WgpuError};
+use crate::frame::GpuVisibility;
+use crate::gbuffer::{GpuGBuffer, check_size};
+use crate::pipelines::DEPTH_STENCIL;
+use crate::{readback, shaders};
+
+/// Pipelines, the maps and the reconstruction of the last build.
+pub struct State {
+    light_pass: wgpu::RenderPipeline,
+    /// Parity passes: the boundary with the depth test, the caps without.
+    boundary: wgpu::RenderPipeline,
+    caps: wgpu::RenderPipeline,
+    /// The same with the stencil off and the depth test off, for the fragment count.
+    count_boundary: wgpu::RenderPipeline,
+    count_caps: wgpu::RenderPipeline,
+    resolve: StencilResolve,
+    maps: Option<wgpu::Texture>,
+    projections: Vec<Projection>,
+    /// The boundary's vertices and their count.
+    boundary_vertices: Option<(wgpu::Buffer, u32)>,
+}
+
+/// Bit 0 inverted on every fragment that passes `depth_compare`, both faces.
+fn parity(depth_compare: wgpu::CompareFunction) -> wgpu::DepthStencilState {
+    let face = wgpu::StencilFaceState {
+        compare: wgpu::CompareFunction::Always,
+        fail_op: wgpu::StencilOperation::Keep,
+        depth_fail_op: wgpu::StencilOperation::Keep,
+        pass_op: wgpu::StencilOperation::Invert,
+    };
+    wgpu::DepthStencilState {
+        format: DEPTH_STENCIL,
+        depth_write_enabled: Some(false),
+        depth_compare: Some(depth_compare),
+        stencil: wgpu::StencilState { front: face, back: face, read_mask: 1, write_mask: 1 },
+        bias: Default::default(),
+    }
+}
+
+/// Every fragment, nothing written.
+fn count_all() -> wgpu::DepthStencilState {
+    wgpu::DepthStencilState {
+        format: DEPTH_STENCIL,
+        depth_write_enabled: Some(false),
+        depth_compare: Some(wgpu::CompareFunction::Always),
+        stencil: Default::default(),
+        bias: Default::default(),
+    }
+}
+
+fn vertex_buffer(cx: &WgpuContext, label: &str, triangles: &[HomTriangle]) -> Option<(wgpu::Buffer, u32)> {
+    if triangles.is_empty() {
+        return None;
+    }
+    let vertices: Vec<Vec4> = triangles.iter().flatten().copied().collect();
+    let buffer = cx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some(label),
+        contents: bytemuck::cast_slice(&vertices),
+        usage: wgpu::BufferUsages::VERTEX,
+    });
+    Some((buffer, vertices.len() as u32))
+}
+
+impl ShadowTechnique<WgpuBackend> for VolumeReconstruction {
+    type State = State;
+
+    fn name(&self) -> &'static str {
+        "volume-reconstruction"
+    }
+
+    fn create_state(&self, cx: &mut WgpuContext) -> Result<State, WgpuError> {
+        cx.scoped("creating the volume-reconstruction pipelines", |cx| {
+            let maps = shaders::module(&cx.device, "shadow_map", shaders::shadow_map());
+            let module = shaders::module(&cx.device, "volume_reconstruction", shaders::volume_reconstruction());
+            let ccw = wgpu::FrontFace::Ccw;
+            State {
+                light_pass: light_pass_pipeline(cx, &maps, depth_bias(&self.depth)),
+                boundary: volume_pipeline(cx, &module, "vs_boundary", ccw, parity(wgpu::CompareFunction::Less)),
+                caps: volume_pipeline(cx, &module, "vs_cap", ccw, parity(wgpu::CompareFunction::Always)),
+                count_boundary: volume_pipeline(cx, &module, "vs_boundary", ccw, count_all()),
+                count_caps: volume_pipeline(cx, &module, "vs_cap", ccw, count_all()),
+                resolve: StencilResolve::new(cx, &module, 1),
+                maps: None,
+                projections: Vec::new(),
+                boundary_vertices: None,
+            }
+        })
+    }
+
+    fn build(
+        &self,
+        cx: &mut WgpuContext,
+        state: &mut State,
+        frame: &FrameInputs,
+        light: &LightView,
+        stats: &mut FrameStats,
+    ) -> Result<(), WgpuError> {
+        let res = self.depth.resolution;
+        check_size(cx, "depth map", res, res)?;
+        let view = light.with_seamless_faces(res);
+        let layers = view.projections.len() as u32;
+        let fits = state.maps.as_ref().is_some_and(|m| m.width() == res && m.depth_or_array_layers() == layers);
+        if !fits {
+            state.maps = Some(cx.scoped("allocating depth maps", |cx| map_texture(cx, res, layers))?);
+        }
+        let maps = state.maps.clone().ok_or_else(|| TechniqueError::NotBuilt(self.name().into()))?;
+        cx.cache.upload_meshes(&cx.device, frame);
+        let instances = cx.cache.instances(&cx.device, frame).clone();
+        cx.scoped("the light pass", |cx| render_maps(cx, &state.light_pass, frame, &view, &maps, &instances))?;
+        let t = std::time::Instant::now();
+        let depths = (0..layers)
+            .map(|k| readback::read_f32(cx, &maps, k, wgpu::TextureAspect::DepthOnly))
+            .collect::<Result<Vec<_>, _>>()?;
+        stats.timings.extra.insert("depth_readback".into(), shadow_core::stats::ms(t.elapsed()));
+        state.projections =
+            view.projections.iter().zip(&depths).map(|(&p, map)| reconstruct_projection(self, &view, p, map)).collect();
+        record_build(&state.projections, stats);
+        let triangles: Vec<HomTriangle> = state.projections.iter().flat_map(|p| p.triangles.iter().copied()).collect();
+        state.boundary_vertices =
+            cx.scoped("uploading the boundary", |cx| vertex_buffer(cx, "boundary", &triangles))?;
+        Ok(())
+    }
+
+    fn query(
+        &self,
+        cx: &mut WgpuContext,
+        state: &mut State,
+        _: &FrameInputs,
+        _: &LightView,
+        g: &GpuGBuffer,
+        out: &mut GpuVisibility,
+        stats: &mut FrameStats,
+    ) -> Result<(), WgpuError> {
+        if state.projections.is_empty() {
+            return Err(TechniqueError::NotBuilt(self.name().into()).into());
+        }
+        let eye = g.camera.clip_from_world(g.width as f32 / g.height as f32);
+        let (invert, caps) =
+            if self.capping == Capping::On { caps_for_view(&state.projections, eye) } else { (false, Vec::new()) };
+        let cap_vertices = cx.scoped("uploading the caps", |cx| vertex_buffer(cx, "caps", &caps))?;
+        let draws = [(&state.boundary_vertices, &state.boundary), (&cap_vertices, &state.caps)];
+        let depth = g.depth_view();
+        let passed = cx.scoped("the parity pass", |cx| {
+            let q = parity_pass(cx, g, &depth, &draws, Some(u32::from(invert)));
+            state.resolve.run(cx, g, out, &depth);
+            q
+        })?;
+        let passed = read_query(cx, &passed)?;
+        // Every rasterized fragment, after the resolve so it cannot disturb it, timed on its own.
+        let t = std::time::Instant::now();
+        let counting = [(&state.boundary_vertices, &state.count_boundary), (&cap_vertices, &state.count_caps)];
+        let all = cx.scoped("the fragment count", |cx| parity_pass(cx, g, &depth, &counting, None))?;
+        let all = read_query(cx, &all)?;
+        stats.timings.extra.insert("count_fragments".into(), shadow_core::stats::ms(t.elapsed()));
+        let boundary = state.projections.iter().map(|p| p.triangles.len()).sum::<usize>();
+        let c = &mut stats.counters;
+        c.volume_triangles = Some((boundary + caps.len()) as u64);
+        c.volume_fragments = Some(all);
+        c.stencil_updates = Some(passed);
+        c.extra.insert("cap_triangles".into(), caps.len() as f64);
+        c.extra.insert("cap_inverted".into(), f64::from(u8::from(invert)));
+        Ok(())
+    }
+
+    fn debug_views(&self, _: &mut WgpuContext, state: &State) -> Result<Vec<DebugView>, WgpuError> {
+        Ok(state
+            .projections
+            .iter()
+            .enumerate()
+            .map(|(k, p)| DebugView { name: format!("edges{k}"), image: edge_view(&p.samples, &p.mesh_edges) })
+            .collect())
+    }
+}
+
+type Draw<'a> = (&'a Option<(wgpu::Buffer, u32)>, &'a wgpu::RenderPipeline);
+
+/// The draws in one pass inside an occlusion query; `clear` starts the stencil at that value (else it is
+/// kept).
+fn parity_pass(
+    cx: &WgpuContext,
+    g: &GpuGBuffer,
+    depth: &wgpu::TextureView,
+    draws: &[Draw<'_>],
+    clear: Option<u32>,
+) -> (wgpu::QuerySet, wgpu::Buffer) {
+    let (set, resolve) = occlusion_query(cx);
+    let mut enc = cx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("parity") });
+    {
+        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("parity"),
+            color_attachments: &[],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: depth,
+                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store }),
+                stencil_ops: Some(wgpu::Operations {
+                    load: clear.map_or(wgpu::LoadOp::Load, wgpu::LoadOp::Clear),
+                    store: wgpu::StoreOp::Store,
+                }),
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: Some(&set),
+            multiview_mask: None,
+        });
+        pass.set_bind_group(0, &g.frame_group, &[]);
+        pass.begin_occlusion_query(0);
+        for (vertices, pipeline) in draws {
+            if let Some((buffer, count)) = vertices {
+                pass.set_pipeline(pipeline);
+                pass.set_vertex_buffer(0, buffer.slice(..));
+                pass.draw(0..*count, 0..1);
+            }
+        }
+        pass.end_occlusion_query();
+    }
+    enc.resolve_query_set(&set, 0..1, &resolve, 0);
+    cx.queue.submit([enc.finish()]);
+    (set, resolve)
+}
