@@ -80,6 +80,27 @@ pub fn read_f32(
         .ok_or_else(|| WgpuError::Gpu { during: "readback".into(), message: "size mismatch".into() })
 }
 
+/// One layer of an R32Uint texture as an image.
+///
+/// # Errors
+/// A GPU failure.
+pub fn read_u32(cx: &WgpuContext, tex: &wgpu::Texture, layer: u32) -> Result<Image<u32>, WgpuError> {
+    let bytes = read_layer(cx, tex, layer, 4, wgpu::TextureAspect::All)?;
+    let data = bytes.chunks_exact(4).map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect();
+    Image::from_vec(tex.width(), tex.height(), data)
+        .ok_or_else(|| WgpuError::Gpu { during: "readback".into(), message: "size mismatch".into() })
+}
+
+/// The stencil aspect of a depth-stencil texture as an image.
+///
+/// # Errors
+/// A GPU failure.
+pub fn read_stencil(cx: &WgpuContext, tex: &wgpu::Texture) -> Result<Image<u8>, WgpuError> {
+    let bytes = read_layer(cx, tex, 0, 1, wgpu::TextureAspect::StencilOnly)?;
+    Image::from_vec(tex.width(), tex.height(), bytes)
+        .ok_or_else(|| WgpuError::Gpu { during: "readback".into(), message: "size mismatch".into() })
+}
+
 /// An Rgba8 texture as an RGB image.
 ///
 /// # Errors

@@ -15,9 +15,17 @@
 //! up to that many steps. The extremum test keeps the contour from wandering off along a steep surface,
 //! whose differences are large but even.
 //!
+//! An object-ID channel of the light pass (section 3.2, "as a last resort") adds flags wherever adjacent
+//! samples belong to different objects: everywhere ([`ObjectIds::All`], ORed with the depth flags), or only
+//! where a dangling contour is followed ([`ObjectIds::Dangling`]: a side between two objects is taken
+//! before any side the lowered depth test would pick), which is where the paper says it is needed: depth
+//! contrast fades where one object meets another, and objects' own concavities still need the depth test.
+//!
 //! Depths here are linear (distances along the light's axis), so the thresholds are scene distances: the
 //! quantization of NDC depth is not constant in world space (section 3.1), but a threshold on an object's
 //! separation from what is behind it should be.
+
+use crate::technique::hard::ObjectIds;
 
 /// Thresholds, in the depth map's units.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -142,6 +150,39 @@ impl EdgeMap {
         cells.dedup();
         cells
     }
+
+    /// Sets every flag `other` has (the same size).
+    ///
+    /// # Panics
+    /// When the sizes differ: a caller bug.
+    pub fn union_with(&mut self, other: &EdgeMap) {
+        assert_eq!(self.size(), other.size(), "edge maps of different sizes");
+        for (a, b) in self.u.iter_mut().zip(&other.u).chain(self.v.iter_mut().zip(&other.v)) {
+            *a |= *b;
+        }
+    }
+}
+
+/// Flags between every pair of adjacent samples of a `w x h` ID map whose IDs differ.
+#[must_use]
+pub fn id_edges(ids: &[u32], w: u32, h: u32) -> EdgeMap {
+    let mut map = EdgeMap::empty(w, h);
+    let id = |x: u32, y: u32| ids[(y * w + x) as usize];
+    for y in 0..h {
+        for x in 0..w.saturating_sub(1) {
+            if id(x, y) != id(x + 1, y) {
+                map.set_u(x, y);
+            }
+        }
+    }
+    for y in 0..h.saturating_sub(1) {
+        for x in 0..w {
+            if id(x, y) != id(x, y + 1) {
+                map.set_v(x, y);
+            }
+        }
+    }
+    map
 }
 
 /// Whether the difference `d`, with `before` and `after` its neighbours along the same direction, is an
@@ -168,10 +209,47 @@ fn is_edge(d: f32, before: f32, after: f32, s: &EdgeSettings) -> bool {
 /// The edge map of a `w x h` linear depth map (row-major).
 #[must_use]
 pub fn depth_edges(depth: &[f32], w: u32, h: u32, s: &EdgeSettings) -> EdgeMap {
-    let mut map = EdgeMap::empty(w, h);
-    if w < 2 || h < 2 {
-        return map;
+    detect(depth, None, w, h, s)
+}
+
+/// The edge map of a `w x h` linear depth map and the object IDs of the same samples, combined as `mode`
+/// says (see the module's documentation).
+///
+/// # Panics
+/// When `ids` is not the size of `depth`: a caller bug.
+#[must_use]
+pub fn depth_and_id_edges(depth: &[f32], ids: &[u32], w: u32, h: u32, s: &EdgeSettings, mode: ObjectIds) -> EdgeMap {
+    assert_eq!(ids.len(), depth.len(), "an ID map the size of the depth map");
+    match mode {
+        ObjectIds::Off => depth_edges(depth, w, h, s),
+        ObjectIds::Dangling => detect(depth, Some(ids), w, h, s),
+        ObjectIds::All => {
+            // Every ID flag before the dangling ends are looked for: a contour that fades where two objects
+            // meet is then already closed by the ID boundary.
+            let mut map = EdgeMap::empty(w, h);
+            if w >= 2 && h >= 2 {
+                threshold_flags(&mut map, depth, s);
+                map.union_with(&id_edges(ids, w, h));
+                follow_dangling(&mut map, depth, None, s);
+            }
+            map
+        }
     }
+}
+
+/// Depth flags, dangling contours followed preferring ID boundaries when `ids` are given.
+fn detect(depth: &[f32], ids: Option<&[u32]>, w: u32, h: u32, s: &EdgeSettings) -> EdgeMap {
+    let mut map = EdgeMap::empty(w, h);
+    if w >= 2 && h >= 2 {
+        threshold_flags(&mut map, depth, s);
+        follow_dangling(&mut map, depth, ids, s);
+    }
+    map
+}
+
+/// The first-difference flags, thinned by the second-derivative test when `s` has it.
+fn threshold_flags(map: &mut EdgeMap, depth: &[f32], s: &EdgeSettings) {
+    let (w, h) = map.size();
     let z = |x: u32, y: u32| depth[(y * w + x) as usize];
     // First differences along x at (x, y) for x in -1..=w-1, 0 outside.
     let dx = |x: i64, y: u32| if x < 0 || x >= i64::from(w) - 1 { 0.0 } else { z(x as u32 + 1, y) - z(x as u32, y) };
@@ -192,8 +270,6 @@ pub fn depth_edges(depth: &[f32], w: u32, h: u32, s: &EdgeSettings) -> EdgeMap {
             }
         }
     }
-    follow_dangling(&mut map, depth, s);
-    map
 }
 
 /// How strongly the flag at `(x, y)` (a `u` flag when `is_u`) stands out under the lowered thresholds:
@@ -218,6 +294,13 @@ fn lowered_strength(depth: &[f32], w: u32, h: u32, is_u: bool, x: u32, y: u32, f
     (d.abs() - sign * diff(pos - 1)).min(d.abs() - sign * diff(pos + 1)).max(0.0)
 }
 
+/// Whether the samples on the two sides of the flag at `(x, y)` (a `u` flag when `is_u`) are of different
+/// objects.
+fn ids_differ(ids: &[u32], w: u32, is_u: bool, x: u32, y: u32) -> bool {
+    let (x2, y2) = if is_u { (x + 1, y) } else { (x, y + 1) };
+    ids[(y * w + x) as usize] != ids[(y2 * w + x2) as usize]
+}
+
 /// Whether a code has exactly one bit: a dangling edge ends in that cell.
 #[must_use]
 pub fn dangling(code: u8) -> bool {
@@ -225,8 +308,9 @@ pub fn dangling(code: u8) -> bool {
 }
 
 /// Extends dangling edges under the lowered threshold, one cell per step, all dangling cells of a step at
-/// once (so the result does not depend on the order cells are visited in).
-fn follow_dangling(map: &mut EdgeMap, depth: &[f32], s: &EdgeSettings) {
+/// once (so the result does not depend on the order cells are visited in). With `ids`, a side between two
+/// objects outranks any the depth test picks.
+fn follow_dangling(map: &mut EdgeMap, depth: &[f32], ids: Option<&[u32]>, s: &EdgeSettings) {
     let (w, h) = map.size();
     let mut frontier = map.marked_cells();
     for _ in 0..s.dangling_steps {
@@ -247,7 +331,12 @@ fn follow_dangling(map: &mut EdgeMap, depth: &[f32], s: &EdgeSettings) {
                 .iter()
                 .filter(|side| side.0 & code == 0)
                 .map(|&(bit, is_u, fx, fy)| {
-                    (bit, is_u, fx, fy, lowered_strength(depth, w, h, is_u, fx, fy, s.dangling))
+                    let strength = if ids.is_some_and(|ids| ids_differ(ids, w, is_u, fx, fy)) {
+                        f32::INFINITY
+                    } else {
+                        lowered_strength(depth, w, h, is_u, fx, fy, s.dangling)
+                    };
+                    (bit, is_u, fx, fy, strength)
                 })
                 .filter(|side| side.4 > 0.0)
                 .max_by(|a, b| a.4.total_cmp(&b.4).then((a.0 == opposite).cmp(&(b.0 == opposite))));

@@ -4,7 +4,7 @@
 use glam::{Mat4, Vec4};
 
 use super::caps::near_plane_cap;
-use super::edges::{EdgeMap, depth_edges};
+use super::edges::{EdgeMap, depth_and_id_edges, depth_edges};
 use super::mesh::{border_walls, reconstruct};
 use super::{HomTriangle, SampleGrid, texel_square_grid};
 use crate::Image;
@@ -41,18 +41,27 @@ pub fn light_origin(view: &LightView) -> Vec4 {
     }
 }
 
-/// Edges and boundary of one rendered map (shared by both backends: the GPU reads its maps back first).
+/// Edges and boundary of one rendered map (shared by both backends: the GPU reads its maps back first),
+/// with the object IDs of its texels when the light pass rendered them (`ids` other than `off`).
+///
+/// # Panics
+/// When `ids` is not the size of `map`: a caller bug.
 #[must_use]
 pub fn reconstruct_projection(
     s: &VolumeReconstruction,
     view: &LightView,
     proj: LightProjection,
     map: &Image<f32>,
+    ids: Option<&Image<u32>>,
 ) -> Projection {
     let n = map.width();
     let point = matches!(view.light.kind, LightKind::Point { .. });
     let texels: Vec<f32> = map.data().iter().map(|&z| proj.linear_depth(z.min(1.0))).collect();
-    let edges = depth_edges(&texels, n, n, &s.edge_settings(proj.far - proj.near));
+    let thresholds = s.edge_settings(proj.far - proj.near);
+    let edges = match ids {
+        Some(ids) => depth_and_id_edges(&texels, ids.data(), n, n, &thresholds, s.ids),
+        None => depth_edges(&texels, n, n, &thresholds),
+    };
     let (grid, samples, linear, mesh_edges) = match s.vertices {
         MeshVertices::Texel => {
             let ring = u32::from(point);
@@ -114,4 +123,21 @@ pub fn edge_view(samples: &[f32], edges: &EdgeMap) -> Image<Rgb8> {
         }
     }
     img
+}
+
+/// The reconstructed volume's debug view from per-pixel counts of the boundary and cap triangles covering
+/// each pixel (no depth test): a false-colour ramp up to the largest count, black where none.
+#[must_use]
+pub fn coverage_view(counts: &Image<u8>) -> Image<Rgb8> {
+    let top = counts.data().iter().copied().max().unwrap_or(0).max(1);
+    let ramp = false_colour(
+        &Image::from_fn(counts.width(), counts.height(), |x, y| f32::from(*counts.get(x, y))),
+        0.0,
+        f32::from(top),
+    );
+    Image::from_fn(
+        counts.width(),
+        counts.height(),
+        |x, y| if *counts.get(x, y) == 0 { [0, 0, 0] } else { *ramp.get(x, y) },
+    )
 }

@@ -5,12 +5,13 @@
 use glam::{Mat4, Vec2, Vec3, Vec4};
 
 use super::caps::near_plane_cap;
-use super::edges::{EdgeMap, EdgeSettings, dangling, depth_edges};
+use super::edges::{EdgeMap, EdgeSettings, dangling, depth_and_id_edges, depth_edges, id_edges};
 use super::mesh::reconstruct;
 use super::{HomTriangle, SampleGrid, Split, texel_square_grid};
 use crate::bounds::Aabb;
 use crate::light::{LightProjection, LightView};
 use crate::scene::{Camera, Light};
+use crate::technique::hard::ObjectIds;
 
 const N: u32 = 64;
 const SLAB: f32 = 0.5; // half-width of the slab, at height 1 over the ground y = 0
@@ -152,6 +153,41 @@ fn dangling_edges_are_followed_into_fading_contrast() {
     // Followed under theta_D = 0.005 through the 0.045 step, and not past the contact.
     let e = depth_edges(&depth, w, h, &settings());
     assert_eq!(rows(&e), vec![0, 1, 2, 3, 4]);
+}
+
+#[test]
+fn id_boundaries_close_contours_the_depth_test_loses() {
+    // An object (ID 2, columns 5 on) on the ground (ID 1) whose height over it fades to nothing three rows
+    // before the last, and a second object boundary (columns 0 and 1) with no depth contrast at all.
+    let heights = [0.25, 0.2, 0.15, 0.1, 0.045, 0.0, 0.0, 0.0];
+    let (w, h) = (10, heights.len() as u32);
+    let depth: Vec<f32> = (0..w * h).map(|i| if i % w >= 5 { 1.0 - heights[(i / w) as usize] } else { 1.0 }).collect();
+    let ids: Vec<u32> = (0..w * h)
+        .map(|i| {
+            if i % w >= 5 {
+                2
+            } else if i % w == 0 {
+                3
+            } else {
+                1
+            }
+        })
+        .collect();
+    let rows = |e: &EdgeMap, x: u32| (0..h).filter(|&y| e.u(x, y)).collect::<Vec<_>>();
+    let depth_only = depth_and_id_edges(&depth, &ids, w, h, &settings(), ObjectIds::Off);
+    assert_eq!(depth_only, depth_edges(&depth, w, h, &settings()));
+    assert_eq!(rows(&depth_only, 4), vec![0, 1, 2, 3, 4], "no depth contrast below row 4");
+    // Dangling: the contour goes on along the ID boundary (up to 4 steps); the far boundary, with no
+    // dangling edge near it, is left alone.
+    let dangling = depth_and_id_edges(&depth, &ids, w, h, &settings(), ObjectIds::Dangling);
+    assert_eq!(rows(&dangling, 4), vec![0, 1, 2, 3, 4, 5, 6, 7]);
+    assert!(rows(&dangling, 0).is_empty());
+    // All: every ID boundary is an edge.
+    let all = depth_and_id_edges(&depth, &ids, w, h, &settings(), ObjectIds::All);
+    assert_eq!(rows(&all, 4), vec![0, 1, 2, 3, 4, 5, 6, 7]);
+    assert_eq!(rows(&all, 0), (0..h).collect::<Vec<_>>());
+    let plain = id_edges(&ids, w, h);
+    assert_eq!(plain.flag_count(), 2 * h as usize);
 }
 
 #[test]

@@ -238,6 +238,21 @@ crate::named_enum! {
 }
 
 crate::named_enum! {
+    /// Whether `volume-reconstruction`'s light pass also renders object IDs, whose differences become edge
+    /// flags (McCool section 3.2: "as a last resort").
+    pub enum ObjectIds {
+        /// Depth edges only.
+        Off = "off",
+        /// A dangling depth edge is followed along an ID boundary first, before the lowered depth test: the
+        /// paper's "this need only be done in the vicinity of a dangling edge".
+        Dangling = "dangling",
+        /// Every ID difference is an edge, ORed with the depth edges (the paper's test for scenes of convex
+        /// objects, which then need no depth test at all).
+        All = "all",
+    }
+}
+
+crate::named_enum! {
     /// Where the mesh of `volume-reconstruction` has its vertices.
     pub enum MeshVertices {
         /// At texel centres, edge midpoints and corners, a border sample taking the far side: shadows the
@@ -271,11 +286,13 @@ pub struct VolumeReconstruction {
     pub theta_dangling: f32,
     /// How many cells a dangling edge is followed under the lowered thresholds.
     pub dangling_steps: u32,
+    /// Object-ID edges from an ID channel of the light pass.
+    pub ids: ObjectIds,
     /// The near-plane cap.
     pub capping: Capping,
 }
 
-const RECONSTRUCTION_KEYS: [SettingKey; 13] = [
+const RECONSTRUCTION_KEYS: [SettingKey; 14] = [
     SettingKey { key: "res", default: "1024", help: "depth-map side in texels (16 to 16384)" },
     MAP_KEYS[1],
     MAP_KEYS[2],
@@ -316,6 +333,11 @@ const RECONSTRUCTION_KEYS: [SettingKey; 13] = [
         help: "lowered threshold along dangling edges, fraction of the light depth range",
     },
     SettingKey { key: "dangling_steps", default: "8", help: "cells a dangling edge is followed (0 to 64)" },
+    SettingKey {
+        key: "ids",
+        default: "off",
+        help: "object-ID edges: off, dangling (dangling edges follow ID boundaries) or all (ORed with depth edges)",
+    },
     SettingKey { key: "capping", default: "on", help: "near-plane caps: on, or off to see the inversion" },
 ];
 
@@ -333,6 +355,7 @@ impl TechniqueSettings for VolumeReconstruction {
             theta_second: v.ranged("theta_second", 0.0, 1.0)?,
             theta_dangling: v.ranged("theta_dangling", 0.0, 1.0)?,
             dangling_steps: v.ranged("dangling_steps", 0, 64)?,
+            ids: v.get("ids")?,
             capping: v.get("capping")?,
         };
         if r.theta_high < r.theta_low {
@@ -355,6 +378,7 @@ impl TechniqueSettings for VolumeReconstruction {
             self.theta_second.to_string(),
             self.theta_dangling.to_string(),
             self.dangling_steps.to_string(),
+            self.ids.to_string(),
             self.capping.to_string(),
         ]
     }

@@ -16,7 +16,7 @@ use shadow_core::{FrameInputs, Image};
 
 use crate::context::{CpuError, MAX_MAP_TEXELS, check_size};
 use crate::gbuffer::{GBuffer, clip_vertices};
-use crate::raster::{CullMode, DepthState, DepthStencil, Indexed, RasterCounters, RasterState, draw_depth};
+use crate::raster::{CullMode, DepthState, DepthStencil, Indexed, RasterCounters, RasterState, draw, draw_depth};
 
 /// Refuses a set of `count` square maps of side `res` before anything is allocated.
 ///
@@ -82,6 +82,39 @@ pub fn render_depth_maps(
     let mut old = std::mem::take(maps).into_iter();
     *maps =
         light.projections.iter().map(|p| render_depth_map(frame, p, res, bias, CullMode::None, old.next()).0).collect();
+    Ok(())
+}
+
+/// Renders one depth map per projection of `light` as [`render_depth_maps`] does, and with each an ID map:
+/// 1 + the index in `frame.instances` of the caster a texel shows, 0 where it shows none (McCool's object-ID
+/// channel, section 3.2; the GPU backend's light pass writes the same values).
+///
+/// # Errors
+/// [`CpuError::BadSize`] over the limits.
+pub fn render_depth_and_id_maps(
+    frame: &FrameInputs,
+    light: &LightView,
+    res: u32,
+    bias: DepthBias,
+    maps: &mut Vec<Image<f32>>,
+    ids: &mut Vec<Image<u32>>,
+) -> Result<(), CpuError> {
+    check_maps(res, light.projections.len())?;
+    let state = RasterState { depth: Some(DepthState { bias, ..DepthState::LESS_WRITE }), ..RasterState::default() };
+    maps.clear();
+    ids.clear();
+    for p in &light.projections {
+        let mut ds = DepthStencil::new(res, res, 1.0, 0);
+        let mut id = Image::new(res, res, 0u32);
+        for (k, inst) in frame.instances.iter().enumerate().filter(|(_, i)| i.casts_shadow) {
+            let clip = clip_vertices(inst.mesh.positions(), p.clip_from_world * inst.world_from_local);
+            let src = Indexed { positions: &clip, triangles: inst.mesh.triangles(), prim_base: 0, flip: inst.mirrored };
+            let value = k as u32 + 1;
+            let _ = draw(&mut ds, &mut id, &src, &state, |_| Some(value), |d, s| *d = s);
+        }
+        maps.push(ds.into_depth_image());
+        ids.push(id);
+    }
     Ok(())
 }
 

@@ -8,17 +8,17 @@
 //! inverted without a depth test, and the bit read: set means shadowed.
 
 use shadow_core::glam::{Mat4, Vec4};
-use shadow_core::image::{Rgb8, false_colour};
+use shadow_core::image::Rgb8;
 use shadow_core::light::LightView;
 use shadow_core::reconstruction::HomTriangle;
 use shadow_core::reconstruction::projection::{
-    Projection, caps_for_view, edge_view, reconstruct_projection, record_build,
+    Projection, caps_for_view, coverage_view, edge_view, reconstruct_projection, record_build,
 };
-use shadow_core::technique::hard::{Capping, VolumeReconstruction};
+use shadow_core::technique::hard::{Capping, ObjectIds, VolumeReconstruction};
 use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
 use shadow_core::{FrameInputs, Image};
 
-use super::{per_receiver, render_depth_maps};
+use super::{per_receiver, render_depth_and_id_maps, render_depth_maps};
 use crate::context::{CpuBackend, CpuContext, CpuError};
 use crate::gbuffer::GBuffer;
 use crate::raster::{
@@ -26,10 +26,12 @@ use crate::raster::{
     draw_depth,
 };
 
-/// The projections of the last build, and what the last query drew (for the debug views).
+/// The projections of the last build, and the last query's view and caps (for the debug views).
 #[derive(Default)]
 pub struct State {
     maps: Vec<Image<f32>>,
+    /// The ID channel, when `ids` is not `off`.
+    ids: Vec<Image<u32>>,
     projections: Vec<Projection>,
     last_view: Option<(Mat4, u32, u32, Vec<HomTriangle>)>,
 }
@@ -80,12 +82,18 @@ impl ShadowTechnique<CpuBackend> for VolumeReconstruction {
     ) -> Result<(), CpuError> {
         let res = self.depth.resolution;
         let view = light.with_seamless_faces(res);
-        render_depth_maps(frame, &view, res, self.depth.depth_bias(), &mut state.maps)?;
+        let bias = self.depth.depth_bias();
+        if self.ids == ObjectIds::Off {
+            render_depth_maps(frame, &view, res, bias, &mut state.maps)?;
+            state.ids.clear();
+        } else {
+            render_depth_and_id_maps(frame, &view, res, bias, &mut state.maps, &mut state.ids)?;
+        }
         state.projections = view
             .projections
             .iter()
-            .zip(&state.maps)
-            .map(|(&p, map)| reconstruct_projection(self, &view, p, map))
+            .enumerate()
+            .map(|(k, &p)| reconstruct_projection(self, &view, p, &state.maps[k], state.ids.get(k)))
             .collect();
         record_build(&state.projections, stats);
         Ok(())
@@ -125,9 +133,7 @@ impl ShadowTechnique<CpuBackend> for VolumeReconstruction {
         counters.stencil_updates = Some(c.stencil_updates);
         counters.extra.insert("cap_triangles".into(), capped.len() as f64);
         counters.extra.insert("cap_inverted".into(), f64::from(u8::from(invert)));
-        let mut all = state.projections.iter().flat_map(|p| p.triangles.iter().copied()).collect::<Vec<_>>();
-        all.extend(caps);
-        state.last_view = Some((eye, g.width(), g.height(), all));
+        state.last_view = Some((eye, g.width(), g.height(), caps));
         Ok(())
     }
 
@@ -138,17 +144,18 @@ impl ShadowTechnique<CpuBackend> for VolumeReconstruction {
             .enumerate()
             .map(|(k, p)| DebugView { name: format!("edges{k}"), image: edge_view(&p.samples, &p.mesh_edges) })
             .collect();
-        if let Some((eye, w, h, tris)) = &state.last_view {
-            views.push(DebugView { name: "volume".into(), image: volume_view(*eye, *w, *h, tris) });
+        if let Some((eye, w, h, caps)) = &state.last_view {
+            let image = volume_view(*eye, *w, *h, &state.projections, caps);
+            views.push(DebugView { name: "volume".into(), image });
         }
         Ok(views)
     }
 }
 
 /// The reconstructed volume in the eye's view: how many boundary and cap triangles cover each pixel, with
-/// no depth test, as a false-colour ramp (black: none).
+/// no depth test (`coverage_view`; the GPU backend draws the same counts in its stencil).
 #[must_use]
-pub fn volume_view(eye: Mat4, w: u32, h: u32, triangles: &[HomTriangle]) -> Image<Rgb8> {
+pub fn volume_view(eye: Mat4, w: u32, h: u32, projections: &[Projection], caps: &[HomTriangle]) -> Image<Rgb8> {
     let mut ds = DepthStencil::new(w, h, 1.0, 0);
     let count = StencilFace {
         compare: CompareFn::Always,
@@ -161,10 +168,9 @@ pub fn volume_view(eye: Mat4, w: u32, h: u32, triangles: &[HomTriangle]) -> Imag
         stencil: Some(StencilState { front: count, back: count, read_mask: 0xff, write_mask: 0xff, reference: 0 }),
         ..RasterState::default()
     };
-    let clip: Vec<[Vec4; 3]> = triangles.iter().map(|t| t.map(|v| eye * v)).collect();
+    let mut clip: Vec<[Vec4; 3]> = projections.iter().flat_map(|p| &p.triangles).map(|t| t.map(|v| eye * v)).collect();
+    clip.extend(caps.iter().map(|t| cap_clip(eye, t)));
     let _ = draw_depth(&mut ds, &Soup { triangles: &clip, prim_base: 0, flip: false }, &state);
-    let top = ds.stencil.iter().copied().max().unwrap_or(0).max(1);
-    let counts = Image::from_fn(w, h, |x, y| f32::from(ds.stencil[(y * w + x) as usize]));
-    let img = false_colour(&counts, 0.0, f32::from(top));
-    Image::from_fn(w, h, |x, y| if *counts.get(x, y) == 0.0 { [0, 0, 0] } else { *img.get(x, y) })
+    let counts = Image::from_fn(w, h, |x, y| ds.stencil[(y * w + x) as usize]);
+    coverage_view(&counts)
 }

@@ -37,6 +37,26 @@ fn vs_light_depth(@location(0) p: vec4<f32>, @builtin(instance_index) instance: 
     return out;
 }
 
+struct IdOut {
+    @invariant @builtin(position) pos: vec4<f32>,
+    @location(0) @interpolate(flat) id: u32,
+};
+
+// The light pass with McCool's object-ID channel (volume-reconstruction's `ids`): 1 + the instance's index,
+// 0 (the clear value) where no caster is (twin: shadow-cpu's `render_depth_and_id_maps`).
+@vertex
+fn vs_light_id(@location(0) p: vec4<f32>, @builtin(instance_index) instance: u32) -> IdOut {
+    var out: IdOut;
+    out.pos = clip_position(instance, p);
+    out.id = instance + 1u;
+    return out;
+}
+
+@fragment
+fn fs_light_id(in: IdOut) -> @location(0) u32 {
+    return in.id;
+}
+
 // Twin: shadow_core::light::cube_face.
 fn cube_face(d: vec3<f32>) -> i32 {
     let a = abs(d);

@@ -189,24 +189,48 @@ pub fn depth_bias(s: &ShadowMap) -> wgpu::DepthBiasState {
     }
 }
 
-/// Depth-only pipeline of a light pass.
+/// The light pass: casters' depth, both faces, with `bias`.
 #[must_use]
 pub fn light_pass_pipeline(
     cx: &WgpuContext,
     module: &wgpu::ShaderModule,
     bias: wgpu::DepthBiasState,
 ) -> wgpu::RenderPipeline {
+    light_pipeline(cx, module, bias, false)
+}
+
+/// The light pass with an object-ID target ([`ID_FORMAT`]): 1 + the instance index of the caster a texel
+/// shows (McCool's ID channel).
+#[must_use]
+pub fn light_id_pipeline(
+    cx: &WgpuContext,
+    module: &wgpu::ShaderModule,
+    bias: wgpu::DepthBiasState,
+) -> wgpu::RenderPipeline {
+    light_pipeline(cx, module, bias, true)
+}
+
+/// The format of the light pass's ID target.
+pub const ID_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
+
+fn light_pipeline(
+    cx: &WgpuContext,
+    module: &wgpu::ShaderModule,
+    bias: wgpu::DepthBiasState,
+    ids: bool,
+) -> wgpu::RenderPipeline {
     let layout = cx.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some("light pass"),
         bind_group_layouts: &[Some(&cx.shared.frame_layout)],
         immediate_size: 0,
     });
+    let id_target = [Some(wgpu::ColorTargetState::from(ID_FORMAT))];
     cx.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some("light pass"),
+        label: Some(if ids { "light pass with IDs" } else { "light pass" }),
         layout: Some(&layout),
         vertex: wgpu::VertexState {
             module,
-            entry_point: Some("vs_light_depth"),
+            entry_point: Some(if ids { "vs_light_id" } else { "vs_light_depth" }),
             compilation_options: Default::default(),
             buffers: &[Some(POSITION_LAYOUT)],
         },
@@ -219,20 +243,27 @@ pub fn light_pass_pipeline(
             bias,
         }),
         multisample: Default::default(),
-        fragment: None,
+        fragment: ids.then(|| wgpu::FragmentState {
+            module,
+            entry_point: Some("fs_light_id"),
+            compilation_options: Default::default(),
+            targets: &id_target,
+        }),
         multiview_mask: None,
         cache: None,
     })
 }
 
 /// Renders the casters' depth from every projection of `light` into the layers of `maps` (meshes and
-/// `instances` already uploaded).
+/// `instances` already uploaded), and their IDs into the layers of `ids` when given (with a pipeline from
+/// [`light_id_pipeline`]).
 pub fn render_maps(
     cx: &WgpuContext,
     pipeline: &wgpu::RenderPipeline,
     frame: &FrameInputs,
     light: &LightView,
     maps: &wgpu::Texture,
+    ids: Option<&wgpu::Texture>,
     instances: &wgpu::Buffer,
 ) {
     let res = maps.width();
@@ -241,9 +272,17 @@ pub fn render_maps(
         let group =
             cx.shared.frame_group(&cx.device, &ViewRaw::new(p.clip_from_world, glam::Vec3::ZERO, res, res), instances);
         let view = layer_view(maps, k as u32);
+        let id_view = ids.map(|t| layer_view(t, k as u32));
+        let id_attachment = id_view.as_ref().map(|view| wgpu::RenderPassColorAttachment {
+            view,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT), store: wgpu::StoreOp::Store },
+        });
+        let colour = [id_attachment];
         let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("light pass"),
-            color_attachments: &[],
+            color_attachments: if ids.is_some() { &colour } else { &[] },
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                 view: &view,
                 depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
@@ -313,7 +352,9 @@ impl ShadowTechnique<WgpuBackend> for ShadowMap {
         let maps = state.maps.clone().ok_or_else(|| TechniqueError::NotBuilt(self.name().into()))?;
         cx.cache.upload_meshes(&cx.device, frame);
         let instances = cx.cache.instances(&cx.device, frame).clone();
-        cx.scoped("the shadow-map light pass", |cx| render_maps(cx, &state.depth, frame, light, &maps, &instances))
+        cx.scoped("the shadow-map light pass", |cx| {
+            render_maps(cx, &state.depth, frame, light, &maps, None, &instances)
+        })
     }
 
     fn query(

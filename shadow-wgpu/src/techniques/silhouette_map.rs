@@ -357,7 +357,7 @@ impl ShadowTechnique<WgpuBackend> for SilhouetteMap {
         let instances = cx.cache.instances(&cx.device, frame).clone();
         let edges = frame.silhouette_segments(light);
         cx.scoped("the silhouette-map passes", |cx| {
-            render_maps(cx, &state.light_pass, frame, light, &maps.depth, &instances);
+            render_maps(cx, &state.light_pass, frame, light, &maps.depth, None, &instances);
             let (segments, ranges) = upload_segments(cx, &edges, light, res);
             draw_points(cx, state, maps, &segments, &ranges, self.corner_margin);
         })?;
