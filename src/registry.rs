@@ -3,7 +3,7 @@
 //! conformance tests enumerate it, so a new technique gets all of them for free.
 
 use shadow_core::technique::hard::{
-    DepthLayers, DualShadowMap, MidpointShadowMap, RayTraced, SecondDepthShadowMap, ShadowMap, ShadowVolume,
+    DepthLayers, DualShadowMap, Hybrid, MidpointShadowMap, RayTraced, SecondDepthShadowMap, ShadowMap, ShadowVolume,
     SilhouetteMap, VolumeReconstruction,
 };
 use shadow_core::technique::settings::{SettingKey, SettingsError, TechniqueSettings, TechniqueSpec};
@@ -157,6 +157,16 @@ impl TechniqueRegistry {
             canonical: canonical::<VolumeReconstruction>,
             cpu: Some(plain::<CpuBackend, VolumeReconstruction>),
             wgpu: Some(plain::<WgpuBackend, VolumeReconstruction>),
+        });
+        r.register(TechniqueEntry {
+            name: "hybrid",
+            description: "a shadow map, with z-fail shadow volumes at its silhouette pixels only (a computation mask)",
+            paper: "Chan 2004 (thesis, chapter 3)",
+            reference: false,
+            keys: Hybrid::keys,
+            canonical: canonical::<Hybrid>,
+            cpu: Some(plain::<CpuBackend, Hybrid>),
+            wgpu: None,
         });
         r.register(TechniqueEntry {
             name: "shadow-volume-zpass",

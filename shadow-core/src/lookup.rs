@@ -78,6 +78,41 @@ pub fn compare_bilinear(map: &Image<f32>, uv: Vec2, depth: f32) -> f32 {
     top * (1.0 - f.y) + bottom * f.y
 }
 
+/// How a receiver stands against the four texels nearest its map position.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MapClass {
+    /// All four depth tests say lit.
+    Lit,
+    /// All four say shadowed, or they disagree on a surface facing away from the light (always shadowed).
+    Shadowed,
+    /// They disagree on a surface facing the light: a shadow silhouette pixel (Chan, thesis 3.1 step 2).
+    Silhouette,
+}
+
+/// Chan's classification (thesis Fig. 3-3) through the 2x2 texels a bilinear comparison would read
+/// (WGSL twin: `classify`). The thesis reads them through the hardware's filter and tests 0 < v < 1; the
+/// four texels are compared one by one here, so a receiver exactly on a texel row, whose filter weight
+/// for the far row is 0, is still a silhouette pixel when that row disagrees, on both backends alike.
+/// Outside the map a receiver is lit, as in [`shadow_lookup`].
+#[must_use]
+pub fn classify(map: &Image<f32>, uv: Vec2, depth: f32, faces_light: bool) -> MapClass {
+    if uv.x < 0.0 || uv.x > 1.0 || uv.y < 0.0 || uv.y > 1.0 {
+        return MapClass::Lit;
+    }
+    let st = uv * map.width() as f32 - Vec2::splat(0.5);
+    let (x, y) = (st.x.floor() as i32, st.y.floor() as i32);
+    let lit = compare_texel(map, x, y, depth)
+        + compare_texel(map, x + 1, y, depth)
+        + compare_texel(map, x, y + 1, depth)
+        + compare_texel(map, x + 1, y + 1, depth);
+    match lit {
+        4.0 => MapClass::Lit,
+        0.0 => MapClass::Shadowed,
+        _ if faces_light => MapClass::Silhouette,
+        _ => MapClass::Shadowed,
+    }
+}
+
 /// Visibility from a shadow map with a filter (WGSL twin: `shadow_lookup`). `radius` is the kernel radius
 /// in texels for the jittered and Poisson filters; `pixel` seeds their per-pixel rotation or jitter.
 #[must_use]

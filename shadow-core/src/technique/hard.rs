@@ -654,3 +654,73 @@ mod layer_tests {
         assert_eq!(s.combine(1.0, 5.0), 5.0);
     }
 }
+
+/// `hybrid` (Chan, thesis chapter 3): a shadow map classifies each receiver; where its four nearest
+/// depth tests disagree on a surface facing the light (a silhouette pixel) z-fail shadow volumes decide,
+/// confined to those pixels by a computation mask; everywhere else the map decides.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hybrid {
+    /// The classifying map: resolution and bias as `shadow-map` has them (the filter is unused: the
+    /// classification reads the four nearest texels). Chan uses a lower resolution than a plain map needs,
+    /// the volumes drawing the edges.
+    pub depth: ShadowMap,
+    /// Side in pixels of the CPU computation mask's tiles, which the rasterizer skips whole where no pixel
+    /// is masked in.
+    pub mask_tile: u32,
+    /// Whether the query also counts the volumes' unmasked fill (what `shadow-volume-zfail` rasterizes),
+    /// in a pass of its own timed as `count_fragments`.
+    pub unmasked_fill: FillCount,
+}
+
+crate::named_enum! {
+    /// Whether `hybrid` counts the fill its computation mask saves.
+    pub enum FillCount {
+        /// No: the frame costs what the technique costs.
+        Off = "off",
+        /// Yes: the counter `unmasked_volume_fragments`, at the cost of a second, unmasked volume pass.
+        On = "on",
+    }
+}
+
+const HYBRID_KEYS: [SettingKey; 7] = [
+    SettingKey { key: "res", default: "512", help: "classifying map side in texels (16 to 16384)" },
+    MAP_KEYS[1],
+    MAP_KEYS[2],
+    MAP_KEYS[3],
+    MAP_KEYS[6],
+    SettingKey {
+        key: "mask_tile",
+        default: "8",
+        help: "CPU computation-mask tile side in pixels (1 to 64): tiles with no silhouette pixel are skipped whole",
+    },
+    SettingKey {
+        key: "unmasked_fill",
+        default: "off",
+        help: "on: also count the volumes' fill without the mask (unmasked_volume_fragments), in an extra pass",
+    },
+];
+
+impl TechniqueSettings for Hybrid {
+    fn keys() -> &'static [SettingKey] {
+        &HYBRID_KEYS
+    }
+    fn from_values(v: &Values<'_>) -> Result<Self, SettingsError> {
+        Ok(Self {
+            depth: ShadowMap::read_depth(v)?,
+            mask_tile: v.ranged("mask_tile", 1, 64)?,
+            unmasked_fill: v.get("unmasked_fill")?,
+        })
+    }
+    fn to_values(&self) -> Vec<String> {
+        let d = &self.depth;
+        vec![
+            d.resolution.to_string(),
+            d.bias.to_string(),
+            d.bias_constant.to_string(),
+            d.bias_slope.to_string(),
+            d.bias_world.to_string(),
+            self.mask_tile.to_string(),
+            self.unmasked_fill.to_string(),
+        ]
+    }
+}

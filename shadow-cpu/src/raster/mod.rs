@@ -8,12 +8,14 @@
 //! triangles in submission order, so the output does not depend on the thread count.
 
 pub mod clip;
+pub mod mask;
 pub mod state;
 
 use glam::Vec4;
 use rayon::prelude::*;
 use shadow_core::Image;
 
+pub use mask::ComputationMask;
 pub use state::*;
 
 /// Rows per band of the binning grid.
@@ -361,21 +363,42 @@ where
     F: Fn(&Fragment) -> Option<T> + Sync,
     B: Fn(&mut T, T) + Sync,
 {
-    draw_with(ds, color, src, st, None, shader, blend)
+    draw_with(ds, color, src, st, None, None, shader, blend)
 }
 
 /// Depth (and stencil) only: shadow-map renders and shadow-volume counting take branch-free inner loops.
 pub fn draw_depth<S: TriangleSource + ?Sized>(ds: &mut DepthStencil, src: &S, st: &RasterState) -> RasterCounters {
-    let mut none = Image::new(ds.width, ds.height, ());
-    draw_with(ds, &mut none, src, st, DepthKernel::for_state(st), |_| Some(()), |_, _| {})
+    draw_depth_masked(ds, src, st, None)
 }
 
+/// [`draw_depth`] confined to the pixels of a computation mask (Chan, thesis 3.2), rejected as coarsely
+/// as the mask allows before any depth or stencil work: a triangle is not binned into a band where its
+/// bounds meet no masked-in tile, a row is not set up where they meet none in its tile row, and a span
+/// skips unmasked tiles whole and the rest pixel by pixel. Only masked-in fragments are counted.
+///
+/// # Panics
+/// When the mask is not the size of `ds`: a caller bug.
+pub fn draw_depth_masked<S: TriangleSource + ?Sized>(
+    ds: &mut DepthStencil,
+    src: &S,
+    st: &RasterState,
+    mask: Option<&ComputationMask>,
+) -> RasterCounters {
+    if let Some(m) = mask {
+        assert_eq!(m.size(), (ds.width, ds.height), "a computation mask the size of the target");
+    }
+    let mut none = Image::new(ds.width, ds.height, ());
+    draw_with(ds, &mut none, src, st, DepthKernel::for_state(st), mask, |_| Some(()), |_, _| {})
+}
+
+#[allow(clippy::too_many_arguments)]
 fn draw_with<T, S, F, B>(
     ds: &mut DepthStencil,
     color: &mut Image<T>,
     src: &S,
     st: &RasterState,
     fast: Option<DepthKernel>,
+    mask: Option<&ComputationMask>,
     shader: F,
     blend: B,
 ) -> RasterCounters
@@ -414,7 +437,11 @@ where
         }
         for (i, t) in setups.iter().enumerate() {
             for band in (t.min_y as u32 / BAND_ROWS)..=(t.max_y as u32 / BAND_ROWS) {
-                bins[band as usize].push(i as u32);
+                let (y0, y1) =
+                    ((band * BAND_ROWS).max(t.min_y as u32), ((band + 1) * BAND_ROWS - 1).min(t.max_y as u32));
+                if mask.is_none_or(|m| m.any_in(t.min_x as u32, y0, t.max_x as u32, y1)) {
+                    bins[band as usize].push(i as u32);
+                }
             }
         }
         let counters = ds
@@ -429,7 +456,7 @@ where
                 let y0 = band as i32 * BAND_ROWS as i32;
                 let mut rows = BandRows { depth, stencil, color: col, y0, width: w as usize };
                 for &t in bin {
-                    raster_band(&setups[t as usize], &mut rows, st, fast, &shader, &blend, &mut c);
+                    raster_band(&setups[t as usize], &mut rows, st, fast, mask, &shader, &blend, &mut c);
                 }
                 c
             })
@@ -586,11 +613,13 @@ fn row_fast(t: &Setup, k: DepthKernel, row: RowStart, depth: &mut [f32], stencil
 }
 
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 fn raster_band<T, F, B>(
     t: &Setup,
     rows: &mut BandRows<'_, T>,
     st: &RasterState,
     fast: Option<DepthKernel>,
+    mask: Option<&ComputationMask>,
     shader: &F,
     blend: &B,
     c: &mut RasterCounters,
@@ -602,82 +631,116 @@ fn raster_band<T, F, B>(
     let y_lo = t.min_y.max(rows.y0);
     let y_hi = t.max_y.min(rows.y0 + band_rows - 1);
     let clamp = st.depth.is_some_and(|d| d.clamp);
+    let mut runs = Vec::new();
     for y in y_lo..=y_hi {
         let py = i64::from(y) * ONE + HALF;
         let Some((xs, xe)) = span(t, py) else { continue };
         let z_row = row_base(t, py);
         let row = (y - rows.y0) as usize * rows.width;
-        let (lo, hi) = (row + xs as usize, row + xe as usize + 1);
-        if let Some(k) = fast {
-            row_fast(t, k, RowStart { z_row, clamp, xs }, &mut rows.depth[lo..hi], &mut rows.stencil[lo..hi], c);
-            continue;
+        let mut run = |a: i32, b: i32| {
+            if let Some(k) = fast {
+                let (lo, hi) = (row + a as usize, row + b as usize + 1);
+                let start = RowStart { z_row, clamp, xs: a };
+                row_fast(t, k, start, &mut rows.depth[lo..hi], &mut rows.stencil[lo..hi], c);
+            } else {
+                row_general(t, rows, st, (y, py, row), (a, b, z_row, clamp), shader, blend, c);
+            }
+        };
+        match mask {
+            None => run(xs, xe),
+            Some(m) => {
+                runs.clear();
+                m.runs(y as u32, xs as u32, xe as u32, &mut runs);
+                for &(a, b) in &runs {
+                    run(a as i32, b as i32);
+                }
+            }
         }
-        let px0 = i64::from(xs) * ONE + HALF;
-        let mut e: [i64; 3] = std::array::from_fn(|k| t.a[k] * px0 + t.b[k] * py + t.c[k]);
-        let step: [i64; 3] = t.a.map(|a| a * ONE);
-        for x in xs..=xe {
-            let depth = depth_at(t, z_row, x, clamp);
-            let here = e;
-            for (e, s) in e.iter_mut().zip(step) {
-                *e += s;
-            }
-            c.fragments += 1;
-            let frag = || {
-                // Perspective-correct weights of the clipped corners, then of the source triangle.
-                let q = [0, 1, 2].map(|k| here[k] as f32 * t.inv_area * t.inv_w[k]);
-                let s = 1.0 / (q[0] + q[1] + q[2]);
-                let bary = [0, 1, 2].map(|k| (q[0] * t.bary[0][k] + q[1] * t.bary[1][k] + q[2] * t.bary[2][k]) * s);
-                Fragment { x: x as u32, y: y as u32, depth, prim: t.prim, front_facing: t.front, bary }
-            };
-            let i = row + x as usize;
-            let mut value = None;
-            if !st.early_tests {
-                value = shader(&frag());
-                if value.is_none() {
-                    continue;
-                }
-            }
-            if let Some(s) = &st.stencil {
-                let face = if t.front { s.front } else { s.back };
-                let stored = rows.stencil[i];
-                let op = if !face.compare.test(s.reference & s.read_mask, stored & s.read_mask) {
-                    Some(face.fail)
-                } else if st.depth.is_some_and(|d| !d.compare.test(depth, rows.depth[i])) {
-                    Some(face.depth_fail)
-                } else {
-                    None
-                };
-                if let Some(op) = op {
-                    if op != StencilOp::Keep {
-                        rows.stencil[i] = (stored & !s.write_mask) | (op.apply(stored, s.reference) & s.write_mask);
-                        c.stencil_updates += 1;
-                    }
-                    continue;
-                }
-                if face.pass != StencilOp::Keep {
-                    rows.stencil[i] = (stored & !s.write_mask) | (face.pass.apply(stored, s.reference) & s.write_mask);
-                    c.stencil_updates += 1;
-                }
-            } else if let Some(d) = &st.depth
-                && !d.compare.test(depth, rows.depth[i])
-            {
+    }
+}
+
+/// Columns `a..=b` of row `y` (`py` its centre in fixed point, `row` its first index in the band) through
+/// the general per-fragment path.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn row_general<T, F, B>(
+    t: &Setup,
+    rows: &mut BandRows<'_, T>,
+    st: &RasterState,
+    (y, py, row): (i32, i64, usize),
+    (xs, xe, z_row, clamp): (i32, i32, f32, bool),
+    shader: &F,
+    blend: &B,
+    c: &mut RasterCounters,
+) where
+    F: Fn(&Fragment) -> Option<T>,
+    B: Fn(&mut T, T),
+{
+    let px0 = i64::from(xs) * ONE + HALF;
+    let mut e: [i64; 3] = std::array::from_fn(|k| t.a[k] * px0 + t.b[k] * py + t.c[k]);
+    let step: [i64; 3] = t.a.map(|a| a * ONE);
+    for x in xs..=xe {
+        let depth = depth_at(t, z_row, x, clamp);
+        let here = e;
+        for (e, s) in e.iter_mut().zip(step) {
+            *e += s;
+        }
+        c.fragments += 1;
+        let frag = || {
+            // Perspective-correct weights of the clipped corners, then of the source triangle.
+            let q = [0, 1, 2].map(|k| here[k] as f32 * t.inv_area * t.inv_w[k]);
+            let s = 1.0 / (q[0] + q[1] + q[2]);
+            let bary = [0, 1, 2].map(|k| (q[0] * t.bary[0][k] + q[1] * t.bary[1][k] + q[2] * t.bary[2][k]) * s);
+            Fragment { x: x as u32, y: y as u32, depth, prim: t.prim, front_facing: t.front, bary }
+        };
+        let i = row + x as usize;
+        let mut value = None;
+        if !st.early_tests {
+            value = shader(&frag());
+            if value.is_none() {
                 continue;
             }
-            if st.early_tests {
-                value = shader(&frag());
-                if value.is_none() {
-                    continue;
+        }
+        if let Some(s) = &st.stencil {
+            let face = if t.front { s.front } else { s.back };
+            let stored = rows.stencil[i];
+            let op = if !face.compare.test(s.reference & s.read_mask, stored & s.read_mask) {
+                Some(face.fail)
+            } else if st.depth.is_some_and(|d| !d.compare.test(depth, rows.depth[i])) {
+                Some(face.depth_fail)
+            } else {
+                None
+            };
+            if let Some(op) = op {
+                if op != StencilOp::Keep {
+                    rows.stencil[i] = (stored & !s.write_mask) | (op.apply(stored, s.reference) & s.write_mask);
+                    c.stencil_updates += 1;
                 }
+                continue;
             }
-            c.passed += 1;
-            if let Some(d) = &st.depth
-                && d.write
-            {
-                rows.depth[i] = depth;
+            if face.pass != StencilOp::Keep {
+                rows.stencil[i] = (stored & !s.write_mask) | (face.pass.apply(stored, s.reference) & s.write_mask);
+                c.stencil_updates += 1;
             }
-            if let Some(v) = value {
-                blend(&mut rows.color[i], v);
+        } else if let Some(d) = &st.depth
+            && !d.compare.test(depth, rows.depth[i])
+        {
+            continue;
+        }
+        if st.early_tests {
+            value = shader(&frag());
+            if value.is_none() {
+                continue;
             }
+        }
+        c.passed += 1;
+        if let Some(d) = &st.depth
+            && d.write
+        {
+            rows.depth[i] = depth;
+        }
+        if let Some(v) = value {
+            blend(&mut rows.color[i], v);
         }
     }
 }

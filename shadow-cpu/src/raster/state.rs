@@ -185,7 +185,7 @@ impl Default for RasterState {
 pub struct RasterCounters {
     /// Triangles that reached setup (after clipping; one per clipped sub-triangle).
     pub triangles: u64,
-    /// Fragments rasterized, before any test.
+    /// Fragments rasterized, before any test (under a computation mask: the masked-in ones only).
     pub fragments: u64,
     /// Fragments that passed the depth and stencil tests.
     pub passed: u64,

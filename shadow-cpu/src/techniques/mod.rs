@@ -2,6 +2,7 @@
 //! Helpers two techniques share live here.
 
 pub mod depth_layers;
+pub mod hybrid;
 pub mod ray_traced;
 pub mod shadow_map;
 pub mod shadow_volume;

@@ -21,8 +21,8 @@ use super::per_receiver;
 use crate::context::{CpuBackend, CpuContext, CpuError};
 use crate::gbuffer::GBuffer;
 use crate::raster::{
-    CompareFn, DepthState, DepthStencil, Indexed, RasterCounters, RasterState, Soup, StencilFace, StencilOp,
-    StencilState, draw_depth,
+    CompareFn, ComputationMask, DepthState, DepthStencil, Indexed, RasterCounters, RasterState, Soup, StencilFace,
+    StencilOp, StencilState, TriangleSource, draw_depth_masked,
 };
 
 /// The volumes of the last build.
@@ -47,26 +47,29 @@ pub fn stencil_state(counting: VolumeCounting) -> StencilState {
 }
 
 /// Rasterizes shadow volumes into the stencil of `ds` (which holds the G-buffer depth): sides, and for
-/// z-fail the near caps from the G-buffer's own clip-space vertices and the far caps at infinity.
+/// z-fail the near caps from the G-buffer's own clip-space vertices and the far caps at infinity; only
+/// the pixels of `mask` when one is given (`hybrid`).
 pub fn rasterize_volumes(
     frame: &FrameInputs,
     g: &GBuffer,
     volumes: &[InstanceVolume],
     counting: VolumeCounting,
     ds: &mut DepthStencil,
+    mask: Option<&ComputationMask>,
 ) -> RasterCounters {
     let state = RasterState {
         depth: Some(DepthState::LESS_READ),
         stencil: Some(stencil_state(counting)),
         ..RasterState::default()
     };
+    let draw = |ds: &mut DepthStencil, src: &dyn TriangleSource| draw_depth_masked(ds, src, &state, mask);
     let mut c = RasterCounters::default();
     for iv in volumes {
         let inst = &frame.instances[iv.instance];
         let vol = &iv.volume;
         let clip_from_local: Mat4 = g.clip_from_world * inst.world_from_local;
         let sides: Vec<[Vec4; 3]> = vol.sides.iter().map(|t| t.map(|v| clip_from_local * v)).collect();
-        c += draw_depth(ds, &Soup { triangles: &sides, prim_base: 0, flip: inst.mirrored }, &state);
+        c += draw(ds, &Soup { triangles: &sides, prim_base: 0, flip: inst.mirrored });
         if counting == VolumeCounting::ZPass {
             continue;
         }
@@ -78,18 +81,14 @@ pub fn rasterize_volumes(
         // Near caps: the G-buffer's vertices, in the mesh's own winding; faces cast turned around are drawn
         // with front and back swapped rather than re-wound, so their depths stay bit-identical.
         let near = &g.clip_vertices[iv.instance];
-        c += draw_depth(ds, &Indexed { positions: near, triangles: &fwd, prim_base: 0, flip: inst.mirrored }, &state);
-        c += draw_depth(ds, &Indexed { positions: near, triangles: &rev, prim_base: 0, flip: !inst.mirrored }, &state);
+        c += draw(ds, &Indexed { positions: near, triangles: &fwd, prim_base: 0, flip: inst.mirrored });
+        c += draw(ds, &Indexed { positions: near, triangles: &rev, prim_base: 0, flip: !inst.mirrored });
         // Far caps: the same faces projected to infinity, forward ones reversed.
         let light = vol.light;
         let far: Vec<Vec4> = inst.mesh.positions().iter().map(|&p| clip_from_local * light.extrude(p)).collect();
         let far_fwd = pick(&vol.caps_forward, true);
-        c += draw_depth(
-            ds,
-            &Indexed { positions: &far, triangles: &far_fwd, prim_base: 0, flip: inst.mirrored },
-            &state,
-        );
-        c += draw_depth(ds, &Indexed { positions: &far, triangles: &rev, prim_base: 0, flip: inst.mirrored }, &state);
+        c += draw(ds, &Indexed { positions: &far, triangles: &far_fwd, prim_base: 0, flip: inst.mirrored });
+        c += draw(ds, &Indexed { positions: &far, triangles: &rev, prim_base: 0, flip: inst.mirrored });
     }
     c
 }
@@ -137,7 +136,7 @@ impl ShadowTechnique<CpuBackend> for ShadowVolume {
     ) -> Result<(), CpuError> {
         let volumes = state.volumes.as_ref().ok_or_else(|| TechniqueError::NotBuilt(self.name().into()))?;
         let mut ds = DepthStencil::from_depth(&g.depth, 0);
-        let c = rasterize_volumes(frame, g, volumes, self.counting, &mut ds);
+        let c = rasterize_volumes(frame, g, volumes, self.counting, &mut ds, None);
         per_receiver(g, out, |_, _, i| if ds.stencil[i] == 0 { 1.0 } else { 0.0 });
         let counters = &mut stats.counters;
         counters.volume_fragments = Some(c.fragments);

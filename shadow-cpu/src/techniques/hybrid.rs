@@ -1,0 +1,184 @@
+//! `hybrid` (Chan, thesis chapter 3): shadow maps where they are right, shadow volumes where they are not.
+//!
+//! Build: the classifying depth maps as `shadow-map` renders them, and the z-fail volumes of every caster
+//! (shared geometry, as `shadow-volume-zfail` builds them). Query, the thesis's steps 2 to 4: each receiver
+//! is compared with the four texels nearest its map position (`shadow_core::lookup::classify`); where they
+//! disagree and the surface faces the light it is a silhouette pixel, otherwise the map's answer is final.
+//! The silhouette pixels make a computation mask, tiled so the rasterizer skips whole tiles with none;
+//! the volumes are counted z-fail through it, and a silhouette pixel is shadowed where its count is not 0.
+//!
+//! Counters: `silhouette_pixels`; `volume_fragments`, the fragments rasterized under the mask (the work
+//! actually done); `mask_tiles` and `mask_tiles_total`; with `unmasked_fill=on`,
+//! `unmasked_volume_fragments`, what `shadow-volume-zfail` rasterizes, from a second pass without the mask
+//! (timed as `count_fragments`). Sub-phases: `classify` (the map test and the mask) and `volumes`.
+
+use rayon::prelude::*;
+use shadow_core::frame::InstanceVolume;
+use shadow_core::geometry::volume::Caps;
+use shadow_core::image::Rgb8;
+use shadow_core::light::LightView;
+use shadow_core::lookup::{MapClass, classify};
+use shadow_core::stats::ms;
+use shadow_core::technique::hard::{FillCount, Hybrid, VolumeCounting};
+use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
+use shadow_core::{FrameInputs, Image};
+use std::time::Instant;
+
+use super::shadow_volume::rasterize_volumes;
+use super::{map_position, per_receiver, render_depth_maps};
+use crate::context::{CpuBackend, CpuContext, CpuError};
+use crate::gbuffer::GBuffer;
+use crate::raster::{ComputationMask, DepthStencil};
+
+/// The maps and volumes of the last build; the last query's classes (for the debug view).
+#[derive(Default)]
+pub struct State {
+    maps: Vec<Image<f32>>,
+    volumes: Option<Vec<InstanceVolume>>,
+    classes: Option<Image<PixelClass>>,
+}
+
+/// What decided a pixel, as the debug view shows it (thesis Fig. 3-5).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum PixelClass {
+    /// Not a receiver.
+    #[default]
+    None,
+    /// The map: shadowed (red).
+    MapShadowed,
+    /// The map: lit (blue).
+    MapLit,
+    /// The volumes, at a silhouette pixel: shadowed (black).
+    VolumeShadowed,
+    /// The volumes, at a silhouette pixel: lit (green).
+    VolumeLit,
+}
+
+impl PixelClass {
+    /// The thesis's colours; grey where nothing was decided.
+    #[must_use]
+    pub fn colour(self) -> Rgb8 {
+        match self {
+            Self::None => [96, 96, 96],
+            Self::MapShadowed => [200, 30, 30],
+            Self::MapLit => [40, 70, 210],
+            Self::VolumeShadowed => [0, 0, 0],
+            Self::VolumeLit => [40, 200, 60],
+        }
+    }
+}
+
+/// The map's class of every receiver pixel (`Lit` elsewhere), rows in parallel.
+fn classify_receivers(maps: &[Image<f32>], light: &LightView, g: &GBuffer, receiver_offset: f32) -> Image<MapClass> {
+    let w = g.width() as usize;
+    let mut classes = Image::new(g.width(), g.height(), MapClass::Lit);
+    classes.data_mut().par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+        for (x, class) in row.iter_mut().enumerate() {
+            let i = y * w + x;
+            if !g.receiver.data()[i] {
+                continue;
+            }
+            let p = g.position.data()[i];
+            let faces_light = g.geometric_normal.data()[i].dot(light.light.to_light(p)) > 0.0;
+            let m = map_position(light, p, receiver_offset);
+            *class = classify(&maps[m.projection], m.uv, m.depth, faces_light);
+        }
+    });
+    classes
+}
+
+impl ShadowTechnique<CpuBackend> for Hybrid {
+    type State = State;
+
+    fn name(&self) -> &'static str {
+        "hybrid"
+    }
+
+    fn create_state(&self, _: &mut CpuContext) -> Result<State, CpuError> {
+        Ok(State::default())
+    }
+
+    fn build(
+        &self,
+        _: &mut CpuContext,
+        state: &mut State,
+        frame: &FrameInputs,
+        light: &LightView,
+        stats: &mut FrameStats,
+    ) -> Result<(), CpuError> {
+        render_depth_maps(frame, light, self.depth.resolution, self.depth.depth_bias(), &mut state.maps)?;
+        let volumes = frame.shadow_volumes(light, Caps::Both);
+        let c = &mut stats.counters;
+        c.silhouette_edges = Some(volumes.iter().map(|v| v.silhouette_edges as u64).sum());
+        c.volume_triangles = Some(volumes.iter().map(|v| v.volume.triangle_count() as u64).sum());
+        state.volumes = Some(volumes);
+        Ok(())
+    }
+
+    fn query(
+        &self,
+        _: &mut CpuContext,
+        state: &mut State,
+        frame: &FrameInputs,
+        light: &LightView,
+        g: &GBuffer,
+        out: &mut Image<f32>,
+        stats: &mut FrameStats,
+    ) -> Result<(), CpuError> {
+        let volumes = state.volumes.as_ref().ok_or_else(|| TechniqueError::NotBuilt(self.name().into()))?;
+        if state.maps.len() != light.projections.len() {
+            return Err(TechniqueError::NotBuilt(self.name().into()).into());
+        }
+        let (w, h) = (g.width(), g.height());
+        let t = Instant::now();
+        let map_class = classify_receivers(&state.maps, light, g, self.depth.receiver_offset());
+        let silhouette = |x, y| *map_class.get(x, y) == MapClass::Silhouette;
+        let mask = ComputationMask::from_fn(w, h, self.mask_tile, silhouette);
+        stats.timings.extra.insert("classify".into(), ms(t.elapsed()));
+        let t = Instant::now();
+        let mut ds = DepthStencil::from_depth(&g.depth, 0);
+        let c = rasterize_volumes(frame, g, volumes, VolumeCounting::ZFail, &mut ds, Some(&mask));
+        stats.timings.extra.insert("volumes".into(), ms(t.elapsed()));
+        per_receiver(g, out, |x, y, i| match map_class.get(x, y) {
+            MapClass::Lit => 1.0,
+            MapClass::Shadowed => 0.0,
+            MapClass::Silhouette => f32::from(u8::from(ds.stencil[i] == 0)),
+        });
+        state.classes = Some(Image::from_fn(w, h, |x, y| {
+            let i = (y * w + x) as usize;
+            match (g.receiver.data()[i], map_class.get(x, y), ds.stencil[i] == 0) {
+                (false, ..) => PixelClass::None,
+                (true, MapClass::Lit, _) => PixelClass::MapLit,
+                (true, MapClass::Shadowed, _) => PixelClass::MapShadowed,
+                (true, MapClass::Silhouette, true) => PixelClass::VolumeLit,
+                (true, MapClass::Silhouette, false) => PixelClass::VolumeShadowed,
+            }
+        }));
+        let counters = &mut stats.counters;
+        counters.silhouette_pixels = Some(mask.count() as u64);
+        counters.volume_fragments = Some(c.fragments);
+        counters.stencil_updates = Some(c.stencil_updates);
+        let (tiles, all_tiles) = mask.tiles_in();
+        counters.extra.insert("mask_tiles".into(), tiles as f64);
+        counters.extra.insert("mask_tiles_total".into(), all_tiles as f64);
+        if self.unmasked_fill == FillCount::On {
+            let t = Instant::now();
+            let mut scratch = DepthStencil::from_depth(&g.depth, 0);
+            let all = rasterize_volumes(frame, g, volumes, VolumeCounting::ZFail, &mut scratch, None).fragments;
+            stats.counters.extra.insert("unmasked_volume_fragments".into(), all as f64);
+            stats.timings.extra.insert("count_fragments".into(), ms(t.elapsed()));
+        }
+        Ok(())
+    }
+
+    fn debug_views(&self, _: &mut CpuContext, state: &State) -> Result<Vec<DebugView>, CpuError> {
+        Ok(state
+            .classes
+            .iter()
+            .map(|c| DebugView {
+                name: "classes".into(),
+                image: Image::from_fn(c.width(), c.height(), |x, y| c.get(x, y).colour()),
+            })
+            .collect())
+    }
+}

@@ -1,0 +1,73 @@
+//! Chan's claims for `hybrid` (thesis chapter 3), as issue 9 states them, at 512x512 against the ray-traced
+//! reference (CPU backend):
+//!
+//! - shadow-volume accuracy from a 512^2 classifying map: mismatch at or under 0.1% on every built-in
+//!   scene but `tree`, whose thin branches the map undersamples (the thesis's Fig. 3-8); `tree` meets it
+//!   with a 1024^2 map;
+//! - the computation mask confines the volumes to the silhouette pixels: the fragments processed under it
+//!   are at most a tenth of `shadow-volume-zfail`'s on cubes and cage, and the unmasked fill it reports is
+//!   exactly z-fail's.
+
+use shadow_core::FrameInputs;
+use shadow_core::scenes::{self, SceneParams};
+use shadow_core::technique::TechniqueSpec;
+use shadowlab::compare::{CompareJob, ResultEntry, run_compare};
+use shadowlab::{BackendKind, Renderer, TechniqueRegistry};
+
+fn run(scene: &str, specs: &[&str]) -> Vec<ResultEntry> {
+    let s = scenes::build(scene, &SceneParams::default()).expect("scene");
+    let cam = s.cameras().next().expect("camera").0;
+    let frame = FrameInputs::from_scene(&s, cam).expect("frame");
+    let mut renderer = Renderer::new(TechniqueRegistry::builtin());
+    let job = CompareJob {
+        scene: scene.into(),
+        frame: &frame,
+        width: 512,
+        height: 512,
+        techniques: specs.iter().map(|t| TechniqueSpec::parse(t).expect("spec")).collect(),
+        backends: vec![BackendKind::Cpu],
+        out_dir: None,
+    };
+    run_compare(&mut renderer, &job, |_| {}).expect("compare").results
+}
+
+fn counter(r: &ResultEntry, name: &str) -> f64 {
+    r.counters.get(name).copied().unwrap_or_else(|| panic!("{} has no counter {name}", r.technique))
+}
+
+#[test]
+fn silhouette_pixels_get_shadow_volume_accuracy() {
+    let (mut rows, mut failures) = (Vec::new(), Vec::new());
+    for scene in scenes::names() {
+        let specs: &[&str] = if scene == "tree" { &["hybrid:res=512", "hybrid:res=1024"] } else { &["hybrid:res=512"] };
+        let r = run(scene, specs);
+        let m = r.last().expect("a result").vs_reference["mismatch"];
+        rows.push(format!("{scene:<14} {} {:.3}%", specs[specs.len() - 1], m * 100.0));
+        if m > 0.001 {
+            failures.push(format!("{scene}: {:.3}% > 0.1%", m * 100.0));
+        }
+    }
+    eprintln!("{}", rows.join("\n"));
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+#[test]
+fn the_computation_mask_saves_nine_tenths_of_the_fill() {
+    let (mut rows, mut failures) = (Vec::new(), Vec::new());
+    for scene in ["cubes", "cage", "tree"] {
+        let r = run(scene, &["hybrid:res=512,unmasked_fill=on", "shadow-volume-zfail"]);
+        let (processed, unmasked) = (counter(&r[0], "volume_fragments"), counter(&r[0], "unmasked_volume_fragments"));
+        let zfail = counter(&r[1], "volume_fragments");
+        let ratio = processed / zfail;
+        rows.push(format!("{scene:<6} processed {processed} of z-fail's {zfail} ({:.1}%)", ratio * 100.0));
+        if unmasked != zfail {
+            failures.push(format!("{scene}: unmasked fill {unmasked} is not z-fail's {zfail}"));
+        }
+        // Tree: 18% at 512^2 (its silhouette pixels are 9% of the view); not met, see the README.
+        if scene != "tree" && ratio > 0.1 {
+            failures.push(format!("{scene}: {:.1}% of z-fail's fill > 10%", ratio * 100.0));
+        }
+    }
+    eprintln!("{}", rows.join("\n"));
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
