@@ -342,7 +342,7 @@ fn a_computation_mask_confines_stencil_work_to_its_pixels() {
     let src = Soup { triangles: &tris, prim_base: 0, flip: false };
     let mut all = DepthStencil::new(w, h, 0.5, 0);
     let unmasked = draw_depth(&mut all, &src, &st);
-    let on = |x: u32, y: u32| (x * 7 + y * 13) % 29 == 0 || (40..52).contains(&x) && (10..30).contains(&y);
+    let on = |x: u32, y: u32| (x * 7 + y * 13).is_multiple_of(29) || (40..52).contains(&x) && (10..30).contains(&y);
     for tile in [4, 8] {
         let mask = ComputationMask::from_fn(w, h, tile, on);
         let mut ds = DepthStencil::new(w, h, 0.5, 0);
