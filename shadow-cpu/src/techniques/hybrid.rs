@@ -24,18 +24,42 @@ use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueEr
 use shadow_core::{FrameInputs, Image};
 use std::time::Instant;
 
-use super::shadow_volume::rasterize_volumes;
+use super::shadow_volume::{build_volumes, rasterize_volumes};
 use super::{map_position, per_receiver, render_depth_maps};
 use crate::context::{CpuBackend, CpuContext, CpuError};
 use crate::gbuffer::GBuffer;
 use crate::raster::{ComputationMask, DepthStencil};
 
-/// The maps and volumes of the last build; the last query's classes (for the debug view).
+/// The maps and volumes of the last build; what the last query decided with (for the debug view, which
+/// derives the classes from it only when asked).
 #[derive(Default)]
 pub struct State {
     maps: Vec<Image<f32>>,
     volumes: Option<Vec<InstanceVolume>>,
-    classes: Option<Image<PixelClass>>,
+    last: Option<LastQuery>,
+}
+
+/// The map's classes, the receivers and the volumes' stencil of the last query.
+struct LastQuery {
+    map_class: Image<MapClass>,
+    receiver: Image<bool>,
+    stencil: Vec<u8>,
+}
+
+impl LastQuery {
+    fn classes(&self) -> Image<PixelClass> {
+        let (w, h) = (self.map_class.width(), self.map_class.height());
+        Image::from_fn(w, h, |x, y| {
+            let i = (y * w + x) as usize;
+            match (self.receiver.data()[i], self.map_class.get(x, y), self.stencil[i] == 0) {
+                (false, ..) => PixelClass::None,
+                (true, MapClass::Lit, _) => PixelClass::MapLit,
+                (true, MapClass::Shadowed, _) => PixelClass::MapShadowed,
+                (true, MapClass::Silhouette, true) => PixelClass::VolumeLit,
+                (true, MapClass::Silhouette, false) => PixelClass::VolumeShadowed,
+            }
+        })
+    }
 }
 
 /// What decided a pixel, as the debug view shows it (thesis Fig. 3-5).
@@ -107,11 +131,7 @@ impl ShadowTechnique<CpuBackend> for Hybrid {
         stats: &mut FrameStats,
     ) -> Result<(), CpuError> {
         render_depth_maps(frame, light, self.depth.resolution, self.depth.depth_bias(), &mut state.maps)?;
-        let volumes = frame.shadow_volumes(light, Caps::Both);
-        let c = &mut stats.counters;
-        c.silhouette_edges = Some(volumes.iter().map(|v| v.silhouette_edges as u64).sum());
-        c.volume_triangles = Some(volumes.iter().map(|v| v.volume.triangle_count() as u64).sum());
-        state.volumes = Some(volumes);
+        state.volumes = Some(build_volumes(frame, light, Caps::Both, stats));
         Ok(())
     }
 
@@ -144,16 +164,6 @@ impl ShadowTechnique<CpuBackend> for Hybrid {
             MapClass::Shadowed => 0.0,
             MapClass::Silhouette => f32::from(u8::from(ds.stencil[i] == 0)),
         });
-        state.classes = Some(Image::from_fn(w, h, |x, y| {
-            let i = (y * w + x) as usize;
-            match (g.receiver.data()[i], map_class.get(x, y), ds.stencil[i] == 0) {
-                (false, ..) => PixelClass::None,
-                (true, MapClass::Lit, _) => PixelClass::MapLit,
-                (true, MapClass::Shadowed, _) => PixelClass::MapShadowed,
-                (true, MapClass::Silhouette, true) => PixelClass::VolumeLit,
-                (true, MapClass::Silhouette, false) => PixelClass::VolumeShadowed,
-            }
-        }));
         let counters = &mut stats.counters;
         counters.silhouette_pixels = Some(mask.count() as u64);
         counters.volume_fragments = Some(c.fragments);
@@ -161,6 +171,7 @@ impl ShadowTechnique<CpuBackend> for Hybrid {
         let (tiles, all_tiles) = mask.tiles_in();
         counters.extra.insert("mask_tiles".into(), tiles as f64);
         counters.extra.insert("mask_tiles_total".into(), all_tiles as f64);
+        state.last = Some(LastQuery { map_class, receiver: g.receiver.clone(), stencil: ds.stencil });
         if self.unmasked_fill == FillCount::On {
             let t = Instant::now();
             let mut scratch = DepthStencil::from_depth(&g.depth, 0);
@@ -173,11 +184,14 @@ impl ShadowTechnique<CpuBackend> for Hybrid {
 
     fn debug_views(&self, _: &mut CpuContext, state: &State) -> Result<Vec<DebugView>, CpuError> {
         Ok(state
-            .classes
+            .last
             .iter()
-            .map(|c| DebugView {
-                name: "classes".into(),
-                image: Image::from_fn(c.width(), c.height(), |x, y| c.get(x, y).colour()),
+            .map(|last| {
+                let c = last.classes();
+                DebugView {
+                    name: "classes".into(),
+                    image: Image::from_fn(c.width(), c.height(), |x, y| c.get(x, y).colour()),
+                }
             })
             .collect())
     }

@@ -31,6 +31,22 @@ pub struct State {
     volumes: Option<Vec<InstanceVolume>>,
 }
 
+/// The volumes of every caster with `caps`, and the build's counters (silhouette edges, volume
+/// triangles).
+#[must_use]
+pub fn build_volumes(
+    frame: &FrameInputs,
+    light: &LightView,
+    caps: Caps,
+    stats: &mut FrameStats,
+) -> Vec<InstanceVolume> {
+    let volumes = frame.shadow_volumes(light, caps);
+    let c = &mut stats.counters;
+    c.silhouette_edges = Some(volumes.iter().map(|v| v.silhouette_edges as u64).sum());
+    c.volume_triangles = Some(volumes.iter().map(|v| v.volume.triangle_count() as u64).sum());
+    volumes
+}
+
 /// Two-sided stencil state of a counting.
 #[must_use]
 pub fn stencil_state(counting: VolumeCounting) -> StencilState {
@@ -116,11 +132,7 @@ impl ShadowTechnique<CpuBackend> for ShadowVolume {
         stats: &mut FrameStats,
     ) -> Result<(), CpuError> {
         let caps = if self.counting == VolumeCounting::ZFail { Caps::Both } else { Caps::None };
-        let volumes = frame.shadow_volumes(light, caps);
-        let c = &mut stats.counters;
-        c.silhouette_edges = Some(volumes.iter().map(|v| v.silhouette_edges as u64).sum());
-        c.volume_triangles = Some(volumes.iter().map(|v| v.volume.triangle_count() as u64).sum());
-        state.volumes = Some(volumes);
+        state.volumes = Some(build_volumes(frame, light, caps, stats));
         Ok(())
     }
 
