@@ -166,7 +166,7 @@ impl TechniqueRegistry {
             keys: Hybrid::keys,
             canonical: canonical::<Hybrid>,
             cpu: Some(plain::<CpuBackend, Hybrid>),
-            wgpu: None,
+            wgpu: Some(plain::<WgpuBackend, Hybrid>),
         });
         r.register(TechniqueEntry {
             name: "shadow-volume-zpass",

@@ -89,6 +89,60 @@ pub enum MapClass {
     Silhouette,
 }
 
+/// What decided a pixel of `hybrid`, as its debug view shows it (Chan, thesis Fig. 3-5). The GPU writes
+/// the discriminants as codes (`from_code`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum PixelClass {
+    /// Not a receiver.
+    #[default]
+    None = 0,
+    /// The map: shadowed (red).
+    MapShadowed = 1,
+    /// The map: lit (blue).
+    MapLit = 2,
+    /// The volumes, at a silhouette pixel: shadowed (black).
+    VolumeShadowed = 3,
+    /// The volumes, at a silhouette pixel: lit (green).
+    VolumeLit = 4,
+}
+
+impl PixelClass {
+    /// The class of a code the GPU wrote (its discriminant); `None` for anything else.
+    #[must_use]
+    pub fn from_code(code: u32) -> Self {
+        match code {
+            1 => Self::MapShadowed,
+            2 => Self::MapLit,
+            3 => Self::VolumeShadowed,
+            4 => Self::VolumeLit,
+            _ => Self::None,
+        }
+    }
+
+    /// The class of a receiver from the map's class and, at a silhouette pixel, the volumes' answer.
+    #[must_use]
+    pub fn of(map: MapClass, volume_shadowed: bool) -> Self {
+        match (map, volume_shadowed) {
+            (MapClass::Lit, _) => Self::MapLit,
+            (MapClass::Shadowed, _) => Self::MapShadowed,
+            (MapClass::Silhouette, true) => Self::VolumeShadowed,
+            (MapClass::Silhouette, false) => Self::VolumeLit,
+        }
+    }
+
+    /// The thesis's colours; grey where nothing was decided.
+    #[must_use]
+    pub fn colour(self) -> crate::image::Rgb8 {
+        match self {
+            Self::None => [96, 96, 96],
+            Self::MapShadowed => [200, 30, 30],
+            Self::MapLit => [40, 70, 210],
+            Self::VolumeShadowed => [0, 0, 0],
+            Self::VolumeLit => [40, 200, 60],
+        }
+    }
+}
+
 /// Chan's classification (thesis Fig. 3-3) through the 2x2 texels a bilinear comparison would read
 /// (WGSL twin: `classify`). The thesis reads them through the hardware's filter and tests 0 < v < 1; the
 /// four texels are compared one by one here, so a receiver exactly on a texel row, whose filter weight

@@ -171,15 +171,22 @@ impl Shared {
             ],
         });
         let smod = shaders::module(device, "shade", shaders::shade());
-        let shade =
-            full_screen_pipeline(device, "shade", &smod, "fs_shade", &[&frame_layout, &shade_layout], COLOR, None);
+        let shade = full_screen_pipeline(
+            device,
+            "shade",
+            &smod,
+            "fs_shade",
+            &[&frame_layout, &shade_layout],
+            Some(COLOR),
+            None,
+        );
         let receivers = full_screen_pipeline(
             device,
             "receivers",
             &smod,
             "fs_receivers",
             &[&frame_layout, &shade_layout],
-            COLOR,
+            Some(COLOR),
             None,
         );
         Self { frame_layout, gbuffer, shade_layout, shade, receivers }
@@ -219,7 +226,8 @@ impl<'a> From<&'a str> for FragmentEntry<'a> {
     }
 }
 
-/// A pipeline drawing `vs_full_screen` into one colour target, optionally with a depth-stencil state.
+/// A pipeline drawing `vs_full_screen` into one colour target of `format` (none: a pass that only tests
+/// and writes the stencil), optionally with a depth-stencil state.
 #[must_use]
 pub fn full_screen_pipeline<'a>(
     device: &wgpu::Device,
@@ -227,11 +235,15 @@ pub fn full_screen_pipeline<'a>(
     module: &wgpu::ShaderModule,
     fragment: impl Into<FragmentEntry<'a>>,
     groups: &[&wgpu::BindGroupLayout],
-    format: wgpu::TextureFormat,
+    format: Option<wgpu::TextureFormat>,
     depth_stencil: Option<wgpu::DepthStencilState>,
 ) -> wgpu::RenderPipeline {
     let groups: Vec<Option<&wgpu::BindGroupLayout>> = groups.iter().map(|g| Some(*g)).collect();
     let fragment = fragment.into();
+    let targets: Vec<_> = format
+        .map(|format| Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL }))
+        .into_iter()
+        .collect();
     let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some(label),
         bind_group_layouts: &groups,
@@ -256,7 +268,7 @@ pub fn full_screen_pipeline<'a>(
                 constants: fragment.constants,
                 ..Default::default()
             },
-            targets: &[Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL })],
+            targets: &targets,
         }),
         multiview_mask: None,
         cache: None,

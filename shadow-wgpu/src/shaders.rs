@@ -51,6 +51,12 @@ pub fn silhouette_query() -> String {
     format!("{}\n{}", shadow_map(), include_str!("shaders/silhouette_query.wgsl"))
 }
 
+/// Hybrid maps and volumes: the classification, the mask and the answer, after the shadow-map shader.
+#[must_use]
+pub fn hybrid() -> String {
+    format!("{}\n{}", shadow_map(), include_str!("shaders/hybrid.wgsl"))
+}
+
 /// Depth-layer passes (peeling and combination).
 #[must_use]
 pub fn depth_layers() -> String {
@@ -81,6 +87,7 @@ pub fn all() -> Vec<(&'static str, String)> {
         ("depth_layers", depth_layers()),
         ("silhouette_build", silhouette_build()),
         ("silhouette_query", silhouette_query()),
+        ("hybrid", hybrid()),
     ]
 }
 

@@ -15,9 +15,8 @@
 use rayon::prelude::*;
 use shadow_core::frame::InstanceVolume;
 use shadow_core::geometry::volume::Caps;
-use shadow_core::image::Rgb8;
 use shadow_core::light::LightView;
-use shadow_core::lookup::{MapClass, classify};
+use shadow_core::lookup::{MapClass, PixelClass, classify};
 use shadow_core::stats::ms;
 use shadow_core::technique::hard::{FillCount, Hybrid, VolumeCounting};
 use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
@@ -51,44 +50,12 @@ impl LastQuery {
         let (w, h) = (self.map_class.width(), self.map_class.height());
         Image::from_fn(w, h, |x, y| {
             let i = (y * w + x) as usize;
-            match (self.receiver.data()[i], self.map_class.get(x, y), self.stencil[i] == 0) {
-                (false, ..) => PixelClass::None,
-                (true, MapClass::Lit, _) => PixelClass::MapLit,
-                (true, MapClass::Shadowed, _) => PixelClass::MapShadowed,
-                (true, MapClass::Silhouette, true) => PixelClass::VolumeLit,
-                (true, MapClass::Silhouette, false) => PixelClass::VolumeShadowed,
+            if self.receiver.data()[i] {
+                PixelClass::of(*self.map_class.get(x, y), self.stencil[i] != 0)
+            } else {
+                PixelClass::None
             }
         })
-    }
-}
-
-/// What decided a pixel, as the debug view shows it (thesis Fig. 3-5).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum PixelClass {
-    /// Not a receiver.
-    #[default]
-    None,
-    /// The map: shadowed (red).
-    MapShadowed,
-    /// The map: lit (blue).
-    MapLit,
-    /// The volumes, at a silhouette pixel: shadowed (black).
-    VolumeShadowed,
-    /// The volumes, at a silhouette pixel: lit (green).
-    VolumeLit,
-}
-
-impl PixelClass {
-    /// The thesis's colours; grey where nothing was decided.
-    #[must_use]
-    pub fn colour(self) -> Rgb8 {
-        match self {
-            Self::None => [96, 96, 96],
-            Self::MapShadowed => [200, 30, 30],
-            Self::MapLit => [40, 70, 210],
-            Self::VolumeShadowed => [0, 0, 0],
-            Self::VolumeLit => [40, 200, 60],
-        }
     }
 }
 

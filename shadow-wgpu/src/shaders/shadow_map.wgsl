@@ -134,6 +134,13 @@ fn shadow_lookup(layer: i32, uv: vec2<f32>, depth: f32, pixel: vec2<u32>) -> f32
     return sum / 16.0;
 }
 
+// The direction towards the light of `map` (common.wgsl's `to_light`; the cone is not needed).
+fn map_to_light(p: vec3<f32>) -> vec3<f32> {
+    let kind = vec4<u32>(u32(map.light.w));
+    let light = Light(kind, vec4<f32>(map.light.xyz, 1.0), map.direction, vec4<f32>(0.0), vec4<f32>(0.0));
+    return to_light(light, p);
+}
+
 // Where a receiver looks into the maps. Twin: shadow-cpu's `MapPosition`.
 struct MapPoint {
     layer: i32,
@@ -147,11 +154,7 @@ struct MapPoint {
 fn map_point(receiver: vec3<f32>) -> MapPoint {
     var p = receiver;
     if (map.settings.w != 0.0) {
-        var to_light = -map.direction.xyz;
-        if (map.light.w != 1.0) {
-            to_light = normalize(map.light.xyz - p);
-        }
-        p = p + to_light * map.settings.w;
+        p = p + map_to_light(p) * map.settings.w;
     }
     var layer = 0;
     if (map.light.w == 2.0) {

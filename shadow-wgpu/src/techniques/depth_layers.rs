@@ -13,7 +13,7 @@ use shadow_core::technique::settings::Filter;
 use shadow_core::technique::{FrameStats, ShadowTechnique, TechniqueError};
 use wgpu::util::DeviceExt;
 
-use super::shadow_map::{MapQuery, QueryExtras, map_texture};
+use super::shadow_map::{LookupParams, MapQuery, QueryExtras, map_texture};
 use crate::context::{WgpuBackend, WgpuContext, WgpuError};
 use crate::frame::{GpuVisibility, layer_view};
 use crate::gbuffer::{GpuGBuffer, check_size};
@@ -280,6 +280,7 @@ impl ShadowTechnique<WgpuBackend> for DepthLayers {
         _: &mut FrameStats,
     ) -> Result<(), WgpuError> {
         let maps = state.maps.as_ref().ok_or_else(|| TechniqueError::NotBuilt(self.name().into()))?;
-        state.query.run(cx, maps, light, g, out, self.filter_radius, 0.0, &QueryExtras::NONE)
+        let lookup = LookupParams { radius: self.filter_radius, receiver_offset: 0.0 };
+        state.query.run(cx, maps, light, g, out, lookup, &QueryExtras::NONE)
     }
 }

@@ -1,6 +1,7 @@
 //! GPU versions of the techniques, each next to its WGSL in `shaders/`; helpers they share.
 
 pub mod depth_layers;
+pub mod hybrid;
 pub mod shadow_map;
 pub mod shadow_volume;
 pub mod silhouette_map;

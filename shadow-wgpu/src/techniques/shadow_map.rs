@@ -32,10 +32,9 @@ struct MapParams {
     extra: [f32; 4],
 }
 
-/// The lookup every map-based technique shares (twin: `query_maps` in shadow-cpu): a full-screen pass
-/// running `shadow_lookup` of shadow_map.wgsl over the G-buffer.
-pub struct MapQuery {
-    pipeline: wgpu::RenderPipeline,
+/// The bindings every map lookup shares (group 1, bindings 0 to 3: G-buffer positions, the maps, the
+/// comparison sampler, `MapParams`), with a technique's own from 4 on.
+pub struct MapBindings {
     layout: wgpu::BindGroupLayout,
     sampler: wgpu::Sampler,
 }
@@ -51,6 +50,113 @@ pub struct QueryExtras<'a> {
 impl QueryExtras<'_> {
     /// None: the plain shadow-map query.
     pub const NONE: QueryExtras<'static> = QueryExtras { settings: [0.0; 4], entries: &[] };
+}
+
+/// How a map lookup reads the maps: the filter's kernel radius in texels and the receiver offset
+/// towards the light (`bias=world`).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct LookupParams {
+    /// Kernel radius in texels (jittered and Poisson filters).
+    pub radius: f32,
+    /// World distance a receiver moves towards the light before the lookup.
+    pub receiver_offset: f32,
+}
+
+impl MapBindings {
+    /// The layout: the shared bindings 0 to 3 and `extra` from 4 on.
+    #[must_use]
+    pub fn new(cx: &WgpuContext, extra: &[wgpu::BindGroupLayoutEntry]) -> Self {
+        let mut entries = vec![
+            attribute_entry(0),
+            depth_array_entry(1),
+            wgpu::BindGroupLayoutEntry {
+                binding: 2,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
+                count: None,
+            },
+            buffer_entry(3, wgpu::BufferBindingType::Uniform, wgpu::ShaderStages::FRAGMENT),
+        ];
+        entries.extend_from_slice(extra);
+        let layout = cx
+            .device
+            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("map query"), entries: &entries });
+        let sampler = cx.device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("shadow comparison"),
+            address_mode_u: wgpu::AddressMode::ClampToEdge,
+            address_mode_v: wgpu::AddressMode::ClampToEdge,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            compare: Some(wgpu::CompareFunction::LessEqual),
+            ..Default::default()
+        });
+        Self { layout, sampler }
+    }
+
+    /// The group-1 layout, for pipelines that look into the maps.
+    #[must_use]
+    pub fn layout(&self) -> &wgpu::BindGroupLayout {
+        &self.layout
+    }
+
+    /// The group for looking into `maps` (one layer per projection of `light`) from the receivers of `g`.
+    #[must_use]
+    pub fn group(
+        &self,
+        cx: &WgpuContext,
+        maps: &wgpu::Texture,
+        light: &LightView,
+        g: &GpuGBuffer,
+        lookup: LookupParams,
+        extras: &QueryExtras<'_>,
+    ) -> wgpu::BindGroup {
+        let (mut proj, mut planes) = ([[[0.0f32; 4]; 4]; 6], [[[0.0f32; 4]; 4]; 6]);
+        for ((slot, plane), p) in proj.iter_mut().zip(&mut planes).zip(&light.projections) {
+            *slot = p.clip_from_world.to_cols_array_2d();
+            *plane = p.clip_plane_from_world_plane.to_cols_array_2d();
+        }
+        let (pos, dir, kind) = match light.light.kind {
+            LightKind::Spot { position, direction, .. } => (position, direction, 0.0),
+            LightKind::Directional { direction } => (glam::Vec3::ZERO, direction, 1.0),
+            LightKind::Point { position } => (position, glam::Vec3::NEG_Y, 2.0),
+        };
+        let params = MapParams {
+            proj,
+            light: pos.extend(kind).to_array(),
+            direction: dir.normalize().extend(0.0).to_array(),
+            settings: [0.0, lookup.radius, maps.width() as f32, lookup.receiver_offset],
+            planes,
+            extra: extras.settings,
+        };
+        let ubuf = cx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("map params"),
+            contents: bytemuck::bytes_of(&params),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let maps_view = maps.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        });
+        let mut entries = vec![
+            wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&g.position) },
+            wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&maps_view) },
+            wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&self.sampler) },
+            wgpu::BindGroupEntry { binding: 3, resource: ubuf.as_entire_binding() },
+        ];
+        entries.extend_from_slice(extras.entries);
+        cx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("map query"),
+            layout: &self.layout,
+            entries: &entries,
+        })
+    }
+}
+
+/// The lookup every map-based technique shares (twin: `query_maps` in shadow-cpu): a full-screen pass
+/// running `shadow_lookup` of shadow_map.wgsl over the G-buffer.
+pub struct MapQuery {
+    pipeline: wgpu::RenderPipeline,
+    bindings: MapBindings,
 }
 
 impl MapQuery {
@@ -70,40 +176,17 @@ impl MapQuery {
         entry: FragmentEntry<'_>,
         extra: &[wgpu::BindGroupLayoutEntry],
     ) -> Self {
-        let mut entries = vec![
-            attribute_entry(0),
-            depth_array_entry(1),
-            wgpu::BindGroupLayoutEntry {
-                binding: 2,
-                visibility: wgpu::ShaderStages::FRAGMENT,
-                ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
-                count: None,
-            },
-            buffer_entry(3, wgpu::BufferBindingType::Uniform, wgpu::ShaderStages::FRAGMENT),
-        ];
-        entries.extend_from_slice(extra);
-        let layout = cx
-            .device
-            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("map query"), entries: &entries });
+        let bindings = MapBindings::new(cx, extra);
         let pipeline = full_screen_pipeline(
             &cx.device,
             "map query",
             module,
             entry,
-            &[&cx.shared.frame_layout, &layout],
-            VISIBILITY,
+            &[&cx.shared.frame_layout, bindings.layout()],
+            Some(VISIBILITY),
             None,
         );
-        let sampler = cx.device.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("shadow comparison"),
-            address_mode_u: wgpu::AddressMode::ClampToEdge,
-            address_mode_v: wgpu::AddressMode::ClampToEdge,
-            mag_filter: wgpu::FilterMode::Linear,
-            min_filter: wgpu::FilterMode::Linear,
-            compare: Some(wgpu::CompareFunction::LessEqual),
-            ..Default::default()
-        });
-        Self { pipeline, layout, sampler }
+        Self { pipeline, bindings }
     }
 
     /// Writes the visibility of every receiver through the maps (one layer per light projection).
@@ -118,50 +201,11 @@ impl MapQuery {
         light: &LightView,
         g: &GpuGBuffer,
         out: &GpuVisibility,
-        radius: f32,
-        receiver_offset: f32,
+        lookup: LookupParams,
         extras: &QueryExtras<'_>,
     ) -> Result<(), WgpuError> {
-        let (mut proj, mut planes) = ([[[0.0f32; 4]; 4]; 6], [[[0.0f32; 4]; 4]; 6]);
-        for ((slot, plane), p) in proj.iter_mut().zip(&mut planes).zip(&light.projections) {
-            *slot = p.clip_from_world.to_cols_array_2d();
-            *plane = p.clip_plane_from_world_plane.to_cols_array_2d();
-        }
-        let (pos, dir, kind) = match light.light.kind {
-            LightKind::Spot { position, direction, .. } => (position, direction, 0.0),
-            LightKind::Directional { direction } => (glam::Vec3::ZERO, direction, 1.0),
-            LightKind::Point { position } => (position, glam::Vec3::NEG_Y, 2.0),
-        };
-        let params = MapParams {
-            proj,
-            light: pos.extend(kind).to_array(),
-            direction: dir.normalize().extend(0.0).to_array(),
-            settings: [0.0, radius, maps.width() as f32, receiver_offset],
-            planes,
-            extra: extras.settings,
-        };
         cx.scoped("the shadow-map query", |cx| {
-            let ubuf = cx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("map params"),
-                contents: bytemuck::bytes_of(&params),
-                usage: wgpu::BufferUsages::UNIFORM,
-            });
-            let maps_view = maps.create_view(&wgpu::TextureViewDescriptor {
-                dimension: Some(wgpu::TextureViewDimension::D2Array),
-                ..Default::default()
-            });
-            let mut entries = vec![
-                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&g.position) },
-                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&maps_view) },
-                wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&self.sampler) },
-                wgpu::BindGroupEntry { binding: 3, resource: ubuf.as_entire_binding() },
-            ];
-            entries.extend_from_slice(extras.entries);
-            let group = cx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("map query"),
-                layout: &self.layout,
-                entries: &entries,
-            });
+            let group = self.bindings.group(cx, maps, light, g, lookup, extras);
             crate::techniques::full_screen(cx, "map query", &out.view, &self.pipeline, &[&g.frame_group, &group], None);
         })
     }
@@ -172,6 +216,14 @@ pub struct State {
     depth: wgpu::RenderPipeline,
     query: MapQuery,
     maps: Option<wgpu::Texture>,
+}
+
+impl State {
+    /// The maps of the last build, one layer per light projection.
+    #[must_use]
+    pub fn maps(&self) -> Option<&wgpu::Texture> {
+        self.maps.as_ref()
+    }
 }
 
 /// The depth-bias state of a shadow-map's light pass. wgpu takes the constant factor as an integer (in
@@ -368,6 +420,7 @@ impl ShadowTechnique<WgpuBackend> for ShadowMap {
         _: &mut FrameStats,
     ) -> Result<(), WgpuError> {
         let maps = state.maps.as_ref().ok_or_else(|| TechniqueError::NotBuilt(self.name().into()))?;
-        state.query.run(cx, maps, light, g, out, self.filter_radius, self.receiver_offset(), &QueryExtras::NONE)
+        let lookup = LookupParams { radius: self.filter_radius, receiver_offset: self.receiver_offset() };
+        state.query.run(cx, maps, light, g, out, lookup, &QueryExtras::NONE)
     }
 }

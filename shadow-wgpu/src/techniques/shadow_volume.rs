@@ -22,7 +22,7 @@ use crate::pipelines::{DEPTH_STENCIL, POSITION_LAYOUT, VISIBILITY, attribute_ent
 use crate::shaders;
 
 /// One draw of volume geometry: vertices, optional indices, instance, winding.
-struct VolumeDraw {
+pub(crate) struct VolumeDraw {
     vertices: Option<wgpu::Buffer>,
     indices: Option<(wgpu::Buffer, u32)>,
     count: u32,
@@ -42,17 +42,28 @@ pub struct State {
     draws: Vec<VolumeDraw>,
 }
 
-fn stencil_faces(counting: VolumeCounting) -> (wgpu::StencilFaceState, wgpu::StencilFaceState) {
+/// The depth-stencil state of a volume pass counting `counting`'s way with wrapping ops in the bits of
+/// `write_mask`, on the fragments whose stencil passes `test` against the reference under `read_mask`;
+/// the depth test `Less`, no depth writes.
+pub(crate) fn counting_state(
+    counting: VolumeCounting,
+    test: wgpu::CompareFunction,
+    read_mask: u32,
+    write_mask: u32,
+) -> wgpu::DepthStencilState {
     use wgpu::StencilOperation as Op;
-    let face = |pass_op, depth_fail_op| wgpu::StencilFaceState {
-        compare: wgpu::CompareFunction::Always,
-        fail_op: Op::Keep,
-        depth_fail_op,
-        pass_op,
-    };
-    match counting {
+    let face =
+        |pass_op, depth_fail_op| wgpu::StencilFaceState { compare: test, fail_op: Op::Keep, depth_fail_op, pass_op };
+    let (front, back) = match counting {
         VolumeCounting::ZPass => (face(Op::IncrementWrap, Op::Keep), face(Op::DecrementWrap, Op::Keep)),
         VolumeCounting::ZFail => (face(Op::Keep, Op::DecrementWrap), face(Op::Keep, Op::IncrementWrap)),
+    };
+    wgpu::DepthStencilState {
+        format: DEPTH_STENCIL,
+        depth_write_enabled: Some(false),
+        depth_compare: Some(wgpu::CompareFunction::Less),
+        stencil: wgpu::StencilState { front, back, read_mask, write_mask },
+        bias: Default::default(),
     }
 }
 
@@ -101,16 +112,9 @@ impl ShadowTechnique<WgpuBackend> for ShadowVolume {
         let counting = self.counting;
         cx.scoped("creating the shadow-volume pipelines", |cx| {
             let module = shaders::module(&cx.device, "shadow_volume", shaders::shadow_volume());
-            let (front, back) = stencil_faces(counting);
-            let counting_state = wgpu::DepthStencilState {
-                format: DEPTH_STENCIL,
-                depth_write_enabled: Some(false),
-                depth_compare: Some(wgpu::CompareFunction::Less),
-                stencil: wgpu::StencilState { front, back, read_mask: 0xff, write_mask: 0xff },
-                bias: Default::default(),
-            };
-            let ccw = volume_pipeline(cx, &module, "vs_volume", wgpu::FrontFace::Ccw, counting_state.clone());
-            let cw = volume_pipeline(cx, &module, "vs_volume", wgpu::FrontFace::Cw, counting_state);
+            let state = counting_state(counting, wgpu::CompareFunction::Always, 0xff, 0xff);
+            let ccw = volume_pipeline(cx, &module, "vs_volume", wgpu::FrontFace::Ccw, state.clone());
+            let cw = volume_pipeline(cx, &module, "vs_volume", wgpu::FrontFace::Cw, state);
             let all = wgpu::DepthStencilState {
                 format: DEPTH_STENCIL,
                 depth_write_enabled: Some(false),
@@ -133,12 +137,7 @@ impl ShadowTechnique<WgpuBackend> for ShadowVolume {
         stats: &mut FrameStats,
     ) -> Result<(), WgpuError> {
         let caps = if self.counting == VolumeCounting::ZFail { Caps::Both } else { Caps::None };
-        let volumes = frame.shadow_volumes(light, caps);
-        let c = &mut stats.counters;
-        c.silhouette_edges = Some(volumes.iter().map(|v| v.silhouette_edges as u64).sum());
-        c.volume_triangles = Some(volumes.iter().map(|v| v.volume.triangle_count() as u64).sum());
-        cx.cache.upload_meshes(&cx.device, frame);
-        state.draws = cx.scoped("uploading shadow volumes", |cx| upload(cx, frame, &volumes))?;
+        state.draws = build_draws(cx, frame, light, caps, stats)?;
         Ok(())
     }
 
@@ -156,8 +155,15 @@ impl ShadowTechnique<WgpuBackend> for ShadowVolume {
             return Err(TechniqueError::NotBuilt(self.name().into()).into());
         }
         let depth = g.depth_view();
+        let counting = VolumePass {
+            label: "shadow volumes",
+            ccw: &state.ccw,
+            cw: &state.cw,
+            stencil: wgpu::LoadOp::Clear(0),
+            reference: 0,
+        };
         let passed = cx.scoped("the shadow-volume pass", |cx| {
-            let q = occlusion_pass(cx, state, frame, g, &depth, false);
+            let q = counting.run(cx, &state.draws, frame, g, &depth);
             state.resolve.run(cx, g, out, &depth);
             q
         })?;
@@ -165,7 +171,8 @@ impl ShadowTechnique<WgpuBackend> for ShadowVolume {
         // Every rasterized fragment, for Sen's overdraw: a second pass with the depth test off. It runs
         // after the resolve, so it does not disturb the result; its time lands in a separate sub-phase.
         let t = std::time::Instant::now();
-        let all = cx.scoped("the volume fragment count", |cx| occlusion_pass(cx, state, frame, g, &depth, true))?;
+        let every = VolumePass::count(&state.count_all, "count volume fragments");
+        let all = cx.scoped("the volume fragment count", |cx| every.run(cx, &state.draws, frame, g, &depth))?;
         let all = read_query(cx, &all)?;
         stats.timings.extra.insert("count_fragments".into(), shadow_core::stats::ms(t.elapsed()));
         let c = &mut stats.counters;
@@ -207,7 +214,7 @@ impl StencilResolve {
             module,
             "fs_volume_resolve",
             &[&cx.shared.frame_layout, &layout],
-            VISIBILITY,
+            Some(VISIBILITY),
             Some(state),
         );
         Self { pipeline, layout }
@@ -239,6 +246,23 @@ pub(crate) fn occlusion_query(cx: &WgpuContext) -> (wgpu::QuerySet, wgpu::Buffer
         mapped_at_creation: false,
     });
     (set, resolve)
+}
+
+/// Builds the volumes of `light`'s casters with `caps` (shared geometry), records their counters
+/// (silhouette edges, volume triangles) and uploads them.
+pub(crate) fn build_draws(
+    cx: &mut WgpuContext,
+    frame: &FrameInputs,
+    light: &LightView,
+    caps: Caps,
+    stats: &mut FrameStats,
+) -> Result<Vec<VolumeDraw>, WgpuError> {
+    let volumes = frame.shadow_volumes(light, caps);
+    let c = &mut stats.counters;
+    c.silhouette_edges = Some(volumes.iter().map(|v| v.silhouette_edges as u64).sum());
+    c.volume_triangles = Some(volumes.iter().map(|v| v.volume.triangle_count() as u64).sum());
+    cx.cache.upload_meshes(&cx.device, frame);
+    cx.scoped("uploading shadow volumes", |cx| upload(cx, frame, &volumes))
 }
 
 /// Uploads the volumes: sides and far caps as homogeneous vertices, near caps as index lists into the
@@ -317,64 +341,78 @@ fn upload(cx: &WgpuContext, frame: &FrameInputs, volumes: &[InstanceVolume]) -> 
     draws
 }
 
-/// One pass over every volume draw inside an occlusion query; `all` counts every fragment instead.
-fn occlusion_pass(
-    cx: &WgpuContext,
-    state: &State,
-    frame: &FrameInputs,
-    g: &GpuGBuffer,
-    depth: &wgpu::TextureView,
-    all: bool,
-) -> (wgpu::QuerySet, wgpu::Buffer) {
-    let (set, resolve) = occlusion_query(cx);
-    let mut enc = cx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("volumes") });
-    {
-        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("volumes"),
-            color_attachments: &[],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: depth,
-                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store }),
-                stencil_ops: Some(wgpu::Operations {
-                    load: if all { wgpu::LoadOp::Load } else { wgpu::LoadOp::Clear(0) },
-                    store: wgpu::StoreOp::Store,
-                }),
-            }),
-            timestamp_writes: None,
-            occlusion_query_set: Some(&set),
-            multiview_mask: None,
-        });
-        pass.push_debug_group(if all { "count volume fragments" } else { "shadow volumes" });
-        pass.set_bind_group(0, &g.frame_group, &[]);
-        pass.begin_occlusion_query(0);
-        for d in &state.draws {
-            pass.set_pipeline(if all {
-                &state.count_all
-            } else if d.cw {
-                &state.cw
-            } else {
-                &state.ccw
-            });
-            let mesh = frame.instances.get(d.instance as usize).and_then(|i| cx.cache.mesh(i.mesh_key));
-            match (&d.vertices, d.mesh_vertices, mesh) {
-                (Some(v), _, _) => pass.set_vertex_buffer(0, v.slice(..)),
-                (None, true, Some(m)) => pass.set_vertex_buffer(0, m.positions.slice(..)),
-                _ => continue,
-            }
-            match &d.indices {
-                Some((ib, n)) => {
-                    pass.set_index_buffer(ib.slice(..), wgpu::IndexFormat::Uint32);
-                    pass.draw_indexed(0..*n, 0, d.instance..d.instance + 1);
-                }
-                None => pass.draw(0..d.count, d.instance..d.instance + 1),
-            }
-        }
-        pass.end_occlusion_query();
-        pass.pop_debug_group();
+/// One pass over every volume draw inside an occlusion query: the pipelines for either winding, how the
+/// stencil starts and the stencil reference.
+pub(crate) struct VolumePass<'a> {
+    /// For debuggers.
+    pub label: &'static str,
+    /// The pipeline for counter-clockwise front faces.
+    pub ccw: &'a wgpu::RenderPipeline,
+    /// The pipeline for clockwise front faces.
+    pub cw: &'a wgpu::RenderPipeline,
+    /// Clear or keep the stencil.
+    pub stencil: wgpu::LoadOp<u32>,
+    /// The stencil reference the pipelines test against.
+    pub reference: u32,
+}
+
+impl<'a> VolumePass<'a> {
+    /// A counting pass: `pipeline` for both windings (it does not cull), the stencil kept.
+    pub(crate) fn count(pipeline: &'a wgpu::RenderPipeline, label: &'static str) -> Self {
+        Self { label, ccw: pipeline, cw: pipeline, stencil: wgpu::LoadOp::Load, reference: 0 }
     }
-    enc.resolve_query_set(&set, 0..1, &resolve, 0);
-    cx.queue.submit([enc.finish()]);
-    (set, resolve)
+
+    /// Draws `draws` over the depth-stencil `depth` of `g`; the query counts the samples that pass.
+    pub(crate) fn run(
+        &self,
+        cx: &WgpuContext,
+        draws: &[VolumeDraw],
+        frame: &FrameInputs,
+        g: &GpuGBuffer,
+        depth: &wgpu::TextureView,
+    ) -> (wgpu::QuerySet, wgpu::Buffer) {
+        let (set, resolve) = occlusion_query(cx);
+        let mut enc = cx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(self.label) });
+        {
+            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some(self.label),
+                color_attachments: &[],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: depth,
+                    depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store }),
+                    stencil_ops: Some(wgpu::Operations { load: self.stencil, store: wgpu::StoreOp::Store }),
+                }),
+                timestamp_writes: None,
+                occlusion_query_set: Some(&set),
+                multiview_mask: None,
+            });
+            pass.push_debug_group(self.label);
+            pass.set_bind_group(0, &g.frame_group, &[]);
+            pass.set_stencil_reference(self.reference);
+            pass.begin_occlusion_query(0);
+            for d in draws {
+                pass.set_pipeline(if d.cw { self.cw } else { self.ccw });
+                let mesh = frame.instances.get(d.instance as usize).and_then(|i| cx.cache.mesh(i.mesh_key));
+                match (&d.vertices, d.mesh_vertices, mesh) {
+                    (Some(v), _, _) => pass.set_vertex_buffer(0, v.slice(..)),
+                    (None, true, Some(m)) => pass.set_vertex_buffer(0, m.positions.slice(..)),
+                    _ => continue,
+                }
+                match &d.indices {
+                    Some((ib, n)) => {
+                        pass.set_index_buffer(ib.slice(..), wgpu::IndexFormat::Uint32);
+                        pass.draw_indexed(0..*n, 0, d.instance..d.instance + 1);
+                    }
+                    None => pass.draw(0..d.count, d.instance..d.instance + 1),
+                }
+            }
+            pass.end_occlusion_query();
+            pass.pop_debug_group();
+        }
+        enc.resolve_query_set(&set, 0..1, &resolve, 0);
+        cx.queue.submit([enc.finish()]);
+        (set, resolve)
+    }
 }
 
 /// Reads an occlusion query's resolved count.

@@ -18,7 +18,9 @@ use shadow_core::technique::hard::SilhouetteMap;
 use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
 use wgpu::util::DeviceExt;
 
-use super::shadow_map::{MapQuery, QueryExtras, depth_bias, light_pass_pipeline, map_texture, render_maps};
+use super::shadow_map::{
+    LookupParams, MapQuery, QueryExtras, depth_bias, light_pass_pipeline, map_texture, render_maps,
+};
 use crate::context::{WgpuBackend, WgpuContext, WgpuError};
 use crate::frame::{GpuVisibility, layer_view, layered};
 use crate::gbuffer::{GpuGBuffer, check_size};
@@ -395,8 +397,8 @@ impl ShadowTechnique<WgpuBackend> for SilhouetteMap {
         ];
         let receiver_plane = if self.corner_depth == CornerDepth::ReceiverPlane { 1.0 } else { 0.0 };
         let extras = QueryExtras { settings: [receiver_plane, 0.0, 0.0, 0.0], entries: &entries };
-        let offset = self.depth.receiver_offset();
-        state.query.run(cx, &maps.depth, light, g, out, 0.0, offset, &extras)?;
+        let lookup = LookupParams { radius: 0.0, receiver_offset: self.depth.receiver_offset() };
+        state.query.run(cx, &maps.depth, light, g, out, lookup, &extras)?;
         // The counters cost a compute pass and a readback that the technique itself does not need: a
         // sub-phase of their own, after the query's work is done, so they can be told apart.
         cx.wait()?;

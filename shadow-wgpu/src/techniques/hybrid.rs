@@ -1,0 +1,359 @@
+//! `hybrid` (Chan, thesis chapter 3) on the GPU (twin: shadow-cpu's techniques/hybrid.rs).
+//!
+//! Build: the classifying maps, rendered as `shadow-map` renders them, and the z-fail volumes, built and
+//! uploaded as `shadow-volume-zfail` does. Query, the thesis's section 3.2 in three passes over the
+//! G-buffer's depth-stencil:
+//!
+//! 1. **Mask.** A full-screen pass classifies each receiver against the four nearest texels and discards
+//!    every pixel but the silhouette pixels, on which the stencil's bit 7 is set ([`MASK`]).
+//! 2. **Volumes.** The z-fail volumes, with the stencil test "bit 7 set": outside the mask the hardware's
+//!    early stencil test rejects the fragments before any other work. The count wraps in the other seven
+//!    bits ([`COUNT`]), so it is exact up to 127 overlapping volumes.
+//! 3. **Answer.** One colour pass, two draws: outside the mask the map's answer; inside it, 0 where the
+//!    count is not 0 (the stencil is above 0x80). Silhouette pixels the volumes leave lit keep the cleared 1.
+//!
+//! The map's classification runs twice, in the mask pass on every pixel and in the answer outside the
+//! mask: a full-screen pass can write a colour or set the stencil for the pixels it keeps, but not both
+//! for different pixels, and one more 4-texel lookup costs less than a class target written and read.
+//!
+//! Counters come from occlusion queries: the mask pass's samples are `silhouette_pixels`; after the
+//! answer, a pass with the depth test off and the mask's stencil test counts `volume_fragments` (those the
+//! mask lets through), and with `unmasked_fill=on` one without the stencil test counts
+//! `unmasked_volume_fragments`; both are timed as the sub-phase `count_fragments`.
+
+use shadow_core::FrameInputs;
+use shadow_core::Image;
+use shadow_core::geometry::volume::Caps;
+use shadow_core::light::LightView;
+use shadow_core::lookup::PixelClass;
+use shadow_core::technique::hard::{FillCount, Hybrid, ShadowMap, VolumeCounting};
+use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
+
+use super::shadow_map::{LookupParams, MapBindings, QueryExtras};
+use super::shadow_volume::{
+    VolumeDraw, VolumePass, build_draws, counting_state, occlusion_query, read_query, volume_pipeline,
+};
+use crate::context::{WgpuBackend, WgpuContext, WgpuError};
+use crate::frame::GpuVisibility;
+use crate::gbuffer::GpuGBuffer;
+use crate::pipelines::{DEPTH_STENCIL, FragmentEntry, VISIBILITY, attribute_entry, full_screen_pipeline};
+use crate::{readback, shaders};
+
+/// The stencil bit of the computation mask.
+pub const MASK: u32 = 0x80;
+/// The stencil bits the volumes count in.
+pub const COUNT: u32 = 0x7f;
+
+/// The format of the debug view's class codes.
+const CODES: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
+
+/// Pipelines, the maps and volumes of the last build, and what the debug view needs of the last query.
+pub struct State {
+    /// The classifying maps (`shadow-map`'s own build).
+    map: super::shadow_map::State,
+    bindings: MapBindings,
+    module: wgpu::ShaderModule,
+    mask: wgpu::RenderPipeline,
+    volumes_ccw: wgpu::RenderPipeline,
+    volumes_cw: wgpu::RenderPipeline,
+    answer_map: wgpu::RenderPipeline,
+    answer_shadowed: wgpu::RenderPipeline,
+    count_masked: wgpu::RenderPipeline,
+    count_all: wgpu::RenderPipeline,
+    draws: Option<Vec<VolumeDraw>>,
+    last: Option<LastQuery>,
+}
+
+/// The bindings and the depth-stencil of the last query, for the classes view.
+struct LastQuery {
+    frame_group: wgpu::BindGroup,
+    map_group: wgpu::BindGroup,
+    depth: wgpu::Texture,
+}
+
+/// A depth-stencil state that only tests the stencil: `compare` against the reference under `read_mask`,
+/// the depth test off, nothing written.
+fn stencil_test(compare: wgpu::CompareFunction, read_mask: u32) -> wgpu::DepthStencilState {
+    let face = wgpu::StencilFaceState { compare, ..Default::default() };
+    wgpu::DepthStencilState {
+        format: DEPTH_STENCIL,
+        depth_write_enabled: Some(false),
+        depth_compare: Some(wgpu::CompareFunction::Always),
+        stencil: wgpu::StencilState { front: face, back: face, read_mask, write_mask: 0 },
+        bias: Default::default(),
+    }
+}
+
+/// The stencil tests of the answer's draws, each with its reference: outside the mask; inside it with a
+/// count that is not 0 (the stencil above `MASK`); inside it with a count of 0.
+const OUTSIDE: (wgpu::CompareFunction, u32, u32) = (wgpu::CompareFunction::Equal, MASK, 0);
+const SHADOWED: (wgpu::CompareFunction, u32, u32) = (wgpu::CompareFunction::Less, 0xff, MASK);
+const LIT: (wgpu::CompareFunction, u32, u32) = (wgpu::CompareFunction::Equal, 0xff, MASK);
+
+/// One pass of full-screen draws over `depth`'s stencil (kept), into `target` cleared to `clear` when
+/// given; each draw a pipeline and its stencil reference. With a `query` (an occlusion query set and its
+/// resolve buffer), counts the samples that pass.
+fn full_screen_draws(
+    cx: &WgpuContext,
+    label: &str,
+    target: Option<(&wgpu::TextureView, wgpu::Color)>,
+    depth: (&wgpu::TextureView, wgpu::LoadOp<u32>),
+    groups: [&wgpu::BindGroup; 2],
+    draws: &[(&wgpu::RenderPipeline, u32)],
+    query: Option<&(wgpu::QuerySet, wgpu::Buffer)>,
+) -> wgpu::CommandBuffer {
+    let mut enc = cx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
+    {
+        let colour = target.map(|(view, clear)| wgpu::RenderPassColorAttachment {
+            view,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations { load: wgpu::LoadOp::Clear(clear), store: wgpu::StoreOp::Store },
+        });
+        let colour = [colour];
+        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some(label),
+            color_attachments: if target.is_some() { &colour } else { &[] },
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: depth.0,
+                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store }),
+                stencil_ops: Some(wgpu::Operations { load: depth.1, store: wgpu::StoreOp::Store }),
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: query.map(|q| &q.0),
+            multiview_mask: None,
+        });
+        pass.push_debug_group(label);
+        for (i, g) in groups.iter().enumerate() {
+            pass.set_bind_group(i as u32, *g, &[]);
+        }
+        if query.is_some() {
+            pass.begin_occlusion_query(0);
+        }
+        for (pipeline, reference) in draws {
+            pass.set_pipeline(pipeline);
+            pass.set_stencil_reference(*reference);
+            pass.draw(0..3, 0..1);
+        }
+        if query.is_some() {
+            pass.end_occlusion_query();
+        }
+        pass.pop_debug_group();
+    }
+    if let Some((set, resolve)) = query {
+        enc.resolve_query_set(set, 0..1, resolve, 0);
+    }
+    enc.finish()
+}
+
+impl ShadowTechnique<WgpuBackend> for Hybrid {
+    type State = State;
+
+    fn name(&self) -> &'static str {
+        "hybrid"
+    }
+
+    fn create_state(&self, cx: &mut WgpuContext) -> Result<State, WgpuError> {
+        let map = <ShadowMap as ShadowTechnique<WgpuBackend>>::create_state(&self.depth, cx)?;
+        cx.scoped("creating the hybrid pipelines", |cx| {
+            let module = shaders::module(&cx.device, "hybrid", shaders::hybrid());
+            let volume_module = shaders::module(&cx.device, "shadow_volume", shaders::shadow_volume());
+            let bindings = MapBindings::new(cx, &[attribute_entry(4)]);
+            let groups = [&cx.shared.frame_layout, bindings.layout()];
+            let set_mask = wgpu::StencilFaceState {
+                compare: wgpu::CompareFunction::Always,
+                pass_op: wgpu::StencilOperation::Replace,
+                ..Default::default()
+            };
+            let mask_state = wgpu::DepthStencilState {
+                stencil: wgpu::StencilState { front: set_mask, back: set_mask, read_mask: 0, write_mask: MASK },
+                ..stencil_test(wgpu::CompareFunction::Always, 0)
+            };
+            let mask = full_screen_pipeline(
+                &cx.device,
+                "hybrid mask",
+                &module,
+                "fs_hybrid_mask",
+                &groups,
+                None,
+                Some(mask_state),
+            );
+            let counting = counting_state(VolumeCounting::ZFail, wgpu::CompareFunction::Equal, MASK, COUNT);
+            let volume = |front| volume_pipeline(cx, &volume_module, "vs_volume", front, counting.clone());
+            let (volumes_ccw, volumes_cw) = (volume(wgpu::FrontFace::Ccw), volume(wgpu::FrontFace::Cw));
+            let count = |state| volume_pipeline(cx, &volume_module, "vs_volume", wgpu::FrontFace::Ccw, state);
+            let count_masked = count(stencil_test(wgpu::CompareFunction::Equal, MASK));
+            let count_all = count(stencil_test(wgpu::CompareFunction::Always, 0));
+            let answer = |entry, (compare, read_mask, _): (_, u32, u32)| {
+                let state = stencil_test(compare, read_mask);
+                full_screen_pipeline(
+                    &cx.device,
+                    "hybrid answer",
+                    &module,
+                    entry,
+                    &groups,
+                    Some(VISIBILITY),
+                    Some(state),
+                )
+            };
+            let answer_map = answer("fs_hybrid_map", OUTSIDE);
+            let answer_shadowed = answer("fs_hybrid_shadowed", SHADOWED);
+            State {
+                map,
+                bindings,
+                module,
+                mask,
+                volumes_ccw,
+                volumes_cw,
+                answer_map,
+                answer_shadowed,
+                count_masked,
+                count_all,
+                draws: None,
+                last: None,
+            }
+        })
+    }
+
+    fn build(
+        &self,
+        cx: &mut WgpuContext,
+        state: &mut State,
+        frame: &FrameInputs,
+        light: &LightView,
+        stats: &mut FrameStats,
+    ) -> Result<(), WgpuError> {
+        self.depth.build(cx, &mut state.map, frame, light, stats)?;
+        state.draws = Some(build_draws(cx, frame, light, Caps::Both, stats)?);
+        Ok(())
+    }
+
+    fn query(
+        &self,
+        cx: &mut WgpuContext,
+        state: &mut State,
+        frame: &FrameInputs,
+        light: &LightView,
+        g: &GpuGBuffer,
+        out: &mut GpuVisibility,
+        stats: &mut FrameStats,
+    ) -> Result<(), WgpuError> {
+        let not_built = || TechniqueError::NotBuilt(self.name().into());
+        let draws = state.draws.as_ref().ok_or_else(not_built)?;
+        let maps = state.map.maps().ok_or_else(not_built)?;
+        let depth = g.depth_view();
+        let extras =
+            [wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::TextureView(&g.geometric_normal) }];
+        let lookup = LookupParams { radius: 0.0, receiver_offset: self.depth.receiver_offset() };
+        let map_group =
+            state.bindings.group(cx, maps, light, g, lookup, &QueryExtras { settings: [0.0; 4], entries: &extras });
+        let groups = [&g.frame_group, &map_group];
+        let (silhouettes, passed) = cx.scoped("the hybrid passes", |cx| {
+            let silhouettes = occlusion_query(cx);
+            let mask = full_screen_draws(
+                cx,
+                "hybrid mask",
+                None,
+                (&depth, wgpu::LoadOp::Clear(0)),
+                groups,
+                &[(&state.mask, MASK)],
+                Some(&silhouettes),
+            );
+            cx.queue.submit([mask]);
+            let counting = VolumePass {
+                label: "hybrid volumes",
+                ccw: &state.volumes_ccw,
+                cw: &state.volumes_cw,
+                stencil: wgpu::LoadOp::Load,
+                reference: MASK,
+            };
+            let passed = counting.run(cx, draws, frame, g, &depth);
+            let answer = full_screen_draws(
+                cx,
+                "hybrid answer",
+                Some((&out.view, wgpu::Color::WHITE)),
+                (&depth, wgpu::LoadOp::Load),
+                groups,
+                &[(&state.answer_map, OUTSIDE.2), (&state.answer_shadowed, SHADOWED.2)],
+                None,
+            );
+            cx.queue.submit([answer]);
+            (silhouettes, passed)
+        })?;
+        // The counters are not the technique's work: after it is done, a sub-phase of their own.
+        cx.wait()?;
+        let t = std::time::Instant::now();
+        let masked = VolumePass { reference: MASK, ..VolumePass::count(&state.count_masked, "count masked fragments") };
+        let processed = cx.scoped("the masked fragment count", |cx| masked.run(cx, draws, frame, g, &depth))?;
+        let c = &mut stats.counters;
+        c.silhouette_pixels = Some(read_query(cx, &silhouettes)?);
+        let processed = read_query(cx, &processed)?;
+        c.volume_fragments = Some(processed);
+        // Z-fail updates the count where the depth test fails.
+        c.stencil_updates = Some(processed - read_query(cx, &passed)?.min(processed));
+        if self.unmasked_fill == FillCount::On {
+            let every = VolumePass::count(&state.count_all, "count volume fragments");
+            let all = cx.scoped("the volume fragment count", |cx| every.run(cx, draws, frame, g, &depth))?;
+            stats.counters.extra.insert("unmasked_volume_fragments".into(), read_query(cx, &all)? as f64);
+        }
+        stats.timings.extra.insert("count_fragments".into(), shadow_core::stats::ms(t.elapsed()));
+        state.last = Some(LastQuery { frame_group: g.frame_group.clone(), map_group, depth: g.depth.clone() });
+        Ok(())
+    }
+
+    fn debug_views(&self, cx: &mut WgpuContext, state: &State) -> Result<Vec<DebugView>, WgpuError> {
+        let Some(last) = &state.last else { return Ok(Vec::new()) };
+        let image = cx.scoped("the hybrid classes view", |cx| classes(cx, state, last))??;
+        let image =
+            Image::from_fn(image.width(), image.height(), |x, y| PixelClass::from_code(*image.get(x, y)).colour());
+        Ok(vec![DebugView { name: "classes".into(), image }])
+    }
+}
+
+/// The class code of every pixel (Fig. 3-5), drawn under the answer's stencil tests: the map's class
+/// outside the mask, volume-shadowed and volume-lit inside it; 0 (no receiver) where nothing draws.
+fn classes(cx: &WgpuContext, state: &State, last: &LastQuery) -> Result<Image<u32>, WgpuError> {
+    let (w, h) = (last.depth.width(), last.depth.height());
+    let target = cx.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("hybrid classes"),
+        size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: CODES,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+        view_formats: &[],
+    });
+    let code = |test: (wgpu::CompareFunction, u32, u32), class: u32| {
+        let constants = [("CODE", f64::from(class))];
+        let entry = FragmentEntry { name: "fs_hybrid_code", constants: &constants };
+        let groups = [&cx.shared.frame_layout, state.bindings.layout()];
+        let depth_stencil = Some(stencil_test(test.0, test.1));
+        let pipeline = full_screen_pipeline(
+            &cx.device,
+            "hybrid classes",
+            &state.module,
+            entry,
+            &groups,
+            Some(CODES),
+            depth_stencil,
+        );
+        (pipeline, test.2)
+    };
+    let draws =
+        [code(OUTSIDE, 0), code(SHADOWED, PixelClass::VolumeShadowed as u32), code(LIT, PixelClass::VolumeLit as u32)];
+    let draws: Vec<_> = draws.iter().map(|(p, r)| (p, *r)).collect();
+    let depth = last.depth.create_view(&Default::default());
+    let view = target.create_view(&Default::default());
+    let pass = full_screen_draws(
+        cx,
+        "hybrid classes",
+        Some((&view, wgpu::Color::TRANSPARENT)),
+        (&depth, wgpu::LoadOp::Load),
+        [&last.frame_group, &last.map_group],
+        &draws,
+        None,
+    );
+    cx.queue.submit([pass]);
+    readback::read_u32(cx, &target, 0)
+}
