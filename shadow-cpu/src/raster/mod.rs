@@ -191,9 +191,13 @@ struct Setup {
     max_x: i32,
     min_y: i32,
     max_y: i32,
+    /// Where each edge with `a != 0` crosses a row: `px = x_at[k].0 + x_at[k].1 * py` (fixed point), for
+    /// [`slab_columns`].
+    x_at: [(f64, f64); 3],
+    /// The corners in fixed point, in edge order; the depth plane is anchored at corner 0.
+    fx: [i64; 3],
+    fy: [i64; 3],
     /// Depth plane: z = z0 + dzdx (x - x0) + dzdy (y - y0), in pixels.
-    fx0: i64,
-    fy0: i64,
     z0: f32,
     dzdx: f32,
     dzdy: f32,
@@ -304,8 +308,10 @@ fn setup_one(v: [clip::ClipVertex; 3], src: &SourceTriangle, st: &RasterState, w
         max_x: max_x as i32,
         min_y: min_y as i32,
         max_y: max_y as i32,
-        fx0: fx[0],
-        fy0: fy[0],
+        x_at: [0, 1, 2]
+            .map(|k| if a[k] == 0 { (0.0, 0.0) } else { (-(c[k] as f64) / a[k] as f64, -(b[k] as f64) / a[k] as f64) }),
+        fx,
+        fy,
         z0: z[0],
         dzdx,
         dzdy,
@@ -373,8 +379,9 @@ pub fn draw_depth<S: TriangleSource + ?Sized>(ds: &mut DepthStencil, src: &S, st
 
 /// [`draw_depth`] confined to the pixels of a computation mask (Chan, thesis 3.2), rejected as coarsely
 /// as the mask allows before any depth or stencil work: a triangle is not binned into a band where its
-/// bounds meet no masked-in tile, a row is not set up where they meet none in its tile row, and a span
-/// skips unmasked tiles whole and the rest pixel by pixel. Only masked-in fragments are counted.
+/// bounds meet no masked-in tile; with a fast kernel (depth tests, stencil counting) it is walked tile by
+/// tile, as a tiled rasterizer walks it, so its cost follows the masked-in tiles it meets rather than its
+/// rows; otherwise its rows' spans are cut to the mask's runs. Only masked-in fragments are counted.
 ///
 /// # Panics
 /// When the mask is not the size of `ds`: a caller bug.
@@ -498,6 +505,47 @@ fn span(t: &Setup, py: i64) -> Option<(i32, i32)> {
     (lo <= hi).then_some((lo as i32, hi as i32))
 }
 
+/// A superset of the columns rows `ya..=yb` have inside the triangle, clamped to its bounds, or `None`
+/// when it has none there: the x extent of the triangle cut to the slab between the rows' centres, whose
+/// corners are triangle corners inside the slab or points on its two lines (in the triangle's cross
+/// sections there). Floating point from the edges' precomputed row crossings (far below a pixel off for
+/// fixed-point inputs), widened by a pixel each side, so a whole tile row of a triangle is tested against
+/// a mask with a few multiply-adds, not three integer divisions per row.
+fn slab_columns(t: &Setup, ya: i32, yb: i32) -> Option<(i32, i32)> {
+    let (pa, pb) = (i64::from(ya) * ONE + HALF, i64::from(yb) * ONE + HALF);
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for k in 0..3 {
+        if (pa..=pb).contains(&t.fy[k]) {
+            lo = lo.min(t.fx[k] as f64);
+            hi = hi.max(t.fx[k] as f64);
+        }
+    }
+    for py in [pa, pb] {
+        // The cross section at py: E_k(px, py) = a px + b py + c >= 0 for every edge.
+        let (mut l, mut r) = (f64::NEG_INFINITY, f64::INFINITY);
+        for k in 0..3 {
+            let x = t.x_at[k].0 + t.x_at[k].1 * py as f64;
+            match t.a[k].signum() {
+                1 => l = l.max(x),
+                -1 => r = r.min(x),
+                _ if t.b[k] * py + t.c[k] < 0 => r = f64::NEG_INFINITY,
+                _ => {}
+            }
+        }
+        if l <= r + ONE as f64 {
+            lo = lo.min(l);
+            hi = hi.max(r);
+        }
+    }
+    if lo > hi + ONE as f64 {
+        return None;
+    }
+    let first = ((lo - HALF as f64) / ONE as f64).floor() as i64 - 1;
+    let last = ((hi - HALF as f64) / ONE as f64).ceil() as i64 + 1;
+    let (first, last) = (first.max(i64::from(t.min_x)), last.min(i64::from(t.max_x)));
+    (first <= last).then_some((first as i32, last as i32))
+}
+
 /// Depth at pixel column `x` of a row whose depth at column 0's centre is `z_row` (clamped when asked).
 #[inline(always)]
 fn depth_at(t: &Setup, z_row: f32, x: i32, clamp: bool) -> f32 {
@@ -509,8 +557,8 @@ fn depth_at(t: &Setup, z_row: f32, x: i32, clamp: bool) -> f32 {
 /// every draw of a triangle gives it bit-identical depths.
 #[inline(always)]
 fn row_base(t: &Setup, py: i64) -> f32 {
-    let dx0 = (HALF - t.fx0) as f32 / ONE as f32;
-    let dy = (py - t.fy0) as f32 / ONE as f32;
+    let dx0 = (HALF - t.fx[0]) as f32 / ONE as f32;
+    let dy = (py - t.fy[0]) as f32 / ONE as f32;
     t.z0 + t.dzdx * dx0 + t.dzdy * dy + t.offset
 }
 
@@ -631,6 +679,10 @@ fn raster_band<T, F, B>(
     let y_lo = t.min_y.max(rows.y0);
     let y_hi = t.max_y.min(rows.y0 + band_rows - 1);
     let clamp = st.depth.is_some_and(|d| d.clamp);
+    if let (Some(m), Some(k)) = (mask, fast) {
+        masked_tiles(t, rows, k, clamp, m, (y_lo, y_hi), c);
+        return;
+    }
     let mut runs = Vec::new();
     for y in y_lo..=y_hi {
         let py = i64::from(y) * ONE + HALF;
@@ -657,6 +709,71 @@ fn raster_band<T, F, B>(
             }
         }
     }
+}
+
+/// Rows `y_lo..=y_hi` of a triangle under a computation mask, with a fast kernel, walked tile by tile as
+/// a tiled rasterizer walks them: per tile row the triangle's columns (`slab_columns`), per masked-in
+/// tile among them its runs of masked-in pixels, each cut to the pixels inside all three edges. Empty
+/// tiles cost a lookup and rows without a masked-in pixel nothing, so the work follows the mask, not
+/// the triangle's rows. Same fragments, depths and counters as the row walk: the inside test is the
+/// edge functions `span` solves, the depth `row_base` and `depth_at`.
+fn masked_tiles<T>(
+    t: &Setup,
+    rows: &mut BandRows<'_, T>,
+    k: DepthKernel,
+    clamp: bool,
+    m: &ComputationMask,
+    (y_lo, y_hi): (i32, i32),
+    c: &mut RasterCounters,
+) {
+    let tile = m.tile() as i32;
+    let mut y = y_lo;
+    while y <= y_hi {
+        let end = (y - y % tile + tile - 1).min(y_hi);
+        // The bounds' tiles first (a table lookup), the triangle's own columns only where one is in.
+        let any = m.any_in(t.min_x as u32, y as u32, t.max_x as u32, end as u32);
+        if let Some((a, b)) = slab_columns(t, y, end).filter(|_| any) {
+            for tx in a / tile..=b / tile {
+                for &(ry, x0, x1) in m.tile_runs(tx as u32, (y / tile) as u32) {
+                    let ry = ry as i32;
+                    if ry < y || ry > end {
+                        continue;
+                    }
+                    let py = i64::from(ry) * ONE + HALF;
+                    let Some((xs, xe)) = inside(t, py, (x0 as i32).max(a), (x1 as i32).min(b)) else { continue };
+                    let row = (ry - rows.y0) as usize * rows.width;
+                    let (lo, hi) = (row + xs as usize, row + xe as usize + 1);
+                    let start = RowStart { z_row: row_base(t, py), clamp, xs };
+                    row_fast(t, k, start, &mut rows.depth[lo..hi], &mut rows.stencil[lo..hi], c);
+                }
+            }
+        }
+        y = end + 1;
+    }
+}
+
+/// The columns of `xs..=xe` in row `py` (fixed point) inside all three edges, tested pixel by pixel (the
+/// test `span` solves by division); contiguous, the triangle being convex.
+#[inline(always)]
+fn inside(t: &Setup, py: i64, xs: i32, xe: i32) -> Option<(i32, i32)> {
+    let px = i64::from(xs) * ONE + HALF;
+    let mut e = [0, 1, 2].map(|k| t.a[k] * px + t.b[k] * py + t.c[k] + t.tl[k]);
+    let step = t.a.map(|a| a * ONE);
+    // An edge function is linear along the row: outside at both ends of the run, outside all along it.
+    let last = i64::from(xe - xs);
+    if (0..3).any(|k| e[k] < 0 && e[k] + step[k] * last < 0) {
+        return None;
+    }
+    let mut found = None;
+    for x in xs..=xe {
+        if e[0] >= 0 && e[1] >= 0 && e[2] >= 0 {
+            found = Some(found.map_or((x, x), |(first, _)| (first, x)));
+        } else if found.is_some() {
+            break;
+        }
+        e = [e[0] + step[0], e[1] + step[1], e[2] + step[2]];
+    }
+    found
 }
 
 /// Columns `a..=b` of row `y` (`py` its centre in fixed point, `row` its first index in the band) through

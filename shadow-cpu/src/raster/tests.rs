@@ -325,7 +325,8 @@ fn fast_kernels_match_the_general_loop() {
 #[test]
 fn a_computation_mask_confines_stencil_work_to_its_pixels() {
     // Counting volumes (both ops incrementing) over a jittered mesh with perspective and clipping, once
-    // unmasked and once under a mask of scattered pixels and a block, in tiles of 4 and 8.
+    // unmasked and once under a mask of scattered pixels and a block, in tiles of several sides: ones
+    // that divide the rasterizer's bands, and ones whose tile rows straddle them.
     let tris = jittered_grid(9, 7, 2.0);
     let (w, h) = (83, 57);
     let face = StencilFace {
@@ -343,7 +344,7 @@ fn a_computation_mask_confines_stencil_work_to_its_pixels() {
     let mut all = DepthStencil::new(w, h, 0.5, 0);
     let unmasked = draw_depth(&mut all, &src, &st);
     let on = |x: u32, y: u32| (x * 7 + y * 13).is_multiple_of(29) || (40..52).contains(&x) && (10..30).contains(&y);
-    for tile in [4, 8] {
+    for tile in [1, 3, 4, 8, 24] {
         let mask = ComputationMask::from_fn(w, h, tile, on);
         let mut ds = DepthStencil::new(w, h, 0.5, 0);
         let c = draw_depth_masked(&mut ds, &src, &st, Some(&mask));
