@@ -5,7 +5,8 @@
 //! with the stencil test "count != 0" writes the shadowed receivers.
 //!
 //! Counters come from occlusion queries: samples passing the volume pass, and, in a separate pass with
-//! the depth test off, every rasterized volume fragment (outside the timed query phase).
+//! the depth test off, every rasterized volume fragment (inside the query phase, timed as its sub-phase
+//! `count_fragments` so it can be taken out).
 
 use shadow_core::FrameInputs;
 use shadow_core::frame::InstanceVolume;

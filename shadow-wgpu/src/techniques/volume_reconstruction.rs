@@ -9,7 +9,8 @@
 //! read back with the depths (timed as `id_readback`).
 //!
 //! Counters come from occlusion queries: samples passing the parity pass (stencil updates), and, in a
-//! second pass with the depth test off, every rasterized fragment (outside the timed query phase).
+//! second pass with the depth test off, every rasterized fragment (inside the query phase, timed as its
+//! sub-phase `count_fragments` so it can be taken out).
 
 use shadow_core::FrameInputs;
 use shadow_core::glam::Vec4;
