@@ -9,6 +9,7 @@ use shadow_core::technique::hard::{
 use shadow_core::technique::settings::{SettingKey, SettingsError, TechniqueSettings, TechniqueSpec};
 use shadow_core::technique::{DynShadowTechnique, Stateful};
 use shadow_cpu::CpuBackend;
+use shadow_soft::AreaLightReference;
 use shadow_wgpu::WgpuBackend;
 
 /// Builds a technique for the CPU backend from a spec.
@@ -126,6 +127,16 @@ impl TechniqueRegistry {
             keys: RayTraced::keys,
             canonical: canonical::<RayTraced>,
             cpu: Some(plain::<CpuBackend, RayTraced>),
+            wgpu: None,
+        });
+        r.register(TechniqueEntry {
+            name: "area-light-reference",
+            description: "soft shadows of a spherical light: stratified Monte Carlo shadow rays per pixel through a BVH",
+            paper: "reference (shadow-soft)",
+            reference: true,
+            keys: AreaLightReference::keys,
+            canonical: canonical::<AreaLightReference>,
+            cpu: Some(plain::<CpuBackend, AreaLightReference>),
             wgpu: None,
         });
         r.register(TechniqueEntry {

@@ -1,1 +1,10 @@
-//! placeholder
+//! Soft shadows, written only against the public APIs of shadow-core, shadow-cpu and shadow-wgpu (DESIGN
+//! 2): the proof that a technique can live outside the backends. Where a backend lacked something a
+//! technique here needed, it was added to that backend's public API, documented.
+//!
+//! - [`area_light::AreaLightReference`] (`area-light-reference`): the reference soft techniques are
+//!   measured against, Monte Carlo visibility of a spherical light through the CPU backend's BVH.
+
+pub mod area_light;
+
+pub use area_light::AreaLightReference;
