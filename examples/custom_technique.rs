@@ -42,6 +42,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         width: 512,
         height: 512,
         techniques: vec![TechniqueSpec::named("planar-shadow"), TechniqueSpec::named("shadow-map")],
+        reference: TechniqueSpec::named("ray-traced"),
         backends,
         out_dir: Some(out.clone().into()),
     };

@@ -27,6 +27,9 @@ pub struct CompareJob<'a> {
     pub height: u32,
     /// Techniques to measure (the reference is always run first).
     pub techniques: Vec<TechniqueSpec>,
+    /// What they are measured against, on the CPU: `ray-traced` for hard shadows, `area-light-reference`
+    /// for soft ones (see [`reference_for`]).
+    pub reference: TechniqueSpec,
     /// Backends to run them on.
     pub backends: Vec<BackendKind>,
     /// Where the files go (`None`: compute only).
@@ -87,6 +90,19 @@ pub struct CompareReport {
     pub results: Vec<ResultEntry>,
     /// One entry per technique run on both backends.
     pub cross_backend: Vec<CrossEntry>,
+    /// The reference, as its spec reads.
+    pub reference: String,
+}
+
+/// The reference for `techniques`: `area-light-reference` when they are all soft, `ray-traced` otherwise
+/// (a soft technique's penumbra measured against a hard edge is an error only in name; a mix of both
+/// kinds is measured against the hard reference).
+#[must_use]
+pub fn reference_for(registry: &crate::TechniqueRegistry, techniques: &[TechniqueSpec]) -> TechniqueSpec {
+    let soft = |t: &TechniqueSpec| registry.get(&t.name).is_ok_and(|e| e.soft);
+    let name =
+        if !techniques.is_empty() && techniques.iter().all(soft) { "area-light-reference" } else { "ray-traced" };
+    TechniqueSpec::named(name)
 }
 
 /// Report keys of a frame's timings.
@@ -131,9 +147,9 @@ pub fn run_compare(
     if let Some(dir) = &job.out_dir {
         std::fs::create_dir_all(dir).map_err(|e| Error::Write { path: dir.clone(), why: e.to_string() })?;
     }
-    progress("reference: ray-traced on cpu");
-    let reference = TechniqueSpec::named("ray-traced");
-    let (ref_frame, _) = renderer.run_cpu_frame(job.frame, job.width, job.height, &reference)?;
+    let reference = &job.reference;
+    progress(&format!("reference: {reference} on cpu"));
+    let (ref_frame, _) = renderer.run_cpu_frame(job.frame, job.width, job.height, reference)?;
     let view = ref_frame.light_views.first().ok_or_else(|| Error::Usage("the scene has no light".into()))?;
     let g = &ref_frame.gbuffer;
     let mask = measured_pixels(&g.receiver, &g.position, &g.geometric_normal, view);
@@ -149,7 +165,8 @@ pub fn run_compare(
         reference: ref_vis,
         mask: &mask,
     };
-    let mut sheet: Vec<(String, Image<Rgb8>)> = vec![("ray-traced\nreference".into(), ref_frame.color.clone())];
+    let mut sheet: Vec<(String, Image<Rgb8>)> =
+        vec![(format!("{}\nreference", reference.name), ref_frame.color.clone())];
     if let Some(dir) = &job.out_dir {
         save(&ref_frame.color, dir, "reference.png")?;
         save(&visibility_to_rgb(ref_vis, &mask), dir, "reference.vis.png")?;
@@ -229,8 +246,14 @@ pub fn run_compare(
         }
     }
 
-    let report =
-        CompareReport { scene: job.scene.clone(), width: job.width, height: job.height, results, cross_backend };
+    let report = CompareReport {
+        scene: job.scene.clone(),
+        width: job.width,
+        height: job.height,
+        results,
+        cross_backend,
+        reference: job.reference.to_string(),
+    };
     if let Some(dir) = &job.out_dir {
         save(&contact_sheet(&sheet, 320), dir, "contact.png")?;
         let json = serde_json::to_string_pretty(&report).map_err(|e| Error::Usage(e.to_string()))?;
@@ -247,8 +270,8 @@ pub fn run_compare(
 #[must_use]
 pub fn report_markdown(r: &CompareReport) -> String {
     let mut s = format!(
-        "# {} at {}x{}\n\nErrors against `ray-traced` over receiver pixels that face the light and lie in its reach.\n\n",
-        r.scene, r.width, r.height
+        "# {} at {}x{}\n\nErrors against `{}` over receiver pixels that face the light and lie in its reach.\n\n",
+        r.scene, r.width, r.height, r.reference
     );
     s.push_str("| technique | backend | mismatch | edge band | interior | false shadow | false light | RMSE | FLIP | total ms | picture |\n");
     s.push_str("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---|\n");

@@ -151,7 +151,8 @@ enum Command {
         #[arg(long, short)]
         out: PathBuf,
     },
-    /// Every asked-for technique against the ray-traced reference: pictures, error maps, a contact sheet,
+    /// Every asked-for technique against the reference (ray-traced; area-light-reference when every
+    /// technique asked for is a soft one): pictures, error maps, a contact sheet,
     /// report.md and report.json.
     Compare {
         #[command(flatten)]
@@ -165,6 +166,10 @@ enum Command {
         /// Backend: auto, cpu, wgpu or both.
         #[arg(long, default_value = "auto")]
         backend: String,
+        /// The reference, NAME[:key=value,...]: ray-traced or area-light-reference (default: the latter
+        /// when every technique asked for is a soft one).
+        #[arg(long)]
+        reference: Option<String>,
         /// Output folder (default out/compare-SCENE).
         #[arg(long)]
         out_dir: Option<PathBuf>,
@@ -188,8 +193,8 @@ fn run(cli: Cli) -> Result<(), Error> {
         Command::Techniques { json } => list_techniques(json),
         Command::Inspect { target, json } => inspect(&target, json),
         Command::Render { scene, technique, backend, out } => render(&scene, &technique, &backend, &out),
-        Command::Compare { scene, technique, techniques, backend, out_dir } => {
-            compare(&scene, technique, techniques, &backend, out_dir)
+        Command::Compare { scene, technique, techniques, backend, reference, out_dir } => {
+            compare(&scene, technique, techniques, &backend, reference.as_deref(), out_dir)
         }
         Command::Bench { scene, technique, techniques, backend, frames, warmup, json, sweep, out_dir } => {
             bench(&scene, BenchArgs { technique, techniques, backend, frames, warmup, json, sweep, out_dir })
@@ -347,10 +352,21 @@ fn compare(
     technique: Vec<String>,
     techniques: Option<String>,
     backend: &str,
+    reference: Option<&str>,
     out_dir: Option<PathBuf>,
 ) -> Result<(), Error> {
     let mut renderer = Renderer::new(TechniqueRegistry::builtin()).with_adapter(args.adapter.clone());
     let specs = technique_specs(&renderer, &technique, techniques.as_deref())?;
+    let reference = match reference {
+        Some(text) => {
+            let spec = TechniqueSpec::parse(text)?;
+            if !renderer.registry().get(&spec.name)?.reference {
+                return Err(Error::Usage(format!("--reference {text}: '{}' is not a reference technique", spec.name)));
+            }
+            spec
+        }
+        None => shadowlab::compare::reference_for(renderer.registry(), &specs),
+    };
     check_availability(&renderer, &specs, backend)?;
     let kinds = backends(&mut renderer, backend)?;
     let (frame, w, h) = args.frame()?;
@@ -360,6 +376,7 @@ fn compare(
         frame: &frame,
         width: w,
         height: h,
+        reference,
         techniques: specs,
         backends: kinds,
         out_dir: Some(out.clone()),

@@ -9,7 +9,7 @@ use shadow_core::technique::hard::{
 use shadow_core::technique::settings::{SettingKey, SettingsError, TechniqueSettings, TechniqueSpec};
 use shadow_core::technique::{DynShadowTechnique, Stateful};
 use shadow_cpu::CpuBackend;
-use shadow_soft::AreaLightReference;
+use shadow_soft::{AreaLightReference, Smoothies};
 use shadow_wgpu::WgpuBackend;
 
 /// Builds a technique for the CPU backend from a spec.
@@ -36,6 +36,9 @@ pub struct TechniqueEntry {
     pub paper: &'static str,
     /// Whether it is a reference (measured against, not measured).
     pub reference: bool,
+    /// Whether it renders soft shadows: measured against `area-light-reference` (hard techniques against
+    /// `ray-traced`).
+    pub soft: bool,
     /// Settings keys with defaults.
     pub keys: fn() -> &'static [SettingKey],
     /// Canonical settings string of a spec (all keys, defaults filled in).
@@ -124,6 +127,7 @@ impl TechniqueRegistry {
             description: "exact hard shadows: one shadow ray per pixel through a BVH",
             paper: "reference",
             reference: true,
+            soft: false,
             keys: RayTraced::keys,
             canonical: canonical::<RayTraced>,
             cpu: Some(plain::<CpuBackend, RayTraced>),
@@ -134,6 +138,7 @@ impl TechniqueRegistry {
             description: "soft shadows of a spherical light: stratified Monte Carlo shadow rays per pixel through a BVH",
             paper: "reference (shadow-soft)",
             reference: true,
+            soft: true,
             keys: AreaLightReference::keys,
             canonical: canonical::<AreaLightReference>,
             cpu: Some(plain::<CpuBackend, AreaLightReference>),
@@ -144,6 +149,7 @@ impl TechniqueRegistry {
             description: "depth map from the light with Vulkan depth bias and percentage-closer filtering",
             paper: "Williams 1978; Reeves et al. 1987 (survey: Nealen 2005)",
             reference: false,
+            soft: false,
             keys: ShadowMap::keys,
             canonical: canonical::<ShadowMap>,
             cpu: Some(plain::<CpuBackend, ShadowMap>),
@@ -154,6 +160,7 @@ impl TechniqueRegistry {
             description: "a shadow map plus silhouette points half a texel off: piecewise-linear shadow edges",
             paper: "Sen, Cammarano, Hanrahan 2003",
             reference: false,
+            soft: false,
             keys: SilhouetteMap::keys,
             canonical: canonical::<SilhouetteMap>,
             cpu: Some(plain::<CpuBackend, SilhouetteMap>),
@@ -164,6 +171,7 @@ impl TechniqueRegistry {
             description: "a shadow volume rebuilt from the light's depth map, resolved with one stencil bit",
             paper: "McCool 2000",
             reference: false,
+            soft: false,
             keys: VolumeReconstruction::keys,
             canonical: canonical::<VolumeReconstruction>,
             cpu: Some(plain::<CpuBackend, VolumeReconstruction>),
@@ -174,16 +182,29 @@ impl TechniqueRegistry {
             description: "a shadow map, with z-fail shadow volumes at its silhouette pixels only (a computation mask)",
             paper: "Chan 2004 (thesis, chapter 3)",
             reference: false,
+            soft: false,
             keys: Hybrid::keys,
             canonical: canonical::<Hybrid>,
             cpu: Some(plain::<CpuBackend, Hybrid>),
             wgpu: Some(plain::<WgpuBackend, Hybrid>),
         });
         r.register(TechniqueEntry {
+            name: "smoothies",
+            description: "fake soft shadows: a shadow map plus alpha ramps hung outward from the silhouettes (smoothies)",
+            paper: "Chan-Durand 2003; Chan 2004 (thesis, chapter 4)",
+            reference: false,
+            soft: true,
+            keys: Smoothies::keys,
+            canonical: canonical::<Smoothies>,
+            cpu: Some(plain::<CpuBackend, Smoothies>),
+            wgpu: None,
+        });
+        r.register(TechniqueEntry {
             name: "shadow-volume-zpass",
             description: "stencil shadow volumes counted from the eye: wrong when the eye is in shadow",
             paper: "Crow 1977; Heidmann 1991",
             reference: false,
+            soft: false,
             keys: ShadowVolume::keys,
             canonical: canonical::<ShadowVolume>,
             cpu: Some(volume::<CpuBackend>),
@@ -194,6 +215,7 @@ impl TechniqueRegistry {
             description: "stencil shadow volumes counted from infinity, capped: right with the eye in shadow",
             paper: "Everitt-Kilgard 2002",
             reference: false,
+            soft: false,
             keys: ShadowVolume::keys,
             canonical: canonical::<ShadowVolume>,
             cpu: Some(volume::<CpuBackend>),
@@ -240,6 +262,7 @@ impl TechniqueRegistry {
                 description,
                 paper,
                 reference: false,
+                soft: false,
                 keys,
                 canonical,
                 cpu: Some(cpu),

@@ -316,6 +316,7 @@ pub fn register(registry: &mut TechniqueRegistry) {
         description: "caster triangles squashed onto the ground plane from the light (fake shadows)",
         paper: "Blinn 1988 (survey: Nealen 2005)",
         reference: false,
+        soft: false,
         keys: PlanarShadow::keys,
         canonical,
         cpu: Some(cpu),

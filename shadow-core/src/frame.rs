@@ -177,6 +177,14 @@ impl FrameInputs {
             .collect()
     }
 
+    /// The silhouette of every casting instance for the light, in instance order: its index in
+    /// `instances` and its edges in the welded vertices of the instance's adjacency
+    /// (`adjacency.positions()`, mesh space), oriented as [`silhouette`] orients them.
+    #[must_use]
+    pub fn caster_silhouettes(&self, light: &LightView) -> Vec<(usize, Silhouette)> {
+        self.silhouettes(light).filter(|(i, ..)| self.instances[*i].casts_shadow).map(|(i, _, s)| (i, s)).collect()
+    }
+
     /// The silhouette edges of every casting instance for the light, in world space, in instance order
     /// (what silhouette maps rasterize; the edges' weights do not matter there).
     #[must_use]

@@ -25,6 +25,7 @@ fn run(scene: &str, specs: Vec<String>) -> Vec<ResultEntry> {
         width: 384,
         height: 384,
         techniques,
+        reference: TechniqueSpec::named("ray-traced"),
         backends: vec![BackendKind::Cpu],
         out_dir: None,
     };

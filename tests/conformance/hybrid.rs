@@ -25,6 +25,7 @@ fn run(scene: &str, specs: &[&str]) -> Vec<ResultEntry> {
         width: 512,
         height: 512,
         techniques: specs.iter().map(|t| TechniqueSpec::parse(t).expect("spec")).collect(),
+        reference: TechniqueSpec::named("ray-traced"),
         backends: vec![BackendKind::Cpu],
         out_dir: None,
     };

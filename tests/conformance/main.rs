@@ -5,6 +5,7 @@ mod cli;
 mod depth_layers;
 mod hybrid;
 mod silhouette_map;
+mod smoothies;
 // The technique of examples/custom_technique.rs, registered at runtime like a user's would be.
 #[path = "../../examples/planar/mod.rs"]
 #[allow(dead_code)]

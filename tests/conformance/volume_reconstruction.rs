@@ -35,6 +35,7 @@ fn run(frame: &FrameInputs, specs: &[String]) -> Vec<ResultEntry> {
         width: 512,
         height: 512,
         techniques: specs.iter().map(|t| TechniqueSpec::parse(t).expect("spec")).collect(),
+        reference: TechniqueSpec::named("ray-traced"),
         backends: vec![BackendKind::Cpu],
         out_dir: None,
     };

@@ -56,7 +56,10 @@ pub struct ShadowMap {
     pub bias_world: f32,
 }
 
-const MAP_KEYS: [SettingKey; 7] = [
+/// The keys of `shadow-map`, in order: `res`, `bias`, `bias_constant`, `bias_slope`, `filter`,
+/// `filter_radius`, `bias_world`. Techniques built on a depth map take the ones they use from here, so
+/// their defaults and help stay the same.
+pub const MAP_KEYS: [SettingKey; 7] = [
     SettingKey { key: "res", default: "2048", help: "map side in texels (16 to 16384)" },
     SettingKey {
         key: "bias",
@@ -107,8 +110,12 @@ impl ShadowMap {
         if self.bias == BiasMode::World { self.bias_world } else { 0.0 }
     }
 
-    /// The depth-map keys (`res` and the bias keys), with no filter.
-    fn read_depth(v: &Values<'_>) -> Result<Self, SettingsError> {
+    /// Reads the depth-map keys (`res` and the bias keys, as [`MAP_KEYS`] has them), with no filter: for
+    /// techniques built on a depth map.
+    ///
+    /// # Errors
+    /// A value that does not parse or is out of range.
+    pub fn read_depth(v: &Values<'_>) -> Result<Self, SettingsError> {
         Ok(Self {
             resolution: read_resolution(v)?,
             bias: v.get("bias")?,

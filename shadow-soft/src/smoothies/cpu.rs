@@ -1,0 +1,176 @@
+//! `smoothies` on the CPU backend, through its public rasterizer and depth-map API.
+
+use shadow_core::glam::{Vec2, Vec4};
+use shadow_core::image::false_colour;
+use shadow_core::light::LightView;
+use shadow_core::stats::ms;
+use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
+use shadow_core::{FrameInputs, Image};
+use shadow_cpu::raster::{CullMode, DepthStencil, RasterState, Soup, draw};
+use shadow_cpu::techniques::{map_position, per_receiver, render_depth_maps};
+use shadow_cpu::{CpuBackend, CpuContext, CpuError, GBuffer};
+use std::time::Instant;
+
+use super::geometry::{self, SmoothieTriangle};
+use super::{Smoothies, Toggle};
+
+/// The depth map and the smoothie buffer of the last build.
+#[derive(Default)]
+pub struct State {
+    maps: Vec<Image<f32>>,
+    buffer: Option<SmoothieBuffer>,
+}
+
+/// A smoothie buffer: per texel the nearest smoothie's NDC depth (1 where none) and the minimum alpha
+/// (1 where none).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SmoothieBuffer {
+    /// Nearest smoothie depth.
+    pub depth: Image<f32>,
+    /// Minimum alpha.
+    pub alpha: Image<f32>,
+}
+
+/// Renders `triangles` into a `res x res` smoothie buffer over `map` (the blockers' NDC depths) of
+/// projection `proj`: alpha from each triangle's ramp at the texel centre, remapped when `remap`,
+/// discarded behind the map's surface, minimum-blended. Returns the buffer and the fragment count.
+#[must_use]
+pub fn render_buffer(
+    triangles: &[SmoothieTriangle],
+    map: &Image<f32>,
+    proj: &shadow_core::light::LightProjection,
+    t: f32,
+    remap: bool,
+) -> (SmoothieBuffer, u64) {
+    let res = map.width();
+    let clip: Vec<[Vec4; 3]> = triangles
+        .iter()
+        .map(|tri| tri.corners.map(|c| Vec4::new(2.0 * c.x - 1.0, 1.0 - 2.0 * c.y, c.z, 1.0)))
+        .collect();
+    let mut ds = DepthStencil::new(res, res, 1.0, 0);
+    let mut texels = Image::new(res, res, [1.0f32, 1.0]);
+    let state = RasterState { cull: CullMode::None, depth: None, ..RasterState::default() };
+    let counters = draw(
+        &mut ds,
+        &mut texels,
+        &Soup { triangles: &clip, prim_base: 0, flip: false },
+        &state,
+        |f| {
+            let p = Vec2::new(f.x as f32 + 0.5, f.y as f32 + 0.5) / res as f32;
+            let a = triangles[f.prim as usize].ramp.alpha(p, t);
+            // Eq. 4.1 on linear depths: b the smoothie's, r the surface the map sees behind it.
+            let ratio = proj.linear_depth(f.depth) / proj.linear_depth(*map.get(f.x, f.y));
+            if ratio >= 1.0 {
+                return None;
+            }
+            let a = if remap { (a / (1.0 - ratio)).clamp(0.0, 1.0) } else { a };
+            Some([f.depth, a])
+        },
+        |dst, src| *dst = [dst[0].min(src[0]), dst[1].min(src[1])],
+    );
+    let depth = Image::from_fn(res, res, |x, y| texels.get(x, y)[0]);
+    let alpha = Image::from_fn(res, res, |x, y| texels.get(x, y)[1]);
+    (SmoothieBuffer { depth, alpha }, counters.fragments)
+}
+
+/// The thesis's three cases at one texel (clamped to the map): behind the blocker 0, behind a smoothie
+/// its alpha, else 1.
+fn texel_visibility(map: &Image<f32>, buffer: &SmoothieBuffer, x: i32, y: i32, depth: f32) -> f32 {
+    let n = map.width() as i32 - 1;
+    let (x, y) = (x.clamp(0, n) as u32, y.clamp(0, n) as u32);
+    if depth > *map.get(x, y) {
+        0.0
+    } else if depth > *buffer.depth.get(x, y) {
+        *buffer.alpha.get(x, y)
+    } else {
+        1.0
+    }
+}
+
+/// Visibility at map point `uv`, NDC depth `depth`: the three cases at the four nearest texels, bilinearly
+/// weighted (the thesis's 2x2 filtering); 1 outside the map. Before the falloff.
+#[must_use]
+pub fn smoothie_lookup(map: &Image<f32>, buffer: &SmoothieBuffer, uv: Vec2, depth: f32) -> f32 {
+    if !(0.0..=1.0).contains(&uv.x) || !(0.0..=1.0).contains(&uv.y) {
+        return 1.0;
+    }
+    let st = uv * map.width() as f32 - Vec2::splat(0.5);
+    let i = st.floor();
+    let f = st - i;
+    let (x, y) = (i.x as i32, i.y as i32);
+    let v = |dx, dy| texel_visibility(map, buffer, x + dx, y + dy, depth);
+    let top = v(0, 0) * (1.0 - f.x) + v(1, 0) * f.x;
+    let bottom = v(0, 1) * (1.0 - f.x) + v(1, 1) * f.x;
+    top * (1.0 - f.y) + bottom * f.y
+}
+
+impl ShadowTechnique<CpuBackend> for Smoothies {
+    type State = State;
+
+    fn name(&self) -> &'static str {
+        Self::NAME
+    }
+
+    fn create_state(&self, _: &mut CpuContext) -> Result<State, CpuError> {
+        Ok(State::default())
+    }
+
+    fn build(
+        &self,
+        _: &mut CpuContext,
+        state: &mut State,
+        frame: &FrameInputs,
+        light: &LightView,
+        stats: &mut FrameStats,
+    ) -> Result<(), CpuError> {
+        let proj = Self::projection(light)?;
+        render_depth_maps(frame, light, self.depth.resolution, self.depth.depth_bias(), &mut state.maps)?;
+        let t0 = Instant::now();
+        let casters = frame.caster_silhouettes(light);
+        let centre = geometry::silhouette_centre(frame, &casters).unwrap_or(frame.bounds.center());
+        let t = self.size_for(light, proj, centre);
+        let smoothies = geometry::build(frame, &casters, proj, t);
+        let (buffer, fragments) =
+            render_buffer(&smoothies.triangles, &state.maps[0], proj, t, self.remap == Toggle::On);
+        state.buffer = Some(buffer);
+        stats.timings.extra.insert("smoothies".into(), ms(t0.elapsed()));
+        let c = &mut stats.counters;
+        c.silhouette_edges = Some(smoothies.edges as u64);
+        c.extra.insert("smoothie_triangles".into(), smoothies.triangles.len() as f64);
+        c.extra.insert("smoothie_fragments".into(), fragments as f64);
+        c.extra.insert("special_vertices".into(), smoothies.special_vertices as f64);
+        c.extra.insert("smoothie_size".into(), f64::from(t));
+        Ok(())
+    }
+
+    fn query(
+        &self,
+        _: &mut CpuContext,
+        state: &mut State,
+        _: &FrameInputs,
+        light: &LightView,
+        g: &GBuffer,
+        out: &mut Image<f32>,
+        _: &mut FrameStats,
+    ) -> Result<(), CpuError> {
+        let not_built = || TechniqueError::NotBuilt(self.name().into());
+        let (Some(buffer), Some(map)) = (&state.buffer, state.maps.first()) else { return Err(not_built().into()) };
+        let offset = self.depth.receiver_offset();
+        per_receiver(g, out, |_, _, i| {
+            let m = map_position(light, g.position.data()[i], offset);
+            self.falloff.apply(smoothie_lookup(map, buffer, m.uv, m.depth))
+        });
+        Ok(())
+    }
+
+    fn debug_views(&self, _: &mut CpuContext, state: &State) -> Result<Vec<DebugView>, CpuError> {
+        let Some(buffer) = &state.buffer else { return Ok(Vec::new()) };
+        let alpha = &buffer.alpha;
+        let grey = Image::from_fn(alpha.width(), alpha.height(), |x, y| [(alpha.get(x, y) * 255.0).round() as u8; 3]);
+        let nearest = buffer.depth.data().iter().copied().fold(1.0f32, f32::min);
+        Ok(vec![
+            DebugView { name: "smoothie-alpha".into(), image: grey },
+            DebugView { name: "smoothie-depth".into(), image: false_colour(&buffer.depth, nearest, 1.0) },
+        ])
+    }
+}

@@ -1,0 +1,161 @@
+//! `smoothies` (Chan and Durand 2003; Chan's thesis, chapter 4): fake soft shadows from a shadow map and
+//! a smoothie buffer.
+//!
+//! Build: the blockers' depth map; their silhouette edges (shadow-core's extraction) each extended
+//! outward by `t` in the light's map space into a smoothie edge, with a smoothie corner at every
+//! silhouette vertex ([`geometry`]); the smoothies rendered from the light into a buffer of depth and
+//! alpha, alpha rising from 0 at the silhouette to 1 at the smoothie's far side, remapped to
+//! `a / (1 - b / r)` on linear depths (b the smoothie's, r the map's there: Fig. 4-10, the penumbra widens
+//! with the distance behind the blocker) and clamped; pixels behind a blocker (b / r >= 1) discarded;
+//! overlapping smoothies keep the minimum. Query, at the four nearest texels: behind the map's depth 0,
+//! else behind the smoothie's its alpha, else 1; bilinearly weighted (a 2x2 tent), then the sinusoidal
+//! falloff of a spherical light.
+//!
+//! Like the thesis, smoothies only extend outward: the umbra does not shrink as the light grows.
+
+pub mod cpu;
+pub mod geometry;
+
+use shadow_core::glam::Vec3;
+use shadow_core::light::{LightProjection, LightView};
+use shadow_core::scene::LightKind;
+use shadow_core::technique::TechniqueError;
+use shadow_core::technique::hard::{MAP_KEYS, ShadowMap};
+use shadow_core::technique::settings::{SettingKey, SettingsError, TechniqueSettings, Values};
+
+/// `smoothies` settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Smoothies {
+    /// The depth map: resolution (the smoothie buffer's too) and bias, as `shadow-map` has them.
+    pub depth: ShadowMap,
+    /// The smoothie size `t`.
+    pub size: SmoothieSize,
+    /// Whether alpha is remapped by the distances (Eq. 4.1); off shows the fixed-width ramp of Fig. 4-4b.
+    pub remap: Toggle,
+    /// The penumbra's profile.
+    pub falloff: Falloff,
+}
+
+/// The smoothie size `t`, in map coordinates (`[0, 1]` across the map).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum SmoothieSize {
+    /// From the light's radius: the radius as seen from the light at the casters' centre, so the
+    /// penumbra outside the hard shadow edge is as wide as a spherical light of that radius makes it
+    /// there (`t (r - b) / r` of the map at the receiver against `radius (r - b) / b` in the world).
+    Auto,
+    /// A fixed size; the thesis uses 0.02 to 0.2 for scenes 10 units across.
+    Fixed(f32),
+}
+
+shadow_core::named_enum! {
+    /// On or off.
+    pub enum Toggle {
+        /// Off.
+        Off = "off",
+        /// On.
+        On = "on",
+    }
+}
+
+shadow_core::named_enum! {
+    /// How visibility falls off across a smoothie.
+    pub enum Falloff {
+        /// `(1 - cos(pi v)) / 2`: the sinusoidal falloff of a diffuse spherical light (Parker et al.,
+        /// after Haines), which the thesis precomputes into a 1D texture.
+        Sinusoidal = "sinusoidal",
+        /// The alpha as it is.
+        Linear = "linear",
+    }
+}
+
+impl Falloff {
+    /// The visibility of a filtered alpha `v`.
+    #[must_use]
+    pub fn apply(self, v: f32) -> f32 {
+        match self {
+            Self::Sinusoidal => 0.5 - 0.5 * (std::f32::consts::PI * v).cos(),
+            Self::Linear => v,
+        }
+    }
+}
+
+const KEYS: [SettingKey; 8] = [
+    SettingKey { key: "res", default: "1024", help: "depth map and smoothie buffer side in texels (16 to 16384)" },
+    MAP_KEYS[1],
+    MAP_KEYS[2],
+    MAP_KEYS[3],
+    MAP_KEYS[6],
+    SettingKey {
+        key: "size",
+        default: "auto",
+        help: "smoothie size t in map coordinates (0.001 to 1), or auto: the light's radius seen at the casters",
+    },
+    SettingKey {
+        key: "remap",
+        default: "on",
+        help: "on: alpha / (1 - b/r) on linear depths (Eq. 4.1); off: linear ramp",
+    },
+    SettingKey { key: "falloff", default: "sinusoidal", help: "sinusoidal or linear" },
+];
+
+impl TechniqueSettings for Smoothies {
+    fn keys() -> &'static [SettingKey] {
+        &KEYS
+    }
+
+    fn from_values(v: &Values<'_>) -> Result<Self, SettingsError> {
+        let size = match v.text("size") {
+            "auto" => SmoothieSize::Auto,
+            _ => SmoothieSize::Fixed(v.ranged("size", 0.001, 1.0).map_err(|_| v.bad("size", "auto or 0.001 to 1"))?),
+        };
+        Ok(Self { depth: ShadowMap::read_depth(v)?, size, remap: v.get("remap")?, falloff: v.get("falloff")? })
+    }
+
+    fn to_values(&self) -> Vec<String> {
+        let d = &self.depth;
+        vec![
+            d.resolution.to_string(),
+            d.bias.to_string(),
+            d.bias_constant.to_string(),
+            d.bias_slope.to_string(),
+            d.bias_world.to_string(),
+            match self.size {
+                SmoothieSize::Auto => "auto".into(),
+                SmoothieSize::Fixed(t) => t.to_string(),
+            },
+            self.remap.to_string(),
+            self.falloff.to_string(),
+        ]
+    }
+}
+
+impl Smoothies {
+    /// The technique's name.
+    pub const NAME: &'static str = "smoothies";
+
+    /// The one projection smoothies use: spot and directional lights. Point lights need six buffers the
+    /// thesis does not build (section 4.5); they are refused by name.
+    ///
+    /// # Errors
+    /// [`TechniqueError::UnsupportedLight`] for a point light.
+    pub fn projection(light: &LightView) -> Result<&LightProjection, TechniqueError> {
+        match (light.light.kind, light.projections.as_slice()) {
+            (LightKind::Spot { .. } | LightKind::Directional { .. }, [p]) => Ok(p),
+            _ => Err(TechniqueError::UnsupportedLight { technique: Self::NAME.into(), light: light.light.type_name() }),
+        }
+    }
+
+    /// `t` for a frame: fixed, or the light's radius as the projection sees it at `centre` (the casters').
+    #[must_use]
+    pub fn size_for(&self, light: &LightView, proj: &LightProjection, centre: Vec3) -> f32 {
+        match self.size {
+            SmoothieSize::Fixed(t) => t,
+            SmoothieSize::Auto => {
+                let across = proj.view_from_world.inverse().transform_vector3(Vec3::X);
+                let (a, _) = proj.uv_depth(centre);
+                let (b, _) = proj.uv_depth(centre + across.normalize() * light.light.radius);
+                (b - a).length().max(1e-4)
+            }
+        }
+    }
+}
