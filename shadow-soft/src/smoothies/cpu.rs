@@ -12,47 +12,69 @@ use shadow_cpu::{CpuBackend, CpuContext, CpuError, GBuffer};
 use std::time::Instant;
 
 use super::geometry::{self, SmoothieTriangle};
-use super::{Smoothies, Toggle};
+use super::{FalloffTable, Smoothies, Toggle};
 
-/// The depth map and the smoothie buffer of the last build.
+/// The depth map and the smoothie buffer of the last build, and the rasterizer's scratch target (kept so
+/// frames reuse their memory).
 #[derive(Default)]
 pub struct State {
     maps: Vec<Image<f32>>,
     buffer: Option<SmoothieBuffer>,
+    scratch: Option<DepthStencil>,
 }
 
 /// A smoothie buffer: per texel the nearest smoothie's NDC depth (1 where none) and the minimum alpha
-/// (1 where none).
+/// (1 where none), side by side so a lookup reads them together.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SmoothieBuffer {
-    /// Nearest smoothie depth.
-    pub depth: Image<f32>,
-    /// Minimum alpha.
-    pub alpha: Image<f32>,
+    /// `[depth, alpha]` per texel.
+    pub texels: Image<[f32; 2]>,
 }
 
-/// Renders `triangles` into a `res x res` smoothie buffer over `map` (the blockers' NDC depths) of
-/// projection `proj`: alpha from each triangle's ramp at the texel centre, remapped when `remap`,
-/// discarded behind the map's surface, minimum-blended. Returns the buffer and the fragment count.
-#[must_use]
+impl SmoothieBuffer {
+    /// An empty buffer of side `res`: no smoothie anywhere.
+    #[must_use]
+    pub fn new(res: u32) -> Self {
+        Self { texels: Image::new(res, res, [1.0, 1.0]) }
+    }
+
+    /// One channel as an image (0: depth, 1: alpha).
+    #[must_use]
+    pub fn channel(&self, k: usize) -> Image<f32> {
+        Image::from_fn(self.texels.width(), self.texels.height(), |x, y| self.texels.get(x, y)[k])
+    }
+}
+
+/// Renders `triangles` into `buffer` (cleared first; the size of `map`) over `map`, the blockers' NDC
+/// depths in projection `proj`: alpha from each triangle's ramp at the texel centre, remapped when
+/// `remap`, discarded behind the map's surface, minimum-blended. `scratch` is the rasterizer's depth
+/// target (no depth test is made; reused when the size fits). Returns the fragment count.
 pub fn render_buffer(
     triangles: &[SmoothieTriangle],
     map: &Image<f32>,
     proj: &shadow_core::light::LightProjection,
-    t: f32,
-    remap: bool,
-) -> (SmoothieBuffer, u64) {
+    (t, remap): (f32, bool),
+    buffer: &mut SmoothieBuffer,
+    scratch: &mut Option<DepthStencil>,
+) -> u64 {
     let res = map.width();
     let clip: Vec<[Vec4; 3]> = triangles
         .iter()
         .map(|tri| tri.corners.map(|c| Vec4::new(2.0 * c.x - 1.0, 1.0 - 2.0 * c.y, c.z, 1.0)))
         .collect();
-    let mut ds = DepthStencil::new(res, res, 1.0, 0);
-    let mut texels = Image::new(res, res, [1.0f32, 1.0]);
+    if buffer.texels.width() == res {
+        buffer.texels.data_mut().fill([1.0, 1.0]);
+    } else {
+        *buffer = SmoothieBuffer::new(res);
+    }
+    let ds = match scratch {
+        Some(ds) if ds.width() == res => ds,
+        _ => scratch.insert(DepthStencil::new(res, res, 1.0, 0)),
+    };
     let state = RasterState { cull: CullMode::None, depth: None, ..RasterState::default() };
     let counters = draw(
-        &mut ds,
-        &mut texels,
+        ds,
+        &mut buffer.texels,
         &Soup { triangles: &clip, prim_base: 0, flip: false },
         &state,
         |f| {
@@ -68,9 +90,7 @@ pub fn render_buffer(
         },
         |dst, src| *dst = [dst[0].min(src[0]), dst[1].min(src[1])],
     );
-    let depth = Image::from_fn(res, res, |x, y| texels.get(x, y)[0]);
-    let alpha = Image::from_fn(res, res, |x, y| texels.get(x, y)[1]);
-    (SmoothieBuffer { depth, alpha }, counters.fragments)
+    counters.fragments
 }
 
 /// The thesis's three cases at one texel (clamped to the map): behind the blocker 0, behind a smoothie
@@ -78,13 +98,9 @@ pub fn render_buffer(
 fn texel_visibility(map: &Image<f32>, buffer: &SmoothieBuffer, x: i32, y: i32, depth: f32) -> f32 {
     let n = map.width() as i32 - 1;
     let (x, y) = (x.clamp(0, n) as u32, y.clamp(0, n) as u32);
-    if depth > *map.get(x, y) {
-        0.0
-    } else if depth > *buffer.depth.get(x, y) {
-        *buffer.alpha.get(x, y)
-    } else {
-        1.0
-    }
+    let [smoothie, alpha] = *buffer.texels.get(x, y);
+    let penumbra = if depth > smoothie { alpha } else { 1.0 };
+    if depth > *map.get(x, y) { 0.0 } else { penumbra }
 }
 
 /// Visibility at map point `uv`, NDC depth `depth`: the three cases at the four nearest texels, bilinearly
@@ -130,9 +146,9 @@ impl ShadowTechnique<CpuBackend> for Smoothies {
         let centre = geometry::silhouette_centre(frame, &casters).unwrap_or(frame.bounds.center());
         let t = self.size_for(light, proj, centre);
         let smoothies = geometry::build(frame, &casters, proj, t);
-        let (buffer, fragments) =
-            render_buffer(&smoothies.triangles, &state.maps[0], proj, t, self.remap == Toggle::On);
-        state.buffer = Some(buffer);
+        let buffer = state.buffer.get_or_insert_with(|| SmoothieBuffer::new(self.depth.resolution));
+        let settings = (t, self.remap == Toggle::On);
+        let fragments = render_buffer(&smoothies.triangles, &state.maps[0], proj, settings, buffer, &mut state.scratch);
         stats.timings.extra.insert("smoothies".into(), ms(t0.elapsed()));
         let c = &mut stats.counters;
         c.silhouette_edges = Some(smoothies.edges as u64);
@@ -156,21 +172,22 @@ impl ShadowTechnique<CpuBackend> for Smoothies {
         let not_built = || TechniqueError::NotBuilt(self.name().into());
         let (Some(buffer), Some(map)) = (&state.buffer, state.maps.first()) else { return Err(not_built().into()) };
         let offset = self.depth.receiver_offset();
+        let falloff = FalloffTable::new(self.falloff);
         per_receiver(g, out, |_, _, i| {
             let m = map_position(light, g.position.data()[i], offset);
-            self.falloff.apply(smoothie_lookup(map, buffer, m.uv, m.depth))
+            falloff.apply(smoothie_lookup(map, buffer, m.uv, m.depth))
         });
         Ok(())
     }
 
     fn debug_views(&self, _: &mut CpuContext, state: &State) -> Result<Vec<DebugView>, CpuError> {
         let Some(buffer) = &state.buffer else { return Ok(Vec::new()) };
-        let alpha = &buffer.alpha;
+        let (depth, alpha) = (buffer.channel(0), buffer.channel(1));
         let grey = Image::from_fn(alpha.width(), alpha.height(), |x, y| [(alpha.get(x, y) * 255.0).round() as u8; 3]);
-        let nearest = buffer.depth.data().iter().copied().fold(1.0f32, f32::min);
+        let nearest = depth.data().iter().copied().fold(1.0f32, f32::min);
         Ok(vec![
             DebugView { name: "smoothie-alpha".into(), image: grey },
-            DebugView { name: "smoothie-depth".into(), image: false_colour(&buffer.depth, nearest, 1.0) },
+            DebugView { name: "smoothie-depth".into(), image: false_colour(&depth, nearest, 1.0) },
         ])
     }
 }

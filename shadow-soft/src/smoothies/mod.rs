@@ -69,13 +69,47 @@ shadow_core::named_enum! {
 }
 
 impl Falloff {
-    /// The visibility of a filtered alpha `v`.
+    /// The visibility of a filtered alpha `v` (in `[0, 1]`), exactly.
     #[must_use]
-    pub fn apply(self, v: f32) -> f32 {
+    pub fn exact(self, v: f32) -> f32 {
         match self {
             Self::Sinusoidal => 0.5 - 0.5 * (std::f32::consts::PI * v).cos(),
             Self::Linear => v,
         }
+    }
+}
+
+/// A falloff tabulated as the thesis keeps it, a 1D texture read with linear filtering: `FALLOFF_TEXELS`
+/// samples from 0 to 1 (the sinusoid's largest error between them is under 1e-5).
+#[derive(Clone, Debug, PartialEq)]
+pub struct FalloffTable {
+    samples: Vec<f32>,
+}
+
+/// Samples in a [`FalloffTable`].
+pub const FALLOFF_TEXELS: usize = 256;
+
+impl FalloffTable {
+    /// The table of `falloff`.
+    #[must_use]
+    pub fn new(falloff: Falloff) -> Self {
+        let last = (FALLOFF_TEXELS - 1) as f32;
+        Self { samples: (0..FALLOFF_TEXELS).map(|i| falloff.exact(i as f32 / last)).collect() }
+    }
+
+    /// The samples, for a GPU texture.
+    #[must_use]
+    pub fn samples(&self) -> &[f32] {
+        &self.samples
+    }
+
+    /// The falloff at `v`, clamped to `[0, 1]`, linearly interpolated between samples.
+    #[must_use]
+    pub fn apply(&self, v: f32) -> f32 {
+        let x = v.clamp(0.0, 1.0) * (FALLOFF_TEXELS - 1) as f32;
+        let i = (x as usize).min(FALLOFF_TEXELS - 2);
+        let f = x - i as f32;
+        self.samples[i] * (1.0 - f) + self.samples[i + 1] * f
     }
 }
 
@@ -157,5 +191,25 @@ impl Smoothies {
                 (b - a).length().max(1e-4)
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_tabulated_falloff_follows_the_sinusoid() {
+        for falloff in [Falloff::Sinusoidal, Falloff::Linear] {
+            let table = FalloffTable::new(falloff);
+            let worst = (0..=1000)
+                .map(|i| i as f32 / 1000.0)
+                .map(|v| (table.apply(v) - falloff.exact(v)).abs())
+                .fold(0.0, f32::max);
+            assert!(worst < 1e-5, "{falloff}: {worst}");
+        }
+        let table = FalloffTable::new(Falloff::Sinusoidal);
+        assert_eq!((table.apply(-1.0), table.apply(0.0), table.apply(1.0), table.apply(2.0)), (0.0, 0.0, 1.0, 1.0));
+        assert!((table.apply(0.5) - 0.5).abs() < 1e-6);
     }
 }
