@@ -52,6 +52,16 @@ impl Error {
                 | Self::Usage(_)
         )
     }
+
+    /// The technique error inside, when a backend's technique refused or failed (an unsupported light,
+    /// bad settings, a query before a build).
+    #[must_use]
+    pub fn technique(&self) -> Option<&shadow_core::technique::TechniqueError> {
+        match self {
+            Self::Cpu(shadow_cpu::CpuError::Technique(e)) | Self::Gpu(shadow_wgpu::WgpuError::Technique(e)) => Some(e),
+            _ => None,
+        }
+    }
 }
 
 impl From<shadow_core::image::ImageWriteError> for Error {

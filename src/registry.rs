@@ -197,7 +197,7 @@ impl TechniqueRegistry {
             keys: Smoothies::keys,
             canonical: canonical::<Smoothies>,
             cpu: Some(plain::<CpuBackend, Smoothies>),
-            wgpu: None,
+            wgpu: Some(plain::<WgpuBackend, Smoothies>),
         });
         r.register(TechniqueEntry {
             name: "shadow-volume-zpass",

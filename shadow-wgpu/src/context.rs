@@ -240,6 +240,14 @@ impl WgpuContext {
         }
     }
 
+    /// The layout of bind group 0 of every pass that reads the frame (a view uniform and the instances):
+    /// what a pipeline outside this crate needs to use the G-buffer's `frame_group` or the shared shader
+    /// functions of `shaders::shadow_map()`.
+    #[must_use]
+    pub fn frame_layout(&self) -> &wgpu::BindGroupLayout {
+        &self.shared.frame_layout
+    }
+
     /// Runs `f` inside validation and out-of-memory error scopes and turns anything they catch into an
     /// error naming `during`.
     ///

@@ -80,6 +80,12 @@ pub fn depth_array_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
     texture_entry(binding, wgpu::TextureSampleType::Depth, wgpu::TextureViewDimension::D2Array)
 }
 
+/// A depth 2D texture binding (one layer), read with `textureLoad`.
+#[must_use]
+pub fn depth_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    texture_entry(binding, wgpu::TextureSampleType::Depth, wgpu::TextureViewDimension::D2)
+}
+
 /// A uniform or storage buffer binding.
 #[must_use]
 pub fn buffer_entry(

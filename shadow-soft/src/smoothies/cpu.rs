@@ -1,7 +1,6 @@
 //! `smoothies` on the CPU backend, through its public rasterizer and depth-map API.
 
 use shadow_core::glam::{Vec2, Vec4};
-use shadow_core::image::false_colour;
 use shadow_core::light::LightView;
 use shadow_core::stats::ms;
 use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
@@ -11,7 +10,7 @@ use shadow_cpu::techniques::{map_position, per_receiver, render_depth_maps};
 use shadow_cpu::{CpuBackend, CpuContext, CpuError, GBuffer};
 use std::time::Instant;
 
-use super::geometry::{self, SmoothieTriangle};
+use super::geometry::SmoothieTriangle;
 use super::{FalloffTable, Smoothies, Toggle};
 
 /// The depth map and the smoothie buffer of the last build, and the rasterizer's scratch target (kept so
@@ -142,20 +141,12 @@ impl ShadowTechnique<CpuBackend> for Smoothies {
         let proj = Self::projection(light)?;
         render_depth_maps(frame, light, self.depth.resolution, self.depth.depth_bias(), &mut state.maps)?;
         let t0 = Instant::now();
-        let casters = frame.caster_silhouettes(light);
-        let centre = geometry::silhouette_centre(frame, &casters).unwrap_or(frame.bounds.center());
-        let t = self.size_for(light, proj, centre);
-        let smoothies = geometry::build(frame, &casters, proj, t);
+        let (t, smoothies) = self.construct(frame, light, proj, stats);
         let buffer = state.buffer.get_or_insert_with(|| SmoothieBuffer::new(self.depth.resolution));
         let settings = (t, self.remap == Toggle::On);
         let fragments = render_buffer(&smoothies.triangles, &state.maps[0], proj, settings, buffer, &mut state.scratch);
         stats.timings.extra.insert("smoothies".into(), ms(t0.elapsed()));
-        let c = &mut stats.counters;
-        c.silhouette_edges = Some(smoothies.edges as u64);
-        c.extra.insert("smoothie_triangles".into(), smoothies.triangles.len() as f64);
-        c.extra.insert("smoothie_fragments".into(), fragments as f64);
-        c.extra.insert("special_vertices".into(), smoothies.special_vertices as f64);
-        c.extra.insert("smoothie_size".into(), f64::from(t));
+        stats.counters.extra.insert("smoothie_fragments".into(), fragments as f64);
         Ok(())
     }
 
@@ -169,7 +160,7 @@ impl ShadowTechnique<CpuBackend> for Smoothies {
         out: &mut Image<f32>,
         _: &mut FrameStats,
     ) -> Result<(), CpuError> {
-        let not_built = || TechniqueError::NotBuilt(self.name().into());
+        let not_built = || TechniqueError::NotBuilt(Self::NAME.into());
         let (Some(buffer), Some(map)) = (&state.buffer, state.maps.first()) else { return Err(not_built().into()) };
         let offset = self.depth.receiver_offset();
         let falloff = FalloffTable::new(self.falloff);
@@ -182,12 +173,6 @@ impl ShadowTechnique<CpuBackend> for Smoothies {
 
     fn debug_views(&self, _: &mut CpuContext, state: &State) -> Result<Vec<DebugView>, CpuError> {
         let Some(buffer) = &state.buffer else { return Ok(Vec::new()) };
-        let (depth, alpha) = (buffer.channel(0), buffer.channel(1));
-        let grey = Image::from_fn(alpha.width(), alpha.height(), |x, y| [(alpha.get(x, y) * 255.0).round() as u8; 3]);
-        let nearest = depth.data().iter().copied().fold(1.0f32, f32::min);
-        Ok(vec![
-            DebugView { name: "smoothie-alpha".into(), image: grey },
-            DebugView { name: "smoothie-depth".into(), image: false_colour(&depth, nearest, 1.0) },
-        ])
+        Ok(super::debug_views(&buffer.channel(0), &buffer.channel(1)))
     }
 }

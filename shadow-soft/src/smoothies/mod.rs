@@ -15,13 +15,18 @@
 
 pub mod cpu;
 pub mod geometry;
+pub mod gpu;
 
 use shadow_core::glam::Vec3;
+use shadow_core::image::false_colour;
 use shadow_core::light::{LightProjection, LightView};
 use shadow_core::scene::LightKind;
+use shadow_core::technique::DebugView;
+use shadow_core::technique::FrameStats;
 use shadow_core::technique::TechniqueError;
 use shadow_core::technique::hard::{MAP_KEYS, ShadowMap};
 use shadow_core::technique::settings::{SettingKey, SettingsError, TechniqueSettings, Values};
+use shadow_core::{FrameInputs, Image};
 
 /// `smoothies` settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -179,6 +184,28 @@ impl Smoothies {
         }
     }
 
+    /// The smoothies of a frame's casters for `light` in its projection `proj`, with the size `t` they
+    /// were built with; their counters recorded in `stats` (both backends alike).
+    #[must_use]
+    pub fn construct(
+        &self,
+        frame: &FrameInputs,
+        light: &LightView,
+        proj: &LightProjection,
+        stats: &mut FrameStats,
+    ) -> (f32, geometry::Smoothies) {
+        let casters = frame.caster_silhouettes(light);
+        let centre = geometry::silhouette_centre(frame, &casters).unwrap_or(frame.bounds.center());
+        let t = self.size_for(light, proj, centre);
+        let smoothies = geometry::build(frame, &casters, proj, t);
+        let c = &mut stats.counters;
+        c.silhouette_edges = Some(smoothies.edges as u64);
+        c.extra.insert("smoothie_triangles".into(), smoothies.triangles.len() as f64);
+        c.extra.insert("special_vertices".into(), smoothies.special_vertices as f64);
+        c.extra.insert("smoothie_size".into(), f64::from(t));
+        (t, smoothies)
+    }
+
     /// `t` for a frame: fixed, or the light's radius as the projection sees it at `centre` (the casters').
     #[must_use]
     pub fn size_for(&self, light: &LightView, proj: &LightProjection, centre: Vec3) -> f32 {
@@ -192,6 +219,17 @@ impl Smoothies {
             }
         }
     }
+}
+
+/// The debug views of a smoothie buffer, the same on both backends: alpha in grey, depth in false colour.
+#[must_use]
+pub fn debug_views(depth: &Image<f32>, alpha: &Image<f32>) -> Vec<DebugView> {
+    let grey = Image::from_fn(alpha.width(), alpha.height(), |x, y| [(alpha.get(x, y) * 255.0).round() as u8; 3]);
+    let nearest = depth.data().iter().copied().fold(1.0f32, f32::min);
+    vec![
+        DebugView { name: "smoothie-alpha".into(), image: grey },
+        DebugView { name: "smoothie-depth".into(), image: false_colour(depth, nearest, 1.0) },
+    ]
 }
 
 #[cfg(test)]

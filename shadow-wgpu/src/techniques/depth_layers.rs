@@ -17,7 +17,7 @@ use super::shadow_map::{LookupParams, MapQuery, QueryExtras, map_texture};
 use crate::context::{WgpuBackend, WgpuContext, WgpuError};
 use crate::frame::{GpuVisibility, layer_view};
 use crate::gbuffer::{GpuGBuffer, check_size};
-use crate::pipelines::{MAP_DEPTH, POSITION_LAYOUT, ViewRaw, buffer_entry};
+use crate::pipelines::{MAP_DEPTH, POSITION_LAYOUT, ViewRaw, buffer_entry, depth_entry};
 use crate::shaders;
 
 /// GPU twin of `LayerParams` in depth_layers.wgsl.
@@ -36,19 +36,6 @@ pub struct State {
     query: MapQuery,
     maps: Option<wgpu::Texture>,
     scratch: Option<(wgpu::Texture, wgpu::Texture)>,
-}
-
-fn depth_texture_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::FRAGMENT,
-        ty: wgpu::BindingType::Texture {
-            sample_type: wgpu::TextureSampleType::Depth,
-            view_dimension: wgpu::TextureViewDimension::D2,
-            multisampled: false,
-        },
-        count: None,
-    }
 }
 
 fn pass_index(peel: bool, cull: bool, cw: bool) -> usize {
@@ -70,8 +57,8 @@ impl State {
         let layout = cx.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("depth layers"),
             entries: &[
-                depth_texture_entry(0),
-                depth_texture_entry(1),
+                depth_entry(0),
+                depth_entry(1),
                 buffer_entry(2, wgpu::BufferBindingType::Uniform, wgpu::ShaderStages::FRAGMENT),
             ],
         });

@@ -1,0 +1,324 @@
+//! `smoothies` on the wgpu backend, through its public API: `shadow-map`'s light pass for the blockers'
+//! depth, two passes drawing the smoothies into the buffer (buffer.wgsl), and a query over the G-buffer
+//! with `shadow-map`'s bindings and three of its own (query.wgsl). The smoothies themselves are built on
+//! the CPU by the shared [`super::geometry`] and uploaded, as the thesis's host code built them.
+
+use bytemuck::{Pod, Zeroable};
+use shadow_core::FrameInputs;
+use shadow_core::light::{LightProjection, LightView};
+use shadow_core::technique::hard::ShadowMap;
+use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
+use shadow_wgpu::frame::layered;
+use shadow_wgpu::pipelines::{
+    FragmentEntry, MAP_DEPTH, VISIBILITY, buffer_entry, depth_array_entry, depth_entry, full_screen_pipeline,
+};
+use shadow_wgpu::techniques::shadow_map::{LookupParams, MapBindings, QueryExtras};
+use shadow_wgpu::{GpuGBuffer, GpuVisibility, WgpuBackend, WgpuContext, WgpuError, readback, shaders};
+use wgpu::util::DeviceExt;
+
+use super::geometry::{Ramp, SmoothieTriangle};
+use super::{FalloffTable, Smoothies, Toggle};
+
+/// GPU twin of `BufferParams` in buffer.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct BufferParams {
+    depth: [f32; 4],
+    smoothie: [f32; 4],
+}
+
+/// One smoothie vertex: corner (u, v, depth), ramp kind, ramp data.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct SmoothieVertex {
+    corner: [f32; 3],
+    kind: f32,
+    ramp: [f32; 4],
+}
+
+const VERTEX_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
+    array_stride: std::mem::size_of::<SmoothieVertex>() as u64,
+    step_mode: wgpu::VertexStepMode::Vertex,
+    attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32, 2 => Float32x4],
+};
+
+/// Pipelines, the blockers' map, the smoothie buffer of the last build.
+pub struct State {
+    map: shadow_wgpu::techniques::shadow_map::State,
+    buffer_layout: wgpu::BindGroupLayout,
+    depth_pass: wgpu::RenderPipeline,
+    alpha_pass: wgpu::RenderPipeline,
+    bindings: MapBindings,
+    query: wgpu::RenderPipeline,
+    falloff: wgpu::Buffer,
+    /// Nearest smoothie depth and minimum alpha, each a one-layer depth texture.
+    buffer: Option<[wgpu::Texture; 2]>,
+}
+
+fn vertices(triangles: &[SmoothieTriangle]) -> Vec<SmoothieVertex> {
+    triangles
+        .iter()
+        .flat_map(|tri| {
+            let (kind, ramp) = match tri.ramp {
+                Ramp::Edge { origin, outward } => (0.0, [origin.x, origin.y, outward.x, outward.y]),
+                Ramp::Corner { vertex } => (1.0, [vertex.x, vertex.y, 0.0, 0.0]),
+            };
+            tri.corners.map(|c| SmoothieVertex { corner: c.to_array(), kind, ramp })
+        })
+        .collect()
+}
+
+/// A pipeline drawing smoothies into a depth target through `entry`, the depth test "less" keeping the
+/// smallest value.
+fn buffer_pipeline(
+    cx: &WgpuContext,
+    module: &wgpu::ShaderModule,
+    layout: &wgpu::BindGroupLayout,
+    entry: &str,
+) -> wgpu::RenderPipeline {
+    let pipeline_layout = cx.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("smoothie buffer"),
+        bind_group_layouts: &[Some(layout)],
+        immediate_size: 0,
+    });
+    cx.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("smoothie buffer"),
+        layout: Some(&pipeline_layout),
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some("vs_smoothie"),
+            compilation_options: Default::default(),
+            buffers: &[Some(VERTEX_LAYOUT)],
+        },
+        primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: MAP_DEPTH,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::Less),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module,
+            entry_point: Some(entry),
+            compilation_options: Default::default(),
+            targets: &[],
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
+impl State {
+    /// Draws `triangles` into the buffer over `maps` (the blockers' depth) of projection `proj`.
+    fn render_buffer(
+        &mut self,
+        cx: &WgpuContext,
+        maps: &wgpu::Texture,
+        proj: &LightProjection,
+        triangles: &[SmoothieTriangle],
+        (t, remap): (f32, bool),
+    ) {
+        let res = maps.width();
+        if self.buffer.as_ref().is_none_or(|b| b[0].width() != res) {
+            self.buffer = Some([0, 1].map(|_| layered(cx, "smoothie buffer", res, res, 1, MAP_DEPTH)));
+        }
+        let Some(buffer) = &self.buffer else { return };
+        let params = BufferParams {
+            depth: [proj.near, proj.far, f32::from(u8::from(proj.orthographic)), res as f32],
+            smoothie: [t, f32::from(u8::from(remap)), 0.0, 0.0],
+        };
+        let uniform = cx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("smoothie params"),
+            contents: bytemuck::bytes_of(&params),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let maps_view = maps.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        });
+        let group = cx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("smoothie buffer"),
+            layout: &self.buffer_layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: uniform.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&maps_view) },
+            ],
+        });
+        let data = vertices(triangles);
+        let vertex_buffer = (!data.is_empty()).then(|| {
+            cx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("smoothies"),
+                contents: bytemuck::cast_slice(&data),
+                usage: wgpu::BufferUsages::VERTEX,
+            })
+        });
+        let mut enc = cx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("smoothies") });
+        for (target, pipeline) in buffer.iter().zip([&self.depth_pass, &self.alpha_pass]) {
+            let view = target.create_view(&wgpu::TextureViewDescriptor {
+                dimension: Some(wgpu::TextureViewDimension::D2),
+                ..Default::default()
+            });
+            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("smoothie buffer"),
+                color_attachments: &[],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &view,
+                    depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
+                    stencil_ops: None,
+                }),
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            if let Some(vb) = &vertex_buffer {
+                pass.set_pipeline(pipeline);
+                pass.set_bind_group(0, &group, &[]);
+                pass.set_vertex_buffer(0, vb.slice(..));
+                pass.draw(0..data.len() as u32, 0..1);
+            }
+        }
+        cx.queue.submit([enc.finish()]);
+    }
+}
+
+impl ShadowTechnique<WgpuBackend> for Smoothies {
+    type State = State;
+
+    fn name(&self) -> &'static str {
+        Self::NAME
+    }
+
+    fn create_state(&self, cx: &mut WgpuContext) -> Result<State, WgpuError> {
+        let map = <ShadowMap as ShadowTechnique<WgpuBackend>>::create_state(&self.depth, cx)?;
+        let falloff = FalloffTable::new(self.falloff);
+        cx.scoped("creating the smoothie pipelines", |cx| {
+            let buffer_module = shaders::module(&cx.device, "smoothie buffer", buffer_shader());
+            let buffer_layout = cx.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("smoothie buffer"),
+                entries: &[
+                    buffer_entry(0, wgpu::BufferBindingType::Uniform, wgpu::ShaderStages::FRAGMENT),
+                    depth_array_entry(1),
+                ],
+            });
+            let depth_pass = buffer_pipeline(cx, &buffer_module, &buffer_layout, "fs_smoothie_depth");
+            let alpha_pass = buffer_pipeline(cx, &buffer_module, &buffer_layout, "fs_smoothie_alpha");
+            let query_module = shaders::module(&cx.device, "smoothie query", query_shader());
+            let storage = wgpu::BufferBindingType::Storage { read_only: true };
+            let bindings = MapBindings::new(
+                cx,
+                &[depth_entry(4), depth_entry(5), buffer_entry(6, storage, wgpu::ShaderStages::FRAGMENT)],
+            );
+            let query = full_screen_pipeline(
+                &cx.device,
+                "smoothie query",
+                &query_module,
+                FragmentEntry::from("fs_smoothie_query"),
+                &[cx.frame_layout(), bindings.layout()],
+                Some(VISIBILITY),
+                None,
+            );
+            let falloff = cx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("smoothie falloff"),
+                contents: bytemuck::cast_slice(falloff.samples()),
+                usage: wgpu::BufferUsages::STORAGE,
+            });
+            State { map, buffer_layout, depth_pass, alpha_pass, bindings, query, falloff, buffer: None }
+        })
+    }
+
+    fn build(
+        &self,
+        cx: &mut WgpuContext,
+        state: &mut State,
+        frame: &FrameInputs,
+        light: &LightView,
+        stats: &mut FrameStats,
+    ) -> Result<(), WgpuError> {
+        let proj = Self::projection(light)?;
+        <ShadowMap as ShadowTechnique<WgpuBackend>>::build(&self.depth, cx, &mut state.map, frame, light, stats)?;
+        let t0 = std::time::Instant::now();
+        let (t, smoothies) = self.construct(frame, light, proj, stats);
+        let maps = state.map.maps().ok_or_else(|| TechniqueError::NotBuilt(Self::NAME.into()))?.clone();
+        cx.scoped("the smoothie buffer", |cx| {
+            state.render_buffer(cx, &maps, proj, &smoothies.triangles, (t, self.remap == Toggle::On));
+        })?;
+        stats.timings.extra.insert("smoothies".into(), shadow_core::stats::ms(t0.elapsed()));
+        Ok(())
+    }
+
+    fn query(
+        &self,
+        cx: &mut WgpuContext,
+        state: &mut State,
+        _: &FrameInputs,
+        light: &LightView,
+        g: &GpuGBuffer,
+        out: &mut GpuVisibility,
+        _: &mut FrameStats,
+    ) -> Result<(), WgpuError> {
+        let not_built = || TechniqueError::NotBuilt(Self::NAME.into());
+        let (Some(maps), Some(buffer)) = (state.map.maps(), &state.buffer) else { return Err(not_built().into()) };
+        let views = buffer.each_ref().map(|t| {
+            t.create_view(&wgpu::TextureViewDescriptor {
+                dimension: Some(wgpu::TextureViewDimension::D2),
+                ..Default::default()
+            })
+        });
+        let entries = [
+            wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::TextureView(&views[0]) },
+            wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&views[1]) },
+            wgpu::BindGroupEntry { binding: 6, resource: state.falloff.as_entire_binding() },
+        ];
+        let lookup = LookupParams { radius: 0.0, receiver_offset: self.depth.receiver_offset() };
+        cx.scoped("the smoothie query", |cx| {
+            let extras = QueryExtras { settings: [0.0; 4], entries: &entries };
+            let group = state.bindings.group(cx, maps, light, g, lookup, &extras);
+            shadow_wgpu::techniques::full_screen(
+                cx,
+                "smoothie query",
+                &out.view,
+                &state.query,
+                &[&g.frame_group, &group],
+                None,
+            );
+        })
+    }
+
+    fn debug_views(&self, cx: &mut WgpuContext, state: &State) -> Result<Vec<DebugView>, WgpuError> {
+        let Some([depth, alpha]) = &state.buffer else { return Ok(Vec::new()) };
+        let depth = readback::read_f32(cx, depth, 0, wgpu::TextureAspect::DepthOnly)?;
+        let alpha = readback::read_f32(cx, alpha, 0, wgpu::TextureAspect::DepthOnly)?;
+        Ok(super::debug_views(&depth, &alpha))
+    }
+}
+
+/// The WGSL of the smoothie buffer passes.
+#[must_use]
+pub fn buffer_shader() -> String {
+    include_str!("buffer.wgsl").to_string()
+}
+
+/// The WGSL of the smoothie query: the shadow-map shader, then the query.
+#[must_use]
+pub fn query_shader() -> String {
+    format!("{}\n{}", shaders::shadow_map(), include_str!("query.wgsl"))
+}
+
+#[cfg(test)]
+mod tests {
+    /// The WGSL parses and validates with naga, so a shader error fails `cargo test`, not a user.
+    #[test]
+    fn the_shaders_validate() {
+        for (name, src) in [("buffer", super::buffer_shader()), ("query", super::query_shader())] {
+            let module =
+                naga::front::wgsl::parse_str(&src).unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&src)));
+            let mut v =
+                naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all());
+            if let Err(e) = v.validate(&module) {
+                panic!("{name}: {}", e.emit_to_string(&src));
+            }
+        }
+    }
+}
