@@ -1,6 +1,11 @@
 //! GPU time per phase from timestamp queries, where the adapter has them: a marker (an empty compute
 //! pass that writes a timestamp) is submitted between phases; as the queue runs in order, the difference
 //! between two markers is the GPU's time for the work submitted between them.
+//!
+//! A technique whose query also runs counter passes (occlusion queries read back on the CPU) calls
+//! [`WgpuContext::end_of_work`] once its own work is submitted: the frame driver then reports the GPU time
+//! up to that marker as the phase's and the rest as `gpu_counters`, so the waits and passes of the
+//! counters do not land in the technique's time.
 
 use crate::context::{WgpuContext, WgpuError};
 
@@ -8,6 +13,7 @@ use crate::context::{WgpuContext, WgpuError};
 pub struct PhaseClock {
     set: wgpu::QuerySet,
     count: u32,
+    work_end: Option<u32>,
 }
 
 /// Most markers a frame writes.
@@ -24,16 +30,31 @@ impl PhaseClock {
                 count: CAPACITY,
             }),
             count: 0,
+            work_end: None,
         })
     }
 
     /// Submits a marker; returns its index.
     pub fn mark(&mut self, cx: &WgpuContext) -> Option<u32> {
+        self.mark_on(&cx.device, &cx.queue)
+    }
+
+    /// Submits the end-of-work marker of the phase under way (see the module docs).
+    pub(crate) fn mark_work_end(&mut self, device: &wgpu::Device, queue: &wgpu::Queue) {
+        self.work_end = self.mark_on(device, queue);
+    }
+
+    /// The end-of-work marker submitted since the last call, if any.
+    pub fn take_work_end(&mut self) -> Option<u32> {
+        self.work_end.take()
+    }
+
+    fn mark_on(&mut self, device: &wgpu::Device, queue: &wgpu::Queue) -> Option<u32> {
         if self.count >= CAPACITY {
             return None;
         }
         let index = self.count;
-        let mut enc = cx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("phase marker") });
+        let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("phase marker") });
         drop(enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("phase marker"),
             timestamp_writes: Some(wgpu::ComputePassTimestampWrites {
@@ -42,7 +63,7 @@ impl PhaseClock {
                 end_of_pass_write_index: None,
             }),
         }));
-        cx.queue.submit([enc.finish()]);
+        queue.submit([enc.finish()]);
         self.count += 1;
         Some(index)
     }

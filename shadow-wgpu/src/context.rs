@@ -123,6 +123,8 @@ pub struct WgpuContext {
     pub queue: wgpu::Queue,
     /// Timestamp queries are available.
     pub timestamps: bool,
+    /// The frame's phase clock while [`crate::frame::render_frame`] runs (timestamp adapters only).
+    pub(crate) clock: Option<crate::clock::PhaseClock>,
     lost: Arc<Mutex<Option<String>>>,
     pub(crate) cache: crate::upload::SceneCache,
     pub(crate) shared: crate::pipelines::Shared,
@@ -223,6 +225,7 @@ impl WgpuContext {
             device,
             queue,
             timestamps,
+            clock: None,
             lost,
             cache: crate::upload::SceneCache::default(),
             shared,
@@ -265,6 +268,15 @@ impl WgpuContext {
         }
         self.check_lost()?;
         Ok(r)
+    }
+
+    /// Marks the end of the technique's own GPU work in the phase under way: what it submits after
+    /// this (counter passes and their readbacks) is timed apart as `gpu_counters` (see [`crate::clock`]).
+    /// Does nothing outside a frame or on adapters without timestamp queries.
+    pub fn end_of_work(&mut self) {
+        if let Some(clock) = &mut self.clock {
+            clock.mark_work_end(&self.device, &self.queue);
+        }
     }
 
     /// Waits for all submitted work.

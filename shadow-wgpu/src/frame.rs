@@ -123,16 +123,39 @@ pub fn render_frame(
     technique: &mut dyn DynShadowTechnique<WgpuBackend>,
 ) -> Result<WgpuFrame, WgpuError> {
     let start = Instant::now();
+    cx.clock = PhaseClock::new(cx);
+    let result = frame_phases(cx, frame, width, height, technique, start);
+    cx.clock = None;
+    result
+}
+
+/// A phase and its clock markers, for GPU times: start, end of the technique's own work (see
+/// [`WgpuContext::end_of_work`]) and end.
+type Span = (Phase, Option<u32>, Option<u32>, Option<u32>);
+
+/// [`render_frame`]'s phases, with the clock in the context.
+fn frame_phases(
+    cx: &mut WgpuContext,
+    frame: &FrameInputs,
+    width: u32,
+    height: u32,
+    technique: &mut dyn DynShadowTechnique<WgpuBackend>,
+    start: Instant,
+) -> Result<WgpuFrame, WgpuError> {
     let mut stats = FrameStats::default();
-    let mut clock = PhaseClock::new(cx);
-    // Marker indices of each phase's start and end, for GPU times.
-    let mut spans: Vec<(Phase, Option<u32>, Option<u32>)> = Vec::new();
-    let mark = |cx: &WgpuContext, clock: &mut Option<PhaseClock>| clock.as_mut().and_then(|c| c.mark(cx));
+    let mut spans: Vec<Span> = Vec::new();
+    let mark = |cx: &mut WgpuContext| {
+        let mut clock = cx.clock.take()?;
+        let index = clock.mark(cx);
+        cx.clock = Some(clock);
+        index
+    };
+    let work_end = |cx: &mut WgpuContext| cx.clock.as_mut().and_then(PhaseClock::take_work_end);
 
     let t = Instant::now();
-    let m0 = mark(cx, &mut clock);
+    let m0 = mark(cx);
     let g = gbuffer::render(cx, frame, width, height)?;
-    spans.push((Phase::GBuffer, m0, mark(cx, &mut clock)));
+    spans.push((Phase::GBuffer, m0, None, mark(cx)));
     cx.wait()?;
     stats.timings.add(Phase::GBuffer, ms(t.elapsed()));
 
@@ -143,16 +166,16 @@ pub fn render_frame(
         let view = frame.light_view(light)?;
         let mut light_stats = FrameStats::default();
         let t = Instant::now();
-        let m0 = mark(cx, &mut clock);
+        let m0 = mark(cx);
         technique.build(cx, frame, &view, &mut light_stats)?;
-        spans.push((Phase::Build, m0, mark(cx, &mut clock)));
+        spans.push((Phase::Build, m0, work_end(cx), mark(cx)));
         cx.wait()?;
         stats.timings.add(Phase::Build, ms(t.elapsed()));
         let mut out = GpuVisibility { view: layer_view(&vis_tex, k as u32), width, height };
         let t = Instant::now();
-        let m0 = mark(cx, &mut clock);
+        let m0 = mark(cx);
         technique.query(cx, frame, &view, &g, &mut out, &mut light_stats)?;
-        spans.push((Phase::Query, m0, mark(cx, &mut clock)));
+        spans.push((Phase::Query, m0, work_end(cx), mark(cx)));
         cx.wait()?;
         stats.timings.add(Phase::Query, ms(t.elapsed()));
         stats.counters.merge(&light_stats.counters);
@@ -163,19 +186,28 @@ pub fn render_frame(
     }
 
     let t = Instant::now();
-    let m0 = mark(cx, &mut clock);
+    let m0 = mark(cx);
     let (color_tex, covered) = shade(cx, frame, &g, &vis_tex)?;
-    spans.push((Phase::Shade, m0, mark(cx, &mut clock)));
+    spans.push((Phase::Shade, m0, None, mark(cx)));
     cx.wait()?;
     stats.timings.add(Phase::Shade, ms(t.elapsed()));
     stats.timings.total = ms(start.elapsed());
     stats.counters.covered_pixels = Some(read_count(cx, &covered)?);
-    if let Some(c) = &clock {
+    if let Some(c) = &cx.clock {
         let at = c.read(cx)?;
-        for (phase, a, b) in spans {
+        let mut add = |key: String, a: u32, b: u32| {
+            *stats.timings.extra.entry(key).or_insert(0.0) += at[b as usize] - at[a as usize];
+        };
+        for (phase, a, work, b) in spans {
             if let (Some(a), Some(b)) = (a, b) {
-                *stats.timings.extra.entry(format!("gpu_{}", phase.key())).or_insert(0.0) +=
-                    at[b as usize] - at[a as usize];
+                let key = format!("gpu_{}", phase.key());
+                match work {
+                    Some(w) => {
+                        add(key, a, w);
+                        add("gpu_counters".into(), w, b);
+                    }
+                    None => add(key, a, b),
+                }
             }
         }
     }

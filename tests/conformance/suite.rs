@@ -46,11 +46,13 @@ fn reference_ceiling(technique: &str, scene: &str) -> Option<f64> {
 
 /// Settings other than the defaults that take a different path through a backend, run as techniques of
 /// their own.
-const VARIANTS: [&str; 2] = [
+const VARIANTS: [&str; 3] = [
     // The light pass's object-ID channel: an R32Uint target read back on the GPU.
     "volume-reconstruction:ids=dangling",
     // The unmasked volume pass that counts what the computation mask saves.
     "hybrid:unmasked_fill=on",
+    // The computation mask kept in a scratch depth buffer, the volumes' depth test turned around.
+    "hybrid:gpu_mask=depth",
 ];
 
 fn scenes() -> Vec<(String, Scene)> {

@@ -49,6 +49,19 @@ fn fs_hybrid_mask(in: FullScreen) {
     }
 }
 
+// The depth mask (gpu_mask=depth): as fs_hybrid_mask, and the silhouette pixels keep the G-buffer's
+// depth in the scratch depth buffer (cleared to 1, which no volume fragment passes `GreaterEqual` at).
+@group(1) @binding(5) var g_depth: texture_depth_2d;
+
+@fragment
+fn fs_hybrid_mask_depth(in: FullScreen) -> @builtin(frag_depth) f32 {
+    let px = vec2<i32>(in.pos.xy);
+    if (receiver_class(px) != SILHOUETTE) {
+        discard;
+    }
+    return textureLoad(g_depth, px, 0);
+}
+
 // The map's answer, drawn under the stencil test "outside the mask"; non-receivers keep the cleared 1.
 @fragment
 fn fs_hybrid_map(in: FullScreen) -> @location(0) vec4<f32> {

@@ -12,6 +12,14 @@
 //! 3. **Answer.** One colour pass, two draws: outside the mask the map's answer; inside it, 0 where the
 //!    count is not 0 (the stencil is above 0x80). Silhouette pixels the volumes leave lit keep the cleared 1.
 //!
+//! With `gpu_mask=depth` the mask lives in a scratch depth-stencil instead, as Chan keeps it (section 3.2,
+//! with the depth bounds test, which wgpu does not expose): the mask pass clears the scratch to depth 1,
+//! writes the G-buffer's depth on the silhouette pixels (and sets bit 7 as before, for the answer), and
+//! the volumes count z-fail's way with the depth test turned around: a fragment behind the receiver fails
+//! `Less` exactly where it passes `GreaterEqual`, so the counting ops move from depth-fail to pass, and
+//! outside the mask (depth 1) every fragment fails the test, which hierarchical depth can do a tile at a
+//! time before rasterizing it.
+//!
 //! The map's classification runs twice, in the mask pass on every pixel and in the answer outside the
 //! mask: a full-screen pass can write a colour or set the stencil for the pixels it keeps, but not both
 //! for different pixels, and one more 4-texel lookup costs less than a class target written and read.
@@ -26,7 +34,7 @@ use shadow_core::Image;
 use shadow_core::geometry::volume::Caps;
 use shadow_core::light::LightView;
 use shadow_core::lookup::PixelClass;
-use shadow_core::technique::hard::{FillCount, Hybrid, ShadowMap, VolumeCounting};
+use shadow_core::technique::hard::{FillCount, GpuMask, Hybrid, ShadowMap, VolumeCounting};
 use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
 
 use super::shadow_map::{LookupParams, MapBindings, QueryExtras};
@@ -36,7 +44,7 @@ use super::shadow_volume::{
 use crate::context::{WgpuBackend, WgpuContext, WgpuError};
 use crate::frame::GpuVisibility;
 use crate::gbuffer::GpuGBuffer;
-use crate::pipelines::{DEPTH_STENCIL, FragmentEntry, VISIBILITY, attribute_entry, full_screen_pipeline};
+use crate::pipelines::{DEPTH_STENCIL, FragmentEntry, VISIBILITY, attribute_entry, depth_entry, full_screen_pipeline};
 use crate::{readback, shaders};
 
 /// The stencil bit of the computation mask.
@@ -61,7 +69,58 @@ pub struct State {
     count_masked: wgpu::RenderPipeline,
     count_all: wgpu::RenderPipeline,
     draws: Option<Vec<VolumeDraw>>,
+    /// With `gpu_mask=depth`: the scratch depth-stencil the mask is written into, at the view's size.
+    scratch: Option<wgpu::Texture>,
     last: Option<LastQuery>,
+}
+
+/// The volumes' depth-stencil state: z-fail counting in [`COUNT`]. The stencil mask: under the stencil
+/// test "bit 7 set", the depth test `Less`. The depth mask: no stencil test, the depth test turned around
+/// to a passing `GreaterEqual`; outside the mask only fragments at depth 1 (far caps) pass, and what they
+/// count there stays in the low bits, which the answer does not read outside the mask.
+fn volume_state(mask: GpuMask) -> wgpu::DepthStencilState {
+    let test = match mask {
+        GpuMask::Stencil => wgpu::CompareFunction::Equal,
+        GpuMask::Depth => wgpu::CompareFunction::Always,
+    };
+    let mut state = counting_state(VolumeCounting::ZFail, test, MASK, COUNT);
+    if mask == GpuMask::Depth {
+        state.depth_compare = Some(wgpu::CompareFunction::GreaterEqual);
+        for face in [&mut state.stencil.front, &mut state.stencil.back] {
+            face.pass_op = face.depth_fail_op;
+            face.depth_fail_op = wgpu::StencilOperation::Keep;
+        }
+    }
+    state
+}
+
+/// The mask pass's depth-stencil state: sets bit 7 on the pixels it keeps; with the depth mask also writes
+/// their depth (the fragment's, which the shader sets to the G-buffer's).
+fn mask_state(mask: GpuMask) -> wgpu::DepthStencilState {
+    let set_mask = wgpu::StencilFaceState {
+        compare: wgpu::CompareFunction::Always,
+        pass_op: wgpu::StencilOperation::Replace,
+        ..Default::default()
+    };
+    wgpu::DepthStencilState {
+        depth_write_enabled: Some(mask == GpuMask::Depth),
+        stencil: wgpu::StencilState { front: set_mask, back: set_mask, read_mask: 0, write_mask: MASK },
+        ..stencil_test(wgpu::CompareFunction::Always, 0)
+    }
+}
+
+/// A depth-stencil target of the G-buffer's size and format, for the depth mask.
+fn scratch_target(cx: &WgpuContext, width: u32, height: u32) -> wgpu::Texture {
+    cx.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("hybrid mask depth"),
+        size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: DEPTH_STENCIL,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+        view_formats: &[],
+    })
 }
 
 /// The bindings and the depth-stencil of the last query, for the classes view.
@@ -90,14 +149,15 @@ const OUTSIDE: (wgpu::CompareFunction, u32, u32) = (wgpu::CompareFunction::Equal
 const SHADOWED: (wgpu::CompareFunction, u32, u32) = (wgpu::CompareFunction::Less, 0xff, MASK);
 const LIT: (wgpu::CompareFunction, u32, u32) = (wgpu::CompareFunction::Equal, 0xff, MASK);
 
-/// One pass of full-screen draws over `depth`'s stencil (kept), into `target` cleared to `clear` when
-/// given; each draw a pipeline and its stencil reference. With a `query` (an occlusion query set and its
+/// One pass of full-screen draws over the depth-stencil `depth` (each aspect loaded or cleared as its
+/// load op says), into `target` cleared to `clear` when given; each draw a pipeline and its stencil
+/// reference. With a `query` (an occlusion query set and its
 /// resolve buffer), counts the samples that pass.
 fn full_screen_draws(
     cx: &WgpuContext,
     label: &str,
     target: Option<(&wgpu::TextureView, wgpu::Color)>,
-    depth: (&wgpu::TextureView, wgpu::LoadOp<u32>),
+    depth: (&wgpu::TextureView, wgpu::LoadOp<f32>, wgpu::LoadOp<u32>),
     groups: [&wgpu::BindGroup; 2],
     draws: &[(&wgpu::RenderPipeline, u32)],
     query: Option<&(wgpu::QuerySet, wgpu::Buffer)>,
@@ -116,8 +176,8 @@ fn full_screen_draws(
             color_attachments: if target.is_some() { &colour } else { &[] },
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                 view: depth.0,
-                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store }),
-                stencil_ops: Some(wgpu::Operations { load: depth.1, store: wgpu::StoreOp::Store }),
+                depth_ops: Some(wgpu::Operations { load: depth.1, store: wgpu::StoreOp::Store }),
+                stencil_ops: Some(wgpu::Operations { load: depth.2, store: wgpu::StoreOp::Store }),
             }),
             timestamp_writes: None,
             occlusion_query_set: query.map(|q| &q.0),
@@ -158,27 +218,28 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
         cx.scoped("creating the hybrid pipelines", |cx| {
             let module = shaders::module(&cx.device, "hybrid", shaders::hybrid());
             let volume_module = shaders::module(&cx.device, "shadow_volume", shaders::shadow_volume());
-            let bindings = MapBindings::new(cx, &[attribute_entry(4)]);
-            let groups = [&cx.shared.frame_layout, bindings.layout()];
-            let set_mask = wgpu::StencilFaceState {
-                compare: wgpu::CompareFunction::Always,
-                pass_op: wgpu::StencilOperation::Replace,
-                ..Default::default()
+            let gpu_mask = self.gpu_mask;
+            // The depth mask reads the G-buffer's depth, which the stencil mask has as its attachment.
+            let extras = match gpu_mask {
+                GpuMask::Stencil => vec![attribute_entry(4)],
+                GpuMask::Depth => vec![attribute_entry(4), depth_entry(5)],
             };
-            let mask_state = wgpu::DepthStencilState {
-                stencil: wgpu::StencilState { front: set_mask, back: set_mask, read_mask: 0, write_mask: MASK },
-                ..stencil_test(wgpu::CompareFunction::Always, 0)
+            let bindings = MapBindings::new(cx, &extras);
+            let groups = [&cx.shared.frame_layout, bindings.layout()];
+            let mask_entry = match gpu_mask {
+                GpuMask::Stencil => "fs_hybrid_mask",
+                GpuMask::Depth => "fs_hybrid_mask_depth",
             };
             let mask = full_screen_pipeline(
                 &cx.device,
                 "hybrid mask",
                 &module,
-                "fs_hybrid_mask",
+                mask_entry,
                 &groups,
                 None,
-                Some(mask_state),
+                Some(mask_state(gpu_mask)),
             );
-            let counting = counting_state(VolumeCounting::ZFail, wgpu::CompareFunction::Equal, MASK, COUNT);
+            let counting = volume_state(gpu_mask);
             let volume = |front| volume_pipeline(cx, &volume_module, "vs_volume", front, counting.clone());
             let (volumes_ccw, volumes_cw) = (volume(wgpu::FrontFace::Ccw), volume(wgpu::FrontFace::Cw));
             let count = |state| volume_pipeline(cx, &volume_module, "vs_volume", wgpu::FrontFace::Ccw, state);
@@ -210,6 +271,7 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
                 count_masked,
                 count_all,
                 draws: None,
+                scratch: None,
                 last: None,
             }
         })
@@ -241,9 +303,28 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
         let not_built = || TechniqueError::NotBuilt(self.name().into());
         let draws = state.draws.as_ref().ok_or_else(not_built)?;
         let maps = state.map.maps().ok_or_else(not_built)?;
-        let depth = g.depth_view();
-        let extras =
-            [wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::TextureView(&g.geometric_normal) }];
+        let g_depth = g
+            .depth
+            .create_view(&wgpu::TextureViewDescriptor { aspect: wgpu::TextureAspect::DepthOnly, ..Default::default() });
+        let mut extras = vec![wgpu::BindGroupEntry {
+            binding: 4,
+            resource: wgpu::BindingResource::TextureView(&g.geometric_normal),
+        }];
+        // The depth-stencil the passes run over: the G-buffer's, or the depth mask's scratch (at depth 1
+        // outside the mask once the mask pass has run), which the mask pass clears.
+        let (target, depth_load) = match self.gpu_mask {
+            GpuMask::Stencil => (g.depth.clone(), wgpu::LoadOp::Load),
+            GpuMask::Depth => {
+                extras
+                    .push(wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&g_depth) });
+                let fits = state.scratch.as_ref().is_some_and(|t| (t.width(), t.height()) == (g.width, g.height));
+                if !fits {
+                    state.scratch = Some(scratch_target(cx, g.width, g.height));
+                }
+                (state.scratch.clone().ok_or_else(not_built)?, wgpu::LoadOp::Clear(1.0))
+            }
+        };
+        let depth = target.create_view(&Default::default());
         let lookup = LookupParams { radius: 0.0, receiver_offset: self.depth.receiver_offset() };
         let map_group =
             state.bindings.group(cx, maps, light, g, lookup, &QueryExtras { settings: [0.0; 4], entries: &extras });
@@ -254,7 +335,7 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
                 cx,
                 "hybrid mask",
                 None,
-                (&depth, wgpu::LoadOp::Clear(0)),
+                (&depth, depth_load, wgpu::LoadOp::Clear(0)),
                 groups,
                 &[(&state.mask, MASK)],
                 Some(&silhouettes),
@@ -272,7 +353,7 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
                 cx,
                 "hybrid answer",
                 Some((&out.view, wgpu::Color::WHITE)),
-                (&depth, wgpu::LoadOp::Load),
+                (&depth, wgpu::LoadOp::Load, wgpu::LoadOp::Load),
                 groups,
                 &[(&state.answer_map, OUTSIDE.2), (&state.answer_shadowed, SHADOWED.2)],
                 None,
@@ -281,6 +362,7 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
             (silhouettes, passed)
         })?;
         // The counters are not the technique's work: after it is done, a sub-phase of their own.
+        cx.end_of_work();
         cx.wait()?;
         let t = std::time::Instant::now();
         let masked = VolumePass { reference: MASK, ..VolumePass::count(&state.count_masked, "count masked fragments") };
@@ -297,7 +379,7 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
             stats.counters.extra.insert("unmasked_volume_fragments".into(), read_query(cx, &all)? as f64);
         }
         stats.timings.extra.insert("count_fragments".into(), shadow_core::stats::ms(t.elapsed()));
-        state.last = Some(LastQuery { frame_group: g.frame_group.clone(), map_group, depth: g.depth.clone() });
+        state.last = Some(LastQuery { frame_group: g.frame_group.clone(), map_group, depth: target });
         Ok(())
     }
 
@@ -349,7 +431,7 @@ fn classes(cx: &WgpuContext, state: &State, last: &LastQuery) -> Result<Image<u3
         cx,
         "hybrid classes",
         Some((&view, wgpu::Color::TRANSPARENT)),
-        (&depth, wgpu::LoadOp::Load),
+        (&depth, wgpu::LoadOp::Load, wgpu::LoadOp::Load),
         [&last.frame_group, &last.map_group],
         &draws,
         None,

@@ -168,6 +168,7 @@ impl ShadowTechnique<WgpuBackend> for ShadowVolume {
             state.resolve.run(cx, g, out, &depth);
             q
         })?;
+        cx.end_of_work();
         let passed = read_query(cx, &passed)?;
         // Every rasterized fragment, for Sen's overdraw: a second pass with the depth test off. It runs
         // after the resolve, so it does not disturb the result; its time lands in a separate sub-phase.

@@ -230,6 +230,7 @@ impl ShadowTechnique<WgpuBackend> for VolumeReconstruction {
             state.resolve.run(cx, g, out, &depth);
             q
         })?;
+        cx.end_of_work();
         let passed = read_query(cx, &passed)?;
         // Every rasterized fragment, after the resolve so it cannot disturb it, timed on its own.
         let t = std::time::Instant::now();
