@@ -9,7 +9,7 @@ use shadow_core::technique::hard::{
 use shadow_core::technique::settings::{SettingKey, SettingsError, TechniqueSettings, TechniqueSpec};
 use shadow_core::technique::{DynShadowTechnique, Stateful};
 use shadow_cpu::CpuBackend;
-use shadow_soft::{AreaLightReference, Smoothies};
+use shadow_soft::{AreaLightReference, Pcss, Smoothies};
 use shadow_wgpu::WgpuBackend;
 
 /// Builds a technique for the CPU backend from a spec.
@@ -198,6 +198,17 @@ impl TechniqueRegistry {
             canonical: canonical::<Smoothies>,
             cpu: Some(plain::<CpuBackend, Smoothies>),
             wgpu: Some(plain::<WgpuBackend, Smoothies>),
+        });
+        r.register(TechniqueEntry {
+            name: "pcss",
+            description: "percentage-closer soft shadows: a blocker search sizes a PCF kernel to the penumbra",
+            paper: "Fernando 2005",
+            reference: false,
+            soft: true,
+            keys: Pcss::keys,
+            canonical: canonical::<Pcss>,
+            cpu: Some(plain::<CpuBackend, Pcss>),
+            wgpu: Some(plain::<WgpuBackend, Pcss>),
         });
         r.register(TechniqueEntry {
             name: "shadow-volume-zpass",

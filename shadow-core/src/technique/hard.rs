@@ -126,6 +126,19 @@ impl ShadowMap {
             bias_world: v.ranged("bias_world", 0.0, 1e6)?,
         })
     }
+
+    /// The depth-map keys' values, in [`ShadowMap::read_depth`]'s order: the first values of
+    /// `to_values` for techniques built on a depth map.
+    #[must_use]
+    pub fn depth_values(&self) -> Vec<String> {
+        vec![
+            self.resolution.to_string(),
+            self.bias.to_string(),
+            self.bias_constant.to_string(),
+            self.bias_slope.to_string(),
+            self.bias_world.to_string(),
+        ]
+    }
 }
 
 impl TechniqueSettings for ShadowMap {
@@ -209,17 +222,9 @@ impl TechniqueSettings for SilhouetteMap {
         })
     }
     fn to_values(&self) -> Vec<String> {
-        let d = &self.depth;
-        vec![
-            d.resolution.to_string(),
-            d.bias.to_string(),
-            d.bias_constant.to_string(),
-            d.bias_slope.to_string(),
-            d.bias_world.to_string(),
-            self.corner_margin.to_string(),
-            self.corner_depth.to_string(),
-            self.keep.to_string(),
-        ]
+        let mut v = self.depth.depth_values();
+        v.extend([self.corner_margin.to_string(), self.corner_depth.to_string(), self.keep.to_string()]);
+        v
     }
 }
 
@@ -371,13 +376,8 @@ impl TechniqueSettings for VolumeReconstruction {
         Ok(r)
     }
     fn to_values(&self) -> Vec<String> {
-        let d = &self.depth;
-        vec![
-            d.resolution.to_string(),
-            d.bias.to_string(),
-            d.bias_constant.to_string(),
-            d.bias_slope.to_string(),
-            d.bias_world.to_string(),
+        let mut v = self.depth.depth_values();
+        v.extend([
             self.vertices.to_string(),
             self.edges.to_string(),
             self.theta_low.to_string(),
@@ -387,7 +387,8 @@ impl TechniqueSettings for VolumeReconstruction {
             self.dangling_steps.to_string(),
             self.ids.to_string(),
             self.capping.to_string(),
-        ]
+        ]);
+        v
     }
 }
 
@@ -742,16 +743,8 @@ impl TechniqueSettings for Hybrid {
         })
     }
     fn to_values(&self) -> Vec<String> {
-        let d = &self.depth;
-        vec![
-            d.resolution.to_string(),
-            d.bias.to_string(),
-            d.bias_constant.to_string(),
-            d.bias_slope.to_string(),
-            d.bias_world.to_string(),
-            self.mask_tile.to_string(),
-            self.gpu_mask.to_string(),
-            self.unmasked_fill.to_string(),
-        ]
+        let mut v = self.depth.depth_values();
+        v.extend([self.mask_tile.to_string(), self.gpu_mask.to_string(), self.unmasked_fill.to_string()]);
+        v
     }
 }

@@ -151,20 +151,16 @@ impl TechniqueSettings for Smoothies {
     }
 
     fn to_values(&self) -> Vec<String> {
-        let d = &self.depth;
-        vec![
-            d.resolution.to_string(),
-            d.bias.to_string(),
-            d.bias_constant.to_string(),
-            d.bias_slope.to_string(),
-            d.bias_world.to_string(),
+        let mut v = self.depth.depth_values();
+        v.extend([
             match self.size {
                 SmoothieSize::Auto => "auto".into(),
                 SmoothieSize::Fixed(t) => t.to_string(),
             },
             self.remap.to_string(),
             self.falloff.to_string(),
-        ]
+        ]);
+        v
     }
 }
 

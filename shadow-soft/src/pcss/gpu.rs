@@ -1,0 +1,112 @@
+//! `pcss` on the wgpu backend, through its public API: `shadow-map`'s light pass, then a query over the
+//! G-buffer with `shadow-map`'s bindings and the geometric normals (query.wgsl).
+
+use shadow_core::FrameInputs;
+use shadow_core::light::LightView;
+use shadow_core::technique::hard::ShadowMap;
+use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
+use shadow_wgpu::pipelines::{FragmentEntry, VISIBILITY, attribute_entry, full_screen_pipeline};
+use shadow_wgpu::techniques::shadow_map::{LookupParams, MapBindings, QueryExtras};
+use shadow_wgpu::{GpuGBuffer, GpuVisibility, WgpuBackend, WgpuContext, WgpuError, shaders};
+
+use super::{Pcss, PcssLens};
+
+/// Pipelines, the blockers' map and the lens of the last build.
+pub struct State {
+    map: shadow_wgpu::techniques::shadow_map::State,
+    bindings: MapBindings,
+    query: wgpu::RenderPipeline,
+    lens: Option<PcssLens>,
+}
+
+impl ShadowTechnique<WgpuBackend> for Pcss {
+    type State = State;
+
+    fn name(&self) -> &'static str {
+        Self::NAME
+    }
+
+    fn create_state(&self, cx: &mut WgpuContext) -> Result<State, WgpuError> {
+        let map = <ShadowMap as ShadowTechnique<WgpuBackend>>::create_state(&self.depth, cx)?;
+        cx.scoped("creating the pcss pipelines", |cx| {
+            let module = shaders::module(&cx.device, "pcss query", query_shader());
+            let bindings = MapBindings::new(cx, &[attribute_entry(4)]);
+            let query = full_screen_pipeline(
+                &cx.device,
+                "pcss query",
+                &module,
+                FragmentEntry::from("fs_pcss_query"),
+                &[cx.frame_layout(), bindings.layout()],
+                Some(VISIBILITY),
+                None,
+            );
+            State { map, bindings, query, lens: None }
+        })
+    }
+
+    fn build(
+        &self,
+        cx: &mut WgpuContext,
+        state: &mut State,
+        frame: &FrameInputs,
+        light: &LightView,
+        stats: &mut FrameStats,
+    ) -> Result<(), WgpuError> {
+        state.lens = Some(Self::lens(light)?);
+        <ShadowMap as ShadowTechnique<WgpuBackend>>::build(&self.depth, cx, &mut state.map, frame, light, stats)
+    }
+
+    fn query(
+        &self,
+        cx: &mut WgpuContext,
+        state: &mut State,
+        _: &FrameInputs,
+        light: &LightView,
+        g: &GpuGBuffer,
+        out: &mut GpuVisibility,
+        _: &mut FrameStats,
+    ) -> Result<(), WgpuError> {
+        let (Some(maps), Some(lens)) = (state.map.maps(), &state.lens) else {
+            return Err(TechniqueError::NotBuilt(Self::NAME.into()).into());
+        };
+        let entries =
+            [wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::TextureView(&g.geometric_normal) }];
+        let lookup = LookupParams { radius: 0.0, receiver_offset: self.depth.receiver_offset() };
+        cx.scoped("the pcss query", |cx| {
+            let extras = QueryExtras { settings: lens.uniform(), entries: &entries };
+            let group = state.bindings.group(cx, maps, light, g, lookup, &extras);
+            shadow_wgpu::techniques::full_screen(
+                cx,
+                "pcss query",
+                &out.view,
+                &state.query,
+                &[&g.frame_group, &group],
+                None,
+            );
+        })
+    }
+
+    fn debug_views(&self, _: &mut WgpuContext, _: &State) -> Result<Vec<DebugView>, WgpuError> {
+        Ok(Vec::new())
+    }
+}
+
+/// The WGSL of the pcss query: the shadow-map shader, then the query.
+#[must_use]
+pub fn query_shader() -> String {
+    format!("{}\n{}", shaders::shadow_map(), include_str!("query.wgsl"))
+}
+
+#[cfg(test)]
+mod tests {
+    /// The WGSL parses and validates with naga, so a shader error fails `cargo test`, not a user.
+    #[test]
+    fn the_shader_validates() {
+        let src = super::query_shader();
+        let module = naga::front::wgsl::parse_str(&src).unwrap_or_else(|e| panic!("{}", e.emit_to_string(&src)));
+        let mut v = naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all());
+        if let Err(e) = v.validate(&module) {
+            panic!("{}", e.emit_to_string(&src));
+        }
+    }
+}
