@@ -9,7 +9,7 @@ use shadow_core::technique::hard::{
 use shadow_core::technique::settings::{SettingKey, SettingsError, TechniqueSettings, TechniqueSpec};
 use shadow_core::technique::{DynShadowTechnique, Stateful};
 use shadow_cpu::CpuBackend;
-use shadow_soft::{AreaLightReference, Pcss, Smoothies};
+use shadow_soft::{AreaLightReference, Pcss, PenumbraMap, Smoothies};
 use shadow_wgpu::WgpuBackend;
 
 /// Builds a technique for the CPU backend from a spec.
@@ -209,6 +209,17 @@ impl TechniqueRegistry {
             canonical: canonical::<Pcss>,
             cpu: Some(plain::<CpuBackend, Pcss>),
             wgpu: Some(plain::<WgpuBackend, Pcss>),
+        });
+        r.register(TechniqueEntry {
+            name: "penumbra-map",
+            description: "fake soft shadows: a shadow map plus cones and sheets at the silhouettes drawn into a penumbra map",
+            paper: "Wyman-Hansen 2003 (compared in Chan 2004, thesis 4.5.1)",
+            reference: false,
+            soft: true,
+            keys: PenumbraMap::keys,
+            canonical: canonical::<PenumbraMap>,
+            cpu: Some(plain::<CpuBackend, PenumbraMap>),
+            wgpu: Some(plain::<WgpuBackend, PenumbraMap>),
         });
         r.register(TechniqueEntry {
             name: "shadow-volume-zpass",

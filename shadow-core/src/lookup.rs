@@ -68,13 +68,20 @@ pub fn compare_nearest(map: &Image<f32>, uv: Vec2, depth: f32) -> f32 {
 /// comparison sampler with linear filtering returns (WGSL: `textureSampleCompareLevel`).
 #[must_use]
 pub fn compare_bilinear(map: &Image<f32>, uv: Vec2, depth: f32) -> f32 {
-    let n = map.width() as f32;
-    let st = uv * n - Vec2::splat(0.5);
+    bilinear(map.width(), uv, |x, y| compare_texel(map, x, y, depth))
+}
+
+/// A per-texel value `texel(x, y)` of an `n x n` map, bilinearly weighted over the 2x2 texels around
+/// `uv - half a texel` (indices may fall one outside the map: `texel` clamps them).
+#[inline]
+#[must_use]
+pub fn bilinear(n: u32, uv: Vec2, texel: impl Fn(i32, i32) -> f32) -> f32 {
+    let st = uv * n as f32 - Vec2::splat(0.5);
     let i = st.floor();
     let f = st - i;
     let (x, y) = (i.x as i32, i.y as i32);
-    let top = compare_texel(map, x, y, depth) * (1.0 - f.x) + compare_texel(map, x + 1, y, depth) * f.x;
-    let bottom = compare_texel(map, x, y + 1, depth) * (1.0 - f.x) + compare_texel(map, x + 1, y + 1, depth) * f.x;
+    let top = texel(x, y) * (1.0 - f.x) + texel(x + 1, y) * f.x;
+    let bottom = texel(x, y + 1) * (1.0 - f.x) + texel(x + 1, y + 1) * f.x;
     top * (1.0 - f.y) + bottom * f.y
 }
 

@@ -6,11 +6,44 @@
 //!   measured against, Monte Carlo visibility of a spherical light through the CPU backend's BVH.
 //! - [`smoothies::Smoothies`] (`smoothies`): Chan and Durand's fake soft shadows.
 //! - [`pcss::Pcss`] (`pcss`): Fernando's percentage-closer soft shadows.
+//! - [`penumbra_map::PenumbraMap`] (`penumbra-map`): Wyman and Hansen's cones and sheets.
 
 pub mod area_light;
+pub mod min_target;
 pub mod pcss;
+pub mod penumbra_map;
 pub mod smoothies;
 
 pub use area_light::AreaLightReference;
 pub use pcss::Pcss;
+pub use penumbra_map::PenumbraMap;
 pub use smoothies::Smoothies;
+
+use shadow_core::light::{LightProjection, LightView};
+use shadow_core::scene::LightKind;
+use shadow_core::technique::TechniqueError;
+
+/// The one projection of a spot light's view, for techniques that need the light's position and a single
+/// map. Point lights (six maps) and directional lights (no position) are refused by name.
+///
+/// # Errors
+/// [`TechniqueError::UnsupportedLight`] for point and directional lights.
+pub fn spot_projection<'a>(light: &'a LightView, technique: &str) -> Result<&'a LightProjection, TechniqueError> {
+    match (light.light.kind, light.projections.as_slice()) {
+        (LightKind::Spot { .. }, [p]) => Ok(p),
+        _ => Err(TechniqueError::UnsupportedLight { technique: technique.into(), light: light.light.type_name() }),
+    }
+}
+
+/// Parses and validates WGSL with naga, so a shader error fails `cargo test`, not a user.
+///
+/// # Panics
+/// On a parse or validation error, with naga's report.
+#[cfg(test)]
+pub(crate) fn validate_wgsl(name: &str, src: &str) {
+    let module = naga::front::wgsl::parse_str(src).unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(src)));
+    let mut v = naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all());
+    if let Err(e) = v.validate(&module) {
+        panic!("{name}: {}", e.emit_to_string(src));
+    }
+}

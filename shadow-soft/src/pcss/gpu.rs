@@ -99,14 +99,8 @@ pub fn query_shader() -> String {
 
 #[cfg(test)]
 mod tests {
-    /// The WGSL parses and validates with naga, so a shader error fails `cargo test`, not a user.
     #[test]
     fn the_shader_validates() {
-        let src = super::query_shader();
-        let module = naga::front::wgsl::parse_str(&src).unwrap_or_else(|e| panic!("{}", e.emit_to_string(&src)));
-        let mut v = naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all());
-        if let Err(e) = v.validate(&module) {
-            panic!("{}", e.emit_to_string(&src));
-        }
+        crate::validate_wgsl("query", &super::query_shader());
     }
 }

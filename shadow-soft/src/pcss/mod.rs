@@ -25,7 +25,6 @@ pub mod cpu;
 pub mod gpu;
 
 use shadow_core::light::{LightProjection, LightView};
-use shadow_core::scene::LightKind;
 use shadow_core::technique::TechniqueError;
 use shadow_core::technique::hard::{MAP_KEYS, ShadowMap};
 use shadow_core::technique::settings::{SettingKey, SettingsError, TechniqueSettings, Values};
@@ -98,14 +97,9 @@ impl Pcss {
     /// # Errors
     /// [`TechniqueError::UnsupportedLight`] for point and directional lights.
     pub fn lens(light: &LightView) -> Result<PcssLens, TechniqueError> {
-        match (light.light.kind, light.projections.as_slice()) {
-            (LightKind::Spot { .. }, [p]) => {
-                // uv = (x_ndc + 1) / 2 and x_ndc = P00 x / z: a lateral offset x at distance z spans
-                // P00 x / (2 z) of the map.
-                let k = light.light.radius * p.clip_from_view.x_axis.x * 0.5;
-                Ok(PcssLens { k, proj: *p })
-            }
-            _ => Err(TechniqueError::UnsupportedLight { technique: Self::NAME.into(), light: light.light.type_name() }),
-        }
+        let p = crate::spot_projection(light, Self::NAME)?;
+        // uv = (x_ndc + 1) / 2 and x_ndc = P00 x / z: a lateral offset x at distance z spans P00 x / (2 z)
+        // of the map.
+        Ok(PcssLens { k: light.light.radius * p.clip_from_view.x_axis.x * 0.5, proj: *p })
     }
 }

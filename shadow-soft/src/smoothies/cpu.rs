@@ -2,6 +2,7 @@
 
 use shadow_core::glam::{Vec2, Vec4};
 use shadow_core::light::LightView;
+use shadow_core::lookup::bilinear;
 use shadow_core::stats::ms;
 use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
 use shadow_core::{FrameInputs, Image};
@@ -109,14 +110,7 @@ pub fn smoothie_lookup(map: &Image<f32>, buffer: &SmoothieBuffer, uv: Vec2, dept
     if !(0.0..=1.0).contains(&uv.x) || !(0.0..=1.0).contains(&uv.y) {
         return 1.0;
     }
-    let st = uv * map.width() as f32 - Vec2::splat(0.5);
-    let i = st.floor();
-    let f = st - i;
-    let (x, y) = (i.x as i32, i.y as i32);
-    let v = |dx, dy| texel_visibility(map, buffer, x + dx, y + dy, depth);
-    let top = v(0, 0) * (1.0 - f.x) + v(1, 0) * f.x;
-    let bottom = v(0, 1) * (1.0 - f.x) + v(1, 1) * f.x;
-    top * (1.0 - f.y) + bottom * f.y
+    bilinear(map.width(), uv, |x, y| texel_visibility(map, buffer, x, y, depth))
 }
 
 impl ShadowTechnique<CpuBackend> for Smoothies {

@@ -9,15 +9,14 @@ use shadow_core::light::{LightProjection, LightView};
 use shadow_core::technique::hard::ShadowMap;
 use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
 use shadow_wgpu::frame::layered;
-use shadow_wgpu::pipelines::{
-    FragmentEntry, MAP_DEPTH, VISIBILITY, buffer_entry, depth_array_entry, depth_entry, full_screen_pipeline,
-};
+use shadow_wgpu::pipelines::{FragmentEntry, MAP_DEPTH, VISIBILITY, buffer_entry, depth_entry, full_screen_pipeline};
 use shadow_wgpu::techniques::shadow_map::{LookupParams, MapBindings, QueryExtras};
 use shadow_wgpu::{GpuGBuffer, GpuVisibility, WgpuBackend, WgpuContext, WgpuError, readback, shaders};
 use wgpu::util::DeviceExt;
 
 use super::geometry::{Ramp, SmoothieTriangle};
 use super::{FalloffTable, Smoothies, Toggle};
+use crate::min_target;
 
 /// GPU twin of `BufferParams` in buffer.wgsl.
 #[repr(C)]
@@ -68,48 +67,6 @@ fn vertices(triangles: &[SmoothieTriangle]) -> Vec<SmoothieVertex> {
         .collect()
 }
 
-/// A pipeline drawing smoothies into a depth target through `entry`, the depth test "less" keeping the
-/// smallest value.
-fn buffer_pipeline(
-    cx: &WgpuContext,
-    module: &wgpu::ShaderModule,
-    layout: &wgpu::BindGroupLayout,
-    entry: &str,
-) -> wgpu::RenderPipeline {
-    let pipeline_layout = cx.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some("smoothie buffer"),
-        bind_group_layouts: &[Some(layout)],
-        immediate_size: 0,
-    });
-    cx.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some("smoothie buffer"),
-        layout: Some(&pipeline_layout),
-        vertex: wgpu::VertexState {
-            module,
-            entry_point: Some("vs_smoothie"),
-            compilation_options: Default::default(),
-            buffers: &[Some(VERTEX_LAYOUT)],
-        },
-        primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
-        depth_stencil: Some(wgpu::DepthStencilState {
-            format: MAP_DEPTH,
-            depth_write_enabled: Some(true),
-            depth_compare: Some(wgpu::CompareFunction::Less),
-            stencil: Default::default(),
-            bias: Default::default(),
-        }),
-        multisample: Default::default(),
-        fragment: Some(wgpu::FragmentState {
-            module,
-            entry_point: Some(entry),
-            compilation_options: Default::default(),
-            targets: &[],
-        }),
-        multiview_mask: None,
-        cache: None,
-    })
-}
-
 impl State {
     /// Draws `triangles` into the buffer over `maps` (the blockers' depth) of projection `proj`.
     fn render_buffer(
@@ -129,55 +86,12 @@ impl State {
             depth: [proj.near, proj.far, f32::from(u8::from(proj.orthographic)), res as f32],
             smoothie: [t, f32::from(u8::from(remap)), 0.0, 0.0],
         };
-        let uniform = cx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("smoothie params"),
-            contents: bytemuck::bytes_of(&params),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
-        let maps_view = maps.create_view(&wgpu::TextureViewDescriptor {
-            dimension: Some(wgpu::TextureViewDimension::D2Array),
-            ..Default::default()
-        });
-        let group = cx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("smoothie buffer"),
-            layout: &self.buffer_layout,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: uniform.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&maps_view) },
-            ],
-        });
+        let group = min_target::bind(cx, &self.buffer_layout, "smoothie buffer", &params, maps);
         let data = vertices(triangles);
-        let vertex_buffer = (!data.is_empty()).then(|| {
-            cx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("smoothies"),
-                contents: bytemuck::cast_slice(&data),
-                usage: wgpu::BufferUsages::VERTEX,
-            })
-        });
+        let vertices = min_target::vertex_buffer(cx, "smoothies", &data);
         let mut enc = cx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("smoothies") });
         for (target, pipeline) in buffer.iter().zip([&self.depth_pass, &self.alpha_pass]) {
-            let view = target.create_view(&wgpu::TextureViewDescriptor {
-                dimension: Some(wgpu::TextureViewDimension::D2),
-                ..Default::default()
-            });
-            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("smoothie buffer"),
-                color_attachments: &[],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &view,
-                    depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
-                    stencil_ops: None,
-                }),
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            if let Some(vb) = &vertex_buffer {
-                pass.set_pipeline(pipeline);
-                pass.set_bind_group(0, &group, &[]);
-                pass.set_vertex_buffer(0, vb.slice(..));
-                pass.draw(0..data.len() as u32, 0..1);
-            }
+            min_target::draw(&mut enc, target, pipeline, &group, vertices.as_ref());
         }
         cx.queue.submit([enc.finish()]);
     }
@@ -195,15 +109,12 @@ impl ShadowTechnique<WgpuBackend> for Smoothies {
         let falloff = FalloffTable::new(self.falloff);
         cx.scoped("creating the smoothie pipelines", |cx| {
             let buffer_module = shaders::module(&cx.device, "smoothie buffer", buffer_shader());
-            let buffer_layout = cx.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("smoothie buffer"),
-                entries: &[
-                    buffer_entry(0, wgpu::BufferBindingType::Uniform, wgpu::ShaderStages::FRAGMENT),
-                    depth_array_entry(1),
-                ],
-            });
-            let depth_pass = buffer_pipeline(cx, &buffer_module, &buffer_layout, "fs_smoothie_depth");
-            let alpha_pass = buffer_pipeline(cx, &buffer_module, &buffer_layout, "fs_smoothie_alpha");
+            let buffer_layout = min_target::layout(cx, "smoothie buffer");
+            let pass = |entry| {
+                let vertex = ("vs_smoothie", VERTEX_LAYOUT);
+                min_target::pipeline(cx, "smoothie buffer", &buffer_module, &buffer_layout, vertex, entry)
+            };
+            let (depth_pass, alpha_pass) = (pass("fs_smoothie_depth"), pass("fs_smoothie_alpha"));
             let query_module = shaders::module(&cx.device, "smoothie query", query_shader());
             let storage = wgpu::BufferBindingType::Storage { read_only: true };
             let bindings = MapBindings::new(
@@ -308,17 +219,9 @@ pub fn query_shader() -> String {
 
 #[cfg(test)]
 mod tests {
-    /// The WGSL parses and validates with naga, so a shader error fails `cargo test`, not a user.
     #[test]
     fn the_shaders_validate() {
-        for (name, src) in [("buffer", super::buffer_shader()), ("query", super::query_shader())] {
-            let module =
-                naga::front::wgsl::parse_str(&src).unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&src)));
-            let mut v =
-                naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all());
-            if let Err(e) = v.validate(&module) {
-                panic!("{name}: {}", e.emit_to_string(&src));
-            }
-        }
+        crate::validate_wgsl("buffer", &super::buffer_shader());
+        crate::validate_wgsl("query", &super::query_shader());
     }
 }

@@ -1,0 +1,140 @@
+//! A depth target as a minimum blend, on the wgpu backend: a pass writes a value as fragment depth and
+//! the depth test "less" keeps the smallest at every texel, at full float precision, where blending a
+//! float colour target is an optional feature. Smoothies keep their buffer's depth and alpha this way,
+//! the penumbra map its values.
+
+use shadow_wgpu::WgpuContext;
+use shadow_wgpu::pipelines::{MAP_DEPTH, buffer_entry, depth_array_entry};
+use wgpu::util::DeviceExt;
+
+/// A pipeline drawing `vertices` through `vertex` and `fragment` of `module` into a [`MAP_DEPTH`]
+/// target, both faces, the depth test "less" with writes.
+#[must_use]
+pub fn pipeline(
+    cx: &WgpuContext,
+    label: &str,
+    module: &wgpu::ShaderModule,
+    layout: &wgpu::BindGroupLayout,
+    (vertex, vertices): (&str, wgpu::VertexBufferLayout<'_>),
+    fragment: &str,
+) -> wgpu::RenderPipeline {
+    let pipeline_layout = cx.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(label),
+        bind_group_layouts: &[Some(layout)],
+        immediate_size: 0,
+    });
+    cx.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(label),
+        layout: Some(&pipeline_layout),
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some(vertex),
+            compilation_options: Default::default(),
+            buffers: &[Some(vertices)],
+        },
+        primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: MAP_DEPTH,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::Less),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module,
+            entry_point: Some(fragment),
+            compilation_options: Default::default(),
+            targets: &[],
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
+/// Records a pass that clears layer 0 of `target` to 1 (nothing drawn) and, given vertices, draws them
+/// with `pipeline` and `group`.
+pub fn draw(
+    enc: &mut wgpu::CommandEncoder,
+    target: &wgpu::Texture,
+    pipeline: &wgpu::RenderPipeline,
+    group: &wgpu::BindGroup,
+    vertices: Option<&(wgpu::Buffer, u32)>,
+) {
+    let view = target.create_view(&wgpu::TextureViewDescriptor {
+        dimension: Some(wgpu::TextureViewDimension::D2),
+        array_layer_count: Some(1),
+        ..Default::default()
+    });
+    let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some("minimum target"),
+        color_attachments: &[],
+        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+            view: &view,
+            depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
+            stencil_ops: None,
+        }),
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    });
+    if let Some((buffer, count)) = vertices {
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, group, &[]);
+        pass.set_vertex_buffer(0, buffer.slice(..));
+        pass.draw(0..*count, 0..1);
+    }
+}
+
+/// The bindings of a pass over the blockers' maps: a uniform at 0, the maps (a depth array) at 1.
+#[must_use]
+pub fn layout(cx: &WgpuContext, label: &str) -> wgpu::BindGroupLayout {
+    cx.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some(label),
+        entries: &[
+            buffer_entry(0, wgpu::BufferBindingType::Uniform, wgpu::ShaderStages::VERTEX_FRAGMENT),
+            depth_array_entry(1),
+        ],
+    })
+}
+
+/// A group of [`layout`]: `params` uploaded as the uniform, and `maps`.
+#[must_use]
+pub fn bind(
+    cx: &WgpuContext,
+    layout: &wgpu::BindGroupLayout,
+    label: &str,
+    params: &impl bytemuck::Pod,
+    maps: &wgpu::Texture,
+) -> wgpu::BindGroup {
+    let uniform = cx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some(label),
+        contents: bytemuck::bytes_of(params),
+        usage: wgpu::BufferUsages::UNIFORM,
+    });
+    let maps_view = maps.create_view(&wgpu::TextureViewDescriptor {
+        dimension: Some(wgpu::TextureViewDimension::D2Array),
+        ..Default::default()
+    });
+    cx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout,
+        entries: &[
+            wgpu::BindGroupEntry { binding: 0, resource: uniform.as_entire_binding() },
+            wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&maps_view) },
+        ],
+    })
+}
+
+/// `vertices` uploaded, with their count; `None` when there are none (a pass then only clears).
+#[must_use]
+pub fn vertex_buffer<V: bytemuck::Pod>(cx: &WgpuContext, label: &str, vertices: &[V]) -> Option<(wgpu::Buffer, u32)> {
+    (!vertices.is_empty()).then(|| {
+        let buffer = cx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(label),
+            contents: bytemuck::cast_slice(vertices),
+            usage: wgpu::BufferUsages::VERTEX,
+        });
+        (buffer, vertices.len() as u32)
+    })
+}
