@@ -11,12 +11,12 @@
 use shadow_core::glam::Vec3;
 use shadow_core::light::LightView;
 use shadow_core::lookup::{hash_unit, pixel_hash};
-use shadow_core::scene::LightKind;
 use shadow_core::technique::settings::{SettingKey, SettingsError, TechniqueSettings, Values};
 use shadow_core::technique::{FrameStats, ShadowTechnique, TechniqueError};
 use shadow_core::{FrameInputs, Image};
 use shadow_cpu::bvh::SceneBvh;
 use shadow_cpu::techniques::per_receiver;
+use shadow_cpu::techniques::ray_traced::{RayOrigins, State as RayState};
 use shadow_cpu::{CpuBackend, CpuContext, CpuError, GBuffer};
 
 /// The largest sample count, per pixel.
@@ -111,27 +111,21 @@ pub fn sphere_visibility(bvh: &SceneBvh, origin: Vec3, n: Vec3, light: Sphere, s
     seen as f32 / (side * side) as f32
 }
 
-/// What the reference keeps: the BVH of the last build.
-#[derive(Default)]
-pub struct State {
-    bvh: Option<std::sync::Arc<SceneBvh>>,
-}
-
 impl ShadowTechnique<CpuBackend> for AreaLightReference {
-    type State = State;
+    type State = RayState;
 
     fn name(&self) -> &'static str {
         "area-light-reference"
     }
 
-    fn create_state(&self, _: &mut CpuContext) -> Result<State, CpuError> {
-        Ok(State::default())
+    fn create_state(&self, _: &mut CpuContext) -> Result<RayState, CpuError> {
+        Ok(RayState::default())
     }
 
     fn build(
         &self,
         cx: &mut CpuContext,
-        state: &mut State,
+        state: &mut RayState,
         frame: &FrameInputs,
         light: &LightView,
         _: &mut FrameStats,
@@ -140,31 +134,28 @@ impl ShadowTechnique<CpuBackend> for AreaLightReference {
             let technique = self.name().into();
             return Err(TechniqueError::UnsupportedLight { technique, light: light.light.type_name() }.into());
         }
-        state.bvh = Some(cx.bvh(frame));
+        state.build(cx, frame);
         Ok(())
     }
 
     fn query(
         &self,
         _: &mut CpuContext,
-        state: &mut State,
+        state: &mut RayState,
         frame: &FrameInputs,
         light: &LightView,
         g: &GBuffer,
         out: &mut Image<f32>,
         stats: &mut FrameStats,
     ) -> Result<(), CpuError> {
-        let not_built = || TechniqueError::NotBuilt(self.name().into());
-        let bvh = state.bvh.as_ref().ok_or_else(not_built)?;
-        let centre = match light.light.kind {
-            LightKind::Spot { position, .. } | LightKind::Point { position } => position,
-            LightKind::Directional { .. } => return Err(not_built().into()),
+        let bvh = state.bvh(self.name())?;
+        let Some(centre) = light.light.position() else {
+            return Err(TechniqueError::NotBuilt(self.name().into()).into());
         };
         let sphere = Sphere { centre, radius: light.light.radius };
-        let eps = self.epsilon * frame.bounds.size().length();
+        let origins = RayOrigins::new(g, frame, self.epsilon);
         per_receiver(g, out, |x, y, i| {
-            let n = g.geometric_normal.data()[i];
-            let origin = g.position.data()[i] + n * eps;
+            let (origin, n) = origins.at(i);
             sphere_visibility(bvh, origin, n, sphere, self.samples, pixel_hash(x, y))
         });
         let rays = g.covered_pixels() as f64 * f64::from(self.samples);

@@ -3,7 +3,7 @@
 use crate::silhouette_map::{CornerDepth, Keep};
 
 use super::settings::{
-    BiasMode, DepthBias, Filter, MAX_MAP_RESOLUTION, SettingKey, SettingsError, TechniqueSettings, Values,
+    BiasMode, DepthBias, Filter, MAX_MAP_RESOLUTION, OnOff, SettingKey, SettingsError, TechniqueSettings, Values,
 };
 
 /// `ray-traced`: one shadow ray per G-buffer pixel, the exact reference.
@@ -229,16 +229,6 @@ impl TechniqueSettings for SilhouetteMap {
 }
 
 crate::named_enum! {
-    /// Whether the near-plane cap of `volume-reconstruction` is drawn.
-    pub enum Capping {
-        /// Software caps (McCool section 6.2).
-        On = "on",
-        /// None: where the eye's near plane cuts the volume, parity inverts (Fig. 7).
-        Off = "off",
-    }
-}
-
-crate::named_enum! {
     /// The edge detector of `volume-reconstruction`.
     pub enum EdgeTest {
         /// First differences over theta_L thinned by the second-derivative test, sure edges over theta_H
@@ -300,8 +290,9 @@ pub struct VolumeReconstruction {
     pub dangling_steps: u32,
     /// Object-ID edges from an ID channel of the light pass.
     pub ids: ObjectIds,
-    /// The near-plane cap.
-    pub capping: Capping,
+    /// The near-plane cap: on, software caps (McCool section 6.2); off, none, so that where the eye's near
+    /// plane cuts the volume parity inverts (Fig. 7).
+    pub capping: OnOff,
 }
 
 const RECONSTRUCTION_KEYS: [SettingKey; 14] = [
@@ -678,18 +669,9 @@ pub struct Hybrid {
     /// Where the GPU keeps the computation mask (the CPU always uses its tiles).
     pub gpu_mask: GpuMask,
     /// Whether the query also counts the volumes' unmasked fill (what `shadow-volume-zfail` rasterizes),
-    /// in a pass of its own timed as `count_fragments`.
-    pub unmasked_fill: FillCount,
-}
-
-crate::named_enum! {
-    /// Whether `hybrid` counts the fill its computation mask saves.
-    pub enum FillCount {
-        /// No: the frame costs what the technique costs.
-        Off = "off",
-        /// Yes: the counter `unmasked_volume_fragments`, at the cost of a second, unmasked volume pass.
-        On = "on",
-    }
+    /// the counter `unmasked_volume_fragments`, in a pass of its own timed as `count_fragments`; off, the
+    /// frame costs what the technique costs.
+    pub unmasked_fill: OnOff,
 }
 
 crate::named_enum! {

@@ -261,6 +261,24 @@ macro_rules! named_enum {
 }
 
 named_enum! {
+    /// A setting that is on or off (each field's docs say what "on" does).
+    pub enum OnOff {
+        /// Off.
+        Off = "off",
+        /// On.
+        On = "on",
+    }
+}
+
+impl OnOff {
+    /// Whether it is on.
+    #[must_use]
+    pub fn is_on(self) -> bool {
+        self == Self::On
+    }
+}
+
+named_enum! {
     /// How a shadow map's depth is offset when the map is rendered (Vulkan's float depth bias, DESIGN 4).
     pub enum BiasMode {
         /// No bias.

@@ -18,7 +18,7 @@ use shadow_core::geometry::volume::Caps;
 use shadow_core::light::LightView;
 use shadow_core::lookup::{MapClass, PixelClass, classify};
 use shadow_core::stats::ms;
-use shadow_core::technique::hard::{FillCount, Hybrid, VolumeCounting};
+use shadow_core::technique::hard::{Hybrid, VolumeCounting};
 use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
 use shadow_core::{FrameInputs, Image};
 use std::time::Instant;
@@ -139,7 +139,7 @@ impl ShadowTechnique<CpuBackend> for Hybrid {
         counters.extra.insert("mask_tiles".into(), tiles as f64);
         counters.extra.insert("mask_tiles_total".into(), all_tiles as f64);
         state.last = Some(LastQuery { map_class, receiver: g.receiver.clone(), stencil: ds.stencil });
-        if self.unmasked_fill == FillCount::On {
+        if self.unmasked_fill.is_on() {
             let t = Instant::now();
             let mut scratch = DepthStencil::from_depth(&g.depth, 0);
             let all = rasterize_volumes(frame, g, volumes, VolumeCounting::ZFail, &mut scratch, None).fragments;

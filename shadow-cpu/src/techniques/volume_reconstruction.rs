@@ -14,7 +14,7 @@ use shadow_core::reconstruction::HomTriangle;
 use shadow_core::reconstruction::projection::{
     Projection, caps_for_view, coverage_view, edge_view, reconstruct_projection, record_build,
 };
-use shadow_core::technique::hard::{Capping, ObjectIds, VolumeReconstruction};
+use shadow_core::technique::hard::{ObjectIds, VolumeReconstruction};
 use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
 use shadow_core::{FrameInputs, Image};
 
@@ -114,7 +114,7 @@ impl ShadowTechnique<CpuBackend> for VolumeReconstruction {
         }
         let eye = g.clip_from_world;
         let (invert, caps) =
-            if self.capping == Capping::On { caps_for_view(&state.projections, eye) } else { (false, Vec::new()) };
+            if self.capping.is_on() { caps_for_view(&state.projections, eye) } else { (false, Vec::new()) };
         let mut ds = DepthStencil::from_depth(&g.depth, u8::from(invert));
         let sides: Vec<[Vec4; 3]> =
             state.projections.iter().flat_map(|p| &p.triangles).map(|t| t.map(|v| eye * v)).collect();

@@ -12,7 +12,7 @@ use shadow_cpu::{CpuBackend, CpuContext, CpuError, GBuffer};
 use std::time::Instant;
 
 use super::geometry::SmoothieTriangle;
-use super::{FalloffTable, Smoothies, Toggle};
+use super::{FalloffTable, Smoothies};
 
 /// The depth map and the smoothie buffer of the last build, and the rasterizer's scratch target (kept so
 /// frames reuse their memory).
@@ -137,7 +137,7 @@ impl ShadowTechnique<CpuBackend> for Smoothies {
         let t0 = Instant::now();
         let (t, smoothies) = self.construct(frame, light, proj, stats);
         let buffer = state.buffer.get_or_insert_with(|| SmoothieBuffer::new(self.depth.resolution));
-        let settings = (t, self.remap == Toggle::On);
+        let settings = (t, self.remap.is_on());
         let fragments = render_buffer(&smoothies.triangles, &state.maps[0], proj, settings, buffer, &mut state.scratch);
         stats.timings.extra.insert("smoothies".into(), ms(t0.elapsed()));
         stats.counters.extra.insert("smoothie_fragments".into(), fragments as f64);

@@ -15,7 +15,7 @@ use shadow_wgpu::{GpuGBuffer, GpuVisibility, WgpuBackend, WgpuContext, WgpuError
 use wgpu::util::DeviceExt;
 
 use super::geometry::{Ramp, SmoothieTriangle};
-use super::{FalloffTable, Smoothies, Toggle};
+use super::{FalloffTable, Smoothies};
 use crate::min_target;
 
 /// GPU twin of `BufferParams` in buffer.wgsl.
@@ -153,7 +153,7 @@ impl ShadowTechnique<WgpuBackend> for Smoothies {
         let (t, smoothies) = self.construct(frame, light, proj, stats);
         let maps = state.map.maps().ok_or_else(|| TechniqueError::NotBuilt(Self::NAME.into()))?.clone();
         cx.scoped("the smoothie buffer", |cx| {
-            state.render_buffer(cx, &maps, proj, &smoothies.triangles, (t, self.remap == Toggle::On));
+            state.render_buffer(cx, &maps, proj, &smoothies.triangles, (t, self.remap.is_on()));
         })?;
         stats.timings.extra.insert("smoothies".into(), shadow_core::stats::ms(t0.elapsed()));
         Ok(())

@@ -25,7 +25,7 @@ use shadow_core::technique::DebugView;
 use shadow_core::technique::FrameStats;
 use shadow_core::technique::TechniqueError;
 use shadow_core::technique::hard::{MAP_KEYS, ShadowMap};
-use shadow_core::technique::settings::{SettingKey, SettingsError, TechniqueSettings, Values};
+use shadow_core::technique::settings::{OnOff, SettingKey, SettingsError, TechniqueSettings, Values};
 use shadow_core::{FrameInputs, Image};
 
 /// `smoothies` settings.
@@ -36,7 +36,7 @@ pub struct Smoothies {
     /// The smoothie size `t`.
     pub size: SmoothieSize,
     /// Whether alpha is remapped by the distances (Eq. 4.1); off shows the fixed-width ramp of Fig. 4-4b.
-    pub remap: Toggle,
+    pub remap: OnOff,
     /// The penumbra's profile.
     pub falloff: Falloff,
 }
@@ -50,16 +50,6 @@ pub enum SmoothieSize {
     Auto,
     /// A fixed size; the thesis uses 0.02 to 0.2 for scenes 10 units across.
     Fixed(f32),
-}
-
-shadow_core::named_enum! {
-    /// On or off.
-    pub enum Toggle {
-        /// Off.
-        Off = "off",
-        /// On.
-        On = "on",
-    }
 }
 
 shadow_core::named_enum! {

@@ -34,12 +34,13 @@ use shadow_core::Image;
 use shadow_core::geometry::volume::Caps;
 use shadow_core::light::LightView;
 use shadow_core::lookup::PixelClass;
-use shadow_core::technique::hard::{FillCount, GpuMask, Hybrid, ShadowMap, VolumeCounting};
+use shadow_core::technique::hard::{GpuMask, Hybrid, ShadowMap, VolumeCounting};
 use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
 
 use super::shadow_map::{LookupParams, MapBindings, QueryExtras};
 use super::shadow_volume::{
-    VolumeDraw, VolumePass, build_draws, counting_state, occlusion_query, read_query, volume_pipeline,
+    VolumeDraw, VolumePass, build_draws, count_all_pipeline, counting_state, occlusion_query, read_query,
+    volume_pipeline,
 };
 use crate::context::{WgpuBackend, WgpuContext, WgpuError};
 use crate::frame::GpuVisibility;
@@ -244,7 +245,7 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
             let (volumes_ccw, volumes_cw) = (volume(wgpu::FrontFace::Ccw), volume(wgpu::FrontFace::Cw));
             let count = |state| volume_pipeline(cx, &volume_module, "vs_volume", wgpu::FrontFace::Ccw, state);
             let count_masked = count(stencil_test(wgpu::CompareFunction::Equal, MASK));
-            let count_all = count(stencil_test(wgpu::CompareFunction::Always, 0));
+            let count_all = count_all_pipeline(cx, &volume_module);
             let answer = |entry, (compare, read_mask, _): (_, u32, u32)| {
                 let state = stencil_test(compare, read_mask);
                 full_screen_pipeline(
@@ -373,7 +374,7 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
         c.volume_fragments = Some(processed);
         // Z-fail updates the count where the depth test fails.
         c.stencil_updates = Some(processed - read_query(cx, &passed)?.min(processed));
-        if self.unmasked_fill == FillCount::On {
+        if self.unmasked_fill.is_on() {
             let every = VolumePass::count(&state.count_all, "count volume fragments");
             let all = cx.scoped("the volume fragment count", |cx| every.run(cx, draws, frame, g, &depth))?;
             stats.counters.extra.insert("unmasked_volume_fragments".into(), read_query(cx, &all)? as f64);

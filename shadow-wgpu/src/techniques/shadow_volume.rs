@@ -68,6 +68,22 @@ pub(crate) fn counting_state(
     }
 }
 
+/// Every fragment passes, nothing written: for counting what a pass rasterizes (occlusion queries).
+pub(crate) fn count_all() -> wgpu::DepthStencilState {
+    wgpu::DepthStencilState {
+        format: DEPTH_STENCIL,
+        depth_write_enabled: Some(false),
+        depth_compare: Some(wgpu::CompareFunction::Always),
+        stencil: Default::default(),
+        bias: Default::default(),
+    }
+}
+
+/// The volumes' whole fill: [`count_all`] over the volume vertices (both faces; it does not cull).
+pub(crate) fn count_all_pipeline(cx: &WgpuContext, module: &wgpu::ShaderModule) -> wgpu::RenderPipeline {
+    volume_pipeline(cx, module, "vs_volume", wgpu::FrontFace::Ccw, count_all())
+}
+
 /// A stencil-only pipeline drawing homogeneous points through `entry` (both faces).
 pub(crate) fn volume_pipeline(
     cx: &WgpuContext,
@@ -116,14 +132,7 @@ impl ShadowTechnique<WgpuBackend> for ShadowVolume {
             let state = counting_state(counting, wgpu::CompareFunction::Always, 0xff, 0xff);
             let ccw = volume_pipeline(cx, &module, "vs_volume", wgpu::FrontFace::Ccw, state.clone());
             let cw = volume_pipeline(cx, &module, "vs_volume", wgpu::FrontFace::Cw, state);
-            let all = wgpu::DepthStencilState {
-                format: DEPTH_STENCIL,
-                depth_write_enabled: Some(false),
-                depth_compare: Some(wgpu::CompareFunction::Always),
-                stencil: Default::default(),
-                bias: Default::default(),
-            };
-            let count_all = volume_pipeline(cx, &module, "vs_volume", wgpu::FrontFace::Ccw, all);
+            let count_all = count_all_pipeline(cx, &module);
             let resolve = StencilResolve::new(cx, &module, 0xff);
             State { ccw, cw, count_all, resolve, draws: Vec::new() }
         })

@@ -19,12 +19,12 @@ use shadow_core::reconstruction::HomTriangle;
 use shadow_core::reconstruction::projection::{
     Projection, caps_for_view, coverage_view, edge_view, reconstruct_projection, record_build,
 };
-use shadow_core::technique::hard::{Capping, ObjectIds, VolumeReconstruction};
+use shadow_core::technique::hard::{ObjectIds, VolumeReconstruction};
 use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
 use wgpu::util::DeviceExt;
 
 use super::shadow_map::{ID_FORMAT, depth_bias, light_id_pipeline, light_pass_pipeline, map_texture, render_maps};
-use super::shadow_volume::{StencilResolve, occlusion_query, read_query, volume_pipeline};
+use super::shadow_volume::{StencilResolve, count_all, occlusion_query, read_query, volume_pipeline};
 use crate::context::{WgpuBackend, WgpuContext, WgpuError};
 use crate::frame::{GpuVisibility, layered};
 use crate::gbuffer::{GpuGBuffer, check_size};
@@ -75,17 +75,6 @@ fn parity(depth_compare: wgpu::CompareFunction) -> wgpu::DepthStencilState {
         depth_write_enabled: Some(false),
         depth_compare: Some(depth_compare),
         stencil: wgpu::StencilState { front: face, back: face, read_mask: 1, write_mask: 1 },
-        bias: Default::default(),
-    }
-}
-
-/// Every fragment, nothing written.
-fn count_all() -> wgpu::DepthStencilState {
-    wgpu::DepthStencilState {
-        format: DEPTH_STENCIL,
-        depth_write_enabled: Some(false),
-        depth_compare: Some(wgpu::CompareFunction::Always),
-        stencil: Default::default(),
         bias: Default::default(),
     }
 }
@@ -221,7 +210,7 @@ impl ShadowTechnique<WgpuBackend> for VolumeReconstruction {
         }
         let eye = g.camera.clip_from_world(g.width as f32 / g.height as f32);
         let (invert, caps) =
-            if self.capping == Capping::On { caps_for_view(&state.projections, eye) } else { (false, Vec::new()) };
+            if self.capping.is_on() { caps_for_view(&state.projections, eye) } else { (false, Vec::new()) };
         let cap_vertices = cx.scoped("uploading the caps", |cx| vertex_buffer(cx, "caps", &caps))?;
         let draws = [(&state.boundary_vertices, &state.boundary), (&cap_vertices, &state.caps)];
         let depth = g.depth_view();
