@@ -174,6 +174,27 @@ pub fn classify(map: &Image<f32>, uv: Vec2, depth: f32, faces_light: bool) -> Ma
     }
 }
 
+/// Whether a silhouette edge nearer the light than `depth` (by [`EDGE_MARGIN`]) crosses one of the four texels nearest `uv` in
+/// `edges`, a map of the nearest edge's NDC depth per texel (1 where none; `hybrid`'s `edge_texels`; WGSL
+/// twin: `near_edge` in shadow-wgpu's hybrid_edges.wgsl). Outside the map, no.
+#[must_use]
+pub fn near_edge(edges: &Image<f32>, uv: Vec2, depth: f32) -> bool {
+    if !(0.0..=1.0).contains(&uv.x) || !(0.0..=1.0).contains(&uv.y) {
+        return false;
+    }
+    let st = uv * edges.width() as f32 - Vec2::splat(0.5);
+    let (x, y) = (st.x.floor() as i32, st.y.floor() as i32);
+    let n = edges.width() as i32 - 1;
+    [(0, 0), (1, 0), (0, 1), (1, 1)]
+        .iter()
+        .any(|(dx, dy)| *edges.get((x + dx).clamp(0, n) as u32, (y + dy).clamp(0, n) as u32) < depth - EDGE_MARGIN)
+}
+
+/// How much nearer the light than a receiver (NDC depth) an edge must be to count in [`near_edge`]: a
+/// surface's own rim lies at the depth of its silhouette edge, where which of the two rounds nearer differs
+/// between backends by a few ulps; a caster that shadows the receiver is orders of magnitude nearer.
+pub const EDGE_MARGIN: f32 = 1e-5;
+
 /// Visibility from a shadow map with a filter (WGSL twin: `shadow_lookup`). `radius` is the kernel radius
 /// in texels for the jittered and Poisson filters; `pixel` seeds their per-pixel rotation or jitter.
 #[must_use]

@@ -53,9 +53,17 @@ pub fn silhouette_query() -> String {
 
 /// Hybrid maps and volumes: the classification, the mask and the answer, after the shadow-map shader.
 #[must_use]
-pub fn hybrid() -> String {
-    format!("{}\n{}", shadow_map(), include_str!("shaders/hybrid.wgsl"))
+pub fn hybrid(edge_texels: bool) -> String {
+    let edges = if edge_texels { include_str!("shaders/hybrid_edges.wgsl") } else { NEAR_EDGE_OFF };
+    format!("{}\n{}\n{}", shadow_map(), edges, include_str!("shaders/hybrid.wgsl"))
 }
+
+/// hybrid's `near_edge` with `edge_texels=off`: never (and no binding for the edge maps).
+const NEAR_EDGE_OFF: &str = "fn near_edge(layer: i32, uv: vec2<f32>, depth: f32) -> bool { return false; }";
+
+/// hybrid's edge pass: clip-space quads into a depth target (the nearest edge per texel).
+pub const HYBRID_EDGE_PASS: &str =
+    "@vertex fn vs_edge(@location(0) p: vec4<f32>) -> @builtin(position) vec4<f32> { return p; }";
 
 /// Depth-layer passes (peeling and combination).
 #[must_use]
@@ -87,7 +95,9 @@ pub fn all() -> Vec<(&'static str, String)> {
         ("depth_layers", depth_layers()),
         ("silhouette_build", silhouette_build()),
         ("silhouette_query", silhouette_query()),
-        ("hybrid", hybrid()),
+        ("hybrid", hybrid(false)),
+        ("hybrid edge_texels", hybrid(true)),
+        ("hybrid edge pass", HYBRID_EDGE_PASS.to_string()),
     ]
 }
 

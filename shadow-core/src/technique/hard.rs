@@ -668,6 +668,10 @@ pub struct Hybrid {
     pub mask_tile: u32,
     /// Where the GPU keeps the computation mask (the CPU always uses its tiles).
     pub gpu_mask: GpuMask,
+    /// On: a receiver facing the light is also a silhouette pixel where a caster's silhouette edge nearer
+    /// the light crosses one of its four texels (drawn into a map of edge depths), so casters thinner than
+    /// a texel, which the map misses (Chan's Fig. 3-8), still get volumes; off: Chan's rule alone.
+    pub edge_texels: OnOff,
     /// Whether the query also counts the volumes' unmasked fill (what `shadow-volume-zfail` rasterizes),
     /// the counter `unmasked_volume_fragments`, in a pass of its own timed as `count_fragments`; off, the
     /// frame costs what the technique costs.
@@ -689,7 +693,7 @@ crate::named_enum! {
     }
 }
 
-const HYBRID_KEYS: [SettingKey; 8] = [
+const HYBRID_KEYS: [SettingKey; 9] = [
     SettingKey { key: "res", default: "512", help: "classifying map side in texels (16 to 16384)" },
     MAP_KEYS[1],
     MAP_KEYS[2],
@@ -704,6 +708,11 @@ const HYBRID_KEYS: [SettingKey; 8] = [
         key: "gpu_mask",
         default: "stencil",
         help: "GPU computation mask: stencil (a stencil bit) or depth (a scratch depth of 1 outside the mask)",
+    },
+    SettingKey {
+        key: "edge_texels",
+        default: "off",
+        help: "on: also mask receivers whose texels a silhouette edge in front crosses (sub-texel casters)",
     },
     SettingKey {
         key: "unmasked_fill",
@@ -721,12 +730,18 @@ impl TechniqueSettings for Hybrid {
             depth: ShadowMap::read_depth(v)?,
             mask_tile: v.ranged("mask_tile", 1, 64)?,
             gpu_mask: v.get("gpu_mask")?,
+            edge_texels: v.get("edge_texels")?,
             unmasked_fill: v.get("unmasked_fill")?,
         })
     }
     fn to_values(&self) -> Vec<String> {
         let mut v = self.depth.depth_values();
-        v.extend([self.mask_tile.to_string(), self.gpu_mask.to_string(), self.unmasked_fill.to_string()]);
+        v.extend([
+            self.mask_tile.to_string(),
+            self.gpu_mask.to_string(),
+            self.edge_texels.to_string(),
+            self.unmasked_fill.to_string(),
+        ]);
         v
     }
 }

@@ -14,9 +14,10 @@
 
 use rayon::prelude::*;
 use shadow_core::frame::InstanceVolume;
+use shadow_core::geometry::silhouette::edge_texel_quads;
 use shadow_core::geometry::volume::Caps;
 use shadow_core::light::LightView;
-use shadow_core::lookup::{MapClass, PixelClass, classify};
+use shadow_core::lookup::{MapClass, PixelClass, classify, near_edge};
 use shadow_core::stats::ms;
 use shadow_core::technique::hard::{Hybrid, VolumeCounting};
 use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
@@ -27,13 +28,15 @@ use super::shadow_volume::{build_volumes, rasterize_volumes};
 use super::{map_position, per_receiver, render_depth_maps};
 use crate::context::{CpuBackend, CpuContext, CpuError};
 use crate::gbuffer::GBuffer;
-use crate::raster::{ComputationMask, DepthStencil};
+use crate::raster::{ComputationMask, CullMode, DepthState, DepthStencil, RasterState, Soup, draw_depth};
 
 /// The maps and volumes of the last build; what the last query decided with (for the debug view, which
 /// derives the classes from it only when asked).
 #[derive(Default)]
 pub struct State {
     maps: Vec<Image<f32>>,
+    /// With `edge_texels=on`: per projection, the nearest silhouette edge's depth in each texel.
+    edge_maps: Vec<Image<f32>>,
     volumes: Option<Vec<InstanceVolume>>,
     last: Option<LastQuery>,
 }
@@ -59,8 +62,15 @@ impl LastQuery {
     }
 }
 
-/// The map's class of every receiver pixel (`Lit` elsewhere), rows in parallel.
-fn classify_receivers(maps: &[Image<f32>], light: &LightView, g: &GBuffer, receiver_offset: f32) -> Image<MapClass> {
+/// The map's class of every receiver pixel (`Lit` elsewhere), rows in parallel; with `edge_maps`, a
+/// receiver facing the light near an edge in front of it is a silhouette pixel too.
+fn classify_receivers(
+    maps: &[Image<f32>],
+    edge_maps: &[Image<f32>],
+    light: &LightView,
+    g: &GBuffer,
+    receiver_offset: f32,
+) -> Image<MapClass> {
     let w = g.width() as usize;
     let mut classes = Image::new(g.width(), g.height(), MapClass::Lit);
     classes.data_mut().par_chunks_mut(w).enumerate().for_each(|(y, row)| {
@@ -73,6 +83,9 @@ fn classify_receivers(maps: &[Image<f32>], light: &LightView, g: &GBuffer, recei
             let faces_light = g.geometric_normal.data()[i].dot(light.light.to_light(p)) > 0.0;
             let m = map_position(light, p, receiver_offset);
             *class = classify(&maps[m.projection], m.uv, m.depth, faces_light);
+            if faces_light && edge_maps.get(m.projection).is_some_and(|e| near_edge(e, m.uv, m.depth)) {
+                *class = MapClass::Silhouette;
+            }
         }
     });
     classes
@@ -98,6 +111,19 @@ impl ShadowTechnique<CpuBackend> for Hybrid {
         stats: &mut FrameStats,
     ) -> Result<(), CpuError> {
         render_depth_maps(frame, light, self.depth.resolution, self.depth.depth_bias(), &mut state.maps)?;
+        state.edge_maps.clear();
+        if self.edge_texels.is_on() {
+            let segments = frame.silhouette_segments(light);
+            let res = self.depth.resolution;
+            let state_ds =
+                RasterState { cull: CullMode::None, depth: Some(DepthState::LESS_WRITE), ..RasterState::default() };
+            for p in &light.projections {
+                let quads = edge_texel_quads(&segments, p, res);
+                let mut ds = DepthStencil::new(res, res, 1.0, 0);
+                draw_depth(&mut ds, &Soup { triangles: &quads, prim_base: 0, flip: false }, &state_ds);
+                state.edge_maps.push(ds.into_depth_image());
+            }
+        }
         state.volumes = Some(build_volumes(frame, light, Caps::Both, stats));
         Ok(())
     }
@@ -118,7 +144,7 @@ impl ShadowTechnique<CpuBackend> for Hybrid {
         }
         let (w, h) = (g.width(), g.height());
         let t = Instant::now();
-        let map_class = classify_receivers(&state.maps, light, g, self.depth.receiver_offset());
+        let map_class = classify_receivers(&state.maps, &state.edge_maps, light, g, self.depth.receiver_offset());
         let silhouette = |x, y| *map_class.get(x, y) == MapClass::Silhouette;
         let mask = ComputationMask::from_fn(w, h, self.mask_tile, silhouette);
         stats.timings.extra.insert("classify".into(), ms(t.elapsed()));

@@ -1,6 +1,7 @@
 // hybrid (Chan, thesis chapter 3): the map's classification of each receiver, the computation mask it
 // makes in the stencil's bit 7, and the passes that answer from the mask (twin: shadow-cpu's
-// techniques/hybrid.rs). Follows shadow_map.wgsl, whose bindings 0 to 3 it shares.
+// techniques/hybrid.rs). Follows shadow_map.wgsl, whose bindings 0 to 3 it shares, and one of
+// hybrid_edges.wgsl's two `near_edge` (edge_texels on or off).
 
 @group(1) @binding(4) var g_geometric_normal: texture_2d<f32>;
 
@@ -37,7 +38,11 @@ fn receiver_class(px: vec2<i32>) -> u32 {
     }
     let faces_light = dot(textureLoad(g_geometric_normal, px, 0).xyz, map_to_light(g.xyz)) > 0.0;
     let m = map_point(g.xyz);
-    return classify(m.layer, m.uv, m.depth, faces_light);
+    let c = classify(m.layer, m.uv, m.depth, faces_light);
+    if (faces_light && near_edge(m.layer, m.uv, m.depth)) {
+        return SILHOUETTE;
+    }
+    return c;
 }
 
 // The computation mask: silhouette pixels pass and the pipeline sets their stencil bit 7; every other

@@ -31,6 +31,7 @@
 
 use shadow_core::FrameInputs;
 use shadow_core::Image;
+use shadow_core::geometry::silhouette::edge_texel_quads;
 use shadow_core::geometry::volume::Caps;
 use shadow_core::light::LightView;
 use shadow_core::lookup::PixelClass;
@@ -44,9 +45,14 @@ use super::shadow_volume::{
 };
 use crate::context::{WgpuBackend, WgpuContext, WgpuError};
 use crate::frame::GpuVisibility;
+use crate::frame::layered;
 use crate::gbuffer::GpuGBuffer;
-use crate::pipelines::{DEPTH_STENCIL, FragmentEntry, VISIBILITY, attribute_entry, depth_entry, full_screen_pipeline};
+use crate::pipelines::{
+    DEPTH_STENCIL, FragmentEntry, MAP_DEPTH, VISIBILITY, attribute_entry, depth_array_entry, depth_entry,
+    full_screen_pipeline,
+};
 use crate::{readback, shaders};
+use wgpu::util::DeviceExt;
 
 /// The stencil bit of the computation mask.
 pub const MASK: u32 = 0x80;
@@ -72,6 +78,10 @@ pub struct State {
     draws: Option<Vec<VolumeDraw>>,
     /// With `gpu_mask=depth`: the scratch depth-stencil the mask is written into, at the view's size.
     scratch: Option<wgpu::Texture>,
+    /// With `edge_texels=on`: the pass drawing the edge quads, and the edge maps of the last build (a
+    /// layer per projection, the nearest edge's depth per texel).
+    edge_pass: Option<wgpu::RenderPipeline>,
+    edge_maps: Option<wgpu::Texture>,
     last: Option<LastQuery>,
 }
 
@@ -150,6 +160,89 @@ const OUTSIDE: (wgpu::CompareFunction, u32, u32) = (wgpu::CompareFunction::Equal
 const SHADOWED: (wgpu::CompareFunction, u32, u32) = (wgpu::CompareFunction::Less, 0xff, MASK);
 const LIT: (wgpu::CompareFunction, u32, u32) = (wgpu::CompareFunction::Equal, 0xff, MASK);
 
+/// Clip-space positions, for the edge pass.
+const CLIP_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
+    array_stride: 16,
+    step_mode: wgpu::VertexStepMode::Vertex,
+    attributes: &wgpu::vertex_attr_array![0 => Float32x4],
+};
+
+/// The edge pass (`edge_texels=on`): clip-space quads into a map depth target, the depth test keeping the
+/// nearest edge per texel.
+fn edge_pass(cx: &WgpuContext) -> wgpu::RenderPipeline {
+    let module = shaders::module(&cx.device, "hybrid edge pass", shaders::HYBRID_EDGE_PASS.to_string());
+    let layout = cx.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("hybrid edge pass"),
+        bind_group_layouts: &[],
+        immediate_size: 0,
+    });
+    cx.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("hybrid edge pass"),
+        layout: Some(&layout),
+        vertex: wgpu::VertexState {
+            module: &module,
+            entry_point: Some("vs_edge"),
+            compilation_options: Default::default(),
+            buffers: &[Some(CLIP_LAYOUT)],
+        },
+        primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: MAP_DEPTH,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::Less),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: Default::default(),
+        fragment: None,
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
+/// The edge maps of a light: per projection, the casters' silhouette edges drawn as
+/// `edge_texel_quads` into a layer cleared to 1 (twin: shadow-cpu's hybrid build).
+fn edge_maps(
+    cx: &WgpuContext,
+    pass: &wgpu::RenderPipeline,
+    frame: &FrameInputs,
+    light: &LightView,
+    res: u32,
+) -> wgpu::Texture {
+    let segments = frame.silhouette_segments(light);
+    let maps = layered(cx, "hybrid edge maps", res, res, light.projections.len() as u32, MAP_DEPTH);
+    let mut enc = cx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("edge maps") });
+    for (k, p) in light.projections.iter().enumerate() {
+        let quads: Vec<[f32; 4]> =
+            edge_texel_quads(&segments, p, res).iter().flat_map(|t| t.map(|v| v.to_array())).collect();
+        let view = crate::frame::layer_view(&maps, k as u32);
+        let mut rp = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("edge map"),
+            color_attachments: &[],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &view,
+                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        if !quads.is_empty() {
+            let vb = cx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("edge quads"),
+                contents: bytemuck::cast_slice(&quads),
+                usage: wgpu::BufferUsages::VERTEX,
+            });
+            rp.set_pipeline(pass);
+            rp.set_vertex_buffer(0, vb.slice(..));
+            rp.draw(0..quads.len() as u32, 0..1);
+        }
+    }
+    cx.queue.submit([enc.finish()]);
+    maps
+}
+
 /// One pass of full-screen draws over the depth-stencil `depth` (each aspect loaded or cleared as its
 /// load op says), into `target` cleared to `clear` when given; each draw a pipeline and its stencil
 /// reference. With a `query` (an occlusion query set and its
@@ -217,14 +310,17 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
     fn create_state(&self, cx: &mut WgpuContext) -> Result<State, WgpuError> {
         let map = <ShadowMap as ShadowTechnique<WgpuBackend>>::create_state(&self.depth, cx)?;
         cx.scoped("creating the hybrid pipelines", |cx| {
-            let module = shaders::module(&cx.device, "hybrid", shaders::hybrid());
+            let module = shaders::module(&cx.device, "hybrid", shaders::hybrid(self.edge_texels.is_on()));
             let volume_module = shaders::module(&cx.device, "shadow_volume", shaders::shadow_volume());
             let gpu_mask = self.gpu_mask;
             // The depth mask reads the G-buffer's depth, which the stencil mask has as its attachment.
-            let extras = match gpu_mask {
+            let mut extras = match gpu_mask {
                 GpuMask::Stencil => vec![attribute_entry(4)],
                 GpuMask::Depth => vec![attribute_entry(4), depth_entry(5)],
             };
+            if self.edge_texels.is_on() {
+                extras.push(depth_array_entry(6));
+            }
             let bindings = MapBindings::new(cx, &extras);
             let groups = [&cx.shared.frame_layout, bindings.layout()];
             let mask_entry = match gpu_mask {
@@ -273,6 +369,8 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
                 count_all,
                 draws: None,
                 scratch: None,
+                edge_pass: self.edge_texels.is_on().then(|| edge_pass(cx)),
+                edge_maps: None,
                 last: None,
             }
         })
@@ -287,6 +385,10 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
         stats: &mut FrameStats,
     ) -> Result<(), WgpuError> {
         self.depth.build(cx, &mut state.map, frame, light, stats)?;
+        if let Some(pass) = &state.edge_pass {
+            let maps = cx.scoped("the edge maps", |cx| edge_maps(cx, pass, frame, light, self.depth.resolution))?;
+            state.edge_maps = Some(maps);
+        }
         state.draws = Some(build_draws(cx, frame, light, Caps::Both, stats)?);
         Ok(())
     }
@@ -313,6 +415,17 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
         }];
         // The depth-stencil the passes run over: the G-buffer's, or the depth mask's scratch (at depth 1
         // outside the mask once the mask pass has run), which the mask pass clears.
+        let edge_view = state.edge_maps.as_ref().map(|t| {
+            t.create_view(&wgpu::TextureViewDescriptor {
+                dimension: Some(wgpu::TextureViewDimension::D2Array),
+                ..Default::default()
+            })
+        });
+        if let Some(view) = &edge_view {
+            extras.push(wgpu::BindGroupEntry { binding: 6, resource: wgpu::BindingResource::TextureView(view) });
+        } else if state.edge_pass.is_some() {
+            return Err(not_built().into());
+        }
         let (target, depth_load) = match self.gpu_mask {
             GpuMask::Stencil => (g.depth.clone(), wgpu::LoadOp::Load),
             GpuMask::Depth => {
