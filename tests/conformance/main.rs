@@ -3,6 +3,7 @@
 
 mod cli;
 mod depth_layers;
+mod gpu_clock;
 mod hybrid;
 mod silhouette_map;
 mod smoothies;
