@@ -686,9 +686,8 @@ crate::named_enum! {
         /// The depth of a scratch depth buffer, 1 outside the mask, with the volumes' z-fail test turned
         /// into a passing `GreaterEqual`: hierarchical depth rejects whole tiles outside the mask, as the
         /// depth bounds test does in Chan's implementation (section 3.2), which wgpu does not expose.
-        /// Measured on an H100 (Vulkan), it is the slower of the two: the volumes' query takes 1.3 to 2.9
-        /// times the stencil mask's, the mask pass writing depth from the shader, which hierarchical depth
-        /// does not follow.
+        /// Measured on an H100 (Vulkan), it is the slower of the two: the query takes 1.4 to 3.3 times the
+        /// stencil mask's, whether the depth outside the mask is written by a shader or rasterized.
         Depth = "depth",
     }
 }

@@ -54,17 +54,11 @@ fn fs_hybrid_mask(in: FullScreen) {
     }
 }
 
-// The depth mask (gpu_mask=depth): as fs_hybrid_mask, and the silhouette pixels keep the G-buffer's
-// depth in the scratch depth buffer (cleared to 1, which no volume fragment passes `GreaterEqual` at).
-@group(1) @binding(5) var g_depth: texture_depth_2d;
-
-@fragment
-fn fs_hybrid_mask_depth(in: FullScreen) -> @builtin(frag_depth) f32 {
-    let px = vec2<i32>(in.pos.xy);
-    if (receiver_class(px) != SILHOUETTE) {
-        discard;
-    }
-    return textureLoad(g_depth, px, 0);
+// The depth mask's far triangle (gpu_mask=depth): full screen at depth 1, rasterized, no fragment stage.
+@vertex
+fn vs_hybrid_far(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
+    // The corners of common.wgsl's vs_full_screen (entry points cannot be called).
+    return vec4<f32>(f32(i32(i & 1u) * 4 - 1), f32(i32(i >> 1u) * 4 - 1), 1.0, 1.0);
 }
 
 // The map's answer, drawn under the stencil test "outside the mask"; non-receivers keep the cleared 1.

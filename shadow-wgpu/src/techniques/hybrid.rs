@@ -13,12 +13,14 @@
 //!    count is not 0 (the stencil is above 0x80). Silhouette pixels the volumes leave lit keep the cleared 1.
 //!
 //! With `gpu_mask=depth` the mask lives in a scratch depth-stencil instead, as Chan keeps it (section 3.2,
-//! with the depth bounds test, which wgpu does not expose): the mask pass clears the scratch to depth 1,
-//! writes the G-buffer's depth on the silhouette pixels (and sets bit 7 as before, for the answer), and
-//! the volumes count z-fail's way with the depth test turned around: a fragment behind the receiver fails
-//! `Less` exactly where it passes `GreaterEqual`, so the counting ops move from depth-fail to pass, and
-//! outside the mask (depth 1) every fragment fails the test, which hierarchical depth can do a tile at a
-//! time before rasterizing it.
+//! with the depth bounds test, which wgpu does not expose): the G-buffer's depth-stencil is copied into the
+//! scratch, the mask pass sets bit 7 as before (for the answer) and then rasterizes a full-screen triangle
+//! at depth 1 where the bit is clear (no depth written by a shader, so hierarchical depth can follow it),
+//! and the volumes count z-fail's way with the depth test turned around: a fragment behind the receiver
+//! fails `Less` exactly where it passes `GreaterEqual`, so the counting ops move from depth-fail to pass,
+//! and outside the mask (depth 1) every fragment fails the test, which hierarchical depth can do a tile at
+//! a time before rasterizing it. A first version wrote the silhouette pixels' depth from the mask shader
+//! instead; on an H100 both were slower than the stencil mask (see `GpuMask::Depth`).
 //!
 //! The map's classification runs twice, in the mask pass on every pixel and in the answer outside the
 //! mask: a full-screen pass can write a colour or set the stencil for the pixels it keeps, but not both
@@ -48,8 +50,7 @@ use crate::frame::GpuVisibility;
 use crate::frame::layered;
 use crate::gbuffer::GpuGBuffer;
 use crate::pipelines::{
-    DEPTH_STENCIL, FragmentEntry, MAP_DEPTH, VISIBILITY, attribute_entry, depth_array_entry, depth_entry,
-    full_screen_pipeline,
+    DEPTH_STENCIL, FragmentEntry, MAP_DEPTH, VISIBILITY, attribute_entry, depth_array_entry, full_screen_pipeline,
 };
 use crate::{readback, shaders};
 use wgpu::util::DeviceExt;
@@ -76,8 +77,10 @@ pub struct State {
     count_masked: wgpu::RenderPipeline,
     count_all: wgpu::RenderPipeline,
     draws: Option<Vec<VolumeDraw>>,
-    /// With `gpu_mask=depth`: the scratch depth-stencil the mask is written into, at the view's size.
+    /// With `gpu_mask=depth`: the scratch depth-stencil the mask is written into, at the view's size, and
+    /// the draw that sets depth 1 outside the mask.
     scratch: Option<wgpu::Texture>,
+    far: Option<wgpu::RenderPipeline>,
     /// With `edge_texels=on`: the pass drawing the edge quads, and the edge maps of the last build (a
     /// layer per projection, the nearest edge's depth per texel).
     edge_pass: Option<wgpu::RenderPipeline>,
@@ -105,19 +108,49 @@ fn volume_state(mask: GpuMask) -> wgpu::DepthStencilState {
     state
 }
 
-/// The mask pass's depth-stencil state: sets bit 7 on the pixels it keeps; with the depth mask also writes
-/// their depth (the fragment's, which the shader sets to the G-buffer's).
-fn mask_state(mask: GpuMask) -> wgpu::DepthStencilState {
+/// The mask pass's depth-stencil state: sets bit 7 on the pixels it keeps.
+fn mask_state() -> wgpu::DepthStencilState {
     let set_mask = wgpu::StencilFaceState {
         compare: wgpu::CompareFunction::Always,
         pass_op: wgpu::StencilOperation::Replace,
         ..Default::default()
     };
     wgpu::DepthStencilState {
-        depth_write_enabled: Some(mask == GpuMask::Depth),
         stencil: wgpu::StencilState { front: set_mask, back: set_mask, read_mask: 0, write_mask: MASK },
         ..stencil_test(wgpu::CompareFunction::Always, 0)
     }
+}
+
+/// The depth mask's second draw: a full-screen triangle at depth 1, rasterized (no depth written by a
+/// shader, so hierarchical depth can follow it), drawn where bit 7 is clear.
+fn far_pass(cx: &WgpuContext, module: &wgpu::ShaderModule, groups: &[&wgpu::BindGroupLayout]) -> wgpu::RenderPipeline {
+    let groups: Vec<_> = groups.iter().map(|g| Some(*g)).collect();
+    let layout = cx.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("hybrid far"),
+        bind_group_layouts: &groups,
+        immediate_size: 0,
+    });
+    let outside = wgpu::StencilFaceState { compare: wgpu::CompareFunction::Equal, ..Default::default() };
+    cx.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("hybrid far"),
+        layout: Some(&layout),
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some("vs_hybrid_far"),
+            compilation_options: Default::default(),
+            buffers: &[],
+        },
+        primitive: Default::default(),
+        depth_stencil: Some(wgpu::DepthStencilState {
+            depth_write_enabled: Some(true),
+            stencil: wgpu::StencilState { front: outside, back: outside, read_mask: MASK, write_mask: 0 },
+            ..stencil_test(wgpu::CompareFunction::Always, 0)
+        }),
+        multisample: Default::default(),
+        fragment: None,
+        multiview_mask: None,
+        cache: None,
+    })
 }
 
 /// A depth-stencil target of the G-buffer's size and format, for the depth mask.
@@ -129,7 +162,7 @@ fn scratch_target(cx: &WgpuContext, width: u32, height: u32) -> wgpu::Texture {
         sample_count: 1,
         dimension: wgpu::TextureDimension::D2,
         format: DEPTH_STENCIL,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_DST,
         view_formats: &[],
     })
 }
@@ -246,7 +279,7 @@ fn edge_maps(
 /// One pass of full-screen draws over the depth-stencil `depth` (each aspect loaded or cleared as its
 /// load op says), into `target` cleared to `clear` when given; each draw a pipeline and its stencil
 /// reference. With a `query` (an occlusion query set and its
-/// resolve buffer), counts the samples that pass.
+/// resolve buffer), counts the samples of the first draw that pass.
 fn full_screen_draws(
     cx: &WgpuContext,
     label: &str,
@@ -281,16 +314,16 @@ fn full_screen_draws(
         for (i, g) in groups.iter().enumerate() {
             pass.set_bind_group(i as u32, *g, &[]);
         }
-        if query.is_some() {
-            pass.begin_occlusion_query(0);
-        }
-        for (pipeline, reference) in draws {
+        for (k, (pipeline, reference)) in draws.iter().enumerate() {
             pass.set_pipeline(pipeline);
             pass.set_stencil_reference(*reference);
-            pass.draw(0..3, 0..1);
-        }
-        if query.is_some() {
-            pass.end_occlusion_query();
+            if query.is_some() && k == 0 {
+                pass.begin_occlusion_query(0);
+                pass.draw(0..3, 0..1);
+                pass.end_occlusion_query();
+            } else {
+                pass.draw(0..3, 0..1);
+            }
         }
         pass.pop_debug_group();
     }
@@ -313,29 +346,22 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
             let module = shaders::module(&cx.device, "hybrid", shaders::hybrid(self.edge_texels.is_on()));
             let volume_module = shaders::module(&cx.device, "shadow_volume", shaders::shadow_volume());
             let gpu_mask = self.gpu_mask;
-            // The depth mask reads the G-buffer's depth, which the stencil mask has as its attachment.
-            let mut extras = match gpu_mask {
-                GpuMask::Stencil => vec![attribute_entry(4)],
-                GpuMask::Depth => vec![attribute_entry(4), depth_entry(5)],
-            };
+            let mut extras = vec![attribute_entry(4)];
             if self.edge_texels.is_on() {
                 extras.push(depth_array_entry(6));
             }
             let bindings = MapBindings::new(cx, &extras);
             let groups = [&cx.shared.frame_layout, bindings.layout()];
-            let mask_entry = match gpu_mask {
-                GpuMask::Stencil => "fs_hybrid_mask",
-                GpuMask::Depth => "fs_hybrid_mask_depth",
-            };
             let mask = full_screen_pipeline(
                 &cx.device,
                 "hybrid mask",
                 &module,
-                mask_entry,
+                "fs_hybrid_mask",
                 &groups,
                 None,
-                Some(mask_state(gpu_mask)),
+                Some(mask_state()),
             );
+            let far = (gpu_mask == GpuMask::Depth).then(|| far_pass(cx, &module, &groups));
             let counting = volume_state(gpu_mask);
             let volume = |front| volume_pipeline(cx, &volume_module, "vs_volume", front, counting.clone());
             let (volumes_ccw, volumes_cw) = (volume(wgpu::FrontFace::Ccw), volume(wgpu::FrontFace::Cw));
@@ -369,6 +395,7 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
                 count_all,
                 draws: None,
                 scratch: None,
+                far,
                 edge_pass: self.edge_texels.is_on().then(|| edge_pass(cx)),
                 edge_maps: None,
                 last: None,
@@ -406,15 +433,10 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
         let not_built = || TechniqueError::NotBuilt(self.name().into());
         let draws = state.draws.as_ref().ok_or_else(not_built)?;
         let maps = state.map.maps().ok_or_else(not_built)?;
-        let g_depth = g
-            .depth
-            .create_view(&wgpu::TextureViewDescriptor { aspect: wgpu::TextureAspect::DepthOnly, ..Default::default() });
         let mut extras = vec![wgpu::BindGroupEntry {
             binding: 4,
             resource: wgpu::BindingResource::TextureView(&g.geometric_normal),
         }];
-        // The depth-stencil the passes run over: the G-buffer's, or the depth mask's scratch (at depth 1
-        // outside the mask once the mask pass has run), which the mask pass clears.
         let edge_view = state.edge_maps.as_ref().map(|t| {
             t.create_view(&wgpu::TextureViewDescriptor {
                 dimension: Some(wgpu::TextureViewDimension::D2Array),
@@ -426,18 +448,22 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
         } else if state.edge_pass.is_some() {
             return Err(not_built().into());
         }
-        let (target, depth_load) = match self.gpu_mask {
-            GpuMask::Stencil => (g.depth.clone(), wgpu::LoadOp::Load),
+        // The depth-stencil the passes run over: the G-buffer's, or for the depth mask a copy of it that
+        // the mask pass sets to depth 1 outside the mask.
+        let target = match self.gpu_mask {
+            GpuMask::Stencil => g.depth.clone(),
             GpuMask::Depth => {
-                extras
-                    .push(wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&g_depth) });
                 let fits = state.scratch.as_ref().is_some_and(|t| (t.width(), t.height()) == (g.width, g.height));
                 if !fits {
                     state.scratch = Some(scratch_target(cx, g.width, g.height));
                 }
-                (state.scratch.clone().ok_or_else(not_built)?, wgpu::LoadOp::Clear(1.0))
+                state.scratch.clone().ok_or_else(not_built)?
             }
         };
+        let mut mask_draws = vec![(&state.mask, MASK)];
+        if let Some(far) = &state.far {
+            mask_draws.push((far, 0));
+        }
         let depth = target.create_view(&Default::default());
         let lookup = LookupParams { radius: 0.0, receiver_offset: self.depth.receiver_offset() };
         let map_group =
@@ -445,13 +471,22 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
         let groups = [&g.frame_group, &map_group];
         let (silhouettes, passed) = cx.scoped("the hybrid passes", |cx| {
             let silhouettes = occlusion_query(cx);
+            if target != g.depth {
+                let mut enc = cx.device.create_command_encoder(&Default::default());
+                enc.copy_texture_to_texture(
+                    g.depth.as_image_copy(),
+                    target.as_image_copy(),
+                    wgpu::Extent3d { width: g.width, height: g.height, depth_or_array_layers: 1 },
+                );
+                cx.queue.submit([enc.finish()]);
+            }
             let mask = full_screen_draws(
                 cx,
                 "hybrid mask",
                 None,
-                (&depth, depth_load, wgpu::LoadOp::Clear(0)),
+                (&depth, wgpu::LoadOp::Load, wgpu::LoadOp::Clear(0)),
                 groups,
-                &[(&state.mask, MASK)],
+                &mask_draws,
                 Some(&silhouettes),
             );
             cx.queue.submit([mask]);
