@@ -53,10 +53,25 @@ pub fn silhouette_query() -> String {
 
 /// Hybrid maps and volumes: the classification, the mask and the answer, after the shadow-map shader.
 #[must_use]
-pub fn hybrid(edge_texels: bool) -> String {
+pub fn hybrid(edge_texels: bool, tile_marks: bool) -> String {
     let edges = if edge_texels { include_str!("shaders/hybrid_edges.wgsl") } else { NEAR_EDGE_OFF };
-    format!("{}\n{}\n{}", shadow_map(), edges, include_str!("shaders/hybrid.wgsl"))
+    let tiles = if tile_marks { TILE_MARKS } else { TILE_MARKS_OFF };
+    format!("{}\n{}\n{}\n{}", shadow_map(), edges, tiles, include_str!("shaders/hybrid.wgsl"))
 }
+
+/// hybrid's `scissor_tile`: the mask pass marks the tile of each silhouette pixel (map.extra: x the tile
+/// side in pixels, y the tiles per row).
+const TILE_MARKS: &str = "
+@group(1) @binding(7) var<storage, read_write> tile_marks: array<atomic<u32>>;
+
+fn mark_tile(px: vec2<i32>) {
+    let t = vec2<u32>(px) / u32(map.extra.x);
+    atomicStore(&tile_marks[t.y * u32(map.extra.y) + t.x], 1u);
+}
+";
+
+/// hybrid's `mark_tile` with `scissor_tile=0`: nothing (and no binding for the marks).
+const TILE_MARKS_OFF: &str = "fn mark_tile(px: vec2<i32>) {}";
 
 /// hybrid's `near_edge` with `edge_texels=off`: never (and no binding for the edge maps).
 const NEAR_EDGE_OFF: &str = "fn near_edge(layer: i32, uv: vec2<f32>, depth: f32) -> bool { return false; }";
@@ -95,8 +110,8 @@ pub fn all() -> Vec<(&'static str, String)> {
         ("depth_layers", depth_layers()),
         ("silhouette_build", silhouette_build()),
         ("silhouette_query", silhouette_query()),
-        ("hybrid", hybrid(false)),
-        ("hybrid edge_texels", hybrid(true)),
+        ("hybrid", hybrid(false, false)),
+        ("hybrid edge_texels, tile marks", hybrid(true, true)),
         ("hybrid edge pass", HYBRID_EDGE_PASS.to_string()),
     ]
 }

@@ -46,7 +46,7 @@ fn reference_ceiling(technique: &str, scene: &str) -> Option<f64> {
 
 /// Settings other than the defaults that take a different path through a backend, run as techniques of
 /// their own.
-const VARIANTS: [&str; 4] = [
+const VARIANTS: [&str; 5] = [
     // The light pass's object-ID channel: an R32Uint target read back on the GPU.
     "volume-reconstruction:ids=dangling",
     // The unmasked volume pass that counts what the computation mask saves.
@@ -55,6 +55,8 @@ const VARIANTS: [&str; 4] = [
     "hybrid:gpu_mask=depth",
     // Silhouette edges drawn into edge maps (per cube face for point lights) widen the mask.
     "hybrid:edge_texels=on",
+    // The GPU's tile marks, read back, and the volumes drawn in scissor rectangles around them.
+    "hybrid:scissor_tile=32",
 ];
 
 fn scenes() -> Vec<(String, Scene)> {

@@ -668,6 +668,11 @@ pub struct Hybrid {
     pub mask_tile: u32,
     /// Where the GPU keeps the computation mask (the CPU always uses its tiles).
     pub gpu_mask: GpuMask,
+    /// GPU: 0, the volumes are drawn over the whole view and the mask rejects fragments; N, the mask pass
+    /// also marks the N x N pixel tiles holding a silhouette pixel, the CPU reads the marks back and the
+    /// volumes are drawn only inside scissor rectangles around those tiles, so the rasterizer never makes
+    /// the fragments elsewhere (the draws are repeated per rectangle).
+    pub scissor_tile: u32,
     /// On: a receiver facing the light is also a silhouette pixel where a caster's silhouette edge nearer
     /// the light crosses one of its four texels (drawn into a map of edge depths), so casters thinner than
     /// a texel, which the map misses (Chan's Fig. 3-8), still get volumes; off: Chan's rule alone.
@@ -692,7 +697,7 @@ crate::named_enum! {
     }
 }
 
-const HYBRID_KEYS: [SettingKey; 9] = [
+const HYBRID_KEYS: [SettingKey; 10] = [
     SettingKey { key: "res", default: "512", help: "classifying map side in texels (16 to 16384)" },
     MAP_KEYS[1],
     MAP_KEYS[2],
@@ -707,6 +712,11 @@ const HYBRID_KEYS: [SettingKey; 9] = [
         key: "gpu_mask",
         default: "stencil",
         help: "GPU computation mask: stencil (a stencil bit) or depth (a scratch depth of 1 outside the mask)",
+    },
+    SettingKey {
+        key: "scissor_tile",
+        default: "0",
+        help: "GPU: 0, or draw the volumes only in scissor rectangles around the masked NxN tiles (8 to 512)",
     },
     SettingKey {
         key: "edge_texels",
@@ -729,6 +739,10 @@ impl TechniqueSettings for Hybrid {
             depth: ShadowMap::read_depth(v)?,
             mask_tile: v.ranged("mask_tile", 1, 64)?,
             gpu_mask: v.get("gpu_mask")?,
+            scissor_tile: match v.text("scissor_tile") {
+                "0" => 0,
+                _ => v.ranged("scissor_tile", 8, 512).map_err(|_| v.bad("scissor_tile", "0, or 8 to 512"))?,
+            },
             edge_texels: v.get("edge_texels")?,
             unmasked_fill: v.get("unmasked_fill")?,
         })
@@ -738,6 +752,7 @@ impl TechniqueSettings for Hybrid {
         v.extend([
             self.mask_tile.to_string(),
             self.gpu_mask.to_string(),
+            self.scissor_tile.to_string(),
             self.edge_texels.to_string(),
             self.unmasked_fill.to_string(),
         ]);

@@ -1,7 +1,7 @@
 // hybrid (Chan, thesis chapter 3): the map's classification of each receiver, the computation mask it
 // makes in the stencil's bit 7, and the passes that answer from the mask (twin: shadow-cpu's
-// techniques/hybrid.rs). Follows shadow_map.wgsl, whose bindings 0 to 3 it shares, and one of
-// hybrid_edges.wgsl's two `near_edge` (edge_texels on or off).
+// techniques/hybrid.rs). Follows shadow_map.wgsl, whose bindings 0 to 3 it shares, one of the two
+// `near_edge` (hybrid_edges.wgsl, or never) and one of the two `mark_tile` (shaders.rs).
 
 @group(1) @binding(4) var g_geometric_normal: texture_2d<f32>;
 
@@ -52,6 +52,7 @@ fn fs_hybrid_mask(in: FullScreen) {
     if (receiver_class(vec2<i32>(in.pos.xy)) != SILHOUETTE) {
         discard;
     }
+    mark_tile(vec2<i32>(in.pos.xy));
 }
 
 // The depth mask's far triangle (gpu_mask=depth): full screen at depth 1, rasterized, no fragment stage.

@@ -171,6 +171,7 @@ impl ShadowTechnique<WgpuBackend> for ShadowVolume {
             cw: &state.cw,
             stencil: wgpu::LoadOp::Clear(0),
             reference: 0,
+            scissors: None,
         };
         let passed = cx.scoped("the shadow-volume pass", |cx| {
             let q = counting.run(cx, &state.draws, frame, g, &depth);
@@ -365,12 +366,15 @@ pub(crate) struct VolumePass<'a> {
     pub stencil: wgpu::LoadOp<u32>,
     /// The stencil reference the pipelines test against.
     pub reference: u32,
+    /// Scissor rectangles `[x, y, width, height]` the draws are repeated in (hybrid's tiles), or `None`
+    /// for the whole view.
+    pub scissors: Option<&'a [[u32; 4]]>,
 }
 
 impl<'a> VolumePass<'a> {
     /// A counting pass: `pipeline` for both windings (it does not cull), the stencil kept.
     pub(crate) fn count(pipeline: &'a wgpu::RenderPipeline, label: &'static str) -> Self {
-        Self { label, ccw: pipeline, cw: pipeline, stencil: wgpu::LoadOp::Load, reference: 0 }
+        Self { label, ccw: pipeline, cw: pipeline, stencil: wgpu::LoadOp::Load, reference: 0, scissors: None }
     }
 
     /// Draws `draws` over the depth-stencil `depth` of `g`; the query counts the samples that pass.
@@ -401,20 +405,24 @@ impl<'a> VolumePass<'a> {
             pass.set_bind_group(0, &g.frame_group, &[]);
             pass.set_stencil_reference(self.reference);
             pass.begin_occlusion_query(0);
-            for d in draws {
-                pass.set_pipeline(if d.cw { self.cw } else { self.ccw });
-                let mesh = frame.instances.get(d.instance as usize).and_then(|i| cx.cache.mesh(i.mesh_key));
-                match (&d.vertices, d.mesh_vertices, mesh) {
-                    (Some(v), _, _) => pass.set_vertex_buffer(0, v.slice(..)),
-                    (None, true, Some(m)) => pass.set_vertex_buffer(0, m.positions.slice(..)),
-                    _ => continue,
-                }
-                match &d.indices {
-                    Some((ib, n)) => {
-                        pass.set_index_buffer(ib.slice(..), wgpu::IndexFormat::Uint32);
-                        pass.draw_indexed(0..*n, 0, d.instance..d.instance + 1);
+            let whole = [[0, 0, g.width, g.height]];
+            for &[x, y, w, h] in self.scissors.unwrap_or(&whole) {
+                pass.set_scissor_rect(x, y, w, h);
+                for d in draws {
+                    pass.set_pipeline(if d.cw { self.cw } else { self.ccw });
+                    let mesh = frame.instances.get(d.instance as usize).and_then(|i| cx.cache.mesh(i.mesh_key));
+                    match (&d.vertices, d.mesh_vertices, mesh) {
+                        (Some(v), _, _) => pass.set_vertex_buffer(0, v.slice(..)),
+                        (None, true, Some(m)) => pass.set_vertex_buffer(0, m.positions.slice(..)),
+                        _ => continue,
                     }
-                    None => pass.draw(0..d.count, d.instance..d.instance + 1),
+                    match &d.indices {
+                        Some((ib, n)) => {
+                            pass.set_index_buffer(ib.slice(..), wgpu::IndexFormat::Uint32);
+                            pass.draw_indexed(0..*n, 0, d.instance..d.instance + 1);
+                        }
+                        None => pass.draw(0..d.count, d.instance..d.instance + 1),
+                    }
                 }
             }
             pass.end_occlusion_query();
