@@ -7,7 +7,7 @@ use shadow_core::technique::hard::{
     SilhouetteMap, VolumeReconstruction,
 };
 use shadow_core::technique::settings::{SettingKey, SettingsError, TechniqueSettings, TechniqueSpec};
-use shadow_core::technique::{DynShadowTechnique, Stateful};
+use shadow_core::technique::{DynShadowTechnique, ShadowTechnique, Stateful};
 use shadow_cpu::CpuBackend;
 use shadow_soft::{AreaLightReference, Pcss, PenumbraMap, Smoothies};
 use shadow_wgpu::WgpuBackend;
@@ -47,6 +47,34 @@ pub struct TechniqueEntry {
     pub cpu: Option<CpuConstructor>,
     /// The wgpu implementation, if any.
     pub wgpu: Option<WgpuConstructor>,
+}
+
+impl TechniqueEntry {
+    /// The entry of a technique whose settings type is itself the technique on both backends (the usual
+    /// case: `S` implements `TechniqueSettings`, and `ShadowTechnique` for `CpuBackend` and `WgpuBackend`).
+    #[must_use]
+    pub fn on_both<S>(name: &'static str, description: &'static str, paper: &'static str) -> Self
+    where
+        S: TechniqueSettings + ShadowTechnique<CpuBackend> + ShadowTechnique<WgpuBackend> + 'static,
+    {
+        Self {
+            name,
+            description,
+            paper,
+            reference: false,
+            soft: false,
+            keys: S::keys,
+            canonical: canonical::<S>,
+            cpu: Some(plain::<CpuBackend, S>),
+            wgpu: Some(plain::<WgpuBackend, S>),
+        }
+    }
+
+    /// The same entry, for a soft technique (measured against `area-light-reference`).
+    #[must_use]
+    pub fn soft(self) -> Self {
+        Self { soft: true, ..self }
+    }
 }
 
 /// Why a technique could not be made.
@@ -144,83 +172,50 @@ impl TechniqueRegistry {
             cpu: Some(plain::<CpuBackend, AreaLightReference>),
             wgpu: None,
         });
-        r.register(TechniqueEntry {
-            name: "shadow-map",
-            description: "depth map from the light with Vulkan depth bias and percentage-closer filtering",
-            paper: "Williams 1978; Reeves et al. 1987 (survey: Nealen 2005)",
-            reference: false,
-            soft: false,
-            keys: ShadowMap::keys,
-            canonical: canonical::<ShadowMap>,
-            cpu: Some(plain::<CpuBackend, ShadowMap>),
-            wgpu: Some(plain::<WgpuBackend, ShadowMap>),
-        });
-        r.register(TechniqueEntry {
-            name: "silhouette-map",
-            description: "a shadow map plus silhouette points half a texel off: piecewise-linear shadow edges",
-            paper: "Sen, Cammarano, Hanrahan 2003",
-            reference: false,
-            soft: false,
-            keys: SilhouetteMap::keys,
-            canonical: canonical::<SilhouetteMap>,
-            cpu: Some(plain::<CpuBackend, SilhouetteMap>),
-            wgpu: Some(plain::<WgpuBackend, SilhouetteMap>),
-        });
-        r.register(TechniqueEntry {
-            name: "volume-reconstruction",
-            description: "a shadow volume rebuilt from the light's depth map, resolved with one stencil bit",
-            paper: "McCool 2000",
-            reference: false,
-            soft: false,
-            keys: VolumeReconstruction::keys,
-            canonical: canonical::<VolumeReconstruction>,
-            cpu: Some(plain::<CpuBackend, VolumeReconstruction>),
-            wgpu: Some(plain::<WgpuBackend, VolumeReconstruction>),
-        });
-        r.register(TechniqueEntry {
-            name: "hybrid",
-            description: "a shadow map, with z-fail shadow volumes at its silhouette pixels only (a computation mask)",
-            paper: "Chan 2004 (thesis, chapter 3)",
-            reference: false,
-            soft: false,
-            keys: Hybrid::keys,
-            canonical: canonical::<Hybrid>,
-            cpu: Some(plain::<CpuBackend, Hybrid>),
-            wgpu: Some(plain::<WgpuBackend, Hybrid>),
-        });
-        r.register(TechniqueEntry {
-            name: "smoothies",
-            description: "fake soft shadows: a shadow map plus alpha ramps hung outward from the silhouettes (smoothies)",
-            paper: "Chan-Durand 2003; Chan 2004 (thesis, chapter 4)",
-            reference: false,
-            soft: true,
-            keys: Smoothies::keys,
-            canonical: canonical::<Smoothies>,
-            cpu: Some(plain::<CpuBackend, Smoothies>),
-            wgpu: Some(plain::<WgpuBackend, Smoothies>),
-        });
-        r.register(TechniqueEntry {
-            name: "pcss",
-            description: "percentage-closer soft shadows: a blocker search sizes a PCF kernel to the penumbra",
-            paper: "Fernando 2005",
-            reference: false,
-            soft: true,
-            keys: Pcss::keys,
-            canonical: canonical::<Pcss>,
-            cpu: Some(plain::<CpuBackend, Pcss>),
-            wgpu: Some(plain::<WgpuBackend, Pcss>),
-        });
-        r.register(TechniqueEntry {
-            name: "penumbra-map",
-            description: "fake soft shadows: a shadow map plus cones and sheets at the silhouettes drawn into a penumbra map",
-            paper: "Wyman-Hansen 2003 (compared in Chan 2004, thesis 4.5.1)",
-            reference: false,
-            soft: true,
-            keys: PenumbraMap::keys,
-            canonical: canonical::<PenumbraMap>,
-            cpu: Some(plain::<CpuBackend, PenumbraMap>),
-            wgpu: Some(plain::<WgpuBackend, PenumbraMap>),
-        });
+        r.register(TechniqueEntry::on_both::<ShadowMap>(
+            "shadow-map",
+            "depth map from the light with Vulkan depth bias and percentage-closer filtering",
+            "Williams 1978; Reeves et al. 1987 (survey: Nealen 2005)",
+        ));
+        r.register(TechniqueEntry::on_both::<SilhouetteMap>(
+            "silhouette-map",
+            "a shadow map plus silhouette points half a texel off: piecewise-linear shadow edges",
+            "Sen, Cammarano, Hanrahan 2003",
+        ));
+        r.register(TechniqueEntry::on_both::<VolumeReconstruction>(
+            "volume-reconstruction",
+            "a shadow volume rebuilt from the light's depth map, resolved with one stencil bit",
+            "McCool 2000",
+        ));
+        r.register(TechniqueEntry::on_both::<Hybrid>(
+            "hybrid",
+            "a shadow map, with z-fail shadow volumes at its silhouette pixels only (a computation mask)",
+            "Chan 2004 (thesis, chapter 3)",
+        ));
+        r.register(
+            TechniqueEntry::on_both::<Smoothies>(
+                "smoothies",
+                "fake soft shadows: a shadow map plus alpha ramps hung outward from the silhouettes (smoothies)",
+                "Chan-Durand 2003; Chan 2004 (thesis, chapter 4)",
+            )
+            .soft(),
+        );
+        r.register(
+            TechniqueEntry::on_both::<Pcss>(
+                "pcss",
+                "percentage-closer soft shadows: a blocker search sizes a PCF kernel to the penumbra",
+                "Fernando 2005",
+            )
+            .soft(),
+        );
+        r.register(
+            TechniqueEntry::on_both::<PenumbraMap>(
+                "penumbra-map",
+                "fake soft shadows: a shadow map plus cones and sheets at the silhouettes drawn into a penumbra map",
+                "Wyman-Hansen 2003 (compared in Chan 2004, thesis 4.5.1)",
+            )
+            .soft(),
+        );
         r.register(TechniqueEntry {
             name: "shadow-volume-zpass",
             description: "stencil shadow volumes counted from the eye: wrong when the eye is in shadow",

@@ -9,8 +9,8 @@
 use glam::{Mat4, Vec3, Vec4};
 use shadow_core::light::LightView;
 use shadow_core::scene::LightKind;
-use shadow_core::technique::settings::{SettingKey, SettingsError, TechniqueSettings, TechniqueSpec, Values};
-use shadow_core::technique::{DynShadowTechnique, FrameStats, ShadowTechnique, Stateful};
+use shadow_core::technique::settings::{SettingKey, SettingsError, TechniqueSettings, Values};
+use shadow_core::technique::{FrameStats, ShadowTechnique};
 use shadow_core::{FrameInputs, Image};
 use shadow_cpu::raster::{DepthStencil, RasterState, Soup, draw};
 use shadow_cpu::{CpuBackend, CpuContext, CpuError, GBuffer};
@@ -295,31 +295,11 @@ impl ShadowTechnique<WgpuBackend> for PlanarShadow {
     }
 }
 
-fn cpu(spec: &TechniqueSpec) -> Result<Box<dyn DynShadowTechnique<CpuBackend>>, SettingsError> {
-    let s = PlanarShadow::parse(&spec.name, &spec.values)?;
-    Ok(Stateful::boxed(s, s.settings_string()))
-}
-
-fn gpu(spec: &TechniqueSpec) -> Result<Box<dyn DynShadowTechnique<WgpuBackend>>, SettingsError> {
-    let s = PlanarShadow::parse(&spec.name, &spec.values)?;
-    Ok(Stateful::boxed(s, s.settings_string()))
-}
-
-fn canonical(spec: &TechniqueSpec) -> Result<String, SettingsError> {
-    Ok(PlanarShadow::parse(&spec.name, &spec.values)?.settings_string())
-}
-
 /// Adds `planar-shadow` to a registry, on both backends.
 pub fn register(registry: &mut TechniqueRegistry) {
-    registry.register(TechniqueEntry {
-        name: "planar-shadow",
-        description: "caster triangles squashed onto the ground plane from the light (fake shadows)",
-        paper: "Blinn 1988 (survey: Nealen 2005)",
-        reference: false,
-        soft: false,
-        keys: PlanarShadow::keys,
-        canonical,
-        cpu: Some(cpu),
-        wgpu: Some(gpu),
-    });
+    registry.register(TechniqueEntry::on_both::<PlanarShadow>(
+        "planar-shadow",
+        "caster triangles squashed onto the ground plane from the light (fake shadows)",
+        "Blinn 1988 (survey: Nealen 2005)",
+    ));
 }
