@@ -4,52 +4,21 @@
 //! the penumbra map its values.
 
 use shadow_wgpu::WgpuContext;
-use shadow_wgpu::pipelines::{MAP_DEPTH, buffer_entry, depth_array_entry};
+use shadow_wgpu::pipelines::{buffer_entry, depth_array_entry, min_depth_pipeline};
 use wgpu::util::DeviceExt;
 
-/// A pipeline drawing `vertices` through `vertex` and `fragment` of `module` into a [`MAP_DEPTH`]
-/// target, both faces, the depth test "less" with writes.
+/// A pipeline drawing `vertices` through `vertex` and `fragment` of `module`, whose fragment depth is the
+/// value kept (shadow-wgpu's `min_depth_pipeline` with a fragment stage).
 #[must_use]
 pub fn pipeline(
     cx: &WgpuContext,
     label: &str,
     module: &wgpu::ShaderModule,
     layout: &wgpu::BindGroupLayout,
-    (vertex, vertices): (&str, wgpu::VertexBufferLayout<'_>),
+    vertex: (&str, wgpu::VertexBufferLayout<'_>),
     fragment: &str,
 ) -> wgpu::RenderPipeline {
-    let pipeline_layout = cx.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some(label),
-        bind_group_layouts: &[Some(layout)],
-        immediate_size: 0,
-    });
-    cx.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some(label),
-        layout: Some(&pipeline_layout),
-        vertex: wgpu::VertexState {
-            module,
-            entry_point: Some(vertex),
-            compilation_options: Default::default(),
-            buffers: &[Some(vertices)],
-        },
-        primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
-        depth_stencil: Some(wgpu::DepthStencilState {
-            format: MAP_DEPTH,
-            depth_write_enabled: Some(true),
-            depth_compare: Some(wgpu::CompareFunction::Less),
-            stencil: Default::default(),
-            bias: Default::default(),
-        }),
-        multisample: Default::default(),
-        fragment: Some(wgpu::FragmentState {
-            module,
-            entry_point: Some(fragment),
-            compilation_options: Default::default(),
-            targets: &[],
-        }),
-        multiview_mask: None,
-        cache: None,
-    })
+    min_depth_pipeline(&cx.device, label, module, &[layout], vertex, Some(fragment))
 }
 
 /// Records a pass that clears layer 0 of `target` to 1 (nothing drawn) and, given vertices, draws them

@@ -232,6 +232,54 @@ impl<'a> From<&'a str> for FragmentEntry<'a> {
     }
 }
 
+/// A pipeline drawing `vertices` through `vertex` (and `fragment`, when given) of `module` into a
+/// [`MAP_DEPTH`] target, both faces, the depth test "less" with writes: every texel keeps the nearest depth
+/// drawn or, where the fragment stage writes its depth, the smallest value (a minimum blend at full
+/// precision).
+#[must_use]
+pub fn min_depth_pipeline(
+    device: &wgpu::Device,
+    label: &str,
+    module: &wgpu::ShaderModule,
+    groups: &[&wgpu::BindGroupLayout],
+    (vertex, vertices): (&str, wgpu::VertexBufferLayout<'_>),
+    fragment: Option<&str>,
+) -> wgpu::RenderPipeline {
+    let groups: Vec<Option<&wgpu::BindGroupLayout>> = groups.iter().map(|g| Some(*g)).collect();
+    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(label),
+        bind_group_layouts: &groups,
+        immediate_size: 0,
+    });
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(label),
+        layout: Some(&layout),
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some(vertex),
+            compilation_options: Default::default(),
+            buffers: &[Some(vertices)],
+        },
+        primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: MAP_DEPTH,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::Less),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: Default::default(),
+        fragment: fragment.map(|entry| wgpu::FragmentState {
+            module,
+            entry_point: Some(entry),
+            compilation_options: Default::default(),
+            targets: &[],
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
 /// A pipeline drawing `vs_full_screen` into one colour target of `format` (none: a pass that only tests
 /// and writes the stencil), optionally with a depth-stencil state.
 #[must_use]

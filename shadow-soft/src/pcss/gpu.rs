@@ -5,8 +5,8 @@ use shadow_core::FrameInputs;
 use shadow_core::light::LightView;
 use shadow_core::technique::hard::ShadowMap;
 use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
-use shadow_wgpu::pipelines::{FragmentEntry, VISIBILITY, attribute_entry, full_screen_pipeline};
-use shadow_wgpu::techniques::shadow_map::{LookupParams, MapBindings, QueryExtras};
+use shadow_wgpu::pipelines::{FragmentEntry, attribute_entry};
+use shadow_wgpu::techniques::shadow_map::{LookupParams, MapQuery, QueryExtras};
 use shadow_wgpu::{GpuGBuffer, GpuVisibility, WgpuBackend, WgpuContext, WgpuError, shaders};
 
 use super::{Pcss, PcssLens};
@@ -14,8 +14,7 @@ use super::{Pcss, PcssLens};
 /// Pipelines, the blockers' map and the lens of the last build.
 pub struct State {
     map: shadow_wgpu::techniques::shadow_map::State,
-    bindings: MapBindings,
-    query: wgpu::RenderPipeline,
+    query: MapQuery,
     lens: Option<PcssLens>,
 }
 
@@ -30,17 +29,8 @@ impl ShadowTechnique<WgpuBackend> for Pcss {
         let map = <ShadowMap as ShadowTechnique<WgpuBackend>>::create_state(&self.depth, cx)?;
         cx.scoped("creating the pcss pipelines", |cx| {
             let module = shaders::module(&cx.device, "pcss query", query_shader());
-            let bindings = MapBindings::new(cx, &[attribute_entry(4)]);
-            let query = full_screen_pipeline(
-                &cx.device,
-                "pcss query",
-                &module,
-                FragmentEntry::from("fs_pcss_query"),
-                &[cx.frame_layout(), bindings.layout()],
-                Some(VISIBILITY),
-                None,
-            );
-            State { map, bindings, query, lens: None }
+            let query = MapQuery::with_entry(cx, &module, FragmentEntry::from("fs_pcss_query"), &[attribute_entry(4)]);
+            State { map, query, lens: None }
         })
     }
 
@@ -72,18 +62,8 @@ impl ShadowTechnique<WgpuBackend> for Pcss {
         let entries =
             [wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::TextureView(&g.geometric_normal) }];
         let lookup = LookupParams { radius: 0.0, receiver_offset: self.depth.receiver_offset() };
-        cx.scoped("the pcss query", |cx| {
-            let extras = QueryExtras { settings: lens.uniform(), entries: &entries };
-            let group = state.bindings.group(cx, maps, light, g, lookup, &extras);
-            shadow_wgpu::techniques::full_screen(
-                cx,
-                "pcss query",
-                &out.view,
-                &state.query,
-                &[&g.frame_group, &group],
-                None,
-            );
-        })
+        let extras = QueryExtras { settings: lens.uniform(), entries: &entries };
+        state.query.run(cx, maps, light, g, out, lookup, &extras)
     }
 
     fn debug_views(&self, _: &mut WgpuContext, _: &State) -> Result<Vec<DebugView>, WgpuError> {

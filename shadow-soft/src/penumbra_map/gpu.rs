@@ -9,8 +9,8 @@ use shadow_core::light::{LightProjection, LightView};
 use shadow_core::technique::hard::ShadowMap;
 use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
 use shadow_wgpu::frame::layered;
-use shadow_wgpu::pipelines::{FragmentEntry, MAP_DEPTH, VISIBILITY, depth_entry, full_screen_pipeline};
-use shadow_wgpu::techniques::shadow_map::{LookupParams, MapBindings, QueryExtras};
+use shadow_wgpu::pipelines::{FragmentEntry, MAP_DEPTH, depth_entry};
+use shadow_wgpu::techniques::shadow_map::{LookupParams, MapQuery, QueryExtras};
 use shadow_wgpu::{GpuGBuffer, GpuVisibility, WgpuBackend, WgpuContext, WgpuError, readback, shaders};
 
 use super::PenumbraMap;
@@ -44,8 +44,7 @@ pub struct State {
     map: shadow_wgpu::techniques::shadow_map::State,
     build_layout: wgpu::BindGroupLayout,
     build: wgpu::RenderPipeline,
-    bindings: MapBindings,
-    query: wgpu::RenderPipeline,
+    query: MapQuery,
     /// The penumbra map: a one-layer depth texture holding the values.
     penumbra: Option<wgpu::Texture>,
 }
@@ -101,17 +100,9 @@ impl ShadowTechnique<WgpuBackend> for PenumbraMap {
             let vertex = ("vs_cone", VERTEX_LAYOUT);
             let build = min_target::pipeline(cx, "penumbra map", &build_module, &build_layout, vertex, "fs_penumbra");
             let query_module = shaders::module(&cx.device, "penumbra query", query_shader());
-            let bindings = MapBindings::new(cx, &[depth_entry(4)]);
-            let query = full_screen_pipeline(
-                &cx.device,
-                "penumbra query",
-                &query_module,
-                FragmentEntry::from("fs_penumbra_query"),
-                &[cx.frame_layout(), bindings.layout()],
-                Some(VISIBILITY),
-                None,
-            );
-            State { map, build_layout, build, bindings, query, penumbra: None }
+            let entry = FragmentEntry::from("fs_penumbra_query");
+            let query = MapQuery::with_entry(cx, &query_module, entry, &[depth_entry(4)]);
+            State { map, build_layout, build, query, penumbra: None }
         })
     }
 
@@ -153,12 +144,8 @@ impl ShadowTechnique<WgpuBackend> for PenumbraMap {
         });
         let entries = [wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::TextureView(&view) }];
         let lookup = LookupParams { radius: 0.0, receiver_offset: self.depth.receiver_offset() };
-        cx.scoped("the penumbra-map query", |cx| {
-            let extras = QueryExtras { settings: [0.0; 4], entries: &entries };
-            let group = state.bindings.group(cx, maps, light, g, lookup, &extras);
-            let groups = [&g.frame_group, &group];
-            shadow_wgpu::techniques::full_screen(cx, "penumbra query", &out.view, &state.query, &groups, None);
-        })
+        let extras = QueryExtras { settings: [0.0; 4], entries: &entries };
+        state.query.run(cx, maps, light, g, out, lookup, &extras)
     }
 
     fn debug_views(&self, cx: &mut WgpuContext, state: &State) -> Result<Vec<DebugView>, WgpuError> {

@@ -9,8 +9,8 @@ use shadow_core::light::{LightProjection, LightView};
 use shadow_core::technique::hard::ShadowMap;
 use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
 use shadow_wgpu::frame::layered;
-use shadow_wgpu::pipelines::{FragmentEntry, MAP_DEPTH, VISIBILITY, buffer_entry, depth_entry, full_screen_pipeline};
-use shadow_wgpu::techniques::shadow_map::{LookupParams, MapBindings, QueryExtras};
+use shadow_wgpu::pipelines::{FragmentEntry, MAP_DEPTH, buffer_entry, depth_entry};
+use shadow_wgpu::techniques::shadow_map::{LookupParams, MapQuery, QueryExtras};
 use shadow_wgpu::{GpuGBuffer, GpuVisibility, WgpuBackend, WgpuContext, WgpuError, readback, shaders};
 use wgpu::util::DeviceExt;
 
@@ -47,8 +47,7 @@ pub struct State {
     buffer_layout: wgpu::BindGroupLayout,
     depth_pass: wgpu::RenderPipeline,
     alpha_pass: wgpu::RenderPipeline,
-    bindings: MapBindings,
-    query: wgpu::RenderPipeline,
+    query: MapQuery,
     falloff: wgpu::Buffer,
     /// Nearest smoothie depth and minimum alpha, each a one-layer depth texture.
     buffer: Option<[wgpu::Texture; 2]>,
@@ -117,25 +116,14 @@ impl ShadowTechnique<WgpuBackend> for Smoothies {
             let (depth_pass, alpha_pass) = (pass("fs_smoothie_depth"), pass("fs_smoothie_alpha"));
             let query_module = shaders::module(&cx.device, "smoothie query", query_shader());
             let storage = wgpu::BufferBindingType::Storage { read_only: true };
-            let bindings = MapBindings::new(
-                cx,
-                &[depth_entry(4), depth_entry(5), buffer_entry(6, storage, wgpu::ShaderStages::FRAGMENT)],
-            );
-            let query = full_screen_pipeline(
-                &cx.device,
-                "smoothie query",
-                &query_module,
-                FragmentEntry::from("fs_smoothie_query"),
-                &[cx.frame_layout(), bindings.layout()],
-                Some(VISIBILITY),
-                None,
-            );
+            let extra = [depth_entry(4), depth_entry(5), buffer_entry(6, storage, wgpu::ShaderStages::FRAGMENT)];
+            let query = MapQuery::with_entry(cx, &query_module, FragmentEntry::from("fs_smoothie_query"), &extra);
             let falloff = cx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("smoothie falloff"),
                 contents: bytemuck::cast_slice(falloff.samples()),
                 usage: wgpu::BufferUsages::STORAGE,
             });
-            State { map, buffer_layout, depth_pass, alpha_pass, bindings, query, falloff, buffer: None }
+            State { map, buffer_layout, depth_pass, alpha_pass, query, falloff, buffer: None }
         })
     }
 
@@ -183,18 +171,8 @@ impl ShadowTechnique<WgpuBackend> for Smoothies {
             wgpu::BindGroupEntry { binding: 6, resource: state.falloff.as_entire_binding() },
         ];
         let lookup = LookupParams { radius: 0.0, receiver_offset: self.depth.receiver_offset() };
-        cx.scoped("the smoothie query", |cx| {
-            let extras = QueryExtras { settings: [0.0; 4], entries: &entries };
-            let group = state.bindings.group(cx, maps, light, g, lookup, &extras);
-            shadow_wgpu::techniques::full_screen(
-                cx,
-                "smoothie query",
-                &out.view,
-                &state.query,
-                &[&g.frame_group, &group],
-                None,
-            );
-        })
+        let extras = QueryExtras { settings: [0.0; 4], entries: &entries };
+        state.query.run(cx, maps, light, g, out, lookup, &extras)
     }
 
     fn debug_views(&self, cx: &mut WgpuContext, state: &State) -> Result<Vec<DebugView>, WgpuError> {

@@ -43,9 +43,14 @@
 //! mask lets through), and with `unmasked_fill=on` one without the stencil test counts
 //! `unmasked_volume_fragments`; both are timed as the sub-phase `count_fragments`.
 
+mod edges;
+mod tiles;
+
+use edges::{edge_maps, edge_pass};
+use tiles::TileMarks;
+
 use shadow_core::FrameInputs;
 use shadow_core::Image;
-use shadow_core::geometry::silhouette::edge_texel_quads;
 use shadow_core::geometry::volume::Caps;
 use shadow_core::light::LightView;
 use shadow_core::lookup::PixelClass;
@@ -59,14 +64,11 @@ use super::shadow_volume::{
 };
 use crate::context::{WgpuBackend, WgpuContext, WgpuError};
 use crate::frame::GpuVisibility;
-use crate::frame::layered;
 use crate::gbuffer::GpuGBuffer;
 use crate::pipelines::{
-    DEPTH_STENCIL, FragmentEntry, MAP_DEPTH, VISIBILITY, attribute_entry, buffer_entry, depth_array_entry,
-    full_screen_pipeline,
+    DEPTH_STENCIL, FragmentEntry, VISIBILITY, attribute_entry, buffer_entry, depth_array_entry, full_screen_pipeline,
 };
 use crate::{readback, shaders};
-use wgpu::util::DeviceExt;
 
 /// The stencil bit of the computation mask.
 pub const MASK: u32 = 0x80;
@@ -207,167 +209,6 @@ fn stencil_test(compare: wgpu::CompareFunction, read_mask: u32) -> wgpu::DepthSt
 const OUTSIDE: (wgpu::CompareFunction, u32, u32) = (wgpu::CompareFunction::Equal, MASK, 0);
 const SHADOWED: (wgpu::CompareFunction, u32, u32) = (wgpu::CompareFunction::Less, 0xff, MASK);
 const LIT: (wgpu::CompareFunction, u32, u32) = (wgpu::CompareFunction::Equal, 0xff, MASK);
-
-/// Clip-space positions, for the edge pass.
-const CLIP_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
-    array_stride: 16,
-    step_mode: wgpu::VertexStepMode::Vertex,
-    attributes: &wgpu::vertex_attr_array![0 => Float32x4],
-};
-
-/// The edge pass (`edge_texels=on`): clip-space quads into a map depth target, the depth test keeping the
-/// nearest edge per texel.
-fn edge_pass(cx: &WgpuContext) -> wgpu::RenderPipeline {
-    let module = shaders::module(&cx.device, "hybrid edge pass", shaders::HYBRID_EDGE_PASS.to_string());
-    let layout = cx.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some("hybrid edge pass"),
-        bind_group_layouts: &[],
-        immediate_size: 0,
-    });
-    cx.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some("hybrid edge pass"),
-        layout: Some(&layout),
-        vertex: wgpu::VertexState {
-            module: &module,
-            entry_point: Some("vs_edge"),
-            compilation_options: Default::default(),
-            buffers: &[Some(CLIP_LAYOUT)],
-        },
-        primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
-        depth_stencil: Some(wgpu::DepthStencilState {
-            format: MAP_DEPTH,
-            depth_write_enabled: Some(true),
-            depth_compare: Some(wgpu::CompareFunction::Less),
-            stencil: Default::default(),
-            bias: Default::default(),
-        }),
-        multisample: Default::default(),
-        fragment: None,
-        multiview_mask: None,
-        cache: None,
-    })
-}
-
-/// The edge maps of a light: per projection, the casters' silhouette edges drawn as
-/// `edge_texel_quads` into a layer cleared to 1 (twin: shadow-cpu's hybrid build).
-fn edge_maps(
-    cx: &WgpuContext,
-    pass: &wgpu::RenderPipeline,
-    frame: &FrameInputs,
-    light: &LightView,
-    res: u32,
-) -> wgpu::Texture {
-    let segments = frame.silhouette_segments(light);
-    let maps = layered(cx, "hybrid edge maps", res, res, light.projections.len() as u32, MAP_DEPTH);
-    let mut enc = cx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("edge maps") });
-    for (k, p) in light.projections.iter().enumerate() {
-        let quads: Vec<[f32; 4]> =
-            edge_texel_quads(&segments, p, res).iter().flat_map(|t| t.map(|v| v.to_array())).collect();
-        let view = crate::frame::layer_view(&maps, k as u32);
-        let mut rp = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("edge map"),
-            color_attachments: &[],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &view,
-                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        if !quads.is_empty() {
-            let vb = cx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("edge quads"),
-                contents: bytemuck::cast_slice(&quads),
-                usage: wgpu::BufferUsages::VERTEX,
-            });
-            rp.set_pipeline(pass);
-            rp.set_vertex_buffer(0, vb.slice(..));
-            rp.draw(0..quads.len() as u32, 0..1);
-        }
-    }
-    cx.queue.submit([enc.finish()]);
-    maps
-}
-
-/// The tile marks of `scissor_tile`: a storage buffer the mask pass writes (1 per tile holding a silhouette
-/// pixel), the buffer it is read back through, and the grid.
-struct TileMarks {
-    marks: wgpu::Buffer,
-    staging: wgpu::Buffer,
-    columns: u32,
-    rows: u32,
-}
-
-impl TileMarks {
-    fn new(cx: &WgpuContext, columns: u32, rows: u32) -> Self {
-        let size = u64::from(columns * rows) * 4;
-        let buffer = |label, usage| {
-            cx.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(label),
-                size,
-                usage,
-                mapped_at_creation: false,
-            })
-        };
-        use wgpu::BufferUsages as U;
-        Self {
-            marks: buffer("hybrid tile marks", U::STORAGE | U::COPY_SRC | U::COPY_DST),
-            staging: buffer("hybrid tile marks readback", U::COPY_DST | U::MAP_READ),
-            columns,
-            rows,
-        }
-    }
-
-    /// The marked tiles (read back) as scissor rectangles within a `width x height` view.
-    fn rectangles(&self, cx: &WgpuContext, tile: u32, size: (u32, u32)) -> Result<Vec<[u32; 4]>, WgpuError> {
-        let mut enc = cx.device.create_command_encoder(&Default::default());
-        enc.copy_buffer_to_buffer(&self.marks, 0, &self.staging, 0, self.marks.size());
-        cx.queue.submit([enc.finish()]);
-        let bytes = readback::map_read(cx, &self.staging, "reading the hybrid tile marks")?;
-        let marked: Vec<bool> = bytes.chunks_exact(4).map(|m| m != [0; 4]).collect();
-        Ok(scissor_rectangles(&marked, self.columns, tile, size))
-    }
-}
-
-/// Scissor rectangles `[x, y, width, height]` covering the marked tiles of a grid `columns` wide (row
-/// major) over a `width x height` view: runs of marked tiles along each row, merged with the run below
-/// while it spans the same columns; clipped to the view.
-fn scissor_rectangles(marked: &[bool], columns: u32, tile: u32, (width, height): (u32, u32)) -> Vec<[u32; 4]> {
-    let mut rects: Vec<[u32; 4]> = Vec::new();
-    // Rectangles that reach the row above, by their column range.
-    let mut open: Vec<((u32, u32), usize)> = Vec::new();
-    for (r, row) in marked.chunks(columns as usize).enumerate() {
-        let r = r as u32;
-        let mut next = Vec::new();
-        let mut c = 0;
-        while c < columns {
-            if !row[c as usize] {
-                c += 1;
-                continue;
-            }
-            let start = c;
-            while c < columns && row[c as usize] {
-                c += 1;
-            }
-            let (x, y) = (start * tile, r * tile);
-            let (w, h) = ((c * tile).min(width) - x, ((r + 1) * tile).min(height) - y);
-            match open.iter().find(|(span, _)| *span == (start, c)) {
-                Some(&(_, k)) => {
-                    rects[k][3] += h;
-                    next.push(((start, c), k));
-                }
-                None => {
-                    rects.push([x, y, w, h]);
-                    next.push(((start, c), rects.len() - 1));
-                }
-            }
-        }
-        open = next;
-    }
-    rects
-}
 
 /// One pass of full-screen draws over the depth-stencil `depth` (each aspect loaded or cleared as its
 /// load op says), into `target` cleared to `clear` when given; each draw a pipeline and its stencil
@@ -712,21 +553,4 @@ fn classes(cx: &WgpuContext, state: &State, last: &LastQuery) -> Result<Image<u3
     );
     cx.queue.submit([pass]);
     readback::read_u32(cx, &target, 0)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::scissor_rectangles;
-
-    #[test]
-    fn marked_tiles_become_row_runs_merged_downwards() {
-        // A 4x3 grid of 16-pixel tiles over a 60x40 view (the last column and row are cut short):
-        //   X X . X
-        //   X X . X
-        //   . X . .
-        let marked = [true, true, false, true, true, true, false, true, false, true, false, false];
-        let rects = scissor_rectangles(&marked, 4, 16, (60, 40));
-        assert_eq!(rects, vec![[0, 0, 32, 32], [48, 0, 12, 32], [16, 32, 16, 8]]);
-        assert!(scissor_rectangles(&[false; 12], 4, 16, (60, 40)).is_empty());
-    }
 }

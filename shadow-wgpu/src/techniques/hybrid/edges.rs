@@ -1,0 +1,70 @@
+//! hybrid's `edge_texels=on` on the GPU: the casters' silhouette edges drawn as texel-covering quads into
+//! edge maps, a layer per light projection holding the nearest edge's depth per texel (twin: shadow-cpu's
+//! hybrid build; the test that reads them is hybrid_edges.wgsl's `near_edge`).
+
+use shadow_core::FrameInputs;
+use shadow_core::geometry::silhouette::edge_texel_quads;
+use shadow_core::light::LightView;
+use wgpu::util::DeviceExt;
+
+use crate::context::WgpuContext;
+use crate::frame::{layer_view, layered};
+use crate::pipelines::{MAP_DEPTH, min_depth_pipeline};
+use crate::shaders;
+
+/// Clip-space positions, for the edge pass.
+const CLIP_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
+    array_stride: 16,
+    step_mode: wgpu::VertexStepMode::Vertex,
+    attributes: &wgpu::vertex_attr_array![0 => Float32x4],
+};
+
+/// The edge pass (`edge_texels=on`): clip-space quads into a map depth target, the depth test keeping the
+/// nearest edge per texel.
+pub(super) fn edge_pass(cx: &WgpuContext) -> wgpu::RenderPipeline {
+    let module = shaders::module(&cx.device, "hybrid edge pass", shaders::HYBRID_EDGE_PASS.to_string());
+    min_depth_pipeline(&cx.device, "hybrid edge pass", &module, &[], ("vs_edge", CLIP_LAYOUT), None)
+}
+
+/// The edge maps of a light: per projection, the casters' silhouette edges drawn as
+/// `edge_texel_quads` into a layer cleared to 1 (twin: shadow-cpu's hybrid build).
+pub(super) fn edge_maps(
+    cx: &WgpuContext,
+    pass: &wgpu::RenderPipeline,
+    frame: &FrameInputs,
+    light: &LightView,
+    res: u32,
+) -> wgpu::Texture {
+    let segments = frame.silhouette_segments(light);
+    let maps = layered(cx, "hybrid edge maps", res, res, light.projections.len() as u32, MAP_DEPTH);
+    let mut enc = cx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("edge maps") });
+    for (k, p) in light.projections.iter().enumerate() {
+        let quads: Vec<[f32; 4]> =
+            edge_texel_quads(&segments, p, res).iter().flat_map(|t| t.map(|v| v.to_array())).collect();
+        let view = layer_view(&maps, k as u32);
+        let mut rp = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("edge map"),
+            color_attachments: &[],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &view,
+                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        if !quads.is_empty() {
+            let vb = cx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("edge quads"),
+                contents: bytemuck::cast_slice(&quads),
+                usage: wgpu::BufferUsages::VERTEX,
+            });
+            rp.set_pipeline(pass);
+            rp.set_vertex_buffer(0, vb.slice(..));
+            rp.draw(0..quads.len() as u32, 0..1);
+        }
+    }
+    cx.queue.submit([enc.finish()]);
+    maps
+}
