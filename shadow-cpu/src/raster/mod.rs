@@ -486,8 +486,9 @@ struct BandRows<'a, T> {
     width: usize,
 }
 
-/// The columns of row `py` (fixed point) inside all three edges.
-#[inline(always)]
+/// The columns of row `py` (fixed point) inside all three edges, solved by division: what [`EdgeWalk`]
+/// steps to, row after row.
+#[cfg(test)]
 fn span(t: &Setup, py: i64) -> Option<(i32, i32)> {
     let (mut lo, mut hi) = (i64::from(t.min_x), i64::from(t.max_x));
     for k in 0..3 {
@@ -505,12 +506,100 @@ fn span(t: &Setup, py: i64) -> Option<(i32, i32)> {
     (lo <= hi).then_some((lo as i32, hi as i32))
 }
 
+/// `floor(m / d)` for `d > 0` while `m` moves by the same amount every row: a quotient and a remainder
+/// stepped with additions, exactly, as a DDA walks an edge.
+#[derive(Clone, Copy, Debug)]
+struct FloorStep {
+    q: i64,
+    r: i64,
+    step_q: i64,
+    step_r: i64,
+    d: i64,
+}
+
+impl FloorStep {
+    fn new(m: i64, step: i64, d: i64) -> Self {
+        Self { q: m.div_euclid(d), r: m.rem_euclid(d), step_q: step.div_euclid(d), step_r: step.rem_euclid(d), d }
+    }
+
+    #[inline(always)]
+    fn next_row(&mut self) {
+        self.r += self.step_r;
+        let carry = i64::from(self.r >= self.d);
+        self.r -= carry * self.d;
+        self.q += self.step_q + carry;
+    }
+}
+
+/// What one edge function says about a row's columns.
+#[derive(Clone, Copy, Debug)]
+enum EdgeBound {
+    /// Inside from this column on (`a > 0`).
+    From(FloorStep),
+    /// Inside up to this column (`a < 0`).
+    To(FloorStep),
+    /// A horizontal edge (`a = 0`): the row is inside while its edge function `kk` is not negative.
+    Rows { kk: i64, step: i64 },
+}
+
+/// A triangle's spans row after row: the columns of each row inside all three edges, with three
+/// divisions where the walk starts and additions after (`E_k(256 x + 128) + tl >= 0` solved for `x`,
+/// each bound's numerator moving by `-b * 256` a row).
+#[derive(Clone, Copy, Debug)]
+struct EdgeWalk {
+    edges: [EdgeBound; 3],
+    min_x: i64,
+    max_x: i64,
+}
+
+impl EdgeWalk {
+    /// The walk of `t` from row `y`.
+    fn new(t: &Setup, y: i32) -> Self {
+        let py = i64::from(y) * ONE + HALF;
+        let edges = std::array::from_fn(|k| {
+            let kk = t.b[k] * py + t.c[k] + t.tl[k];
+            let (num, num_step, den) = (-kk - HALF * t.a[k], -t.b[k] * ONE, ONE * t.a[k]);
+            match den.signum() {
+                // ceil(num / den) = floor((num + den - 1) / den).
+                1 => EdgeBound::From(FloorStep::new(num + den - 1, num_step, den)),
+                // floor(num / den) = floor(-num / -den).
+                -1 => EdgeBound::To(FloorStep::new(-num, -num_step, -den)),
+                _ => EdgeBound::Rows { kk, step: t.b[k] * ONE },
+            }
+        });
+        Self { edges, min_x: i64::from(t.min_x), max_x: i64::from(t.max_x) }
+    }
+
+    /// The current row's columns, then on to the next row.
+    #[inline(always)]
+    fn next_row(&mut self) -> Option<(i32, i32)> {
+        let (mut lo, mut hi, mut rows) = (self.min_x, self.max_x, true);
+        for e in &mut self.edges {
+            match e {
+                EdgeBound::From(f) => {
+                    lo = lo.max(f.q);
+                    f.next_row();
+                }
+                EdgeBound::To(f) => {
+                    hi = hi.min(f.q);
+                    f.next_row();
+                }
+                EdgeBound::Rows { kk, step } => {
+                    rows &= *kk >= 0;
+                    *kk += *step;
+                }
+            }
+        }
+        (rows && lo <= hi).then_some((lo as i32, hi as i32))
+    }
+}
+
 /// A superset of the columns rows `ya..=yb` have inside the triangle, clamped to its bounds, or `None`
 /// when it has none there: the x extent of the triangle cut to the slab between the rows' centres, whose
 /// corners are triangle corners inside the slab or points on its two lines (in the triangle's cross
 /// sections there). Floating point from the edges' precomputed row crossings (far below a pixel off for
 /// fixed-point inputs), widened by a pixel each side, so a whole tile row of a triangle is tested against
-/// a mask with a few multiply-adds, not three integer divisions per row.
+/// a mask with a few multiply-adds, not a walk of its rows.
 fn slab_columns(t: &Setup, ya: i32, yb: i32) -> Option<(i32, i32)> {
     let (pa, pb) = (i64::from(ya) * ONE + HALF, i64::from(yb) * ONE + HALF);
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
@@ -684,9 +773,10 @@ fn raster_band<T, F, B>(
         return;
     }
     let mut runs = Vec::new();
+    let mut walk = EdgeWalk::new(t, y_lo);
     for y in y_lo..=y_hi {
         let py = i64::from(y) * ONE + HALF;
-        let Some((xs, xe)) = span(t, py) else { continue };
+        let Some((xs, xe)) = walk.next_row() else { continue };
         let z_row = row_base(t, py);
         let row = (y - rows.y0) as usize * rows.width;
         let mut run = |a: i32, b: i32| {
@@ -716,7 +806,7 @@ fn raster_band<T, F, B>(
 /// tile among them its runs of masked-in pixels, each cut to the pixels inside all three edges. Empty
 /// tiles cost a lookup and rows without a masked-in pixel nothing, so the work follows the mask, not
 /// the triangle's rows. Same fragments, depths and counters as the row walk: the inside test is the
-/// edge functions `span` solves, the depth `row_base` and `depth_at`.
+/// edge functions [`EdgeWalk`] solves, the depth `row_base` and `depth_at`.
 fn masked_tiles<T>(
     t: &Setup,
     rows: &mut BandRows<'_, T>,
@@ -753,7 +843,7 @@ fn masked_tiles<T>(
 }
 
 /// The columns of `xs..=xe` in row `py` (fixed point) inside all three edges, tested pixel by pixel (the
-/// test `span` solves by division); contiguous, the triangle being convex.
+/// test [`EdgeWalk`] solves row by row); contiguous, the triangle being convex.
 #[inline(always)]
 fn inside(t: &Setup, py: i64, xs: i32, xe: i32) -> Option<(i32, i32)> {
     let px = i64::from(xs) * ONE + HALF;

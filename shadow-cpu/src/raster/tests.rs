@@ -360,3 +360,41 @@ fn a_computation_mask_confines_stencil_work_to_its_pixels() {
         assert!(c.fragments < unmasked.fragments / 4);
     }
 }
+
+#[test]
+fn the_edge_walk_steps_to_the_divided_spans() {
+    // The jittered grid, and long slivers from well outside the screen (shadow-volume sides, clipped to
+    // the guard band), walked from their first row and from every band start, against `span`.
+    let mut rng = shadow_core::scenes::Rng::new(3);
+    let mut tris = jittered_grid(12, 9, 3.0);
+    let grid = tris.len() as u32;
+    for _ in 0..300 {
+        let mut corner = || {
+            let w = rng.range(0.05, 3.0);
+            Vec4::new(rng.range(-4.0, 4.0) * w, rng.range(-4.0, 4.0) * w, 0.5 * w, w)
+        };
+        let (a, b) = (corner(), corner());
+        let c = a + (b - a) * 0.5 + Vec4::new(rng.range(-0.05, 0.05), rng.range(-0.05, 0.05), 0.0, 0.0);
+        tris.push([a, b, c]);
+    }
+    let (w, h) = (301, 217);
+    let st = RasterState { cull: CullMode::None, ..count_state() };
+    let mut setups = Vec::new();
+    for (i, v) in tris.iter().enumerate() {
+        setup(SourceTriangle { v: *v, prim: i as u32, flip: false }, &st, w, h, guard_band(w, h), &mut setups);
+    }
+    let slivers = setups.iter().filter(|t| t.prim >= grid).count();
+    assert!(slivers > 40, "{slivers} slivers set up");
+    let mut rows = 0;
+    for t in &setups {
+        let starts = std::iter::once(t.min_y).chain((0..t.max_y).step_by(BAND_ROWS as usize).filter(|&y| y > t.min_y));
+        for start in starts {
+            let mut walk = EdgeWalk::new(t, start);
+            for y in start..=t.max_y {
+                assert_eq!(walk.next_row(), span(t, i64::from(y) * ONE + HALF), "row {y} of {t:?} from {start}");
+                rows += 1;
+            }
+        }
+    }
+    assert!(rows > 10_000, "{rows} rows walked");
+}
