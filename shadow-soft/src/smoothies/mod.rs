@@ -222,6 +222,40 @@ pub fn debug_views(depth: &Image<f32>, alpha: &Image<f32>) -> Vec<DebugView> {
 mod tests {
     use super::*;
 
+    /// The squared error, along a line across a straight shadow edge of a spherical light, of an outward
+    /// ramp `falloff` of width `w` against the truth, in half-widths of the true penumbra: the truth is the
+    /// visible fraction of the light's disc, `1 - (acos x - x sqrt(1 - x^2)) / pi` from the umbra (x = -1)
+    /// to full light (x = 1), one half at the hard edge (x = 0); the ramp is 0 inside the hard edge and
+    /// rises to 1 at `w`; `w = 0` is the hard edge itself.
+    fn edge_error(falloff: Falloff, w: f64) -> f64 {
+        let truth = |x: f64| {
+            let x = x.clamp(-1.0, 1.0);
+            1.0 - (x.acos() - x * (1.0 - x * x).sqrt()) / std::f64::consts::PI
+        };
+        let ramp = |x: f64| match x {
+            _ if x < 0.0 => 0.0,
+            _ if x >= w => 1.0,
+            _ => f64::from(falloff.exact((x / w) as f32)),
+        };
+        let n = 20_000;
+        let (a, b) = (-1.0, 1.0 + w);
+        (0..n).map(|i| a + (b - a) * (i as f64 + 0.5) / n as f64).map(|x| (truth(x) - ramp(x)).powi(2)).sum::<f64>()
+            * (b - a)
+            / n as f64
+    }
+
+    #[test]
+    fn an_outward_ramp_as_wide_as_the_outer_penumbra_errs_more_than_a_hard_edge() {
+        // Why smoothies at the light's size lose to a hard (or bilinearly filtered) edge in RMSE: the
+        // truth is already one half at the hard edge, where the ramp starts from 0. Narrower ramps do
+        // better, at best by about a sixth, which a bilinear filter's own blur across the edge also gains.
+        let hard = edge_error(Falloff::Linear, 0.0);
+        let at_width = edge_error(Falloff::Sinusoidal, 1.0);
+        assert!(at_width > 1.3 * hard, "sinusoid as wide as the outer penumbra {at_width} against {hard}");
+        let best = (1..=20).map(|i| edge_error(Falloff::Sinusoidal, f64::from(i) / 20.0)).fold(f64::MAX, f64::min);
+        assert!(best < hard && best > 0.8 * hard, "best narrower sinusoid {best} against {hard}");
+    }
+
     #[test]
     fn the_tabulated_falloff_follows_the_sinusoid() {
         for falloff in [Falloff::Sinusoidal, Falloff::Linear] {
