@@ -71,6 +71,14 @@ pub fn compare_bilinear(map: &Image<f32>, uv: Vec2, depth: f32) -> f32 {
     bilinear(map.width(), uv, |x, y| compare_texel(map, x, y, depth))
 }
 
+/// Whether map coordinates `uv` lie on the map (`[0, 1]` on both axes, edges included): what every lookup
+/// asks first, outside being lit (or no edge) by convention.
+#[inline]
+#[must_use]
+pub fn on_map(uv: Vec2) -> bool {
+    (0.0..=1.0).contains(&uv.x) && (0.0..=1.0).contains(&uv.y)
+}
+
 /// A per-texel value `texel(x, y)` of an `n x n` map, bilinearly weighted over the 2x2 texels around
 /// `uv - half a texel` (indices may fall one outside the map: `texel` clamps them).
 #[inline]
@@ -179,7 +187,7 @@ pub fn classify(map: &Image<f32>, uv: Vec2, depth: f32, faces_light: bool) -> Ma
 /// twin: `near_edge` in shadow-wgpu's hybrid_edges.wgsl). Outside the map, no.
 #[must_use]
 pub fn near_edge(edges: &Image<f32>, uv: Vec2, depth: f32) -> bool {
-    if !(0.0..=1.0).contains(&uv.x) || !(0.0..=1.0).contains(&uv.y) {
+    if !on_map(uv) {
         return false;
     }
     let st = uv * edges.width() as f32 - Vec2::splat(0.5);
@@ -199,7 +207,7 @@ pub const EDGE_MARGIN: f32 = 1e-5;
 /// in texels for the jittered and Poisson filters; `pixel` seeds their per-pixel rotation or jitter.
 #[must_use]
 pub fn shadow_lookup(map: &Image<f32>, uv: Vec2, depth: f32, filter: Filter, radius: f32, pixel: (u32, u32)) -> f32 {
-    if !(0.0..=1.0).contains(&uv.x) || !(0.0..=1.0).contains(&uv.y) {
+    if !on_map(uv) {
         return 1.0;
     }
     let texel = 1.0 / map.width() as f32;

@@ -31,7 +31,7 @@ use glam::{Vec2, Vec3, Vec4Swizzles};
 
 use crate::image::{Image, Rgb8};
 use crate::light::{LightProjection, ndc_to_uv};
-use crate::lookup::compare_nearest;
+use crate::lookup::{compare_nearest, on_map};
 
 /// The value of a texel holding no point (stored points lie in `[0, 1]^2`).
 pub const EMPTY: [f32; 2] = [-1.0, -1.0];
@@ -358,7 +358,7 @@ pub fn silhouette_lookup(
     gradient: Vec2,
 ) -> SilhouetteLookup {
     let plain = |v: f32| SilhouetteLookup { visibility: v, silhouette: false };
-    if !(0.0..=1.0).contains(&uv.x) || !(0.0..=1.0).contains(&uv.y) {
+    if !on_map(uv) {
         return plain(1.0);
     }
     let s = uv * depth_map.width() as f32 - Vec2::splat(0.5);

@@ -3,7 +3,7 @@
 
 use shadow_core::glam::Vec2;
 use shadow_core::light::LightView;
-use shadow_core::lookup::{POISSON16, compare_bilinear, hash_unit, pixel_hash};
+use shadow_core::lookup::{POISSON16, compare_bilinear, hash_unit, on_map, pixel_hash};
 use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
 use shadow_core::{FrameInputs, Image};
 use shadow_cpu::techniques::{map_position, per_receiver, render_depth_maps};
@@ -29,7 +29,7 @@ fn texel_depth(map: &Image<f32>, uv: Vec2) -> f32 {
 /// `gradient` per unit of `uv`; `pixel` turns the Poisson disc. 1 outside the map.
 #[must_use]
 pub fn pcss_lookup(map: &Image<f32>, lens: &PcssLens, uv: Vec2, depth: f32, gradient: Vec2, pixel: (u32, u32)) -> f32 {
-    if !(0.0..=1.0).contains(&uv.x) || !(0.0..=1.0).contains(&uv.y) {
+    if !on_map(uv) {
         return 1.0;
     }
     let angle = hash_unit(pixel_hash(pixel.0, pixel.1)) * std::f32::consts::TAU;

@@ -3,7 +3,7 @@
 
 use shadow_core::glam::Vec2;
 use shadow_core::light::{LightProjection, LightView};
-use shadow_core::lookup::bilinear;
+use shadow_core::lookup::{bilinear, on_map};
 use shadow_core::stats::ms;
 use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
 use shadow_core::{FrameInputs, Image};
@@ -69,7 +69,7 @@ fn texel_visibility(map: &Image<f32>, penumbra: &Image<f32>, x: i32, y: i32, dep
 /// outside the map.
 #[must_use]
 pub fn penumbra_lookup(map: &Image<f32>, penumbra: &Image<f32>, uv: Vec2, depth: f32) -> f32 {
-    if !(0.0..=1.0).contains(&uv.x) || !(0.0..=1.0).contains(&uv.y) {
+    if !on_map(uv) {
         return 1.0;
     }
     bilinear(map.width(), uv, |x, y| texel_visibility(map, penumbra, x, y, depth))

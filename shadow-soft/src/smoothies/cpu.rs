@@ -2,7 +2,7 @@
 
 use shadow_core::glam::{Vec2, Vec4};
 use shadow_core::light::LightView;
-use shadow_core::lookup::bilinear;
+use shadow_core::lookup::{bilinear, on_map};
 use shadow_core::stats::ms;
 use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
 use shadow_core::{FrameInputs, Image};
@@ -107,7 +107,7 @@ fn texel_visibility(map: &Image<f32>, buffer: &SmoothieBuffer, x: i32, y: i32, d
 /// weighted (the thesis's 2x2 filtering); 1 outside the map. Before the falloff.
 #[must_use]
 pub fn smoothie_lookup(map: &Image<f32>, buffer: &SmoothieBuffer, uv: Vec2, depth: f32) -> f32 {
-    if !(0.0..=1.0).contains(&uv.x) || !(0.0..=1.0).contains(&uv.y) {
+    if !on_map(uv) {
         return 1.0;
     }
     bilinear(map.width(), uv, |x, y| texel_visibility(map, buffer, x, y, depth))
