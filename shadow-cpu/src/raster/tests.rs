@@ -1,5 +1,6 @@
 use glam::Vec4;
 
+use super::spans::span;
 use super::*;
 
 fn count_state() -> RasterState {
