@@ -128,7 +128,10 @@ pub fn parse_light(text: &str, default: &Light, scene_center: Vec3) -> Result<Li
         }
     }
     if let Some(tg) = target {
-        dir = (tg - pos).normalize_or(dir);
+        if (tg - pos).length_squared() < 1e-12 {
+            return Err(OptionError { flag: F, value: text.into(), why: "light pos and target coincide".into() });
+        }
+        dir = (tg - pos).normalize();
     }
     let kind = match t {
         LightType::Spot => LightKind::Spot { position: pos, direction: dir, cone_angle: fov.to_radians() },
@@ -234,6 +237,8 @@ mod tests {
         assert!(matches!(l.kind, LightKind::Directional { .. }));
         assert!(parse_light("laser", &d, Vec3::ZERO).is_err());
         assert!(parse_light("spot,fov=200", &d, Vec3::ZERO).is_err());
+        let same = parse_light("spot,pos=1,2,3,target=1,2,3", &d, Vec3::ZERO).unwrap_err();
+        assert!(same.to_string().contains("coincide"), "{same}");
         assert_eq!(parse_size("640x480").unwrap(), (640, 480));
         assert!(parse_size("0x480").is_err());
         assert!(parse_size("640").is_err());

@@ -1,12 +1,17 @@
 //! Triangle meshes: positions, per-vertex shading normals and counter-clockwise triangles.
 //!
-//! A [`Mesh`] is valid by construction: every index is in range, every position and normal is finite, and
-//! there is at least one triangle. Loaders and builders go through [`Mesh::new`] or
+//! A [`Mesh`] is valid by construction: every index is in range, every position and normal is finite,
+//! every coordinate within [`MAX_COORDINATE`], and at least one triangle has an area. Loaders and builders go through [`Mesh::new`] or
 //! [`Mesh::with_normals`], so no backend ever sees a mesh that would rasterize garbage.
 
 use glam::Vec3;
 
 use crate::bounds::Aabb;
+
+/// The largest coordinate magnitude a mesh may hold: face normals and areas multiply coordinate
+/// differences, so anything near the square root of `f32::MAX` (1.8e19) overflows to infinity and the
+/// mesh's silhouettes and volumes come out empty; a margin of a hundred leaves room for sums of them.
+pub const MAX_COORDINATE: f32 = 1e17;
 
 /// Why a mesh was refused.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -34,6 +39,17 @@ pub enum MeshError {
         /// The offending value, printed.
         value: String,
     },
+    /// A coordinate beyond [`MAX_COORDINATE`].
+    #[error("vertex {vertex} has a position beyond +-1e17 ({value}), too large for f32 geometry")]
+    TooLarge {
+        /// Vertex number.
+        vertex: usize,
+        /// The position, printed.
+        value: String,
+    },
+    /// Every triangle is degenerate: nothing would be drawn or cast a shadow.
+    #[error("every one of its {0} triangles has zero area (in f32)")]
+    NoArea(usize),
     /// Normals given, but not one per vertex.
     #[error("{normals} normals for {positions} positions")]
     NormalCount {
@@ -93,11 +109,17 @@ impl Mesh {
         if let Some((vertex, p)) = positions.iter().enumerate().find(|(_, p)| !p.is_finite()) {
             return Err(MeshError::NonFinite { vertex, what: "position", value: format!("{p}") });
         }
+        if let Some((vertex, p)) = positions.iter().enumerate().find(|(_, p)| p.abs().max_element() > MAX_COORDINATE) {
+            return Err(MeshError::TooLarge { vertex, value: format!("{p}") });
+        }
         let n = positions.len();
         for (triangle, t) in triangles.iter().enumerate() {
             if let Some(&index) = t.iter().find(|&&i| i as usize >= n) {
                 return Err(MeshError::IndexOutOfRange { triangle, index, vertex_count: n });
             }
+        }
+        if triangles.iter().all(|t| face_normal(t.map(|i| positions[i as usize])) == Vec3::ZERO) {
+            return Err(MeshError::NoArea(triangles.len()));
         }
         Ok(())
     }
@@ -206,6 +228,16 @@ mod tests {
         let mut nan = p.clone();
         nan[1].y = f32::NAN;
         assert!(matches!(Mesh::new(nan, vec![[0, 1, 2]]), Err(MeshError::NonFinite { vertex: 1, .. })));
+        // Finite but past f32's square root: its face normal would be infinite.
+        let huge = vec![Vec3::ZERO, Vec3::X * 1e38, Vec3::Y * 1e38];
+        assert!(!face_normal([huge[0], huge[1], huge[2]]).is_finite());
+        assert!(matches!(Mesh::new(huge, vec![[0, 1, 2]]), Err(MeshError::TooLarge { vertex: 1, .. })));
+        let big = vec![Vec3::ZERO, Vec3::X * MAX_COORDINATE, Vec3::Y * MAX_COORDINATE];
+        assert!(face_normal([big[0], big[1], big[2]]).is_finite());
+        assert!(Mesh::new(big, vec![[0, 1, 2]]).is_ok());
+        let flat = vec![Vec3::ZERO, Vec3::X, Vec3::X * 2.0];
+        assert_eq!(Mesh::new(flat.clone(), vec![[0, 1, 2], [0, 0, 1]]), Err(MeshError::NoArea(2)));
+        assert!(Mesh::new([flat, vec![Vec3::Y]].concat(), vec![[0, 1, 2], [0, 1, 3]]).is_ok());
         let m = Mesh::new(p, vec![[0, 1, 2]]).unwrap();
         assert_eq!(m.normals()[0], Vec3::Z);
     }

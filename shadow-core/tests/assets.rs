@@ -17,6 +17,8 @@ const BAD: &[(&str, &str, fn(&AssetFault) -> bool)] = &[
     ("bad/missing_file.obj", "file not found", |f| matches!(f, AssetFault::NotFound(_))),
     ("bad/index_out_of_range.obj", "index out of range", |f| matches!(f, AssetFault::Malformed(_))),
     ("bad/nan_position.obj", "non-finite position", |f| matches!(f, AssetFault::Mesh(..))),
+    ("bad/huge_position.obj", "too large for f32", |f| matches!(f, AssetFault::Mesh(..))),
+    ("bad/no_area.obj", "zero area", |f| matches!(f, AssetFault::Mesh(..))),
     ("bad/lines_only.obj", "only points or lines", |f| matches!(f, AssetFault::Unsupported(_))),
     ("bad/empty.obj", "no triangles", |f| matches!(f, AssetFault::Unsupported(_))),
     ("bad/bad_number.obj", "position parse error", |f| matches!(f, AssetFault::Malformed(_))),
