@@ -1,6 +1,10 @@
 //! `bench`: frames with the light moving every frame (nothing light-dependent can be cached), a warm-up,
 //! then per phase the median, minimum and maximum over the measured frames, with the counters of the
 //! last frame (DESIGN 11). `--sweep` repeats it over a parameter.
+//!
+//! The techniques take turns frame by frame (frame 1 of every technique and backend, then frame 2, ...),
+//! so a machine that slows down or speeds up during a run moves them all alike and their ratios hold: on
+//! the development machine, timings drift 20-40% over minutes, more than most differences measured.
 
 use std::collections::BTreeMap;
 
@@ -12,7 +16,7 @@ use shadow_core::stats::{Phase, Summary};
 use shadow_core::technique::TechniqueSpec;
 
 use crate::Error;
-use crate::renderer::{BackendKind, Renderer};
+use crate::renderer::{BackendKind, Prepared, Renderer};
 
 /// What to measure.
 pub struct BenchJob<'a> {
@@ -91,7 +95,24 @@ pub fn moved_light(light: &Light, center: Vec3, k: u32, n: u32) -> Light {
     Light { kind, ..*light }
 }
 
-/// Runs the job.
+impl BenchJob<'_> {
+    /// How many times [`run_bench`] reports progress: once per technique and backend as it is prepared,
+    /// then once per frame round (warm-up included).
+    #[must_use]
+    pub fn steps(&self) -> u64 {
+        (self.techniques.len() * self.backends.len()) as u64 + u64::from(self.warmup + self.frames)
+    }
+}
+
+/// One technique on one backend while a bench runs: what it has measured so far.
+struct Lane {
+    prepared: Prepared,
+    backend: BackendKind,
+    samples: BTreeMap<String, Vec<f64>>,
+    counters: BTreeMap<String, f64>,
+}
+
+/// Runs the job, the techniques taking turns frame by frame.
 ///
 /// # Errors
 /// Rendering failures.
@@ -102,45 +123,51 @@ pub fn run_bench(
 ) -> Result<BenchReport, Error> {
     let center = job.frame.bounds.center();
     let total = job.warmup + job.frames;
-    let mut results = Vec::new();
+    let mut lanes = Vec::new();
     for spec in &job.techniques {
         for &backend in &job.backends {
             progress(&format!("{spec} on {}", backend.name()));
-            let mut p = renderer.prepare(backend, spec)?;
-            let mut samples: BTreeMap<String, Vec<f64>> = BTreeMap::new();
-            let mut counters = BTreeMap::new();
-            for k in 0..total {
-                let mut frame = job.frame.clone();
-                frame.lights = job.frame.lights.iter().map(|l| moved_light(l, center, k, total)).collect();
-                let run = renderer.run_prepared(&mut p, &frame, job.width, job.height)?;
-                if k < job.warmup {
-                    continue;
-                }
-                for phase in Phase::ALL {
-                    samples.entry(phase.key().into()).or_default().push(run.stats.timings.get(phase));
-                }
-                samples.entry("total".into()).or_default().push(run.stats.timings.total);
-                for (key, v) in &run.stats.timings.extra {
-                    samples.entry(key.clone()).or_default().push(*v);
-                }
-                counters = run.stats.counters.entries().into_iter().collect();
+            let prepared = renderer.prepare(backend, spec)?;
+            lanes.push(Lane { prepared, backend, samples: BTreeMap::new(), counters: BTreeMap::new() });
+        }
+    }
+    for k in 0..total {
+        progress(&format!("frame {} of {total}{}", k + 1, if k < job.warmup { " (warm-up)" } else { "" }));
+        let mut frame = job.frame.clone();
+        frame.lights = job.frame.lights.iter().map(|l| moved_light(l, center, k, total)).collect();
+        for lane in &mut lanes {
+            let run = renderer.run_prepared(&mut lane.prepared, &frame, job.width, job.height)?;
+            if k < job.warmup {
+                continue;
             }
-            let timings_ms = samples
+            let mut sample = |key: &str, v: f64| lane.samples.entry(key.into()).or_default().push(v);
+            for phase in Phase::ALL {
+                sample(phase.key(), run.stats.timings.get(phase));
+            }
+            sample("total", run.stats.timings.total);
+            for (key, v) in &run.stats.timings.extra {
+                sample(key, *v);
+            }
+            lane.counters = run.stats.counters.entries().into_iter().collect();
+        }
+    }
+    let results = lanes
+        .into_iter()
+        .map(|lane| BenchEntry {
+            technique: lane.prepared.name().into(),
+            settings: lane.prepared.settings().into(),
+            backend: lane.backend.name().into(),
+            timings_ms: lane
+                .samples
                 .into_iter()
                 .map(|(k, v)| {
                     let s = Summary::of(&v);
                     (k, Stat { median: s.median, min: s.min, max: s.max })
                 })
-                .collect();
-            results.push(BenchEntry {
-                technique: p.name().into(),
-                settings: p.settings().into(),
-                backend: backend.name().into(),
-                timings_ms,
-                counters,
-            });
-        }
-    }
+                .collect(),
+            counters: lane.counters,
+        })
+        .collect();
     Ok(BenchReport { scene: job.scene.clone(), width: job.width, height: job.height, frames: job.frames, results })
 }
 
