@@ -2,9 +2,11 @@
 //! then per phase the median, minimum and maximum over the measured frames, with the counters of the
 //! last frame (DESIGN 11). `--sweep` repeats it over a parameter.
 //!
-//! The techniques take turns frame by frame (frame 1 of every technique and backend, then frame 2, ...),
-//! so a machine that slows down or speeds up during a run moves them all alike and their ratios hold: on
-//! the development machine, timings drift 20-40% over minutes, more than most differences measured.
+//! On each backend in turn, the techniques take turns frame by frame (frame 1 of every technique, then
+//! frame 2, ...), so a machine that slows down or speeds up during a run moves them all alike and their
+//! ratios hold: on the development machine, timings drift 20-40% over minutes, more than most differences
+//! measured. The backends do not take turns: between CPU frames, which share the machine's cores with it,
+//! lavapipe ran `smoothies` 1.52 times its shadow map's frame on cylinder, against 1.28 to 1.32 on its own.
 
 use std::collections::BTreeMap;
 
@@ -13,7 +15,7 @@ use serde::Serialize;
 use shadow_core::FrameInputs;
 use shadow_core::scene::{Light, LightKind};
 use shadow_core::stats::{Phase, Summary};
-use shadow_core::technique::TechniqueSpec;
+use shadow_core::technique::{FrameStats, TechniqueSpec};
 
 use crate::Error;
 use crate::renderer::{BackendKind, Prepared, Renderer};
@@ -96,23 +98,25 @@ pub fn moved_light(light: &Light, center: Vec3, k: u32, n: u32) -> Light {
 }
 
 impl BenchJob<'_> {
-    /// How many times [`run_bench`] reports progress: once per technique and backend as it is prepared,
+    /// How many times [`run_bench`] reports progress: per backend, once per technique as it is prepared,
     /// then once per frame round (warm-up included).
     #[must_use]
     pub fn steps(&self) -> u64 {
-        (self.techniques.len() * self.backends.len()) as u64 + u64::from(self.warmup + self.frames)
+        self.backends.len() as u64 * (self.techniques.len() as u64 + u64::from(self.warmup + self.frames))
     }
 }
 
 /// One technique on one backend while a bench runs: what it has measured so far.
 struct Lane {
+    /// Its place in the job's techniques.
+    technique: usize,
     prepared: Prepared,
     backend: BackendKind,
     samples: BTreeMap<String, Vec<f64>>,
     counters: BTreeMap<String, f64>,
 }
 
-/// Runs the job, the techniques taking turns frame by frame.
+/// Runs the job: backend by backend, the techniques taking turns frame by frame.
 ///
 /// # Errors
 /// Rendering failures.
@@ -124,51 +128,63 @@ pub fn run_bench(
     let center = job.frame.bounds.center();
     let total = job.warmup + job.frames;
     let mut lanes = Vec::new();
-    for spec in &job.techniques {
-        for &backend in &job.backends {
+    for &backend in &job.backends {
+        let first = lanes.len();
+        for (technique, spec) in job.techniques.iter().enumerate() {
             progress(&format!("{spec} on {}", backend.name()));
             let prepared = renderer.prepare(backend, spec)?;
-            lanes.push(Lane { prepared, backend, samples: BTreeMap::new(), counters: BTreeMap::new() });
+            lanes.push(Lane { technique, prepared, backend, samples: BTreeMap::new(), counters: BTreeMap::new() });
+        }
+        for k in 0..total {
+            let warm = if k < job.warmup { " (warm-up)" } else { "" };
+            progress(&format!("{}: frame {} of {total}{warm}", backend.name(), k + 1));
+            let mut frame = job.frame.clone();
+            frame.lights = job.frame.lights.iter().map(|l| moved_light(l, center, k, total)).collect();
+            for lane in &mut lanes[first..] {
+                let run = renderer.run_prepared(&mut lane.prepared, &frame, job.width, job.height)?;
+                if k >= job.warmup {
+                    lane.record(&run.stats);
+                }
+            }
         }
     }
-    for k in 0..total {
-        progress(&format!("frame {} of {total}{}", k + 1, if k < job.warmup { " (warm-up)" } else { "" }));
-        let mut frame = job.frame.clone();
-        frame.lights = job.frame.lights.iter().map(|l| moved_light(l, center, k, total)).collect();
-        for lane in &mut lanes {
-            let run = renderer.run_prepared(&mut lane.prepared, &frame, job.width, job.height)?;
-            if k < job.warmup {
-                continue;
-            }
-            let mut sample = |key: &str, v: f64| lane.samples.entry(key.into()).or_default().push(v);
-            for phase in Phase::ALL {
-                sample(phase.key(), run.stats.timings.get(phase));
-            }
-            sample("total", run.stats.timings.total);
-            for (key, v) in &run.stats.timings.extra {
-                sample(key, *v);
-            }
-            lane.counters = run.stats.counters.entries().into_iter().collect();
-        }
-    }
-    let results = lanes
-        .into_iter()
-        .map(|lane| BenchEntry {
-            technique: lane.prepared.name().into(),
-            settings: lane.prepared.settings().into(),
-            backend: lane.backend.name().into(),
-            timings_ms: lane
-                .samples
-                .into_iter()
-                .map(|(k, v)| {
-                    let s = Summary::of(&v);
-                    (k, Stat { median: s.median, min: s.min, max: s.max })
-                })
-                .collect(),
-            counters: lane.counters,
-        })
-        .collect();
+    // Technique by technique, each one's backends in order, as the table lists them (a stable sort).
+    lanes.sort_by_key(|lane| lane.technique);
+    let results = lanes.into_iter().map(Lane::into_entry).collect();
     Ok(BenchReport { scene: job.scene.clone(), width: job.width, height: job.height, frames: job.frames, results })
+}
+
+impl Lane {
+    /// One measured frame's timings and counters.
+    fn record(&mut self, stats: &FrameStats) {
+        let mut sample = |key: &str, v: f64| self.samples.entry(key.into()).or_default().push(v);
+        for phase in Phase::ALL {
+            sample(phase.key(), stats.timings.get(phase));
+        }
+        sample("total", stats.timings.total);
+        for (key, v) in &stats.timings.extra {
+            sample(key, *v);
+        }
+        self.counters = stats.counters.entries().into_iter().collect();
+    }
+
+    fn into_entry(self) -> BenchEntry {
+        let timings_ms = self
+            .samples
+            .into_iter()
+            .map(|(k, v)| {
+                let s = Summary::of(&v);
+                (k, Stat { median: s.median, min: s.min, max: s.max })
+            })
+            .collect();
+        BenchEntry {
+            technique: self.prepared.name().into(),
+            settings: self.prepared.settings().into(),
+            backend: self.backend.name().into(),
+            timings_ms,
+            counters: self.counters,
+        }
+    }
 }
 
 /// The bench table as text.

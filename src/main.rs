@@ -526,8 +526,8 @@ fn bench(args: &SceneArgs, b: BenchArgs) -> Result<(), Error> {
     std::fs::create_dir_all(&out).map_err(|e| Error::Write { path: out.clone(), why: e.to_string() })?;
     let mut csv = String::from("parameter,value,technique,backend,gbuffer_ms,build_ms,query_ms,shade_ms,total_ms\n");
     let mut series: std::collections::BTreeMap<String, Vec<(f64, f64)>> = Default::default();
-    // Per value, as `BenchJob::steps` counts them: each technique and backend prepared, then the frames.
-    let steps = (specs.len() * kinds.len()) as u64 + u64::from(b.warmup + b.frames);
+    // Per value, as `BenchJob::steps` counts them: per backend, each technique prepared, then the frames.
+    let steps = kinds.len() as u64 * (specs.len() as u64 + u64::from(b.warmup + b.frames));
     let bar = progress_bar(values.len() as u64 * steps);
     for &v in &values {
         let (frame, w, h) = if key == "res" {
