@@ -243,3 +243,42 @@ pub fn sweep_scene(tris: u32) -> shadow_core::Scene {
     shadow_core::scenes::stage_model(&mut s, true);
     s
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::TechniqueRegistry;
+    use shadow_core::scenes::{self, SceneParams};
+
+    #[test]
+    fn every_lane_runs_every_frame_and_results_list_technique_by_technique() {
+        let scene = scenes::build("stacked-boxes", &SceneParams::default()).expect("a built-in scene");
+        let camera = scene.cameras().next().expect("the scene's camera").0;
+        let frame = FrameInputs::from_scene(&scene, camera).expect("a frame");
+        let specs = ["shadow-map:res=64", "shadow-volume-zfail"].map(|s| TechniqueSpec::parse(s).expect("spec"));
+        // The CPU twice stands in for two backends: the lanes run backend by backend but are listed
+        // technique by technique.
+        let job = BenchJob {
+            scene: "stacked-boxes".into(),
+            frame: &frame,
+            width: 24,
+            height: 16,
+            frames: 3,
+            warmup: 1,
+            techniques: specs.to_vec(),
+            backends: vec![BackendKind::Cpu, BackendKind::Cpu],
+        };
+        let mut renderer = Renderer::new(TechniqueRegistry::builtin());
+        let mut steps = Vec::new();
+        let report = run_bench(&mut renderer, &job, |m| steps.push(m.to_string())).expect("bench");
+        assert_eq!(steps.len() as u64, job.steps(), "{steps:?}");
+        assert_eq!(steps.iter().filter(|m| m.contains("(warm-up)")).count(), 2, "{steps:?}");
+        let names: Vec<&str> = report.results.iter().map(|e| e.technique.as_str()).collect();
+        assert_eq!(names, ["shadow-map", "shadow-map", "shadow-volume-zfail", "shadow-volume-zfail"]);
+        for e in &report.results {
+            let total = e.timings_ms["total"];
+            assert!(total.min > 0.0 && total.min <= total.median && total.median <= total.max, "{e:?}");
+            assert!(e.counters.contains_key("covered_pixels"), "{e:?}");
+        }
+    }
+}
