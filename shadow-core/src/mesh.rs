@@ -1,8 +1,9 @@
 //! Triangle meshes: positions, per-vertex shading normals and counter-clockwise triangles.
 //!
 //! A [`Mesh`] is valid by construction: every index is in range, every position and normal is finite,
-//! every coordinate within [`MAX_COORDINATE`], and at least one triangle has an area. Loaders and builders go through [`Mesh::new`] or
-//! [`Mesh::with_normals`], so no backend ever sees a mesh that would rasterize garbage.
+//! every coordinate within [`MAX_COORDINATE`], and at least one triangle has an area. Loaders and builders
+//! go through [`Mesh::new`] or [`Mesh::with_normals`], so no backend ever sees a mesh that would rasterize
+//! garbage.
 
 use glam::Vec3;
 
@@ -40,7 +41,7 @@ pub enum MeshError {
         value: String,
     },
     /// A coordinate beyond [`MAX_COORDINATE`].
-    #[error("vertex {vertex} has a position beyond +-1e17 ({value}), too large for f32 geometry")]
+    #[error("vertex {vertex} has a position beyond +-{max:e} ({value}), too large for f32 geometry", max = MAX_COORDINATE)]
     TooLarge {
         /// Vertex number.
         vertex: usize,
