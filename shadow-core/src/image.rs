@@ -105,6 +105,17 @@ impl<T> Image<T> {
         &self.data[self.index(x, y)]
     }
 
+    /// The pixel nearest (x, y): indices clamped to the image's edge, as a clamp-to-edge sampler reads a
+    /// texture (map lookups whose 2x2 footprint reaches one texel past the border).
+    ///
+    /// # Panics
+    /// When the image is empty.
+    #[must_use]
+    pub fn get_clamped(&self, x: i32, y: i32) -> &T {
+        let clamp = |v: i32, n: u32| v.clamp(0, n as i32 - 1) as u32;
+        self.get(clamp(x, self.width), clamp(y, self.height))
+    }
+
     /// Pixel (x, y), mutable.
     ///
     /// # Panics
@@ -236,6 +247,15 @@ pub fn false_colour(values: &Image<f32>, lo: f32, hi: f32) -> Image<Rgb8> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn clamped_reads_take_the_nearest_edge_pixel() {
+        let img = Image::from_fn(3, 2, |x, y| (x, y));
+        assert_eq!(*img.get_clamped(1, 1), (1, 1));
+        assert_eq!(*img.get_clamped(-1, -5), (0, 0));
+        assert_eq!(*img.get_clamped(3, 1), (2, 1));
+        assert_eq!(*img.get_clamped(7, 2), (2, 1));
+    }
 
     #[test]
     fn srgb_round_trip() {

@@ -51,9 +51,7 @@ pub fn hash_unit(h: u32) -> f32 {
 /// One comparison against texel (x, y), clamped to the edge (WGSL twin: `compare_texel`).
 #[inline]
 fn compare_texel(map: &Image<f32>, x: i32, y: i32, depth: f32) -> f32 {
-    let n = map.width() as i32;
-    let v = *map.get(x.clamp(0, n - 1) as u32, y.clamp(0, n - 1) as u32);
-    if depth <= v { 1.0 } else { 0.0 }
+    if depth <= *map.get_clamped(x, y) { 1.0 } else { 0.0 }
 }
 
 /// Comparison against the texel holding `uv` (WGSL twin: `compare_nearest`).
@@ -192,10 +190,7 @@ pub fn near_edge(edges: &Image<f32>, uv: Vec2, depth: f32) -> bool {
     }
     let st = uv * edges.width() as f32 - Vec2::splat(0.5);
     let (x, y) = (st.x.floor() as i32, st.y.floor() as i32);
-    let n = edges.width() as i32 - 1;
-    [(0, 0), (1, 0), (0, 1), (1, 1)]
-        .iter()
-        .any(|(dx, dy)| *edges.get((x + dx).clamp(0, n) as u32, (y + dy).clamp(0, n) as u32) < depth - EDGE_MARGIN)
+    [(0, 0), (1, 0), (0, 1), (1, 1)].iter().any(|(dx, dy)| *edges.get_clamped(x + dx, y + dy) < depth - EDGE_MARGIN)
 }
 
 /// How much nearer the light than a receiver (NDC depth) an edge must be to count in [`near_edge`]: a

@@ -4,6 +4,7 @@
 //! the penumbra map its values.
 
 use shadow_wgpu::WgpuContext;
+use shadow_wgpu::frame::layer_view;
 use shadow_wgpu::pipelines::{buffer_entry, depth_array_entry, min_depth_pipeline};
 use wgpu::util::DeviceExt;
 
@@ -30,11 +31,7 @@ pub fn draw(
     group: &wgpu::BindGroup,
     vertices: Option<&(wgpu::Buffer, u32)>,
 ) {
-    let view = target.create_view(&wgpu::TextureViewDescriptor {
-        dimension: Some(wgpu::TextureViewDimension::D2),
-        array_layer_count: Some(1),
-        ..Default::default()
-    });
+    let view = layer_view(target, 0);
     let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
         label: Some("minimum target"),
         color_attachments: &[],

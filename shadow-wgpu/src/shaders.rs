@@ -39,6 +39,13 @@ pub fn shadow_map() -> String {
     with_common(&format!("{}{}", poisson_constant(), include_str!("shaders/shadow_map.wgsl")))
 }
 
+/// The shadow-map shader followed by `query`: a query written against `MapQuery`'s bindings and the
+/// shadow-map shader's functions (the silhouette map's, hybrid's and the soft techniques' in shadow-soft).
+#[must_use]
+pub fn with_shadow_map(query: &str) -> String {
+    format!("{}\n{query}", shadow_map())
+}
+
 /// Silhouette-map pass 2 (the points) and the texel count.
 #[must_use]
 pub fn silhouette_build() -> String {
@@ -48,7 +55,7 @@ pub fn silhouette_build() -> String {
 /// Silhouette-map query: the shadow-map shader and the reconstruction.
 #[must_use]
 pub fn silhouette_query() -> String {
-    format!("{}\n{}", shadow_map(), include_str!("shaders/silhouette_query.wgsl"))
+    with_shadow_map(include_str!("shaders/silhouette_query.wgsl"))
 }
 
 /// Hybrid maps and volumes: the classification, the mask and the answer, after the shadow-map shader.
@@ -56,7 +63,7 @@ pub fn silhouette_query() -> String {
 pub fn hybrid(edge_texels: bool, tile_marks: bool) -> String {
     let edges = if edge_texels { include_str!("shaders/hybrid_edges.wgsl") } else { NEAR_EDGE_OFF };
     let tiles = if tile_marks { TILE_MARKS } else { TILE_MARKS_OFF };
-    format!("{}\n{}\n{}\n{}", shadow_map(), edges, tiles, include_str!("shaders/hybrid.wgsl"))
+    with_shadow_map(&format!("{edges}\n{tiles}\n{}", include_str!("shaders/hybrid.wgsl")))
 }
 
 /// hybrid's `scissor_tile`: the mask pass marks the tile of each silhouette pixel (map.extra: x the tile

@@ -20,9 +20,8 @@ pub struct State {
 
 /// The NDC depth of the texel holding `uv`, clamped to the map's edge.
 fn texel_depth(map: &Image<f32>, uv: Vec2) -> f32 {
-    let n = map.width() as i32;
-    let t = (uv * n as f32).floor();
-    *map.get((t.x as i32).clamp(0, n - 1) as u32, (t.y as i32).clamp(0, n - 1) as u32)
+    let t = (uv * map.width() as f32).floor();
+    *map.get_clamped(t.x as i32, t.y as i32)
 }
 
 /// PCSS visibility of a receiver at map point `uv`, NDC depth `depth`, whose plane's depth changes by

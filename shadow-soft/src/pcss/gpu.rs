@@ -74,7 +74,7 @@ impl ShadowTechnique<WgpuBackend> for Pcss {
 /// The WGSL of the pcss query: the shadow-map shader, then the query.
 #[must_use]
 pub fn query_shader() -> String {
-    format!("{}\n{}", shaders::shadow_map(), include_str!("query.wgsl"))
+    shaders::with_shadow_map(include_str!("query.wgsl"))
 }
 
 #[cfg(test)]

@@ -60,9 +60,7 @@ pub fn render_penumbra(
 
 /// One texel (clamped to the map): behind the blocker 0, else the penumbra map's value.
 fn texel_visibility(map: &Image<f32>, penumbra: &Image<f32>, x: i32, y: i32, depth: f32) -> f32 {
-    let n = map.width() as i32 - 1;
-    let (x, y) = (x.clamp(0, n) as u32, y.clamp(0, n) as u32);
-    if depth > *map.get(x, y) { 0.0 } else { *penumbra.get(x, y) }
+    if depth > *map.get_clamped(x, y) { 0.0 } else { *penumbra.get_clamped(x, y) }
 }
 
 /// Visibility at map point `uv`, NDC depth `depth`: the four nearest texels, bilinearly weighted; 1

@@ -8,7 +8,7 @@ use shadow_core::FrameInputs;
 use shadow_core::light::{LightProjection, LightView};
 use shadow_core::technique::hard::ShadowMap;
 use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
-use shadow_wgpu::frame::layered;
+use shadow_wgpu::frame::{layer_view, layered};
 use shadow_wgpu::pipelines::{FragmentEntry, MAP_DEPTH, depth_entry};
 use shadow_wgpu::techniques::shadow_map::{LookupParams, MapQuery, QueryExtras};
 use shadow_wgpu::{GpuGBuffer, GpuVisibility, WgpuBackend, WgpuContext, WgpuError, readback, shaders};
@@ -138,10 +138,7 @@ impl ShadowTechnique<WgpuBackend> for PenumbraMap {
         let (Some(maps), Some(penumbra)) = (state.map.maps(), &state.penumbra) else {
             return Err(TechniqueError::NotBuilt(Self::NAME.into()).into());
         };
-        let view = penumbra.create_view(&wgpu::TextureViewDescriptor {
-            dimension: Some(wgpu::TextureViewDimension::D2),
-            ..Default::default()
-        });
+        let view = layer_view(penumbra, 0);
         let entries = [wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::TextureView(&view) }];
         let lookup = LookupParams { radius: 0.0, receiver_offset: self.depth.receiver_offset() };
         let extras = QueryExtras { settings: [0.0; 4], entries: &entries };
@@ -163,7 +160,7 @@ pub fn build_shader() -> String {
 /// The WGSL of the query: the shadow-map shader, then the query.
 #[must_use]
 pub fn query_shader() -> String {
-    format!("{}\n{}", shaders::shadow_map(), include_str!("query.wgsl"))
+    shaders::with_shadow_map(include_str!("query.wgsl"))
 }
 
 #[cfg(test)]

@@ -96,11 +96,9 @@ pub fn render_buffer(
 /// The thesis's three cases at one texel (clamped to the map): behind the blocker 0, behind a smoothie
 /// its alpha, else 1.
 fn texel_visibility(map: &Image<f32>, buffer: &SmoothieBuffer, x: i32, y: i32, depth: f32) -> f32 {
-    let n = map.width() as i32 - 1;
-    let (x, y) = (x.clamp(0, n) as u32, y.clamp(0, n) as u32);
-    let [smoothie, alpha] = *buffer.texels.get(x, y);
+    let [smoothie, alpha] = *buffer.texels.get_clamped(x, y);
     let penumbra = if depth > smoothie { alpha } else { 1.0 };
-    if depth > *map.get(x, y) { 0.0 } else { penumbra }
+    if depth > *map.get_clamped(x, y) { 0.0 } else { penumbra }
 }
 
 /// Visibility at map point `uv`, NDC depth `depth`: the three cases at the four nearest texels, bilinearly

@@ -8,7 +8,7 @@ use shadow_core::FrameInputs;
 use shadow_core::light::{LightProjection, LightView};
 use shadow_core::technique::hard::ShadowMap;
 use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
-use shadow_wgpu::frame::layered;
+use shadow_wgpu::frame::{layer_view, layered};
 use shadow_wgpu::pipelines::{FragmentEntry, MAP_DEPTH, buffer_entry, depth_entry};
 use shadow_wgpu::techniques::shadow_map::{LookupParams, MapQuery, QueryExtras};
 use shadow_wgpu::{GpuGBuffer, GpuVisibility, WgpuBackend, WgpuContext, WgpuError, readback, shaders};
@@ -159,12 +159,7 @@ impl ShadowTechnique<WgpuBackend> for Smoothies {
     ) -> Result<(), WgpuError> {
         let not_built = || TechniqueError::NotBuilt(Self::NAME.into());
         let (Some(maps), Some(buffer)) = (state.map.maps(), &state.buffer) else { return Err(not_built().into()) };
-        let views = buffer.each_ref().map(|t| {
-            t.create_view(&wgpu::TextureViewDescriptor {
-                dimension: Some(wgpu::TextureViewDimension::D2),
-                ..Default::default()
-            })
-        });
+        let views = buffer.each_ref().map(|t| layer_view(t, 0));
         let entries = [
             wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::TextureView(&views[0]) },
             wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&views[1]) },
@@ -192,7 +187,7 @@ pub fn buffer_shader() -> String {
 /// The WGSL of the smoothie query: the shadow-map shader, then the query.
 #[must_use]
 pub fn query_shader() -> String {
-    format!("{}\n{}", shaders::shadow_map(), include_str!("query.wgsl"))
+    shaders::with_shadow_map(include_str!("query.wgsl"))
 }
 
 #[cfg(test)]
