@@ -5,7 +5,7 @@
 
 use shadow_wgpu::WgpuContext;
 use shadow_wgpu::frame::layer_view;
-use shadow_wgpu::pipelines::{buffer_entry, depth_array_entry, min_depth_pipeline};
+use shadow_wgpu::pipelines::{buffer_entry, depth_array_entry, depth_pass, min_depth_pipeline};
 use wgpu::util::DeviceExt;
 
 /// A pipeline drawing `vertices` through `vertex` and `fragment` of `module`, whose fragment depth is the
@@ -32,18 +32,7 @@ pub fn draw(
     vertices: Option<&(wgpu::Buffer, u32)>,
 ) {
     let view = layer_view(target, 0);
-    let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-        label: Some("minimum target"),
-        color_attachments: &[],
-        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-            view: &view,
-            depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
-            stencil_ops: None,
-        }),
-        timestamp_writes: None,
-        occlusion_query_set: None,
-        multiview_mask: None,
-    });
+    let mut pass = depth_pass(enc, &view, "minimum target");
     if let Some((buffer, count)) = vertices {
         pass.set_pipeline(pipeline);
         pass.set_bind_group(0, group, &[]);

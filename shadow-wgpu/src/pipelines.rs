@@ -328,3 +328,24 @@ pub fn full_screen_pipeline<'a>(
         cache: None,
     })
 }
+
+/// A depth-only render pass over one depth view, cleared to 1 (the far plane) and stored: the pass of a
+/// light's depth layers, a minimum target and hybrid's edge maps.
+pub fn depth_pass<'e>(
+    enc: &'e mut wgpu::CommandEncoder,
+    view: &'e wgpu::TextureView,
+    label: &'e str,
+) -> wgpu::RenderPass<'e> {
+    enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some(label),
+        color_attachments: &[],
+        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+            view,
+            depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
+            stencil_ops: None,
+        }),
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    })
+}

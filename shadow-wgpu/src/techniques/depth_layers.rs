@@ -17,7 +17,7 @@ use super::shadow_map::{LookupParams, MapQuery, QueryExtras, map_texture};
 use crate::context::{WgpuBackend, WgpuContext, WgpuError};
 use crate::frame::{GpuVisibility, layer_view};
 use crate::gbuffer::{GpuGBuffer, check_size};
-use crate::pipelines::{MAP_DEPTH, POSITION_LAYOUT, ViewRaw, buffer_entry, depth_entry};
+use crate::pipelines::{MAP_DEPTH, POSITION_LAYOUT, ViewRaw, buffer_entry, depth_entry, depth_pass};
 use crate::shaders;
 
 /// GPU twin of `LayerParams` in depth_layers.wgsl.
@@ -131,26 +131,6 @@ impl State {
         });
         Self { passes, combine, layout, query: MapQuery::new(cx, &map_module, filter), maps: None, scratch: None }
     }
-}
-
-/// A render pass clearing and writing one depth view.
-fn depth_pass<'e>(
-    enc: &'e mut wgpu::CommandEncoder,
-    view: &'e wgpu::TextureView,
-    label: &'e str,
-) -> wgpu::RenderPass<'e> {
-    enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-        label: Some(label),
-        color_attachments: &[],
-        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-            view,
-            depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
-            stencil_ops: None,
-        }),
-        timestamp_writes: None,
-        occlusion_query_set: None,
-        multiview_mask: None,
-    })
 }
 
 /// Both layers and their combination for one projection, into layer `k` of `maps`.

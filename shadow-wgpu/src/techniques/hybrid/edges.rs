@@ -9,7 +9,7 @@ use wgpu::util::DeviceExt;
 
 use crate::context::WgpuContext;
 use crate::frame::{layer_view, layered};
-use crate::pipelines::{MAP_DEPTH, min_depth_pipeline};
+use crate::pipelines::{MAP_DEPTH, depth_pass, min_depth_pipeline};
 use crate::shaders;
 
 /// Clip-space positions, for the edge pass.
@@ -42,18 +42,7 @@ pub(super) fn edge_maps(
         let quads: Vec<[f32; 4]> =
             edge_texel_quads(&segments, p, res).iter().flat_map(|t| t.map(|v| v.to_array())).collect();
         let view = layer_view(&maps, k as u32);
-        let mut rp = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("edge map"),
-            color_attachments: &[],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &view,
-                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let mut rp = depth_pass(&mut enc, &view, "edge map");
         if !quads.is_empty() {
             let vb = cx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("edge quads"),
