@@ -33,6 +33,16 @@ impl LightSource {
         }
     }
 
+    /// The light as a homogeneous point: its position (w = 1), or for parallel light the point at infinity
+    /// its rays meet at (w = 0).
+    #[must_use]
+    pub fn homogeneous(&self) -> Vec4 {
+        match *self {
+            Self::Point(l) => l.extend(1.0),
+            Self::Directional(d) => d.extend(0.0),
+        }
+    }
+
     /// Where the ray from the light through `p` ends: the homogeneous point at infinity (w = 0).
     #[must_use]
     pub fn extrude(&self, p: Vec3) -> Vec4 {

@@ -1,7 +1,11 @@
 //! A computation mask (Chan, thesis 3.2 and 3.4.2): one bit per pixel saying whether later draws may touch
 //! it, and one per square tile saying whether any of its pixels may, so the rasterizer rejects unmasked
-//! tiles whole, as hardware culls tiles early, before any depth or stencil work. The masked-in pixels are
-//! kept as runs, by row and by tile, for the rasterizer's two walks.
+//! tiles whole, as hardware culls tiles early, before any depth or stencil work. The pixels' bits are
+//! kept in 64-bit words per row, so a span meets the mask a word at a time; on request the masked-in
+//! pixels are also ordered around a point ([`ComputationMask::ordered_around`], [`Pencil`]) for counting
+//! draws whose triangles all lie on lines through it.
+
+use super::pencil::Pencil;
 
 /// Which pixels a draw may touch, with a coarse per-tile summary.
 #[derive(Clone, Debug, PartialEq)]
@@ -15,13 +19,12 @@ pub struct ComputationMask {
     tiles: Vec<bool>,
     /// Summed-area table of `tiles`, one row and column larger: any rectangle of tiles in O(1).
     sums: Vec<u32>,
-    /// Per row, its masked-in runs of columns, inclusive, left to right: a span meets them by a binary
-    /// search, not pixel by pixel.
-    row_runs: Vec<Vec<(u32, u32)>>,
-    /// The same runs cut at tile boundaries and grouped by tile, as `(row, first, last)`: tile `i`'s are
-    /// `tile_runs[tile_start[i]..tile_start[i + 1]]`, by row.
-    tile_runs: Vec<(u32, u32, u32)>,
-    tile_start: Vec<u32>,
+    /// Per row, `words` 64-bit words of one bit a pixel (bit `x % 64` of word `x / 64`): a span meets
+    /// the mask in a word or two, whatever the pixels in it.
+    bits: Vec<u64>,
+    words: usize,
+    /// The masked-in pixels in angular order around a point, when asked for ([`Self::ordered_around`]).
+    pencil: Option<Pencil>,
 }
 
 impl ComputationMask {
@@ -51,26 +54,29 @@ impl ComputationMask {
                         - sums[ty * (tw + 1) + tx];
             }
         }
-        let row_runs: Vec<Vec<(u32, u32)>> = (0..height as usize)
-            .map(|y| {
-                let row = &pixels[y * width as usize..][..width as usize];
-                let mut runs = Vec::new();
-                let mut x = 0;
-                while x < row.len() {
-                    if row[x] {
-                        let start = x;
-                        while x < row.len() && row[x] {
-                            x += 1;
-                        }
-                        runs.push((start as u32, x as u32 - 1));
-                    }
-                    x += 1;
-                }
-                runs
-            })
-            .collect();
-        let (tile_runs, tile_start) = group_by_tile(&row_runs, tile, tw, tiles.len());
-        Self { width, height, tile, pixels, tiles, sums, row_runs, tile_runs, tile_start }
+        let words = (width as usize).div_ceil(64);
+        let mut bits = vec![0u64; words * height as usize];
+        for (i, _) in pixels.iter().enumerate().filter(|(_, on)| **on) {
+            let (y, x) = (i / width as usize, i % width as usize);
+            bits[y * words + x / 64] |= 1 << (x % 64);
+        }
+        Self { width, height, tile, pixels, tiles, sums, bits, words, pencil: None }
+    }
+
+    /// The mask with its pixels also sorted by angle around the image of the clip-space point `apex`
+    /// (homogeneous): counting draws whose triangles lie in a pencil of lines through it (shadow volumes'
+    /// sides, around the light's image) then test a triangle only at the masked-in pixels in its angle.
+    /// Without effect when the image is at infinity.
+    #[must_use]
+    pub fn ordered_around(mut self, apex: glam::Vec4) -> Self {
+        self.pencil = Pencil::new(&self, apex);
+        self
+    }
+
+    /// The angular order, if any.
+    #[must_use]
+    pub fn pencil(&self) -> Option<&Pencil> {
+        self.pencil.as_ref()
     }
 
     /// Whether any tile meeting the pixel rectangle `x0..=x1`, `y0..=y1` (clamped to the target) has a
@@ -117,60 +123,84 @@ impl ComputationMask {
         (self.tiles.iter().filter(|&&t| t).count(), self.tiles.len())
     }
 
-    /// The masked-in runs of tile `(tx, ty)` as `(row, first, last)`, by row; none outside the target.
-    #[must_use]
-    pub fn tile_runs(&self, tx: u32, ty: u32) -> &[(u32, u32, u32)] {
-        let tiles_x = self.width.div_ceil(self.tile);
-        if tx >= tiles_x || ty >= self.height.div_ceil(self.tile) {
-            return &[];
+    /// Calls `f(first, last)` for each masked-in run of columns `xs..=xe` of row `y` (inclusive, left to
+    /// right, `xe` below the width): a word of the row's bits at a time, so a span with nothing masked
+    /// in costs a word or two.
+    #[inline]
+    pub fn each_run(&self, y: u32, xs: u32, xe: u32, mut f: impl FnMut(u32, u32)) {
+        let row = &self.bits[y as usize * self.words..][..self.words];
+        let (first_word, last_word) = (xs / 64, xe / 64);
+        // A run reaching a word's last bit may go on in the next word: it is held until it ends.
+        let mut open: Option<(u32, u32)> = None;
+        for wi in first_word..=last_word {
+            let mut word = row[wi as usize];
+            if wi == first_word {
+                word &= !0 << (xs % 64);
+            }
+            if wi == last_word && xe % 64 < 63 {
+                word &= (1 << (xe % 64 + 1)) - 1;
+            }
+            let base = wi * 64;
+            if word & 1 == 0
+                && let Some((a, b)) = open.take()
+            {
+                f(a, b);
+            }
+            while word != 0 {
+                let a = word.trailing_zeros();
+                let len = (!(word >> a)).trailing_zeros();
+                let (first, last) = (base + a, base + a + len - 1);
+                let run = match open.take() {
+                    Some((start, end)) if end + 1 == first => (start, last),
+                    Some(done) => {
+                        f(done.0, done.1);
+                        (first, last)
+                    }
+                    None => (first, last),
+                };
+                word = if a + len >= 64 { 0 } else { word & (!0 << (a + len)) };
+                if last % 64 == 63 {
+                    open = Some(run);
+                } else {
+                    f(run.0, run.1);
+                }
+            }
         }
-        let i = (ty * tiles_x + tx) as usize;
-        &self.tile_runs[self.tile_start[i] as usize..self.tile_start[i + 1] as usize]
-    }
-
-    /// Appends to `runs` the masked-in runs of columns `xs..=xe` of row `y`, as inclusive `(first, last)`
-    /// pairs.
-    pub fn runs(&self, y: u32, xs: u32, xe: u32, runs: &mut Vec<(u32, u32)>) {
-        let row = &self.row_runs[y as usize];
-        let first = row.partition_point(|&(_, last)| last < xs);
-        for &(a, b) in row[first..].iter().take_while(|&&(a, _)| a <= xe) {
-            runs.push((a.max(xs), b.min(xe)));
+        if let Some((a, b)) = open {
+            f(a, b);
         }
     }
 }
 
-/// The row runs cut at tile boundaries and grouped by tile (a counting sort, rows kept in order), with
-/// each tile's start in the list.
-fn group_by_tile(
-    row_runs: &[Vec<(u32, u32)>],
-    tile: u32,
-    tiles_x: usize,
-    tiles: usize,
-) -> (Vec<(u32, u32, u32)>, Vec<u32>) {
-    let mut pieces = Vec::new();
-    for (y, runs) in row_runs.iter().enumerate() {
-        for &(a, b) in runs {
-            let mut x = a;
-            while x <= b {
-                let last = (x / tile * tile + tile - 1).min(b);
-                let t = (y as u32 / tile) as usize * tiles_x + (x / tile) as usize;
-                pieces.push((t, (y as u32, x, last)));
-                x = last + 1;
+#[cfg(test)]
+mod tests {
+    use super::ComputationMask;
+
+    #[test]
+    fn runs_are_the_masked_in_columns_merged_across_words() {
+        // Runs ending on a word's last column, starting on its first, one column long, across two words.
+        let (w, h) = (200, 5);
+        let on = |x: u32, y: u32| match y {
+            0 => (60..70).contains(&x) || x == 127 || x == 128 || (180..200).contains(&x),
+            1 => x.is_multiple_of(3) || x == 64,
+            2 => true,
+            3 => false,
+            _ => (x * 37 + 11) % 7 < 3,
+        };
+        let mask = ComputationMask::from_fn(w, h, 8, on);
+        for y in 0..h {
+            for (xs, xe) in [(0, w - 1), (63, 64), (64, 127), (5, 190), (127, 128), (199, 199), (0, 0), (62, 130)] {
+                let mut got = Vec::new();
+                mask.each_run(y, xs, xe, |a, b| got.push((a, b)));
+                let mut want: Vec<(u32, u32)> = Vec::new();
+                for x in (xs..=xe).filter(|&x| on(x, y)) {
+                    match want.last_mut() {
+                        Some((_, b)) if *b + 1 == x => *b = x,
+                        _ => want.push((x, x)),
+                    }
+                }
+                assert_eq!(got, want, "row {y}, columns {xs}..={xe}");
             }
         }
     }
-    let mut start = vec![0u32; tiles + 1];
-    for &(t, _) in &pieces {
-        start[t + 1] += 1;
-    }
-    for i in 0..tiles {
-        start[i + 1] += start[i];
-    }
-    let mut next = start.clone();
-    let mut grouped = vec![(0, 0, 0); pieces.len()];
-    for (t, run) in pieces {
-        grouped[next[t] as usize] = run;
-        next[t] += 1;
-    }
-    (grouped, start)
 }

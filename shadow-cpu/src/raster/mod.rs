@@ -9,6 +9,7 @@
 
 pub mod clip;
 pub mod mask;
+pub mod pencil;
 mod spans;
 pub mod state;
 
@@ -17,7 +18,7 @@ use rayon::prelude::*;
 use shadow_core::Image;
 
 pub use mask::ComputationMask;
-use spans::{EdgeWalk, inside, slab_columns};
+use spans::{EdgeWalk, slab_columns};
 pub use state::*;
 
 /// Rows per band of the binning grid.
@@ -345,6 +346,17 @@ fn setup(src: SourceTriangle, st: &RasterState, w: u32, h: u32, guard: f32, out:
     }
 }
 
+/// Where clip-space point `p` lands on a `w x h` target, in pixels (top-left origin, y down, the
+/// mapping [`setup_one`] snaps to fixed point), or `None` at or near infinity: `|w|` under 1e-6 of the
+/// point's size, or more than ten million pixels out.
+#[must_use]
+pub fn screen_point(p: Vec4, w: u32, h: u32) -> Option<glam::DVec2> {
+    let p = p.as_dvec4();
+    let s = glam::DVec2::new((p.x / p.w * 0.5 + 0.5) * f64::from(w), (0.5 - p.y / p.w * 0.5) * f64::from(h));
+    // NaN (a zero point, or w = 0 over it) fails both tests.
+    (p.w.abs() > 1e-6 * p.truncate().length() && s.abs().max_element() < 1e7).then_some(s)
+}
+
 /// Guard band: how far beyond the viewport (in viewport widths) geometry may reach before it is clipped,
 /// chosen so fixed-point coordinates stay far inside i32 range for any target up to 16384 pixels.
 fn guard_band(w: u32, h: u32) -> f32 {
@@ -381,9 +393,12 @@ pub fn draw_depth<S: TriangleSource + ?Sized>(ds: &mut DepthStencil, src: &S, st
 
 /// [`draw_depth`] confined to the pixels of a computation mask (Chan, thesis 3.2), rejected as coarsely
 /// as the mask allows before any depth or stencil work: a triangle is not binned into a band where its
-/// bounds meet no masked-in tile; with a fast kernel (depth tests, stencil counting) it is walked tile by
-/// tile, as a tiled rasterizer walks it, so its cost follows the masked-in tiles it meets rather than its
-/// rows; otherwise its rows' spans are cut to the mask's runs. Only masked-in fragments are counted.
+/// bounds meet no masked-in tile; with a fast kernel (depth tests, stencil counting) its tile rows are
+/// tested against the mask's tiles and only those meeting a masked-in one are walked, row by row, each
+/// span cut to the mask's runs. A counting draw under a mask ordered around a point
+/// ([`ComputationMask::ordered_around`]: the light's image, for shadow volumes) tests the triangles that
+/// point bounds cheaply at the masked-in pixels in their angle instead ([`pencil`]). Either way the same
+/// fragments, depths and counters; only masked-in fragments are counted.
 ///
 /// # Panics
 /// When the mask is not the size of `ds`: a caller bug.
@@ -444,12 +459,19 @@ where
         for b in &mut bins {
             b.clear();
         }
-        for (i, t) in setups.iter().enumerate() {
+        // A counting draw under a mask in pencil order leaves to the walk only what the pencil can't bound
+        // cheaply.
+        let pencil = mask.and_then(ComputationMask::pencil).filter(|_| matches!(fast, Some(DepthKernel::Count { .. })));
+        let mut plan = pencil.map(|p| p.plan(&setups));
+        let walked =
+            plan.as_mut().map_or_else(|| (0..setups.len() as u32).collect(), |p| std::mem::take(&mut p.walked));
+        for &i in &walked {
+            let t = &setups[i as usize];
             for band in (t.min_y as u32 / BAND_ROWS)..=(t.max_y as u32 / BAND_ROWS) {
                 let (y0, y1) =
                     ((band * BAND_ROWS).max(t.min_y as u32), ((band + 1) * BAND_ROWS - 1).min(t.max_y as u32));
                 if mask.is_none_or(|m| m.any_in(t.min_x as u32, y0, t.max_x as u32, y1)) {
-                    bins[band as usize].push(i as u32);
+                    bins[band as usize].push(i);
                 }
             }
         }
@@ -473,9 +495,11 @@ where
                 a += b;
                 a
             });
-        total.fragments += counters.fragments;
-        total.passed += counters.passed;
-        total.stencil_updates += counters.stencil_updates;
+        total += counters;
+        if let (Some(p), Some(plan), Some(k)) = (pencil, &plan, fast) {
+            let clamp = st.depth.is_some_and(|d| d.clamp);
+            total += p.count(&setups, plan, k, clamp, (&ds.depth, &mut ds.stencil));
+        }
     }
     total
 }
@@ -622,10 +646,9 @@ fn raster_band<T, F, B>(
     let y_hi = t.max_y.min(rows.y0 + band_rows - 1);
     let clamp = st.depth.is_some_and(|d| d.clamp);
     if let (Some(m), Some(k)) = (mask, fast) {
-        masked_tiles(t, rows, k, clamp, m, (y_lo, y_hi), c);
+        masked_rows(t, rows, k, clamp, m, (y_lo, y_hi), c);
         return;
     }
-    let mut runs = Vec::new();
     let mut walk = EdgeWalk::new(t, y_lo);
     for y in y_lo..=y_hi {
         let py = i64::from(y) * ONE + HALF;
@@ -643,24 +666,19 @@ fn raster_band<T, F, B>(
         };
         match mask {
             None => run(xs, xe),
-            Some(m) => {
-                runs.clear();
-                m.runs(y as u32, xs as u32, xe as u32, &mut runs);
-                for &(a, b) in &runs {
-                    run(a as i32, b as i32);
-                }
-            }
+            Some(m) => m.each_run(y as u32, xs as u32, xe as u32, |a, b| run(a as i32, b as i32)),
         }
     }
 }
 
-/// Rows `y_lo..=y_hi` of a triangle under a computation mask, with a fast kernel, walked tile by tile as
-/// a tiled rasterizer walks them: per tile row the triangle's columns (`slab_columns`), per masked-in
-/// tile among them its runs of masked-in pixels, each cut to the pixels inside all three edges. Empty
-/// tiles cost a lookup and rows without a masked-in pixel nothing, so the work follows the mask, not
-/// the triangle's rows. Same fragments, depths and counters as the row walk: the inside test is the
-/// edge functions [`EdgeWalk`] solves, the depth `row_base` and `depth_at`.
-fn masked_tiles<T>(
+/// Rows `y_lo..=y_hi` of a triangle under a computation mask, with a fast kernel: a tile row at a time,
+/// tested whole against the mask's tiles (the triangle's bounds first, then its own columns there,
+/// [`slab_columns`]), and where a masked-in tile meets it, row by row, each row's span ([`EdgeWalk`], the
+/// row walk's own) cut to the mask's runs a word of bits at a time. A tile row with nothing masked in
+/// costs two table lookups, a row of one a walk step and a word or two of bits, so the work follows the
+/// mask, not the triangle's rows or the silhouette pixels it does not cover. Same fragments, depths and
+/// counters as the row walk.
+fn masked_rows<T>(
     t: &Setup,
     rows: &mut BandRows<'_, T>,
     k: DepthKernel,
@@ -669,27 +687,38 @@ fn masked_tiles<T>(
     (y_lo, y_hi): (i32, i32),
     c: &mut RasterCounters,
 ) {
+    /// Rows a walk steps through rather than starting anew (three divisions a start, one addition an
+    /// edge a row).
+    const STEP_AHEAD: i32 = 32;
     let tile = m.tile() as i32;
+    let mut walk: Option<(EdgeWalk, i32)> = None;
     let mut y = y_lo;
     while y <= y_hi {
         let end = (y - y % tile + tile - 1).min(y_hi);
-        // The bounds' tiles first (a table lookup), the triangle's own columns only where one is in.
-        let any = m.any_in(t.min_x as u32, y as u32, t.max_x as u32, end as u32);
-        if let Some((a, b)) = slab_columns(t, y, end).filter(|_| any) {
-            for tx in a / tile..=b / tile {
-                for &(ry, x0, x1) in m.tile_runs(tx as u32, (y / tile) as u32) {
-                    let ry = ry as i32;
-                    if ry < y || ry > end {
-                        continue;
+        let masked_in = m.any_in(t.min_x as u32, y as u32, t.max_x as u32, end as u32)
+            && slab_columns(t, y, end).is_some_and(|(a, b)| m.any_in(a as u32, y as u32, b as u32, end as u32));
+        if masked_in {
+            let mut w = match walk {
+                Some((mut w, at)) if y - at <= STEP_AHEAD => {
+                    for _ in at..y {
+                        w.next_row();
                     }
-                    let py = i64::from(ry) * ONE + HALF;
-                    let Some((xs, xe)) = inside(t, py, (x0 as i32).max(a), (x1 as i32).min(b)) else { continue };
-                    let row = (ry - rows.y0) as usize * rows.width;
-                    let (lo, hi) = (row + xs as usize, row + xe as usize + 1);
-                    let start = RowStart { z_row: row_base(t, py), clamp, xs };
-                    row_fast(t, k, start, &mut rows.depth[lo..hi], &mut rows.stencil[lo..hi], c);
+                    w
                 }
+                _ => EdgeWalk::new(t, y),
+            };
+            for ry in y..=end {
+                let Some((xs, xe)) = w.next_row() else { continue };
+                let py = i64::from(ry) * ONE + HALF;
+                let row = (ry - rows.y0) as usize * rows.width;
+                let mut z_row = None;
+                m.each_run(ry as u32, xs as u32, xe as u32, |a, b| {
+                    let (lo, hi) = (row + a as usize, row + b as usize + 1);
+                    let start = RowStart { z_row: *z_row.get_or_insert_with(|| row_base(t, py)), clamp, xs: a as i32 };
+                    row_fast(t, k, start, &mut rows.depth[lo..hi], &mut rows.stencil[lo..hi], c);
+                });
             }
+            walk = Some((w, end + 1));
         }
         y = end + 1;
     }

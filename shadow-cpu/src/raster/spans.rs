@@ -1,8 +1,6 @@
 //! Which columns of a row a set-up triangle covers: exactly, row after row ([`EdgeWalk`], the rasterizer's
-//! spans), for a run of columns ([`inside`], under a computation mask), and as a cheap superset over a
-//! slab of rows ([`slab_columns`], to test a tile row against a mask). The exact two solve the same edge
-//! functions with the top-left rule, `E_k(256 x + 128, py) + tl_k >= 0`, so the row walk and the masked
-//! tile walk cover the same pixels.
+//! spans, solving the edge functions with the top-left rule, `E_k(256 x + 128, py) + tl_k >= 0`), and as a
+//! cheap superset over a slab of rows ([`slab_columns`], to test a tile row against a mask).
 
 use super::{HALF, ONE, Setup};
 #[cfg(test)]
@@ -155,28 +153,4 @@ pub(super) fn slab_columns(t: &Setup, ya: i32, yb: i32) -> Option<(i32, i32)> {
     let last = ((hi - HALF as f64) / ONE as f64).ceil() as i64 + 1;
     let (first, last) = (first.max(i64::from(t.min_x)), last.min(i64::from(t.max_x)));
     (first <= last).then_some((first as i32, last as i32))
-}
-
-/// The columns of `xs..=xe` in row `py` (fixed point) inside all three edges, tested pixel by pixel (the
-/// test [`EdgeWalk`] solves row by row); contiguous, the triangle being convex.
-#[inline(always)]
-pub(super) fn inside(t: &Setup, py: i64, xs: i32, xe: i32) -> Option<(i32, i32)> {
-    let px = i64::from(xs) * ONE + HALF;
-    let mut e = [0, 1, 2].map(|k| t.a[k] * px + t.b[k] * py + t.c[k] + t.tl[k]);
-    let step = t.a.map(|a| a * ONE);
-    // An edge function is linear along the row: outside at both ends of the run, outside all along it.
-    let last = i64::from(xe - xs);
-    if (0..3).any(|k| e[k] < 0 && e[k] + step[k] * last < 0) {
-        return None;
-    }
-    let mut found = None;
-    for x in xs..=xe {
-        if e[0] >= 0 && e[1] >= 0 && e[2] >= 0 {
-            found = Some(found.map_or((x, x), |(first, _)| (first, x)));
-        } else if found.is_some() {
-            break;
-        }
-        e = [e[0] + step[0], e[1] + step[1], e[2] + step[2]];
-    }
-    found
 }
