@@ -666,6 +666,10 @@ pub struct Hybrid {
     /// Side in pixels of the CPU computation mask's tiles, which the rasterizer skips whole where no pixel
     /// is masked in.
     pub mask_tile: u32,
+    /// CPU: on, the mask's pixels are also ordered around the light's image, so each volume side (all of
+    /// them lie on lines through it) is tested only at the silhouette pixels in its angle from there; off,
+    /// every side is walked row by row under the tiled mask. Same fragments either way.
+    pub pencil: OnOff,
     /// Where the GPU keeps the computation mask (the CPU always uses its tiles).
     pub gpu_mask: GpuMask,
     /// GPU: 0, the volumes are drawn over the whole view and the mask rejects fragments; N, the mask pass
@@ -697,7 +701,7 @@ crate::named_enum! {
     }
 }
 
-const HYBRID_KEYS: [SettingKey; 10] = [
+const HYBRID_KEYS: [SettingKey; 11] = [
     SettingKey { key: "res", default: "512", help: "classifying map side in texels (16 to 16384)" },
     MAP_KEYS[1],
     MAP_KEYS[2],
@@ -707,6 +711,11 @@ const HYBRID_KEYS: [SettingKey; 10] = [
         key: "mask_tile",
         default: "8",
         help: "CPU computation-mask tile side in pixels (1 to 64): tiles with no silhouette pixel are skipped whole",
+    },
+    SettingKey {
+        key: "pencil",
+        default: "on",
+        help: "CPU: on, volume sides are tested only at the silhouette pixels in their angle around the light's image; off, walked row by row",
     },
     SettingKey {
         key: "gpu_mask",
@@ -738,6 +747,7 @@ impl TechniqueSettings for Hybrid {
         Ok(Self {
             depth: ShadowMap::read_depth(v)?,
             mask_tile: v.ranged("mask_tile", 1, 64)?,
+            pencil: v.get("pencil")?,
             gpu_mask: v.get("gpu_mask")?,
             scissor_tile: match v.text("scissor_tile") {
                 "0" => 0,
@@ -751,6 +761,7 @@ impl TechniqueSettings for Hybrid {
         let mut v = self.depth.depth_values();
         v.extend([
             self.mask_tile.to_string(),
+            self.pencil.to_string(),
             self.gpu_mask.to_string(),
             self.scissor_tile.to_string(),
             self.edge_texels.to_string(),

@@ -38,8 +38,9 @@ const MIN_APEX_DISTANCE: f64 = 2.0;
 /// Walked instead when a triangle has more candidates than this many per row it spans (a pixel test
 /// costs a fraction of a row's walk step and mask lookup).
 const PIXELS_PER_ROW: usize = 4;
-/// Masks holding more than this fraction of their target are not ordered.
-pub const MAX_DENSITY: f64 = 0.25;
+/// Masks holding more than this fraction of their target are not ordered: sorting them is then a large
+/// share of a frame, and most triangles would be walked anyway.
+pub const MAX_DENSITY: f64 = 0.5;
 
 /// The masked-in pixels of a mask sorted by their angle around an apex, in buckets sorted by distance.
 #[derive(Clone, Debug, PartialEq)]
