@@ -347,7 +347,7 @@ fn setup(src: SourceTriangle, st: &RasterState, w: u32, h: u32, guard: f32, out:
 }
 
 /// Where clip-space point `p` lands on a `w x h` target, in pixels (top-left origin, y down, the
-/// mapping [`setup_one`] snaps to fixed point), or `None` at or near infinity: `|w|` under 1e-6 of the
+/// mapping the rasterizer snaps to fixed point), or `None` at or near infinity: `|w|` under 1e-6 of the
 /// point's size, or more than ten million pixels out.
 #[must_use]
 pub fn screen_point(p: Vec4, w: u32, h: u32) -> Option<glam::DVec2> {

@@ -7,7 +7,7 @@
 //! between two of those lines, often hundreds of rows long and a pixel wide, and a row walk pays for every
 //! row of it, masked in or not. Seen from the pencil's apex, though, it spans an angle of a few
 //! thousandths of a radian and a band of distances, and the masked-in pixels it can cover are the few in
-//! that angle and band. The pixels are sorted by angle and cut into buckets of [`BUCKET`] consecutive
+//! that angle and band. The pixels are sorted by angle and cut into buckets of 32 consecutive
 //! ones, each sorted by distance, so a triangle's candidates are found by binary searches; each is then
 //! tested against the triangle's own edge functions (top-left rule included) and depth plane, so exactly
 //! the walk's fragments, depths and counters come out. A triangle with more candidates than it has rows
