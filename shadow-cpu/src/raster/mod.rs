@@ -9,6 +9,7 @@
 
 pub mod clip;
 pub mod mask;
+mod masked;
 pub mod pencil;
 mod spans;
 pub mod state;
@@ -18,7 +19,8 @@ use rayon::prelude::*;
 use shadow_core::Image;
 
 pub use mask::ComputationMask;
-use spans::{EdgeWalk, slab_columns};
+use masked::masked_rows;
+use spans::EdgeWalk;
 pub use state::*;
 
 /// Rows per band of the binning grid.
@@ -346,17 +348,6 @@ fn setup(src: SourceTriangle, st: &RasterState, w: u32, h: u32, guard: f32, out:
     }
 }
 
-/// Where clip-space point `p` lands on a `w x h` target, in pixels (top-left origin, y down, the
-/// mapping the rasterizer snaps to fixed point), or `None` at or near infinity: `|w|` under 1e-6 of the
-/// point's size, or more than ten million pixels out.
-#[must_use]
-pub fn screen_point(p: Vec4, w: u32, h: u32) -> Option<glam::DVec2> {
-    let p = p.as_dvec4();
-    let s = glam::DVec2::new((p.x / p.w * 0.5 + 0.5) * f64::from(w), (0.5 - p.y / p.w * 0.5) * f64::from(h));
-    // NaN (a zero point, or w = 0 over it) fails both tests.
-    (p.w.abs() > 1e-6 * p.truncate().length() && s.abs().max_element() < 1e7).then_some(s)
-}
-
 /// Guard band: how far beyond the viewport (in viewport widths) geometry may reach before it is clipped,
 /// chosen so fixed-point coordinates stay far inside i32 range for any target up to 16384 pixels.
 fn guard_band(w: u32, h: u32) -> f32 {
@@ -668,59 +659,6 @@ fn raster_band<T, F, B>(
             None => run(xs, xe),
             Some(m) => m.each_run(y as u32, xs as u32, xe as u32, |a, b| run(a as i32, b as i32)),
         }
-    }
-}
-
-/// Rows `y_lo..=y_hi` of a triangle under a computation mask, with a fast kernel: a tile row at a time,
-/// tested whole against the mask's tiles (the triangle's bounds first, then its own columns there,
-/// [`slab_columns`]), and where a masked-in tile meets it, row by row, each row's span ([`EdgeWalk`], the
-/// row walk's own) cut to the mask's runs a word of bits at a time. A tile row with nothing masked in
-/// costs two table lookups, a row of one a walk step and a word or two of bits, so the work follows the
-/// mask, not the triangle's rows or the silhouette pixels it does not cover. Same fragments, depths and
-/// counters as the row walk.
-fn masked_rows<T>(
-    t: &Setup,
-    rows: &mut BandRows<'_, T>,
-    k: DepthKernel,
-    clamp: bool,
-    m: &ComputationMask,
-    (y_lo, y_hi): (i32, i32),
-    c: &mut RasterCounters,
-) {
-    /// Rows a walk steps through rather than starting anew (three divisions a start, one addition an
-    /// edge a row).
-    const STEP_AHEAD: i32 = 32;
-    let tile = m.tile() as i32;
-    let mut walk: Option<(EdgeWalk, i32)> = None;
-    let mut y = y_lo;
-    while y <= y_hi {
-        let end = (y - y % tile + tile - 1).min(y_hi);
-        let masked_in = m.any_in(t.min_x as u32, y as u32, t.max_x as u32, end as u32)
-            && slab_columns(t, y, end).is_some_and(|(a, b)| m.any_in(a as u32, y as u32, b as u32, end as u32));
-        if masked_in {
-            let mut w = match walk {
-                Some((mut w, at)) if y - at <= STEP_AHEAD => {
-                    for _ in at..y {
-                        w.next_row();
-                    }
-                    w
-                }
-                _ => EdgeWalk::new(t, y),
-            };
-            for ry in y..=end {
-                let Some((xs, xe)) = w.next_row() else { continue };
-                let py = i64::from(ry) * ONE + HALF;
-                let row = (ry - rows.y0) as usize * rows.width;
-                let mut z_row = None;
-                m.each_run(ry as u32, xs as u32, xe as u32, |a, b| {
-                    let (lo, hi) = (row + a as usize, row + b as usize + 1);
-                    let start = RowStart { z_row: *z_row.get_or_insert_with(|| row_base(t, py)), clamp, xs: a as i32 };
-                    row_fast(t, k, start, &mut rows.depth[lo..hi], &mut rows.stencil[lo..hi], c);
-                });
-            }
-            walk = Some((w, end + 1));
-        }
-        y = end + 1;
     }
 }
 

@@ -42,6 +42,17 @@ const PIXELS_PER_ROW: usize = 4;
 /// share of a frame, and most triangles would be walked anyway.
 pub const MAX_DENSITY: f64 = 0.5;
 
+/// Where clip-space point `p` lands on a `w x h` target, in pixels (top-left origin, y down, the
+/// mapping the rasterizer snaps to fixed point), or `None` at or near infinity: `|w|` under 1e-6 of the
+/// point's size, or more than ten million pixels out.
+#[must_use]
+pub fn screen_point(p: Vec4, w: u32, h: u32) -> Option<DVec2> {
+    let p = p.as_dvec4();
+    let s = DVec2::new((p.x / p.w * 0.5 + 0.5) * f64::from(w), (0.5 - p.y / p.w * 0.5) * f64::from(h));
+    // NaN (a zero point, or w = 0 over it) fails both tests.
+    (p.w.abs() > 1e-6 * p.truncate().length() && s.abs().max_element() < 1e7).then_some(s)
+}
+
 /// The masked-in pixels of a mask sorted by their angle around an apex, in buckets sorted by distance.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Pencil {
@@ -176,12 +187,12 @@ pub(super) struct Plan {
 
 impl Pencil {
     /// The masked-in pixels of `mask` around the image of `apex_clip` (clip space, homogeneous), or `None`
-    /// when that image is at or near infinity ([`super::screen_point`]), or the mask is empty or holds more
+    /// when that image is at or near infinity ([`screen_point`]), or the mask is empty or holds more
     /// than [`MAX_DENSITY`] of the target (most triangles would have too many candidates to be taken).
     #[must_use]
     pub fn new(mask: &ComputationMask, apex_clip: Vec4) -> Option<Self> {
         let (w, h) = mask.size();
-        let apex = super::screen_point(apex_clip, w, h)?;
+        let apex = screen_point(apex_clip, w, h)?;
         let n = mask.count();
         if n == 0 || n as f64 > MAX_DENSITY * f64::from(w) * f64::from(h) {
             return None;
