@@ -13,8 +13,6 @@ pub struct ComputationMask {
     width: u32,
     height: u32,
     tile: u32,
-    /// Per pixel, row-major.
-    pixels: Vec<bool>,
     /// Per tile, row-major over `ceil(width / tile) x ceil(height / tile)` tiles.
     tiles: Vec<bool>,
     /// Summed-area table of `tiles`, one row and column larger: any rectangle of tiles in O(1).
@@ -34,15 +32,13 @@ impl ComputationMask {
     pub fn from_fn(width: u32, height: u32, tile: u32, f: impl Fn(u32, u32) -> bool) -> Self {
         let tile = tile.max(1);
         let tiles_x = width.div_ceil(tile);
-        let mut pixels = Vec::with_capacity(width as usize * height as usize);
+        let words = (width as usize).div_ceil(64);
+        let mut bits = vec![0u64; words * height as usize];
         let mut tiles = vec![false; (tiles_x * height.div_ceil(tile)) as usize];
         for y in 0..height {
-            for x in 0..width {
-                let on = f(x, y);
-                pixels.push(on);
-                if on {
-                    tiles[((y / tile) * tiles_x + x / tile) as usize] = true;
-                }
+            for x in (0..width).filter(|&x| f(x, y)) {
+                bits[y as usize * words + x as usize / 64] |= 1 << (x % 64);
+                tiles[((y / tile) * tiles_x + x / tile) as usize] = true;
             }
         }
         let (tw, th) = (tiles_x as usize, height.div_ceil(tile) as usize);
@@ -54,13 +50,7 @@ impl ComputationMask {
                         - sums[ty * (tw + 1) + tx];
             }
         }
-        let words = (width as usize).div_ceil(64);
-        let mut bits = vec![0u64; words * height as usize];
-        for (i, _) in pixels.iter().enumerate().filter(|(_, on)| **on) {
-            let (y, x) = (i / width as usize, i % width as usize);
-            bits[y * words + x / 64] |= 1 << (x % 64);
-        }
-        Self { width, height, tile, pixels, tiles, sums, bits, words, pencil: None }
+        Self { width, height, tile, tiles, sums, bits, words, pencil: None }
     }
 
     /// The mask with its pixels also sorted by angle around the image of the clip-space point `apex`
@@ -108,13 +98,13 @@ impl ComputationMask {
     /// Whether pixel `(x, y)` is masked in.
     #[must_use]
     pub fn get(&self, x: u32, y: u32) -> bool {
-        self.pixels[(y * self.width + x) as usize]
+        self.bits[y as usize * self.words + x as usize / 64] >> (x % 64) & 1 == 1
     }
 
     /// How many pixels are masked in.
     #[must_use]
     pub fn count(&self) -> usize {
-        self.pixels.iter().filter(|&&p| p).count()
+        self.bits.iter().map(|w| w.count_ones() as usize).sum()
     }
 
     /// How many tiles have a pixel masked in, of how many.

@@ -452,8 +452,12 @@ where
         }
         // A counting draw under a mask in pencil order leaves to the walk only what the pencil can't bound
         // cheaply.
-        let pencil = mask.and_then(ComputationMask::pencil).filter(|_| matches!(fast, Some(DepthKernel::Count { .. })));
-        let mut plan = pencil.map(|p| p.plan(&setups));
+        let counting = match fast {
+            Some(DepthKernel::Count { compare, front, back }) => Some((compare, front, back)),
+            _ => None,
+        };
+        let pencil = mask.and_then(ComputationMask::pencil).zip(counting);
+        let mut plan = pencil.map(|(p, _)| p.plan(&setups));
         let walked =
             plan.as_mut().map_or_else(|| (0..setups.len() as u32).collect(), |p| std::mem::take(&mut p.walked));
         for &i in &walked {
@@ -487,9 +491,9 @@ where
                 a
             });
         total += counters;
-        if let (Some(p), Some(plan), Some(k)) = (pencil, &plan, fast) {
+        if let (Some((p, counting)), Some(plan)) = (pencil, &plan) {
             let clamp = st.depth.is_some_and(|d| d.clamp);
-            total += p.count(&setups, plan, k, clamp, (&ds.depth, &mut ds.stencil));
+            total += p.count(&setups, plan, counting, clamp, (&ds.depth, &mut ds.stencil));
         }
     }
     total

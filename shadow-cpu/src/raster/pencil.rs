@@ -23,7 +23,7 @@ use std::ops::Range;
 use glam::{DVec2, Vec4};
 use rayon::prelude::*;
 
-use super::{DepthKernel, HALF, ONE, RasterCounters, Setup, depth_at, row_base};
+use super::{CompareFn, HALF, ONE, RasterCounters, Setup, depth_at, row_base};
 use crate::raster::ComputationMask;
 
 /// Pixels per angle bucket: fewer cut a sliver's angle closer, more cost more searches per triangle.
@@ -171,6 +171,10 @@ impl Polar {
         (near <= far).then(|| ((near - 1e-6).max(0.0).powi(2), (far + 1e-6).powi(2)))
     }
 }
+
+/// A counting kernel's depth test and its `(pass, depth fail)` stencil increments for front and back faces
+/// (`DepthKernel::Count`).
+pub(super) type Counting = (CompareFn, (u8, u8), (u8, u8));
 
 /// An angle and where the ray from the apex at that angle is inside a triangle, as distances.
 type Span = (f64, Option<(f64, f64)>);
@@ -340,13 +344,10 @@ impl Pencil {
         &self,
         setups: &[Setup],
         plan: &Plan,
-        kernel: DepthKernel,
+        (compare, front, back): Counting,
         clamp: bool,
         (depth, stencil): (&[f32], &mut [u8]),
     ) -> RasterCounters {
-        let DepthKernel::Count { compare, front, back } = kernel else {
-            unreachable!("the pencil takes counting draws only")
-        };
         // The stored depths in the pencil's order: read in sequence, not scattered along the rays.
         let depth: Vec<f32> = self.at.iter().map(|&at| depth[at as usize]).collect();
         let chunk = plan.taken.len().div_ceil(rayon::current_num_threads() * 4).max(64);
