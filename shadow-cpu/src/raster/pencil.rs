@@ -23,7 +23,7 @@ use std::ops::Range;
 use glam::{DVec2, Vec4};
 use rayon::prelude::*;
 
-use super::{CompareFn, HALF, ONE, RasterCounters, Setup, depth_at, row_base};
+use super::{CompareFn, HALF, ONE, RasterCounters, Setup, depth_origin, row_depth};
 use crate::raster::ComputationMask;
 
 /// Pixels per angle bucket: fewer cut a sliver's angle closer, more cost more searches per triangle.
@@ -65,10 +65,11 @@ pub struct Pencil {
     /// Per bucket, the unit direction at its least angle: the ray a bucket's angles start from.
     start_dirs: Vec<DVec2>,
     /// Per pixel, bucket by bucket and by distance within a bucket: the squared distance of its centre
-    /// from the apex, the centre in the rasterizer's fixed point, its column and its index in the target.
+    /// from the apex, the centre in the rasterizer's fixed point (integers, exact in f64), its column and
+    /// its index in the target.
     dist2: Vec<f64>,
-    centres: Vec<[i64; 2]>,
-    columns: Vec<i32>,
+    centres: Vec<[f64; 2]>,
+    columns: Vec<f32>,
     at: Vec<u32>,
 }
 
@@ -225,8 +226,8 @@ impl Pencil {
             angle_min,
             angle_max,
             dist2: sorted.iter().map(|p| p.1).collect(),
-            centres: sorted.iter().map(|&(_, _, [x, y])| [x, y].map(|v| i64::from(v) * ONE + HALF)).collect(),
-            columns: sorted.iter().map(|&(_, _, [x, _])| x as i32).collect(),
+            centres: sorted.iter().map(|&(_, _, [x, y])| [x, y].map(|v| (i64::from(v) * ONE + HALF) as f64)).collect(),
+            columns: sorted.iter().map(|&(_, _, [x, _])| x as f32).collect(),
             at: sorted.iter().map(|&(_, _, [x, y])| y * w + x).collect(),
         })
     }
@@ -348,11 +349,39 @@ impl Pencil {
         clamp: bool,
         (depth, stencil): (&[f32], &mut [u8]),
     ) -> RasterCounters {
+        // One loop per depth test, so the test is not matched per candidate.
+        let (deltas, c) = match compare {
+            CompareFn::Never => self.deltas(setups, plan, (front, back), clamp, depth, |_, _| false),
+            CompareFn::Less => self.deltas(setups, plan, (front, back), clamp, depth, |z, s| z < s),
+            CompareFn::LessEqual => self.deltas(setups, plan, (front, back), clamp, depth, |z, s| z <= s),
+            CompareFn::Equal => self.deltas(setups, plan, (front, back), clamp, depth, |z, s| z == s),
+            CompareFn::Greater => self.deltas(setups, plan, (front, back), clamp, depth, |z, s| z > s),
+            CompareFn::GreaterEqual => self.deltas(setups, plan, (front, back), clamp, depth, |z, s| z >= s),
+            CompareFn::NotEqual => self.deltas(setups, plan, (front, back), clamp, depth, |z, s| z != s),
+            CompareFn::Always => self.deltas(setups, plan, (front, back), clamp, depth, |_, _| true),
+        };
+        for (&at, d) in self.at.iter().zip(deltas) {
+            let s = &mut stencil[at as usize];
+            *s = s.wrapping_add(d);
+        }
+        c
+    }
+
+    /// The stencil increments of the taken triangles per pixel in the pencil's order, with their counters;
+    /// `pass` is the depth test of a fragment's depth against the stored one.
+    fn deltas(
+        &self,
+        setups: &[Setup],
+        plan: &Plan,
+        (front, back): ((u8, u8), (u8, u8)),
+        clamp: bool,
+        depth: &[f32],
+        pass: impl Fn(f32, f32) -> bool + Sync,
+    ) -> (Vec<u8>, RasterCounters) {
         // The stored depths in the pencil's order: read in sequence, not scattered along the rays.
         let depth: Vec<f32> = self.at.iter().map(|&at| depth[at as usize]).collect();
         let chunk = plan.taken.len().div_ceil(rayon::current_num_threads() * 4).max(64);
-        let (deltas, c) = plan
-            .taken
+        plan.taken
             .par_chunks(chunk)
             .map(|part| {
                 let mut delta = vec![0u8; self.len()];
@@ -360,7 +389,12 @@ impl Pencil {
                 for (ti, ranges) in part {
                     let t = &setups[*ti as usize];
                     let (dp, df) = if t.front { front } else { back };
-                    let c_tl = [0, 1, 2].map(|k| t.c[k] + t.tl[k]);
+                    // The walk's edge functions and depth plane, with what is the same for every pixel
+                    // hoisted. In f64 the edge functions' integer terms (far under 2^53) are exact, with no
+                    // 64-bit integer multiplies; `py - fy0` is an exact integer rounded to f32 as the walk's
+                    // i64 is, so the depth is `row_base` and `depth_at`'s f32 arithmetic, bit for bit.
+                    let edge = [0, 1, 2].map(|k| (t.a[k] as f64, t.b[k] as f64, (t.c[k] + t.tl[k]) as f64));
+                    let (origin, fy0) = (depth_origin(t), t.fy[0] as f64);
                     let (mut fragments, mut passed) = (0u64, 0u64);
                     for r in &plan.ranges[ranges.start as usize..ranges.end as usize] {
                         let r = r.start as usize..r.end as usize;
@@ -368,10 +402,11 @@ impl Pencil {
                         let (stored, delta) = (&depth[r.clone()], &mut delta[r]);
                         for (((&[px, py], &x), &stored), delta) in centres.iter().zip(columns).zip(stored).zip(delta) {
                             // Branch-free: which candidates a sliver covers is a coin toss.
-                            let inside = (t.a[0] * px + t.b[0] * py + c_tl[0] >= 0)
-                                & (t.a[1] * px + t.b[1] * py + c_tl[1] >= 0)
-                                & (t.a[2] * px + t.b[2] * py + c_tl[2] >= 0);
-                            let pass = compare.test(depth_at(t, row_base(t, py), x, clamp), stored);
+                            let inside =
+                                edge.iter().fold(true, |inside, &(a, b, c)| inside & (a * px + b * py + c >= 0.0));
+                            let z_row = row_depth(t, origin, ((py - fy0) as f32) / ONE as f32);
+                            let z = z_row + t.dzdx * x;
+                            let pass = pass(if clamp { z.clamp(0.0, 1.0) } else { z }, stored);
                             let op = if pass { dp } else { df };
                             *delta = delta.wrapping_add(op * u8::from(inside));
                             fragments += u64::from(inside);
@@ -395,11 +430,6 @@ impl Pencil {
                     ca += cb;
                     (a, ca)
                 },
-            );
-        for (&at, d) in self.at.iter().zip(deltas) {
-            let s = &mut stencil[at as usize];
-            *s = s.wrapping_add(d);
-        }
-        c
+            )
     }
 }
