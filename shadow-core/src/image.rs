@@ -173,12 +173,53 @@ impl Image<Rgb8> {
     }
 }
 
-/// Linear [0, 1] to the sRGB transfer curve, 8 bits, rounded to nearest.
+/// Linear [0, 1] to the sRGB transfer curve, 8 bits, rounded to nearest (NaN to 0).
+///
+/// By table, not by `powf` per channel (a shaded frame encodes three channels per pixel): the code is the
+/// number of code boundaries at or below `v`, each boundary the linear value where the curve crosses the
+/// midpoint between two codes, computed once in f64. A coarse table of codes gives a lower bound; at most
+/// a step or two up from it finds the code.
 #[must_use]
+#[inline]
 pub fn linear_to_srgb8(v: f32) -> u8 {
+    let t = srgb8_table();
     let v = v.clamp(0.0, 1.0);
-    let s = if v <= 0.003_130_8 { 12.92 * v } else { 1.055 * v.powf(1.0 / 2.4) - 0.055 };
-    (s * 255.0 + 0.5) as u8
+    // NaN survives the clamp, indexes 0 and passes no boundary.
+    let mut code = usize::from(t.lower_bound[(v * SRGB8_BINS as f32) as usize]);
+    while code < 255 && v >= t.boundaries[code] {
+        code += 1;
+    }
+    code as u8
+}
+
+/// Bins of [`Srgb8Table::lower_bound`] over [0, 1]: the curve's steepest part, 12.92 x 255 codes per unit
+/// near black, then crosses under one code per bin.
+const SRGB8_BINS: usize = 4096;
+
+struct Srgb8Table {
+    /// `boundaries[k]`: the least f32 encoded as code `k + 1`.
+    boundaries: [f32; 255],
+    /// The code of each bin's start (and one past the end for 1.0).
+    lower_bound: [u8; SRGB8_BINS + 1],
+}
+
+fn srgb8_table() -> &'static Srgb8Table {
+    static TABLE: std::sync::LazyLock<Srgb8Table> = std::sync::LazyLock::new(|| {
+        let decode = |s: f64| if s <= 0.040_45 { s / 12.92 } else { ((s + 0.055) / 1.055).powf(2.4) };
+        let boundaries: [f32; 255] = std::array::from_fn(|k| {
+            let exact = decode((k as f64 + 0.5) / 255.0);
+            // The least f32 at or above the exact crossing.
+            let f = exact as f32;
+            if f64::from(f) < exact { f.next_up() } else { f }
+        });
+        let mut lower_bound = [0u8; SRGB8_BINS + 1];
+        for (i, code) in lower_bound.iter_mut().enumerate() {
+            let v = i as f32 / SRGB8_BINS as f32;
+            *code = boundaries.partition_point(|&b| b <= v) as u8;
+        }
+        Srgb8Table { boundaries, lower_bound }
+    });
+    &TABLE
 }
 
 /// sRGB 8-bit to linear [0, 1].
@@ -263,6 +304,25 @@ mod tests {
             assert_eq!(linear_to_srgb8(srgb8_to_linear(v)), v);
         }
         assert_eq!(linear_to_srgb8(0.5), 188);
+    }
+
+    #[test]
+    fn srgb_encoding_rounds_the_exact_curve_to_nearest() {
+        let encode = |v: f64| {
+            let s = if v <= 0.003_130_8 { 12.92 * v } else { 1.055 * v.powf(1.0 / 2.4) - 0.055 };
+            s * 255.0
+        };
+        // Every 97th f32 in [0, 1] (some 11 million), and the ends.
+        let one = 1.0f32.to_bits();
+        for bits in (0..=one).step_by(97).chain([one]) {
+            let v = f32::from_bits(bits);
+            let code = linear_to_srgb8(v);
+            let exact = encode(f64::from(v));
+            assert!((f64::from(code) - exact).abs() <= 0.5 + 1e-9, "{v}: code {code}, exact {exact}");
+        }
+        for (v, code) in [(-1.0, 0), (0.0, 0), (2.0, 255), (f32::NAN, 0), (f32::INFINITY, 255)] {
+            assert_eq!(linear_to_srgb8(v), code, "{v}");
+        }
     }
 
     #[test]

@@ -86,10 +86,15 @@ fn classify_receivers(
                 continue;
             }
             let p = g.position.data()[i];
-            let faces_light = g.geometric_normal.data()[i].dot(light.light.to_light(p)) > 0.0;
+            // Asked only where it decides: most receivers' four texels agree.
+            let faces_light = || g.geometric_normal.data()[i].dot(light.light.to_light(p)) > 0.0;
             let m = map_position(light, p, receiver_offset);
-            *class = classify(&maps[m.projection], m.uv, m.depth, faces_light);
-            if faces_light && edge_maps.get(m.projection).is_some_and(|e| near_edge(e, m.uv, m.depth)) {
+            *class = match classify(&maps[m.projection], m.uv, m.depth, true) {
+                MapClass::Silhouette if !faces_light() => MapClass::Shadowed,
+                class => class,
+            };
+            let edges = edge_maps.get(m.projection);
+            if *class != MapClass::Silhouette && edges.is_some_and(|e| near_edge(e, m.uv, m.depth)) && faces_light() {
                 *class = MapClass::Silhouette;
             }
         }
