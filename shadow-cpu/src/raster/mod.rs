@@ -458,10 +458,10 @@ where
             Some(DepthKernel::Count { compare, front, back }) => Some((compare, front, back)),
             _ => None,
         };
-        let pencil = mask.and_then(ComputationMask::pencil).zip(counting);
-        let mut plan = pencil.map(|(p, _)| p.plan(&setups));
-        let walked =
-            plan.as_mut().map_or_else(|| (0..setups.len() as u32).collect(), |p| std::mem::take(&mut p.walked));
+        let mut pencil = mask.and_then(ComputationMask::pencil).zip(counting).map(|(p, k)| (p, k, p.plan(&setups)));
+        let walked = pencil
+            .as_mut()
+            .map_or_else(|| (0..setups.len() as u32).collect(), |(_, _, plan)| std::mem::take(&mut plan.walked));
         for &i in &walked {
             let t = &setups[i as usize];
             for band in (t.min_y as u32 / BAND_ROWS)..=(t.max_y as u32 / BAND_ROWS) {
@@ -493,9 +493,9 @@ where
                 a
             });
         total += counters;
-        if let (Some((p, counting)), Some(plan)) = (pencil, &plan) {
+        if let Some((p, counting, plan)) = &pencil {
             let clamp = st.depth.is_some_and(|d| d.clamp);
-            total += p.count(&setups, plan, counting, clamp, (&ds.depth, &mut ds.stencil));
+            total += p.count(&setups, plan, *counting, clamp, (&ds.depth, &mut ds.stencil));
         }
     }
     total

@@ -349,6 +349,11 @@ impl Pencil {
         clamp: bool,
         (depth, stencil): (&[f32], &mut [u8]),
     ) -> RasterCounters {
+        // Nothing to gather or add up for a draw the pencil took nothing of (most of a many-instance
+        // scene's draws).
+        if plan.taken.is_empty() {
+            return RasterCounters::default();
+        }
         // One loop per depth test, so the test is not matched per candidate.
         let (deltas, c) = match compare {
             CompareFn::Never => self.deltas(setups, plan, (front, back), clamp, depth, |_, _| false),
