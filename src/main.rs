@@ -279,6 +279,7 @@ fn inspect(target: &str, json: bool) -> Result<(), Error> {
             "triangles": i.triangles,
             "vertices": i.vertices,
             "closed": i.closed,
+            "components": i.components,
             "boundary_edges": i.boundary_edges,
             "non_manifold_edges": i.non_manifold_edges,
             "inconsistent_edges": i.inconsistent_edges,
@@ -290,6 +291,7 @@ fn inspect(target: &str, json: bool) -> Result<(), Error> {
     println!("  triangles           {}", i.triangles);
     println!("  vertices (welded)   {}", i.vertices);
     println!("  closed              {}", i.closed);
+    println!("  components          {}", i.components);
     println!("  boundary edges      {}", i.boundary_edges);
     println!("  non-manifold edges  {}", i.non_manifold_edges);
     println!("  inconsistent edges  {}", i.inconsistent_edges);

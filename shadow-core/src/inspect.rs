@@ -13,6 +13,8 @@ pub struct Inspection {
     pub vertices: usize,
     /// Every instance's mesh is closed and consistently wound.
     pub closed: bool,
+    /// Connected components (faces sharing a welded vertex), each casting a closed volume of its own.
+    pub components: usize,
     /// Edges with one face.
     pub boundary_edges: usize,
     /// Edges with three or more faces.
@@ -33,6 +35,7 @@ impl Inspection {
             triangles: 0,
             vertices: 0,
             closed: true,
+            components: 0,
             boundary_edges: 0,
             non_manifold_edges: 0,
             inconsistent_edges: 0,
@@ -44,6 +47,7 @@ impl Inspection {
             out.triangles += m.triangle_count();
             out.vertices += adj.vertex_count();
             out.closed &= adj.closed();
+            out.components += adj.component_bounds().len();
             out.boundary_edges += adj.boundary_edge_count();
             out.non_manifold_edges += adj.non_manifold_edge_count();
             out.inconsistent_edges += adj.inconsistent_edge_count();
@@ -74,6 +78,7 @@ mod tests {
         assert_eq!(i.triangles, 2 + 64 * 4);
         assert_eq!(i.boundary_edges, 4);
         assert!(!i.closed);
+        assert_eq!(i.components, 2);
         // The cylinder's silhouette from an oblique light: two vertical edges plus parts of both rims,
         // and the ground's four boundary edges.
         let sil = i.silhouette_edges.unwrap();

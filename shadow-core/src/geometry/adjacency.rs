@@ -11,6 +11,11 @@
 //! running along the edge first: the pass needs no direction bits. Boundary edges (one face) come next,
 //! and the rest (three or more faces, or two faces running the same way) go to
 //! [`Adjacency::complex_edges`].
+//!
+//! Faces sharing an edge belong to one connected component ([`Adjacency::components`]; sharing a vertex
+//! is not enough, so a tree's twigs sprouting from one point stay apart). A component's shadow volume is
+//! closed on its own (every face of each of its edges is in it), so it shadows nothing outside its own
+//! shadow, which lets a technique skip it wherever that cannot hold the point it counts.
 
 use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};
@@ -18,6 +23,7 @@ use std::hash::{BuildHasherDefault, Hasher};
 use glam::{Vec3, Vec4};
 use rayon::prelude::*;
 
+use crate::bounds::Aabb;
 use crate::mesh::{Mesh, face_normal};
 
 /// One face's use of an edge: `face << 1 | reversed`, where `reversed` means the face runs from the
@@ -87,6 +93,10 @@ pub struct Adjacency {
     complex: Vec<ComplexEdge>,
     non_manifold_edges: usize,
     inconsistent_edges: usize,
+    /// Per face, its connected component, numbered in order of first appearance.
+    component: Vec<u32>,
+    /// Per component, the bounds of its welded vertices.
+    component_bounds: Vec<Aabb>,
 }
 
 #[derive(Default)]
@@ -144,6 +154,8 @@ impl Adjacency {
         uses.par_sort_unstable();
 
         let mut adj = Self {
+            component: Vec::new(),
+            component_bounds: Vec::new(),
             positions,
             remap,
             triangles,
@@ -179,6 +191,7 @@ impl Adjacency {
                 }
             }
         }
+        (adj.component, adj.component_bounds) = components(&adj);
         adj
     }
 
@@ -259,12 +272,67 @@ impl Adjacency {
     pub fn inconsistent_edge_count(&self) -> usize {
         self.inconsistent_edges
     }
+    /// The connected component of each face (faces sharing an edge are connected), numbered from 0 in
+    /// order of first appearance; an edge's component is its faces'.
+    #[must_use]
+    pub fn components(&self) -> &[u32] {
+        &self.component
+    }
+    /// The bounds of each connected component's vertices, in mesh space.
+    #[must_use]
+    pub fn component_bounds(&self) -> &[Aabb] {
+        &self.component_bounds
+    }
     /// Watertight and consistently wound: every edge has exactly two faces running opposite ways. Closed
     /// meshes cast with weight-1 silhouettes and light-facing caps; all others with Bergeron weights.
     #[must_use]
     pub fn closed(&self) -> bool {
         self.boundary.is_empty() && self.complex.is_empty()
     }
+}
+
+/// The connected components of the faces through their edges (union-find with path halving), and their
+/// bounds. A face no edge joins to another (a degenerate one, say) is a component of its own.
+fn components(adj: &Adjacency) -> (Vec<u32>, Vec<Aabb>) {
+    let mut parent: Vec<u32> = (0..adj.triangles.len() as u32).collect();
+    let root = |parent: &mut [u32], mut f: u32| {
+        while parent[f as usize] != f {
+            let up = parent[parent[f as usize] as usize];
+            parent[f as usize] = up;
+            f = up;
+        }
+        f
+    };
+    let mut join = |f: u32, g: u32| {
+        let (rf, rg) = (root(&mut parent, f), root(&mut parent, g));
+        if rf != rg {
+            parent[rf.max(rg) as usize] = rf.min(rg);
+        }
+    };
+    for &[f, g] in &adj.manifold_faces {
+        join(f, g);
+    }
+    for e in &adj.complex {
+        for u in &e.uses[1..] {
+            join(e.uses[0].face(), u.face());
+        }
+    }
+    // Roots are each component's least face, so numbering them in face order numbers the components in
+    // order of first appearance.
+    let mut number = vec![u32::MAX; parent.len()];
+    let mut bounds = Vec::new();
+    let mut component = Vec::with_capacity(parent.len());
+    for (f, t) in adj.triangles.iter().enumerate() {
+        let r = root(&mut parent, f as u32) as usize;
+        if number[r] == u32::MAX {
+            number[r] = bounds.len() as u32;
+            bounds.push(Aabb::EMPTY);
+        }
+        let k = number[r] as usize;
+        bounds[k] = t.iter().fold(bounds[k], |b, &v| b.including(adj.positions[v as usize]));
+        component.push(k as u32);
+    }
+    (component, bounds)
 }
 
 fn weld(positions: &[Vec3]) -> (Vec<Vec3>, Vec<u32>) {

@@ -32,6 +32,9 @@ pub struct SilhouetteEdge {
     /// How many times the side quad counts (1 for closed meshes; 1 or 2, more at non-manifold edges, for
     /// open ones).
     pub weight: u32,
+    /// A face using the edge: the edge's connected component is this face's
+    /// ([`Adjacency::components`]).
+    pub face: u32,
 }
 
 /// How a mesh's faces cast (chosen from [`Adjacency::closed`] unless forced).
@@ -92,11 +95,11 @@ pub fn face_weights(adj: &Adjacency, light: LightSource, mode: CastMode) -> Vec<
     weights
 }
 
-fn oriented(v: [u32; 2], w: i32) -> Option<SilhouetteEdge> {
+fn oriented(v: [u32; 2], w: i32, face: u32) -> Option<SilhouetteEdge> {
     match w {
         0 => None,
-        w if w > 0 => Some(SilhouetteEdge { a: v[0], b: v[1], weight: w as u32 }),
-        w => Some(SilhouetteEdge { a: v[1], b: v[0], weight: w.unsigned_abs() }),
+        w if w > 0 => Some(SilhouetteEdge { a: v[0], b: v[1], weight: w as u32, face }),
+        w => Some(SilhouetteEdge { a: v[1], b: v[0], weight: w.unsigned_abs(), face }),
     }
 }
 
@@ -116,14 +119,21 @@ pub fn silhouette(adj: &Adjacency, light: LightSource, mode: CastMode) -> Silhou
             let base = chunk * 16384;
             faces.iter().enumerate().filter_map(move |(i, &[f0, f1])| {
                 let weight = i32::from(w[f0 as usize]) - i32::from(w[f1 as usize]);
-                if weight == 0 { None } else { oriented(adj.manifold_edges()[base + i].v, weight) }
+                if weight == 0 { None } else { oriented(adj.manifold_edges()[base + i].v, weight, f0) }
             })
         })
         .collect();
     edges.extend(
-        adj.boundary_edges().iter().zip(adj.boundary_faces()).filter_map(|(e, &u)| oriented(e.v, use_weight(u))),
+        adj.boundary_edges()
+            .iter()
+            .zip(adj.boundary_faces())
+            .filter_map(|(e, &u)| oriented(e.v, use_weight(u), u.face())),
     );
-    edges.extend(adj.complex_edges().iter().filter_map(|e| oriented(e.v, e.uses.iter().map(|&u| use_weight(u)).sum())));
+    edges.extend(
+        adj.complex_edges()
+            .iter()
+            .filter_map(|e| oriented(e.v, e.uses.iter().map(|&u| use_weight(u)).sum(), e.uses[0].face())),
+    );
     Silhouette { edges, face_weights }
 }
 

@@ -16,12 +16,19 @@
 //! index data the G-buffer pass used, so a lit surface and its near cap rasterize to bit-identical depths
 //! (the invariance z-fail relies on). Faces cast turned around (Bergeron) are drawn with front and back
 //! swapped instead of re-wound, for the same reason.
+//!
+//! Sides and caps come grouped by the mesh's connected components ([`VolumePiece`]): each group is a
+//! closed volume of its own, the shadow of that component alone, whose count is zero wherever that
+//! shadow is not. Counting draws may skip a piece where its bounds' shadow cannot reach.
+
+use std::ops::Range;
 
 use glam::Vec4;
 
 use super::LightSource;
 use super::adjacency::Adjacency;
 use super::silhouette::Silhouette;
+use crate::bounds::Aabb;
 
 /// Whether a volume needs caps: z-pass counts only the sides, z-fail needs both caps.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -44,6 +51,23 @@ pub struct ShadowVolume {
     pub caps_reversed: Vec<u32>,
     /// The light, in the mesh's space.
     pub light: LightSource,
+    /// The connected components that cast, each with its runs of `sides`, `caps_forward` and
+    /// `caps_reversed`: together they cover all three.
+    pub pieces: Vec<VolumePiece>,
+}
+
+/// The part of a [`ShadowVolume`] one connected component of the mesh casts: a closed volume by itself.
+#[derive(Clone, Debug, PartialEq)]
+pub struct VolumePiece {
+    /// Its run of [`ShadowVolume::sides`].
+    pub sides: Range<u32>,
+    /// Its run of [`ShadowVolume::caps_forward`].
+    pub caps_forward: Range<u32>,
+    /// Its run of [`ShadowVolume::caps_reversed`].
+    pub caps_reversed: Range<u32>,
+    /// The bounds of the component's vertices, in mesh space: the piece is the shadow of what lies in
+    /// them, so it holds only points the light reaches through them.
+    pub bounds: Aabb,
 }
 
 impl ShadowVolume {
@@ -78,35 +102,66 @@ impl ShadowVolume {
     }
 }
 
-/// Extrudes a silhouette into a shadow volume. `silhouette` must come from
-/// [`super::silhouette::silhouette`] with the same adjacency and light.
+/// Extrudes a silhouette into a shadow volume, grouped by connected component. `silhouette` must come
+/// from [`super::silhouette::silhouette`] with the same adjacency and light.
 #[must_use]
 pub fn extrude(adj: &Adjacency, silhouette: &Silhouette, light: LightSource, caps: Caps) -> ShadowVolume {
     let p = adj.positions();
+    let component = adj.components();
     let directional = matches!(light, LightSource::Directional(_));
-    let mut sides = Vec::with_capacity(silhouette.weighted_len() * if directional { 1 } else { 2 });
+    let per_quad = if directional { 1 } else { 2 };
+    // Edges and casting faces bucketed by component (a counting sort keeps each bucket in input order).
+    let components = adj.component_bounds().len();
+    let face_component = |f: usize| component[f] as usize;
+    let cast = |w: i8| caps == Caps::Both && w != 0;
+    let mut counts = vec![[0u32; 3]; components + 1];
+    for e in &silhouette.edges {
+        counts[face_component(e.face as usize) + 1][0] += e.weight * per_quad;
+    }
+    for (f, &w) in silhouette.face_weights.iter().enumerate().filter(|&(_, &w)| cast(w)) {
+        counts[face_component(f) + 1][if w > 0 { 1 } else { 2 }] += 1;
+    }
+    for k in 1..=components {
+        let before = counts[k - 1];
+        for (c, b) in counts[k].iter_mut().zip(before) {
+            *c += b;
+        }
+    }
+    let starts = counts.clone();
+    let mut next = counts;
+    let mut sides = vec![[Vec4::ZERO; 3]; next[components][0] as usize];
     for e in &silhouette.edges {
         let (a, b) = (p[e.a as usize], p[e.b as usize]);
         let (a4, b4, a_inf, b_inf) = (a.extend(1.0), b.extend(1.0), light.extrude(a), light.extrude(b));
+        let at = &mut next[face_component(e.face as usize)][0];
         for _ in 0..e.weight {
             // The outward quad (b, a, a_inf, b_inf); with parallel light a_inf = b_inf and it is one triangle.
-            sides.push([b4, a4, a_inf]);
+            sides[*at as usize] = [b4, a4, a_inf];
+            *at += 1;
             if !directional {
-                sides.push([b4, a_inf, b_inf]);
+                sides[*at as usize] = [b4, a_inf, b_inf];
+                *at += 1;
             }
         }
     }
-    let (mut caps_forward, mut caps_reversed) = (Vec::new(), Vec::new());
-    if caps == Caps::Both {
-        for (f, &w) in silhouette.face_weights.iter().enumerate() {
-            match w {
-                1 => caps_forward.push(f as u32),
-                -1 => caps_reversed.push(f as u32),
-                _ => {}
-            }
-        }
+    let mut caps_forward = vec![0; next[components][1] as usize];
+    let mut caps_reversed = vec![0; next[components][2] as usize];
+    for (f, &w) in silhouette.face_weights.iter().enumerate().filter(|&(_, &w)| cast(w)) {
+        let (list, j) = if w > 0 { (&mut caps_forward, 1) } else { (&mut caps_reversed, 2) };
+        let at = &mut next[face_component(f)][j];
+        list[*at as usize] = f as u32;
+        *at += 1;
     }
-    ShadowVolume { sides, caps_forward, caps_reversed, light }
+    let pieces = (0..components)
+        .filter(|&k| starts[k] != starts[k + 1])
+        .map(|k| VolumePiece {
+            sides: starts[k][0]..starts[k + 1][0],
+            caps_forward: starts[k][1]..starts[k + 1][1],
+            caps_reversed: starts[k][2]..starts[k + 1][2],
+            bounds: adj.component_bounds()[k],
+        })
+        .collect();
+    ShadowVolume { sides, caps_forward, caps_reversed, light, pieces }
 }
 
 #[cfg(test)]
@@ -164,6 +219,48 @@ pub(crate) mod tests {
                         LightSource::Directional(d) => -d,
                     };
                     assert!(n.dot(to_light) > 0.0);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn each_component_casts_a_closed_piece() {
+        // Two boxes, a torus and an open plane in one mesh; a point and a directional light.
+        let parts = [
+            procedural::cuboid(Vec3::ONE),
+            procedural::cuboid(Vec3::splat(0.5)).transformed(glam::Mat4::from_translation(Vec3::new(3.0, 0.5, 0.0))),
+            procedural::torus(1.0, 0.3, 16, 8).transformed(glam::Mat4::from_translation(Vec3::new(-3.0, 0.0, 1.0))),
+            procedural::plane(2.0, 2.0).transformed(glam::Mat4::from_translation(Vec3::new(0.0, -2.0, 0.0))),
+        ];
+        let adj = Adjacency::build(&crate::mesh::Mesh::merged(&parts).expect("four parts"));
+        assert_eq!(adj.component_bounds().len(), 4);
+        for light in
+            [LightSource::Point(Vec3::new(0.5, 4.0, 1.5)), LightSource::Directional(Vec3::new(-0.3, -1.0, 0.2))]
+        {
+            let vol = extrude(&adj, &silhouette(&adj, light, CastMode::Bergeron), light, Caps::Both);
+            assert_eq!(vol.pieces.len(), 4);
+            let covered = |f: fn(&VolumePiece) -> &Range<u32>| vol.pieces.iter().map(|p| f(p).len()).sum::<usize>();
+            assert_eq!(covered(|p| &p.sides), vol.sides.len());
+            assert_eq!(covered(|p| &p.caps_forward), vol.caps_forward.len());
+            assert_eq!(covered(|p| &p.caps_reversed), vol.caps_reversed.len());
+            for piece in &vol.pieces {
+                let part = ShadowVolume {
+                    sides: vol.sides[piece.sides.start as usize..piece.sides.end as usize].to_vec(),
+                    caps_forward: vol.caps_forward[piece.caps_forward.start as usize..piece.caps_forward.end as usize]
+                        .to_vec(),
+                    caps_reversed: vol.caps_reversed
+                        [piece.caps_reversed.start as usize..piece.caps_reversed.end as usize]
+                        .to_vec(),
+                    light,
+                    pieces: Vec::new(),
+                };
+                let tris = all_triangles(&adj, &part);
+                assert!(!tris.is_empty());
+                assert!(edge_balance(&tris).is_empty(), "piece not closed");
+                // Every finite corner lies in the piece's bounds.
+                for v in tris.iter().flatten().filter(|v| v.w == 1.0) {
+                    assert!(v.truncate().cmpge(piece.bounds.min).all() && v.truncate().cmple(piece.bounds.max).all());
                 }
             }
         }

@@ -666,10 +666,16 @@ pub struct Hybrid {
     /// Side in pixels of the CPU computation mask's tiles, which the rasterizer skips whole where no pixel
     /// is masked in.
     pub mask_tile: u32,
-    /// CPU: on, the mask's pixels are also ordered around the light's image, so each volume side (all of
-    /// them lie on lines through it) is tested only at the silhouette pixels in its angle from there; off,
-    /// every side is walked row by row under the tiled mask. Same fragments either way.
+    /// CPU: on, the mask's pixels are also ordered around the light's image, so each side of a volume drawn
+    /// through the whole mask (every volume with `caster_masks=off`, only the pieces too large to list
+    /// otherwise) is tested only at the silhouette pixels in its angle from there (all sides lie on lines
+    /// through it); off, walked row by row under the tiled mask. Same fragments either way. Off by default:
+    /// with caster masks the ordering costs more than it saves.
     pub pencil: OnOff,
+    /// CPU: on, each connected component's volume is counted only at the silhouette pixels within the
+    /// light-space bounds of its shadow (a per-caster mask; its count is zero everywhere else); off, every
+    /// volume through the whole mask. Same picture either way.
+    pub caster_masks: OnOff,
     /// Where the GPU keeps the computation mask (the CPU always uses its tiles).
     pub gpu_mask: GpuMask,
     /// GPU: 0, the volumes are drawn over the whole view and the mask rejects fragments; N, the mask pass
@@ -701,7 +707,7 @@ crate::named_enum! {
     }
 }
 
-const HYBRID_KEYS: [SettingKey; 11] = [
+const HYBRID_KEYS: [SettingKey; 12] = [
     SettingKey { key: "res", default: "512", help: "classifying map side in texels (16 to 16384)" },
     MAP_KEYS[1],
     MAP_KEYS[2],
@@ -714,8 +720,13 @@ const HYBRID_KEYS: [SettingKey; 11] = [
     },
     SettingKey {
         key: "pencil",
+        default: "off",
+        help: "CPU: on, the sides of volumes drawn through the whole mask are tested only at the silhouette pixels in their angle around the light's image; off, walked row by row",
+    },
+    SettingKey {
+        key: "caster_masks",
         default: "on",
-        help: "CPU: on, volume sides are tested only at the silhouette pixels in their angle around the light's image; off, walked row by row",
+        help: "CPU: on, each caster's volume is counted only at the silhouette pixels its shadow's bounds hold; off, through the whole mask",
     },
     SettingKey {
         key: "gpu_mask",
@@ -748,6 +759,7 @@ impl TechniqueSettings for Hybrid {
             depth: ShadowMap::read_depth(v)?,
             mask_tile: v.ranged("mask_tile", 1, 64)?,
             pencil: v.get("pencil")?,
+            caster_masks: v.get("caster_masks")?,
             gpu_mask: v.get("gpu_mask")?,
             scissor_tile: match v.text("scissor_tile") {
                 "0" => 0,
@@ -762,6 +774,7 @@ impl TechniqueSettings for Hybrid {
         v.extend([
             self.mask_tile.to_string(),
             self.pencil.to_string(),
+            self.caster_masks.to_string(),
             self.gpu_mask.to_string(),
             self.scissor_tile.to_string(),
             self.edge_texels.to_string(),

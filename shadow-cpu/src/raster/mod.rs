@@ -7,7 +7,51 @@
 //! rows, and the bands are rasterized in parallel. Every band owns its rows of every target and walks its
 //! triangles in submission order, so the output does not depend on the thread count.
 
+/// Evaluates `$body` with `$pass` bound to the depth test of `$compare` as a closure `(new, stored) ->
+/// bool` of its own type, so a loop over pixels is compiled once per test rather than matching the test
+/// per pixel.
+macro_rules! with_depth_test {
+    ($compare:expr, $pass:ident => $body:expr) => {
+        match $compare {
+            CompareFn::Never => {
+                let $pass = |_: f32, _: f32| false;
+                $body
+            }
+            CompareFn::Less => {
+                let $pass = |z: f32, s: f32| z < s;
+                $body
+            }
+            CompareFn::LessEqual => {
+                let $pass = |z: f32, s: f32| z <= s;
+                $body
+            }
+            CompareFn::Equal => {
+                let $pass = |z: f32, s: f32| z == s;
+                $body
+            }
+            CompareFn::Greater => {
+                let $pass = |z: f32, s: f32| z > s;
+                $body
+            }
+            CompareFn::GreaterEqual => {
+                let $pass = |z: f32, s: f32| z >= s;
+                $body
+            }
+            CompareFn::NotEqual => {
+                let $pass = |z: f32, s: f32| z != s;
+                $body
+            }
+            CompareFn::Always => {
+                let $pass = |_: f32, _: f32| true;
+                $body
+            }
+        }
+    };
+}
+use with_depth_test;
+
 pub mod clip;
+mod listed;
 pub mod mask;
 mod masked;
 pub mod pencil;
@@ -18,6 +62,7 @@ use glam::Vec4;
 use rayon::prelude::*;
 use shadow_core::Image;
 
+pub use listed::{ListedDraw, count_listed};
 pub use mask::ComputationMask;
 use masked::masked_rows;
 use spans::EdgeWalk;

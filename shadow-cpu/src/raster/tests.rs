@@ -400,37 +400,31 @@ fn the_edge_walk_steps_to_the_divided_spans() {
     assert!(rows > 10_000, "{rows} rows walked");
 }
 
-#[test]
-fn the_pencil_counts_what_the_walk_counts() {
-    // Z-fail counting of shadow-volume-like geometry under a mask, walked and in pencil order around the
-    // apex: edges extruded away from it (slivers reaching far off screen and clipped there), mixed with
-    // the jittered grid (caps), against a depth buffer the triangles cross. Apexes on and off the screen,
-    // behind the eye, and at infinity (no order). Same stencil and counters, the pencil taking most sides.
-    let (w, h) = (151, 113);
-    let face = |depth_fail| StencilFace {
-        compare: CompareFn::Always,
-        fail: StencilOp::Keep,
-        depth_fail,
-        pass: StencilOp::Keep,
-    };
-    let st = RasterState {
+/// Z-fail counting: depth test "less", back faces +1 and front faces -1 where it fails.
+fn zfail_state() -> RasterState {
+    RasterState {
         cull: CullMode::None,
         depth: Some(DepthState::LESS_READ),
         stencil: Some(StencilState {
-            front: face(StencilOp::DecrementWrap),
-            back: face(StencilOp::IncrementWrap),
+            front: StencilFace { depth_fail: StencilOp::DecrementWrap, ..StencilFace::KEEP },
+            back: StencilFace { depth_fail: StencilOp::IncrementWrap, ..StencilFace::KEEP },
             read_mask: 0xff,
             write_mask: 0xff,
             reference: 0,
         }),
         ..RasterState::default()
-    };
-    let depth: Vec<f32> = (0..w * h).map(|i| 0.3 + 0.4 * ((i % w) as f32 / w as f32) + 0.01 * (i % 7) as f32).collect();
-    let on = |x: u32, y: u32| (x * 7 + y * 13).is_multiple_of(11) || (60..90).contains(&x) && (20..50).contains(&y);
-    let mask = ComputationMask::from_fn(w, h, 8, on);
-    // A fan around an apex at a pixel centre, from a chain of edges with corners at pixel centres and
-    // sides ending at pixel centres too: the sides' long edges are shared by neighbours and pass through
-    // pixel centres, where the top-left rule decides which side counts.
+    }
+}
+
+/// A stored depth rising across the target with a small ripple, for counting draws to cross.
+fn slanted_depth(w: u32, h: u32) -> Vec<f32> {
+    (0..w * h).map(|i| 0.3 + 0.4 * ((i % w) as f32 / w as f32) + 0.01 * (i % 7) as f32).collect()
+}
+
+/// A fan around an apex at a pixel centre (returned, in pixels), from a chain of edges with corners at
+/// pixel centres and sides ending at pixel centres too: the sides' long edges are shared by neighbours
+/// and pass through pixel centres, where the top-left rule decides which side counts.
+fn pixel_centre_fan(w: u32, h: u32) -> ((f32, f32), Vec<[Vec4; 3]>) {
     let ndc = |x: f32, y: f32, z: f32| Vec4::new(2.0 * x / w as f32 - 1.0, 1.0 - 2.0 * y / h as f32, z, 1.0);
     let centre = (75.5, 56.5);
     let chain = [(10, -3), (12, 2), (9, 7), (3, 11), (-4, 9), (-9, 4), (-11, -2), (-7, -8), (0, -10), (10, -3)];
@@ -441,6 +435,21 @@ fn the_pencil_counts_what_the_walk_counts() {
         fan.push([a, b, b_far]);
         fan.push([a, b_far, a_far]);
     }
+    (centre, fan)
+}
+
+#[test]
+fn the_pencil_counts_what_the_walk_counts() {
+    // Z-fail counting of shadow-volume-like geometry under a mask, walked and in pencil order around the
+    // apex: edges extruded away from it (slivers reaching far off screen and clipped there), mixed with
+    // the jittered grid (caps), against a depth buffer the triangles cross. Apexes on and off the screen,
+    // behind the eye, and at infinity (no order). Same stencil and counters, the pencil taking most sides.
+    let (w, h) = (151, 113);
+    let (st, depth) = (zfail_state(), slanted_depth(w, h));
+    let on = |x: u32, y: u32| (x * 7 + y * 13).is_multiple_of(11) || (60..90).contains(&x) && (20..50).contains(&y);
+    let mask = ComputationMask::from_fn(w, h, 8, on);
+    let ndc = |x: f32, y: f32, z: f32| Vec4::new(2.0 * x / w as f32 - 1.0, 1.0 - 2.0 * y / h as f32, z, 1.0);
+    let (centre, fan) = pixel_centre_fan(w, h);
     for (seed, apex) in [
         (0, ndc(centre.0, centre.1, 0.2)),
         (1, Vec4::new(0.1, 0.2, 0.4, 1.0)),
@@ -483,4 +492,45 @@ fn the_pencil_counts_what_the_walk_counts() {
     }
     // At infinity there is no pencil, and the draw is the walk's.
     assert!(mask.clone().ordered_around(Vec4::new(0.3, 0.2, 0.1, 0.0)).pencil().is_none());
+}
+
+#[test]
+fn listed_draws_count_what_masked_walks_count() {
+    // Three counting draws (slivers extruded to infinity, clipped, and a jittered grid) each confined to
+    // its own list of pixels, overlapping the others', one of them a fan whose edges run through pixel
+    // centres: the same stencil and counters as walking each under a mask of just its pixels.
+    let (w, h) = (151, 113);
+    let (st, depth) = (zfail_state(), slanted_depth(w, h));
+    let mut rng = shadow_core::scenes::Rng::new(7);
+    let apex = Vec4::new(0.1, 0.2, 0.4, 1.0);
+    let mut tris = pixel_centre_fan(w, h).1;
+    tris.extend(jittered_grid(6, 7, 1.0));
+    for _ in 0..300 {
+        let mut corner = || {
+            let w = rng.range(0.5, 2.0);
+            Vec4::new(rng.range(-1.2, 1.2) * w, rng.range(-1.2, 1.2) * w, rng.range(0.2, 0.8) * w, w)
+        };
+        let (a, b) = (corner(), corner());
+        tris.push([a, b, b - apex]);
+        tris.push([a, b - apex, a - apex]);
+    }
+    let parts: Vec<&[[Vec4; 3]]> = tris.chunks(tris.len().div_ceil(3)).collect();
+    let lists: Vec<Vec<u32>> = (0..3u32)
+        .map(|k| (0..w * h).filter(|&i| (i % w * (3 + k) + i / w * (5 + 2 * k)) % (7 + k) < 2 + k).collect())
+        .collect();
+    let sources: Vec<Soup> = parts.iter().map(|t| Soup { triangles: t, prim_base: 0, flip: false }).collect();
+    let draws: Vec<ListedDraw> =
+        sources.iter().zip(&lists).map(|(s, pixels)| ListedDraw { sources: vec![s], pixels }).collect();
+    let mut ds = DepthStencil::from_parts(w, h, depth.clone(), vec![0; (w * h) as usize]);
+    let got = count_listed(&mut ds, &draws, &st);
+    let mut walked = DepthStencil::from_parts(w, h, depth, vec![0; (w * h) as usize]);
+    let mut want = RasterCounters::default();
+    for (src, pixels) in sources.iter().zip(&lists) {
+        let mask = ComputationMask::from_fn(w, h, 8, |x, y| pixels.binary_search(&(y * w + x)).is_ok());
+        want += draw_depth_masked(&mut walked, src, &st, Some(&mask));
+    }
+    let differ = (0..ds.stencil.len()).find(|&i| ds.stencil[i] != walked.stencil[i]);
+    assert!(differ.is_none(), "pixel {differ:?} counted {:?}", differ.map(|i| (ds.stencil[i], walked.stencil[i])));
+    assert_eq!(got, want);
+    assert!(want.fragments > 5_000 && want.stencil_updates > 1_000, "{want:?}");
 }

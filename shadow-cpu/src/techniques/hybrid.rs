@@ -7,16 +7,24 @@
 //! The silhouette pixels make a computation mask, tiled so the rasterizer skips whole tiles with none;
 //! the volumes are counted z-fail through it, and a silhouette pixel is shadowed where its count is not 0.
 //!
-//! The mask's pixels are also ordered around the light's image (`ComputationMask::ordered_around`): every
-//! volume side lies on lines through it, so a side, a sliver hundreds of rows long, is tested only at the
-//! few silhouette pixels in its angle from there rather than walked row by row (Chan's hardware rejects
+//! With `caster_masks=on` (the default; ours) each connected component's volume is counted only at the
+//! silhouette pixels its shadow's light-space bounds hold ([`super::caster_masks`]): its count is zero
+//! everywhere else, so the stencil and the picture are the whole mask's, at a fraction of the fragments
+//! where the volumes of many casters cross each other's shadows on screen (cubes, tree, crowd).
+//!
+//! With `pencil=on` the mask's pixels are also ordered around the light's image
+//! (`ComputationMask::ordered_around`), for the volumes still drawn through the whole mask: every volume
+//! side lies on lines through it, so a side, a sliver hundreds of rows long, is tested only at the few
+//! silhouette pixels in its angle from there rather than walked row by row (Chan's hardware rejects
 //! masked-off tiles for free; a software rasterizer still pays for every row it walks). Same fragments.
 //!
-//! Counters: `silhouette_pixels`; `volume_fragments`, the fragments rasterized under the mask (the work
-//! actually done); `pencil_triangles`, the volume triangles tested that way; `mask_tiles` and
-//! `mask_tiles_total`; with `unmasked_fill=on`,
-//! `unmasked_volume_fragments`, what `shadow-volume-zfail` rasterizes, from a second pass without the mask
-//! (timed as `count_fragments`). Sub-phases: `classify` (the map test and the mask) and `volumes`.
+//! Counters: `silhouette_pixels`; `volume_fragments`, the fragments rasterized under the masks (the work
+//! actually done); `pencil_triangles`, the volume triangles tested in pencil order; `caster_pieces`, of
+//! them `caster_pieces_skipped` (no silhouette pixel in their shadow) and `caster_pieces_listed` (counted
+//! at their own `caster_listed_pixels`), the rest drawn through the whole mask; `mask_tiles` and
+//! `mask_tiles_total`; with `unmasked_fill=on`, `unmasked_volume_fragments`, what `shadow-volume-zfail`
+//! rasterizes, from a second pass without the mask (timed as `count_fragments`). Sub-phases: `classify`
+//! (the map test and the mask), `caster_lists` (each piece's pixels) and `volumes` (lists included).
 
 use rayon::prelude::*;
 use shadow_core::frame::InstanceVolume;
@@ -30,6 +38,7 @@ use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueEr
 use shadow_core::{FrameInputs, Image};
 use std::time::Instant;
 
+use super::caster_masks::{CasterShafts, count_volumes};
 use super::shadow_volume::{build_volumes, rasterize_volumes};
 use super::{map_position, per_receiver, render_depth_maps};
 use crate::context::{CpuBackend, CpuContext, CpuError};
@@ -44,6 +53,8 @@ pub struct State {
     /// With `edge_texels=on`: per projection, the nearest silhouette edge's depth in each texel.
     edge_maps: Vec<Image<f32>>,
     volumes: Option<Vec<InstanceVolume>>,
+    /// With `caster_masks=on`: where each volume piece's shadow can lie.
+    shafts: CasterShafts,
     last: Option<LastQuery>,
 }
 
@@ -135,7 +146,10 @@ impl ShadowTechnique<CpuBackend> for Hybrid {
                 state.edge_maps.push(ds.into_depth_image());
             }
         }
-        state.volumes = Some(build_volumes(frame, light, Caps::Both, stats));
+        let volumes = build_volumes(frame, light, Caps::Both, stats);
+        state.shafts =
+            if self.caster_masks.is_on() { CasterShafts::new(frame, light, &volumes) } else { CasterShafts::default() };
+        state.volumes = Some(volumes);
         Ok(())
     }
 
@@ -164,7 +178,18 @@ impl ShadowTechnique<CpuBackend> for Hybrid {
         stats.timings.extra.insert("classify".into(), ms(t.elapsed()));
         let t = Instant::now();
         let mut ds = DepthStencil::from_depth(&g.depth, 0);
-        let c = rasterize_volumes(frame, g, volumes, VolumeCounting::ZFail, &mut ds, Some(&mask));
+        let c = if self.caster_masks.is_on() {
+            let (c, casters) = count_volumes(frame, light, g, volumes, &state.shafts, &mask, &mut ds);
+            let extra = &mut stats.counters.extra;
+            extra.insert("caster_pieces".into(), casters.pieces as f64);
+            extra.insert("caster_pieces_skipped".into(), casters.skipped as f64);
+            extra.insert("caster_pieces_listed".into(), casters.listed as f64);
+            extra.insert("caster_listed_pixels".into(), casters.listed_pixels as f64);
+            stats.timings.extra.insert("caster_lists".into(), casters.listing_ms);
+            c
+        } else {
+            rasterize_volumes(frame, g, volumes, VolumeCounting::ZFail, &mut ds, Some(&mask))
+        };
         stats.timings.extra.insert("volumes".into(), ms(t.elapsed()));
         per_receiver(g, out, |x, y, i| match map_class.get(x, y) {
             MapClass::Lit => 1.0,

@@ -1,6 +1,7 @@
 //! CPU versions of the techniques: each file is one technique, short enough to read next to its paper.
 //! Helpers two techniques share live here.
 
+pub mod caster_masks;
 pub mod depth_layers;
 pub mod hybrid;
 pub mod ray_traced;

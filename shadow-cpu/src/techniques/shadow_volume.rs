@@ -9,6 +9,8 @@
 //! with the eye in shadow too. Open meshes cast with Bergeron's weights (shared geometry), so the
 //! counts stay right for the teapot and the Cornell box.
 
+use std::ops::Range;
+
 use glam::{Mat4, Vec4};
 use shadow_core::frame::InstanceVolume;
 use shadow_core::geometry::volume::Caps;
@@ -62,9 +64,123 @@ pub fn stencil_state(counting: VolumeCounting) -> StencilState {
     StencilState { front, back, read_mask: 0xff, write_mask: 0xff, reference: 0 }
 }
 
+/// The state of a counting draw.
+#[must_use]
+pub fn counting_state(counting: VolumeCounting) -> RasterState {
+    RasterState { depth: Some(DepthState::LESS_READ), stencil: Some(stencil_state(counting)), ..RasterState::default() }
+}
+
+/// One instance's volume in the G-buffer's clip space, to be drawn whole or a run of pieces at a time:
+/// sides, and for z-fail the near caps on the G-buffer's own clip-space vertices and the far caps at
+/// infinity.
+pub struct ClipVolume<'a> {
+    sides: Vec<[Vec4; 3]>,
+    /// The G-buffer's clip-space vertices of the instance.
+    near: &'a [Vec4],
+    /// The mesh's vertices projected to infinity.
+    far: Vec<Vec4>,
+    /// Caps cast as wound, and cast turned around, as the mesh winds them.
+    forward: Vec<[u32; 3]>,
+    reversed: Vec<[u32; 3]>,
+    /// The forward caps re-wound, for the far cap.
+    far_forward: Vec<[u32; 3]>,
+    mirrored: bool,
+}
+
+/// Runs of a volume's sides, forward caps and reversed caps (a [`VolumePiece`]'s, or several's).
+pub type Runs = [Range<usize>; 3];
+
+impl<'a> ClipVolume<'a> {
+    /// The volume `iv` of `frame` in `g`'s clip space; with `caps` false, the sides alone.
+    #[must_use]
+    pub fn new(frame: &FrameInputs, g: &'a GBuffer, iv: &InstanceVolume, caps: bool) -> Self {
+        let inst = &frame.instances[iv.instance];
+        let vol = &iv.volume;
+        let clip_from_local: Mat4 = g.clip_from_world * inst.world_from_local;
+        let sides = vol.sides.iter().map(|t| t.map(|v| clip_from_local * v)).collect();
+        let tris = inst.mesh.triangles();
+        let pick = |ids: &[u32], reverse: bool| -> Vec<[u32; 3]> {
+            ids.iter().map(|&f| tris[f as usize]).map(|[a, b, c]| if reverse { [a, c, b] } else { [a, b, c] }).collect()
+        };
+        let (forward, reversed, far_forward, far) = if caps {
+            let light = vol.light;
+            let far = inst.mesh.positions().iter().map(|&p| clip_from_local * light.extrude(p)).collect();
+            (pick(&vol.caps_forward, false), pick(&vol.caps_reversed, false), pick(&vol.caps_forward, true), far)
+        } else {
+            Default::default()
+        };
+        Self {
+            sides,
+            near: &g.clip_vertices[iv.instance],
+            far,
+            forward,
+            reversed,
+            far_forward,
+            mirrored: inst.mirrored,
+        }
+    }
+
+    /// All of it.
+    #[must_use]
+    pub fn whole(&self) -> Runs {
+        [0..self.sides.len(), 0..self.forward.len(), 0..self.reversed.len()]
+    }
+
+    /// The volume cut down to the given runs, in order.
+    #[must_use]
+    pub fn gathered(&self, runs: &[Runs]) -> Self {
+        let gather = |all: &[[u32; 3]], k: usize| runs.iter().flat_map(|r| all[r[k].clone()].iter().copied()).collect();
+        Self {
+            sides: runs.iter().flat_map(|r| self.sides[r[0].clone()].iter().copied()).collect(),
+            near: self.near,
+            far: self.far.clone(),
+            forward: gather(&self.forward, 1),
+            reversed: gather(&self.reversed, 2),
+            far_forward: gather(&self.far_forward, 1),
+            mirrored: self.mirrored,
+        }
+    }
+
+    /// The draws of the runs `[sides, forward caps, reversed caps]`: the sides, then the near caps (in
+    /// the mesh's own winding; faces cast turned around are drawn with front and back swapped rather
+    /// than re-wound, so their depths stay bit-identical to the G-buffer's), then the far caps (forward
+    /// ones re-wound). Empty runs give empty draws.
+    #[must_use]
+    pub fn draws(&self, [sides, forward, reversed]: Runs) -> [VolumeDraw<'_>; 5] {
+        let flip = self.mirrored;
+        let indexed =
+            |positions, triangles, flip| VolumeDraw::Caps(Indexed { positions, triangles, prim_base: 0, flip });
+        [
+            VolumeDraw::Sides(Soup { triangles: &self.sides[sides], prim_base: 0, flip }),
+            indexed(self.near, &self.forward[forward.clone()], flip),
+            indexed(self.near, &self.reversed[reversed.clone()], !flip),
+            indexed(&self.far, &self.far_forward[forward], flip),
+            indexed(&self.far, &self.reversed[reversed], flip),
+        ]
+    }
+}
+
+/// One draw of a [`ClipVolume`].
+pub enum VolumeDraw<'a> {
+    /// Sides, corner by corner.
+    Sides(Soup<'a>),
+    /// Caps, indexed into the near or the far vertices.
+    Caps(Indexed<'a>),
+}
+
+impl VolumeDraw<'_> {
+    /// As a triangle source.
+    #[must_use]
+    pub fn source(&self) -> &dyn TriangleSource {
+        match self {
+            Self::Sides(s) => s,
+            Self::Caps(c) => c,
+        }
+    }
+}
+
 /// Rasterizes shadow volumes into the stencil of `ds` (which holds the G-buffer depth): sides, and for
-/// z-fail the near caps from the G-buffer's own clip-space vertices and the far caps at infinity; only
-/// the pixels of `mask` when one is given (`hybrid`).
+/// z-fail the caps ([`ClipVolume`]); only the pixels of `mask` when one is given (`hybrid`).
 pub fn rasterize_volumes(
     frame: &FrameInputs,
     g: &GBuffer,
@@ -73,38 +189,14 @@ pub fn rasterize_volumes(
     ds: &mut DepthStencil,
     mask: Option<&ComputationMask>,
 ) -> RasterCounters {
-    let state = RasterState {
-        depth: Some(DepthState::LESS_READ),
-        stencil: Some(stencil_state(counting)),
-        ..RasterState::default()
-    };
-    let draw = |ds: &mut DepthStencil, src: &dyn TriangleSource| draw_depth_masked(ds, src, &state, mask);
+    let state = counting_state(counting);
     let mut c = RasterCounters::default();
     for iv in volumes {
-        let inst = &frame.instances[iv.instance];
-        let vol = &iv.volume;
-        let clip_from_local: Mat4 = g.clip_from_world * inst.world_from_local;
-        let sides: Vec<[Vec4; 3]> = vol.sides.iter().map(|t| t.map(|v| clip_from_local * v)).collect();
-        c += draw(ds, &Soup { triangles: &sides, prim_base: 0, flip: inst.mirrored });
-        if counting == VolumeCounting::ZPass {
-            continue;
+        let caps = counting == VolumeCounting::ZFail;
+        let clip = ClipVolume::new(frame, g, iv, caps);
+        for d in &clip.draws(clip.whole())[..if caps { 5 } else { 1 }] {
+            c += draw_depth_masked(ds, d.source(), &state, mask);
         }
-        let tris = inst.mesh.triangles();
-        let pick = |ids: &[u32], reverse: bool| -> Vec<[u32; 3]> {
-            ids.iter().map(|&f| tris[f as usize]).map(|[a, b, c]| if reverse { [a, c, b] } else { [a, b, c] }).collect()
-        };
-        let (fwd, rev) = (pick(&vol.caps_forward, false), pick(&vol.caps_reversed, false));
-        // Near caps: the G-buffer's vertices, in the mesh's own winding; faces cast turned around are drawn
-        // with front and back swapped rather than re-wound, so their depths stay bit-identical.
-        let near = &g.clip_vertices[iv.instance];
-        c += draw(ds, &Indexed { positions: near, triangles: &fwd, prim_base: 0, flip: inst.mirrored });
-        c += draw(ds, &Indexed { positions: near, triangles: &rev, prim_base: 0, flip: !inst.mirrored });
-        // Far caps: the same faces projected to infinity, forward ones reversed.
-        let light = vol.light;
-        let far: Vec<Vec4> = inst.mesh.positions().iter().map(|&p| clip_from_local * light.extrude(p)).collect();
-        let far_fwd = pick(&vol.caps_forward, true);
-        c += draw(ds, &Indexed { positions: &far, triangles: &far_fwd, prim_base: 0, flip: inst.mirrored });
-        c += draw(ds, &Indexed { positions: &far, triangles: &rev, prim_base: 0, flip: inst.mirrored });
     }
     c
 }
