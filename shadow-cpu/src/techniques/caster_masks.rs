@@ -21,12 +21,12 @@
 use std::time::Instant;
 
 use rayon::prelude::*;
+use shadow_core::FrameInputs;
 use shadow_core::frame::InstanceVolume;
-use shadow_core::glam::{Vec2, Vec3};
+use shadow_core::glam::{Vec2, Vec3, Vec4, Vec4Swizzles};
 use shadow_core::light::{LightProjection, LightView};
 use shadow_core::stats::ms;
 use shadow_core::technique::hard::VolumeCounting;
-use shadow_core::{Aabb, FrameInputs};
 
 use super::shadow_volume::{ClipVolume, Runs, counting_state};
 use crate::gbuffer::GBuffer;
@@ -36,13 +36,19 @@ use crate::raster::{ComputationMask, DepthStencil, ListedDraw, RasterCounters, c
 /// larger ones go through the whole mask (measured on tree and cubes, see the README).
 const LISTED_TESTS: usize = 1 << 16;
 
-/// Where a piece's shadow can lie in one light projection: light-space bounds of its box, and the least
-/// distance of the box from the light.
+/// Where a piece's shadow can lie in one light projection: the light-space bounds of its finite corners
+/// along x, y and both diagonals (an 8-sided outline, so a twig lying across the light's view gets a
+/// narrow strip rather than its bounding square), and their least distance from the light.
 #[derive(Clone, Copy, Debug)]
 struct Shaft {
-    lo: Vec2,
-    hi: Vec2,
+    lo: Vec4,
+    hi: Vec4,
     near: f32,
+}
+
+/// A light-space position `(x, y)` along x, y and both diagonals: `(x, y, x + y, x - y)`.
+fn outline(xy: Vec2) -> Vec4 {
+    Vec4::new(xy.x, xy.y, xy.x + xy.y, xy.x - xy.y)
 }
 
 /// A point in a projection's light space: `(x / d, y / d)` for a perspective light, `(x, y)` for an
@@ -54,7 +60,7 @@ fn light_coords(proj: &LightProjection, p: Vec3) -> Option<(Vec2, f32)> {
     if proj.orthographic { Some((Vec2::new(v.x, v.y), d)) } else { (d > 0.0).then(|| (Vec2::new(v.x, v.y) / d, d)) }
 }
 
-/// The shafts of every piece of every volume, per projection (`None` where the box reaches the light's
+/// The shafts of every piece of every volume, per projection (`None` where a corner reaches the light's
 /// plane: the piece may then shadow any pixel of that projection).
 #[derive(Default)]
 pub struct CasterShafts {
@@ -67,19 +73,34 @@ impl CasterShafts {
     #[must_use]
     pub fn new(frame: &FrameInputs, light: &LightView, volumes: &[InstanceVolume]) -> Self {
         let shafts = volumes
-            .iter()
+            .par_iter()
             .map(|iv| {
-                let world_from_local = frame.instances[iv.instance].world_from_local;
-                iv.volume
-                    .pieces
+                let inst = &frame.instances[iv.instance];
+                let (tris, positions) = (inst.mesh.triangles(), inst.mesh.positions());
+                let vol = &iv.volume;
+                vol.pieces
                     .iter()
                     .map(|piece| {
-                        // Widened for the rounding of the transforms (the vertices themselves lie in it).
-                        let b = piece.bounds;
+                        // The piece's finite corners: its caps' (every silhouette edge borders a casting
+                        // face), or its sides' without caps.
+                        let caps = vol.caps_forward[piece.caps_forward.start as usize..piece.caps_forward.end as usize]
+                            .iter()
+                            .chain(
+                                &vol.caps_reversed
+                                    [piece.caps_reversed.start as usize..piece.caps_reversed.end as usize],
+                            );
+                        let mut corners: Vec<Vec3> =
+                            caps.flat_map(|&f| tris[f as usize].map(|v| positions[v as usize])).collect();
+                        if corners.is_empty() {
+                            let sides = &vol.sides[piece.sides.start as usize..piece.sides.end as usize];
+                            corners = sides.iter().flatten().filter(|v| v.w != 0.0).map(|v| v.truncate()).collect();
+                        }
+                        let world: Vec<Vec3> =
+                            corners.iter().map(|&c| inst.world_from_local.transform_point3(c)).collect();
+                        // Widened for the rounding of the transforms.
+                        let b = piece.bounds.transformed(inst.world_from_local);
                         let pad = 1e-5 * (b.size().length() + b.min.abs().max(b.max.abs()).max_element());
-                        let b = Aabb::new(b.min - pad, b.max + pad);
-                        let corners = b.corners().map(|c| world_from_local.transform_point3(c));
-                        light.projections.iter().map(|proj| shaft(proj, &corners)).collect()
+                        light.projections.iter().map(|proj| shaft(proj, &world, pad)).collect()
                     })
                     .collect()
             })
@@ -88,13 +109,21 @@ impl CasterShafts {
     }
 }
 
-fn shaft(proj: &LightProjection, corners: &[Vec3; 8]) -> Option<Shaft> {
-    let mut s = Shaft { lo: Vec2::INFINITY, hi: Vec2::NEG_INFINITY, near: f32::INFINITY };
+/// The shaft of `corners` (world space) in `proj`, widened by `pad` world units.
+fn shaft(proj: &LightProjection, corners: &[Vec3], pad: f32) -> Option<Shaft> {
+    let mut s = Shaft { lo: Vec4::INFINITY, hi: Vec4::NEG_INFINITY, near: f32::INFINITY };
     for &c in corners {
         let (xy, d) = light_coords(proj, c)?;
-        (s.lo, s.hi, s.near) = (s.lo.min(xy), s.hi.max(xy), s.near.min(d));
+        let o = outline(xy);
+        (s.lo, s.hi, s.near) = (s.lo.min(o), s.hi.max(o), s.near.min(d));
     }
-    Some(s)
+    // Corners this close to a perspective light's plane do not bound its view.
+    if !proj.orthographic && s.near <= pad {
+        return None;
+    }
+    let side = if proj.orthographic { pad } else { pad / s.near };
+    let widen = Vec4::new(side, side, 2.0 * side, 2.0 * side);
+    Some(Shaft { lo: s.lo - widen, hi: s.hi + widen, near: s.near - pad })
 }
 
 /// How far, in world units, the point a pixel's count is taken at may lie from its G-buffer position, at
@@ -110,6 +139,8 @@ fn tolerance(r: f32, near: f32) -> f32 {
 #[derive(Clone, Copy)]
 struct LightPixel {
     xy: Vec2,
+    /// `outline(xy)`.
+    dop: Vec4,
     d: f32,
     /// Its tolerance in light space: sideways (in `xy`'s units) and along the light.
     side: f32,
@@ -142,8 +173,10 @@ impl Grid {
         }
         // A pixel within its tolerance of a shaft lies in the shaft widened by the widest tolerance, so
         // the pieces of the pixel's own cell are all it needs to test.
-        let cells: Vec<_> =
-            shafts.iter().map(|s| s.as_ref().map(|s| grid.cell_range(s.lo - widest, s.hi + widest))).collect();
+        let cells: Vec<_> = shafts
+            .iter()
+            .map(|s| s.as_ref().map(|s| grid.cell_range(s.lo.xy() - widest, s.hi.xy() + widest)))
+            .collect();
         for ((x0, x1), (y0, y1)) in cells.iter().flatten() {
             for y in *y0..=*y1 {
                 for x in *x0..=*x1 {
@@ -186,7 +219,8 @@ impl Grid {
 
 /// Whether a pixel lies within its tolerance of a shaft.
 fn in_shaft(s: &Shaft, p: &LightPixel) -> bool {
-    p.d >= s.near - p.along && p.xy.cmpge(s.lo - p.side).all() && p.xy.cmple(s.hi + p.side).all()
+    let tol = Vec4::new(p.side, p.side, 2.0 * p.side, 2.0 * p.side);
+    p.d >= s.near - p.along && p.dop.cmpge(s.lo - tol).all() && p.dop.cmple(s.hi + tol).all()
 }
 
 /// Per piece, the silhouette pixels its shadow may hold, ascending. `pixels` are the mask's in target
@@ -332,6 +366,7 @@ fn light_pixels(light: &LightView, g: &GBuffer, mask: &ComputationMask) -> Vec<(
                     let tol = tolerance(p.distance(eye), near);
                     let pixel = light_coords(proj, p).map(|(xy, d)| LightPixel {
                         xy,
+                        dop: outline(xy),
                         d,
                         side: if proj.orthographic { 2.0 * tol } else { 2.0 * tol / d },
                         along: tol,
