@@ -54,6 +54,20 @@ fn compare_texel(map: &Image<f32>, x: i32, y: i32, depth: f32) -> f32 {
     if depth <= *map.get_clamped(x, y) { 1.0 } else { 0.0 }
 }
 
+/// Texels `(x, y)`, `(x + 1, y)`, `(x, y + 1)` and `(x + 1, y + 1)`, clamped to the edge: read straight
+/// from the rows inside the map (nearly every lookup), through [`Image::get_clamped`] at its border.
+#[inline]
+fn texels_2x2(map: &Image<f32>, x: i32, y: i32) -> [f32; 4] {
+    let (w, h) = (map.width() as i32, map.height() as i32);
+    if x >= 0 && y >= 0 && x + 1 < w && y + 1 < h {
+        let at = (y * w + x) as usize;
+        let (top, bottom) = (&map.data()[at..at + 2], &map.data()[at + w as usize..at + w as usize + 2]);
+        [top[0], top[1], bottom[0], bottom[1]]
+    } else {
+        [(x, y), (x + 1, y), (x, y + 1), (x + 1, y + 1)].map(|(x, y)| *map.get_clamped(x, y))
+    }
+}
+
 /// Comparison against the texel holding `uv` (WGSL twin: `compare_nearest`).
 #[must_use]
 pub fn compare_nearest(map: &Image<f32>, uv: Vec2, depth: f32) -> f32 {
@@ -168,13 +182,10 @@ pub fn classify(map: &Image<f32>, uv: Vec2, depth: f32, faces_light: bool) -> Ma
     }
     let st = uv * map.width() as f32 - Vec2::splat(0.5);
     let (x, y) = (st.x.floor() as i32, st.y.floor() as i32);
-    let lit = compare_texel(map, x, y, depth)
-        + compare_texel(map, x + 1, y, depth)
-        + compare_texel(map, x, y + 1, depth)
-        + compare_texel(map, x + 1, y + 1, depth);
+    let lit = texels_2x2(map, x, y).iter().filter(|&&texel| depth <= texel).count();
     match lit {
-        4.0 => MapClass::Lit,
-        0.0 => MapClass::Shadowed,
+        4 => MapClass::Lit,
+        0 => MapClass::Shadowed,
         _ if faces_light => MapClass::Silhouette,
         _ => MapClass::Shadowed,
     }
@@ -253,6 +264,33 @@ mod tests {
     /// A 4x4 map: the left half at depth 0.2 (an occluder), the right half at 1.0.
     fn half_map() -> Image<f32> {
         Image::from_fn(4, 4, |x, _| if x < 2 { 0.2 } else { 1.0 })
+    }
+
+    #[test]
+    fn classification_reads_the_four_texels_clamped_to_the_edge() {
+        // Against the four clamped comparisons written out, over a map with a texel of its own everywhere,
+        // at positions across the whole map, its border and just outside it.
+        let map = Image::from_fn(7, 7, |x, y| ((x * 5 + y * 3) % 7) as f32 / 7.0);
+        for i in 0..=160 {
+            for j in 0..=160 {
+                let uv = Vec2::new(i as f32, j as f32) / 160.0 * 1.02 - Vec2::splat(0.01);
+                for depth in [0.1, 0.45, 0.8] {
+                    let st = uv * 7.0 - Vec2::splat(0.5);
+                    let (x, y) = (st.x.floor() as i32, st.y.floor() as i32);
+                    let lit: f32 = [(x, y), (x + 1, y), (x, y + 1), (x + 1, y + 1)]
+                        .map(|(x, y)| compare_texel(&map, x, y, depth))
+                        .iter()
+                        .sum();
+                    let want = match lit {
+                        _ if uv.x < 0.0 || uv.x > 1.0 || uv.y < 0.0 || uv.y > 1.0 => MapClass::Lit,
+                        4.0 => MapClass::Lit,
+                        0.0 => MapClass::Shadowed,
+                        _ => MapClass::Silhouette,
+                    };
+                    assert_eq!(classify(&map, uv, depth, true), want, "uv {uv}, depth {depth}");
+                }
+            }
+        }
     }
 
     #[test]
