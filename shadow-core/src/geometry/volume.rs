@@ -107,61 +107,85 @@ impl ShadowVolume {
 #[must_use]
 pub fn extrude(adj: &Adjacency, silhouette: &Silhouette, light: LightSource, caps: Caps) -> ShadowVolume {
     let p = adj.positions();
-    let component = adj.components();
     let directional = matches!(light, LightSource::Directional(_));
-    let per_quad = if directional { 1 } else { 2 };
-    // Edges and casting faces bucketed by component (a counting sort keeps each bucket in input order).
-    let components = adj.component_bounds().len();
-    let face_component = |f: usize| component[f] as usize;
-    let cast = |w: i8| caps == Caps::Both && w != 0;
-    let mut counts = vec![[0u32; 3]; components + 1];
-    for e in &silhouette.edges {
-        counts[face_component(e.face as usize) + 1][0] += e.weight * per_quad;
-    }
-    for (f, &w) in silhouette.face_weights.iter().enumerate().filter(|&(_, &w)| cast(w)) {
-        counts[face_component(f) + 1][if w > 0 { 1 } else { 2 }] += 1;
-    }
-    for k in 1..=components {
-        let before = counts[k - 1];
-        for (c, b) in counts[k].iter_mut().zip(before) {
-            *c += b;
-        }
-    }
-    let starts = counts.clone();
-    let mut next = counts;
-    let mut sides = vec![[Vec4::ZERO; 3]; next[components][0] as usize];
+    let mut sides = Vec::with_capacity(silhouette.weighted_len() * if directional { 1 } else { 2 });
+    // The face each side comes from, for the grouping below.
+    let mut side_faces = Vec::with_capacity(sides.capacity());
     for e in &silhouette.edges {
         let (a, b) = (p[e.a as usize], p[e.b as usize]);
         let (a4, b4, a_inf, b_inf) = (a.extend(1.0), b.extend(1.0), light.extrude(a), light.extrude(b));
-        let at = &mut next[face_component(e.face as usize)][0];
         for _ in 0..e.weight {
             // The outward quad (b, a, a_inf, b_inf); with parallel light a_inf = b_inf and it is one triangle.
-            sides[*at as usize] = [b4, a4, a_inf];
-            *at += 1;
+            sides.push([b4, a4, a_inf]);
             if !directional {
-                sides[*at as usize] = [b4, a_inf, b_inf];
-                *at += 1;
+                sides.push([b4, a_inf, b_inf]);
+            }
+        }
+        side_faces.resize(sides.len(), e.face);
+    }
+    let (mut caps_forward, mut caps_reversed) = (Vec::new(), Vec::new());
+    if caps == Caps::Both {
+        for (f, &w) in silhouette.face_weights.iter().enumerate() {
+            match w {
+                1 => caps_forward.push(f as u32),
+                -1 => caps_reversed.push(f as u32),
+                _ => {}
             }
         }
     }
-    let mut caps_forward = vec![0; next[components][1] as usize];
-    let mut caps_reversed = vec![0; next[components][2] as usize];
-    for (f, &w) in silhouette.face_weights.iter().enumerate().filter(|&(_, &w)| cast(w)) {
-        let (list, j) = if w > 0 { (&mut caps_forward, 1) } else { (&mut caps_reversed, 2) };
-        let at = &mut next[face_component(f)][j];
-        list[*at as usize] = f as u32;
-        *at += 1;
+    let bounds = adj.component_bounds();
+    let whole = |n: usize| 0..n as u32;
+    if bounds.len() <= 1 {
+        let anything = !sides.is_empty() || !caps_forward.is_empty() || !caps_reversed.is_empty();
+        let pieces = anything
+            .then(|| VolumePiece {
+                sides: whole(sides.len()),
+                caps_forward: whole(caps_forward.len()),
+                caps_reversed: whole(caps_reversed.len()),
+                bounds: bounds.first().copied().unwrap_or_default(),
+            })
+            .into_iter()
+            .collect();
+        return ShadowVolume { sides, caps_forward, caps_reversed, light, pieces };
     }
-    let pieces = (0..components)
-        .filter(|&k| starts[k] != starts[k + 1])
+    let component = |f: u32| adj.components()[f as usize] as usize;
+    let (sides, side_runs) = by_component(&sides, bounds.len(), |i, _| component(side_faces[i]));
+    let (caps_forward, forward_runs) = by_component(&caps_forward, bounds.len(), |_, &f| component(f));
+    let (caps_reversed, reversed_runs) = by_component(&caps_reversed, bounds.len(), |_, &f| component(f));
+    let pieces = (0..bounds.len())
         .map(|k| VolumePiece {
-            sides: starts[k][0]..starts[k + 1][0],
-            caps_forward: starts[k][1]..starts[k + 1][1],
-            caps_reversed: starts[k][2]..starts[k + 1][2],
-            bounds: adj.component_bounds()[k],
+            sides: side_runs[k]..side_runs[k + 1],
+            caps_forward: forward_runs[k]..forward_runs[k + 1],
+            caps_reversed: reversed_runs[k]..reversed_runs[k + 1],
+            bounds: bounds[k],
         })
+        .filter(|p| !p.sides.is_empty() || !p.caps_forward.is_empty() || !p.caps_reversed.is_empty())
         .collect();
     ShadowVolume { sides, caps_forward, caps_reversed, light, pieces }
+}
+
+/// `items` grouped by their component (`component(index, item)`, below `n`), each group in input order
+/// (a counting sort), with where each component's run starts (`n + 1` entries).
+fn by_component<T: Copy + Default>(
+    items: &[T],
+    n: usize,
+    component: impl Fn(usize, &T) -> usize,
+) -> (Vec<T>, Vec<u32>) {
+    let mut starts = vec![0u32; n + 1];
+    for (i, t) in items.iter().enumerate() {
+        starts[component(i, t) + 1] += 1;
+    }
+    for k in 0..n {
+        starts[k + 1] += starts[k];
+    }
+    let mut next = starts.clone();
+    let mut out = vec![T::default(); items.len()];
+    for (i, t) in items.iter().enumerate() {
+        let at = &mut next[component(i, t)];
+        out[*at as usize] = *t;
+        *at += 1;
+    }
+    (out, starts)
 }
 
 #[cfg(test)]
