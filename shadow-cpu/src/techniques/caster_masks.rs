@@ -2,15 +2,15 @@
 //! connected component's shadow volume is counted only at the silhouette pixels its shadow can hold.
 //!
 //! A component's volume is closed by itself ([`shadow_core::geometry::volume::VolumePiece`]), so its count
-//! is zero at every point outside it, and every point inside lies behind the component as the light sees
-//! it: within the light-space bounds of the component's box and farther from the light than the box's
-//! nearest corner. A silhouette pixel outside those bounds (widened by its own depth and position
-//! precision, see [`tolerance`]) would only ever get increments that cancel, so the piece is not drawn
-//! there. Among a tree's thousand twigs or a cloud of cubes, a piece's volume crosses many silhouette
+//! is zero at every point outside it. Every point inside lies on a ray from the light through one of the
+//! component's casting faces, beyond it: in light space (where rays from the light are points) within the
+//! convex hull of those faces' corners, so within any outline of the corners, and farther from the light
+//! than the nearest corner. A silhouette pixel outside that shaft (widened by the pixel's own depth and
+//! position precision, see `tolerance`) would only ever get increments that cancel, so the piece is not
+//! drawn there. Among a tree's thousand twigs or a cloud of cubes, a piece's volume crosses many silhouette
 //! pixels on screen (the shadows of the others, seen through it) and can shadow only a few.
 //!
-//! Per frame: each piece's shaft (the light-space bounds of its box, per light projection) goes into the
-//! cells of a grid over the silhouette pixels' light-space positions; each pixel tests the pieces of its
+//! Per frame: each piece's shaft (per light projection) goes into the cells of a grid over the silhouette pixels' light-space positions; each pixel tests the pieces of its
 //! cell and joins the lists of those whose shaft holds it. A piece with no pixel is skipped; a short list
 //! is counted pixel by pixel ([`count_listed`]); a piece whose list times its triangles is large (the
 //! ground, a big single mesh) is drawn through the whole mask as before.
@@ -287,7 +287,6 @@ pub struct CasterStats {
 
 /// Counts the z-fail volumes through `mask`, each piece only at the silhouette pixels its shadow can hold
 /// (see the module notes); the same stencil as [`super::shadow_volume::rasterize_volumes`] under the mask.
-#[allow(clippy::too_many_arguments)]
 pub fn count_volumes(
     frame: &FrameInputs,
     light: &LightView,

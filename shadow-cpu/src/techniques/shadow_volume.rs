@@ -87,7 +87,8 @@ pub struct ClipVolume<'a> {
     mirrored: bool,
 }
 
-/// Runs of a volume's sides, forward caps and reversed caps (a [`VolumePiece`]'s, or several's).
+/// Runs of a volume's sides, forward caps and reversed caps (one
+/// [`shadow_core::geometry::volume::VolumePiece`]'s, or several's).
 pub type Runs = [Range<usize>; 3];
 
 impl<'a> ClipVolume<'a> {
