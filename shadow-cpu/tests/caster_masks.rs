@@ -1,7 +1,7 @@
 //! `hybrid`'s caster masks (each connected component's volume counted only at the silhouette pixels its
 //! shadow's bounds hold) change no pixel: the visibility is bit-identical to the whole mask's on every
-//! built-in scene and under point and directional lights, with far fewer fragments where many casters'
-//! volumes cross each other's shadows.
+//! built-in scene and under point, spot and directional lights, some among the casters, with far fewer
+//! fragments where many casters' volumes cross each other's shadows.
 
 use shadow_core::glam::Vec3;
 use shadow_core::scenes::{self, SceneParams};
@@ -33,13 +33,21 @@ fn caster_masks_change_no_pixel() {
             name.to_string(),
             FrameInputs::from_scene(&s, s.cameras().next().expect("camera").0).expect("frame"),
         ));
+        // Lights inside the casters (six cube faces, pieces across their planes; a spot light's plane
+        // through the cloud), and a directional light over the tree.
+        let inside = Vec3::new(0.3, 2.2, 0.4);
         let extra = match name {
-            // A point light inside the cloud (six cube faces), and a directional light over the tree.
-            "cubes" => Some(("point light inside", Light::point(Vec3::new(0.3, 2.2, 0.4)))),
-            "tree" => Some(("directional light", Light::directional(Vec3::new(-1.0, -3.0, -2.0)))),
-            _ => None,
+            "cubes" => vec![
+                ("point light inside", Light::point(inside)),
+                ("spot light inside", Light::spot(inside, inside - Vec3::Y, 120.0)),
+            ],
+            "tree" => vec![
+                ("directional light", Light::directional(Vec3::new(-1.0, -3.0, -2.0))),
+                ("point light in the branches", Light::point(Vec3::new(0.0, 1.8, 0.0))),
+            ],
+            _ => Vec::new(),
         };
-        if let Some((what, light)) = extra {
+        for (what, light) in extra {
             cases.push((format!("{name}, {what}"), FrameInputs::new(&s, cam, vec![light]).expect("frame")));
         }
     }

@@ -366,6 +366,32 @@ mod tests {
     }
 
     #[test]
+    fn components_are_joined_by_edges_not_by_vertices() {
+        // Two cubes touching at one corner, and a pair of triangles sharing only a vertex (a bowtie): four
+        // components, numbered in order of first appearance, each bounding its own faces.
+        let a = procedural::cuboid(Vec3::ONE);
+        let b = procedural::cuboid(Vec3::ONE).transformed(glam::Mat4::from_translation(Vec3::ONE));
+        let bowtie = Mesh::new(
+            vec![
+                Vec3::new(5.0, 0.0, 0.0),
+                Vec3::new(6.0, 0.0, 0.0),
+                Vec3::new(5.5, 1.0, 0.0),
+                Vec3::new(6.0, 2.0, 0.0),
+                Vec3::new(5.0, 2.0, 0.0),
+            ],
+            vec![[0, 1, 2], [2, 3, 4]],
+        )
+        .expect("bowtie");
+        let adj = Adjacency::build(&Mesh::merged(&[a, b, bowtie]).expect("three parts"));
+        let faces = adj.components();
+        assert_eq!(adj.component_bounds().len(), 4);
+        assert!(faces[..12].iter().all(|&c| c == 0) && faces[12..24].iter().all(|&c| c == 1));
+        assert_eq!(&faces[24..], &[2, 3]);
+        assert_eq!(adj.component_bounds()[1], Aabb::new(Vec3::splat(0.5), Vec3::splat(1.5)));
+        assert_eq!(adj.component_bounds()[3], Aabb::new(Vec3::new(5.0, 1.0, 0.0), Vec3::new(6.0, 2.0, 0.0)));
+    }
+
+    #[test]
     fn plane_has_boundary() {
         let adj = Adjacency::build(&procedural::plane(2.0, 2.0));
         assert_eq!(adj.boundary_edge_count(), 4);
