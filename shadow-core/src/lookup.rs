@@ -201,7 +201,7 @@ pub fn near_edge(edges: &Image<f32>, uv: Vec2, depth: f32) -> bool {
     }
     let st = uv * edges.width() as f32 - Vec2::splat(0.5);
     let (x, y) = (st.x.floor() as i32, st.y.floor() as i32);
-    [(0, 0), (1, 0), (0, 1), (1, 1)].iter().any(|(dx, dy)| *edges.get_clamped(x + dx, y + dy) < depth - EDGE_MARGIN)
+    texels_2x2(edges, x, y).iter().any(|&edge| edge < depth - EDGE_MARGIN)
 }
 
 /// How much nearer the light than a receiver (NDC depth) an edge must be to count in [`near_edge`]: a
@@ -267,7 +267,7 @@ mod tests {
     }
 
     #[test]
-    fn classification_reads_the_four_texels_clamped_to_the_edge() {
+    fn classification_and_edges_read_the_four_texels_clamped_to_the_edge() {
         // Against the four clamped comparisons written out, over a map with a texel of its own everywhere,
         // at positions across the whole map, its border and just outside it.
         let map = Image::from_fn(7, 7, |x, y| ((x * 5 + y * 3) % 7) as f32 / 7.0);
@@ -288,6 +288,11 @@ mod tests {
                         _ => MapClass::Silhouette,
                     };
                     assert_eq!(classify(&map, uv, depth, true), want, "uv {uv}, depth {depth}");
+                    // The same texels read as an edge map.
+                    let near = [(x, y), (x + 1, y), (x, y + 1), (x + 1, y + 1)]
+                        .iter()
+                        .any(|&(x, y)| *map.get_clamped(x, y) < depth - EDGE_MARGIN);
+                    assert_eq!(near_edge(&map, uv, depth), on_map(uv) && near, "uv {uv}, depth {depth}");
                 }
             }
         }
