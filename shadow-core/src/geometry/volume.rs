@@ -109,8 +109,9 @@ pub fn extrude(adj: &Adjacency, silhouette: &Silhouette, light: LightSource, cap
     let p = adj.positions();
     let directional = matches!(light, LightSource::Directional(_));
     let mut sides = Vec::with_capacity(silhouette.weighted_len() * if directional { 1 } else { 2 });
-    // The face each side comes from, for the grouping below.
-    let mut side_faces = Vec::with_capacity(sides.capacity());
+    // The face each side comes from, for the grouping below (meshes of one component need none).
+    let grouped = adj.component_bounds().len() > 1;
+    let mut side_faces = Vec::with_capacity(if grouped { sides.capacity() } else { 0 });
     for e in &silhouette.edges {
         let (a, b) = (p[e.a as usize], p[e.b as usize]);
         let (a4, b4, a_inf, b_inf) = (a.extend(1.0), b.extend(1.0), light.extrude(a), light.extrude(b));
@@ -121,7 +122,9 @@ pub fn extrude(adj: &Adjacency, silhouette: &Silhouette, light: LightSource, cap
                 sides.push([b4, a_inf, b_inf]);
             }
         }
-        side_faces.resize(sides.len(), e.face);
+        if grouped {
+            side_faces.resize(sides.len(), e.face);
+        }
     }
     let (mut caps_forward, mut caps_reversed) = (Vec::new(), Vec::new());
     if caps == Caps::Both {
@@ -135,7 +138,7 @@ pub fn extrude(adj: &Adjacency, silhouette: &Silhouette, light: LightSource, cap
     }
     let bounds = adj.component_bounds();
     let whole = |n: usize| 0..n as u32;
-    if bounds.len() <= 1 {
+    if !grouped {
         let anything = !sides.is_empty() || !caps_forward.is_empty() || !caps_reversed.is_empty();
         let pieces = anything
             .then(|| VolumePiece {

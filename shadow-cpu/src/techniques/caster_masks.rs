@@ -67,48 +67,44 @@ fn light_coords(proj: &LightProjection, p: Vec3) -> Option<(Vec2, f32)> {
 /// plane: the piece may then shadow any pixel of that projection).
 #[derive(Default)]
 pub struct CasterShafts {
-    /// Per volume, per piece, per projection.
-    shafts: Vec<Vec<Vec<Option<Shaft>>>>,
+    /// Every piece as (volume, piece within it), in volume order.
+    pieces: Vec<(usize, usize)>,
+    /// Per piece, per projection.
+    shafts: Vec<Vec<Option<Shaft>>>,
 }
 
 impl CasterShafts {
     /// The shafts of `volumes` for `light`.
     #[must_use]
     pub fn new(frame: &FrameInputs, light: &LightView, volumes: &[InstanceVolume]) -> Self {
-        let shafts = volumes
+        let pieces: Vec<(usize, usize)> =
+            volumes.iter().enumerate().flat_map(|(v, iv)| (0..iv.volume.pieces.len()).map(move |p| (v, p))).collect();
+        let shafts = pieces
             .par_iter()
-            .map(|iv| {
+            .map(|&(v, p)| {
+                let iv = &volumes[v];
                 let inst = &frame.instances[iv.instance];
                 let (tris, positions) = (inst.mesh.triangles(), inst.mesh.positions());
-                let vol = &iv.volume;
-                vol.pieces
+                let (vol, piece) = (&iv.volume, &iv.volume.pieces[p]);
+                let at = |m: Vec3| inst.world_from_local.transform_point3(m);
+                // The piece's finite corners, in world space: its caps' (every silhouette edge borders a
+                // casting face), or its sides' without caps.
+                let caps = vol.caps_forward[piece.caps_forward.start as usize..piece.caps_forward.end as usize]
                     .iter()
-                    .map(|piece| {
-                        // The piece's finite corners: its caps' (every silhouette edge borders a casting
-                        // face), or its sides' without caps.
-                        let caps = vol.caps_forward[piece.caps_forward.start as usize..piece.caps_forward.end as usize]
-                            .iter()
-                            .chain(
-                                &vol.caps_reversed
-                                    [piece.caps_reversed.start as usize..piece.caps_reversed.end as usize],
-                            );
-                        let mut corners: Vec<Vec3> =
-                            caps.flat_map(|&f| tris[f as usize].map(|v| positions[v as usize])).collect();
-                        if corners.is_empty() {
-                            let sides = &vol.sides[piece.sides.start as usize..piece.sides.end as usize];
-                            corners = sides.iter().flatten().filter(|v| v.w != 0.0).map(|v| v.truncate()).collect();
-                        }
-                        let world: Vec<Vec3> =
-                            corners.iter().map(|&c| inst.world_from_local.transform_point3(c)).collect();
-                        // Widened for the rounding of the transforms.
-                        let b = piece.bounds.transformed(inst.world_from_local);
-                        let pad = 1e-5 * (b.size().length() + b.min.abs().max(b.max.abs()).max_element());
-                        light.projections.iter().map(|proj| shaft(proj, &world, pad)).collect()
-                    })
-                    .collect()
+                    .chain(&vol.caps_reversed[piece.caps_reversed.start as usize..piece.caps_reversed.end as usize]);
+                let mut corners: Vec<Vec3> =
+                    caps.flat_map(|&f| tris[f as usize].map(|v| at(positions[v as usize]))).collect();
+                if corners.is_empty() {
+                    let sides = &vol.sides[piece.sides.start as usize..piece.sides.end as usize];
+                    corners = sides.iter().flatten().filter(|v| v.w != 0.0).map(|v| at(v.truncate())).collect();
+                }
+                // Widened for the rounding of the transforms.
+                let b = piece.bounds.transformed(inst.world_from_local);
+                let pad = 1e-5 * (b.size().length() + b.min.abs().max(b.max.abs()).max_element());
+                light.projections.iter().map(|proj| shaft(proj, &corners, pad)).collect()
             })
             .collect();
-        Self { shafts }
+        Self { pieces, shafts }
     }
 }
 
@@ -298,9 +294,8 @@ pub fn count_volumes(
 ) -> (RasterCounters, CasterStats) {
     let t = Instant::now();
     let pixels = light_pixels(light, g, mask);
-    let pieces: Vec<(usize, usize)> =
-        volumes.iter().enumerate().flat_map(|(v, iv)| (0..iv.volume.pieces.len()).map(move |p| (v, p))).collect();
-    let piece_shafts: Vec<&[Option<Shaft>]> = pieces.iter().map(|&(v, p)| shafts.shafts[v][p].as_slice()).collect();
+    let pieces = &shafts.pieces;
+    let piece_shafts: Vec<&[Option<Shaft>]> = shafts.shafts.iter().map(Vec::as_slice).collect();
     let lists = piece_lists(&pixels, &piece_shafts);
     let listing_ms = ms(t.elapsed());
     let clips: Vec<ClipVolume> = volumes.par_iter().map(|iv| ClipVolume::new(frame, g, iv, true)).collect();
