@@ -204,6 +204,44 @@ pub fn near_edge(edges: &Image<f32>, uv: Vec2, depth: f32) -> bool {
     texels_2x2(edges, x, y).iter().any(|&edge| edge < depth - EDGE_MARGIN)
 }
 
+/// The cell of an [`edge_cells`](crate::geometry::edge_map::edge_cells) map of a map of side `res` that
+/// holds `uv`: the square between the four texels a lookup at `uv` reads, `(0, 0)` to `(res, res)` for
+/// `uv` on the map.
+#[inline]
+#[must_use]
+pub fn cell_of(res: u32, uv: Vec2) -> (u32, u32) {
+    let st = uv * res as f32 + Vec2::splat(0.5);
+    let cell = |v: f32| (v.floor().max(0.0) as u32).min(res);
+    (cell(st.x), cell(st.y))
+}
+
+/// Whether two silhouette edges or more nearer the light than `depth` (by [`EDGE_MARGIN`]) enter the
+/// square between the four texels of `map` nearest `uv`, where Chan's rule may miss a sliver, a gap or a
+/// corner between them (`hybrid`'s `edge_texels=paired`; `cells` from
+/// [`edge_cells`](crate::geometry::edge_map::edge_cells), side one more than `map`'s; WGSL twin:
+/// `near_edge` in hybrid_edges.wgsl). Outside the map, no.
+///
+/// Not where the edges are hidden: when all four texels hold a surface nearer the light than the nearest
+/// of the edges (by [`EDGE_MARGIN`]), those surfaces cover the whole square in front of the edges, since
+/// nothing nearer has an edge inside it that could end them. This leaves out most of a cloud of casters'
+/// crossings, those behind other casters. It holds as long as a surface's depth changes across the square
+/// by less than the map's bias adds to it: the slope-scaled bias (twice the depth change per texel, by
+/// default, against at most 0.71 texels from the square's centre to a corner) sees to that; with
+/// `bias=none`, light through a sub-texel hole in a steeply tilted caster could be missed.
+#[must_use]
+pub fn near_edge_pair(cells: &Image<f32>, map: &Image<f32>, uv: Vec2, depth: f32) -> bool {
+    if !on_map(uv) {
+        return false;
+    }
+    let (x, y) = cell_of(map.width(), uv);
+    let nearest = *cells.get(x, y);
+    if nearest >= depth - EDGE_MARGIN {
+        return false;
+    }
+    let texels = texels_2x2(map, x as i32 - 1, y as i32 - 1);
+    !texels.iter().all(|&t| t < nearest - EDGE_MARGIN)
+}
+
 /// How much nearer the light than a receiver (NDC depth) an edge must be to count in [`near_edge`]: a
 /// surface's own rim lies at the depth of its silhouette edge, where which of the two rounds nearer differs
 /// between backends by a few ulps; a caster that shadows the receiver is orders of magnitude nearer.

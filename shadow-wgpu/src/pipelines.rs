@@ -80,6 +80,12 @@ pub fn depth_array_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
     texture_entry(binding, wgpu::TextureSampleType::Depth, wgpu::TextureViewDimension::D2Array)
 }
 
+/// A float 2D-array texture binding read with `textureLoad` (hybrid's edge cells).
+#[must_use]
+pub fn float_array_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    texture_entry(binding, wgpu::TextureSampleType::Float { filterable: false }, wgpu::TextureViewDimension::D2Array)
+}
+
 /// A depth 2D texture binding (one layer), read with `textureLoad`.
 #[must_use]
 pub fn depth_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {

@@ -4,6 +4,8 @@
 
 use std::fmt::Write;
 
+use shadow_core::technique::hard::EdgeTexels;
+
 const COMMON: &str = include_str!("shaders/common.wgsl");
 
 /// `common.wgsl` + `body`.
@@ -60,8 +62,12 @@ pub fn silhouette_query() -> String {
 
 /// Hybrid maps and volumes: the classification, the mask and the answer, after the shadow-map shader.
 #[must_use]
-pub fn hybrid(edge_texels: bool, tile_marks: bool) -> String {
-    let edges = if edge_texels { include_str!("shaders/hybrid_edges.wgsl") } else { NEAR_EDGE_OFF };
+pub fn hybrid(edge_texels: EdgeTexels, tile_marks: bool) -> String {
+    let edges = match edge_texels {
+        EdgeTexels::Off => NEAR_EDGE_OFF,
+        EdgeTexels::All => include_str!("shaders/hybrid_edges.wgsl"),
+        EdgeTexels::Paired => include_str!("shaders/hybrid_edge_pairs.wgsl"),
+    };
     let tiles = if tile_marks { TILE_MARKS } else { TILE_MARKS_OFF };
     with_shadow_map(&format!("{edges}\n{tiles}\n{}", include_str!("shaders/hybrid.wgsl")))
 }
@@ -117,8 +123,9 @@ pub fn all() -> Vec<(&'static str, String)> {
         ("depth_layers", depth_layers()),
         ("silhouette_build", silhouette_build()),
         ("silhouette_query", silhouette_query()),
-        ("hybrid", hybrid(false, false)),
-        ("hybrid edge_texels, tile marks", hybrid(true, true)),
+        ("hybrid", hybrid(EdgeTexels::Off, false)),
+        ("hybrid edge_texels=all, tile marks", hybrid(EdgeTexels::All, true)),
+        ("hybrid edge_texels=paired", hybrid(EdgeTexels::Paired, false)),
         ("hybrid edge pass", HYBRID_EDGE_PASS.to_string()),
     ]
 }

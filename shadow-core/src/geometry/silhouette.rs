@@ -15,12 +15,10 @@
 //! A silhouette edge `a -> b` runs the way the casting faces run along it after they were turned towards
 //! the light; [`crate::geometry::volume`] extrudes it into the outward-facing quad `(b, a, a_inf, b_inf)`.
 
-use glam::{Vec3, Vec4};
 use rayon::prelude::*;
 
 use super::LightSource;
 use super::adjacency::{Adjacency, FaceUse};
-use crate::light::LightProjection;
 
 /// An oriented silhouette edge in welded vertices, with its multiplicity.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -137,64 +135,6 @@ pub fn silhouette(adj: &Adjacency, light: LightSource, mode: CastMode) -> Silhou
     Silhouette { edges, face_weights }
 }
 
-/// The texels of an `res x res` map of projection `proj` that world segments cross, as
-/// clip-space triangles for a rasterizer: each segment's projection thickened and lengthened by half a
-/// texel's diagonal, so every texel whose square it touches has its centre covered (`hybrid`'s
-/// `edge_texels`). Corners carry their end's NDC depth, so a depth test "less" keeps the nearest edge in
-/// each texel. Segments are first clipped to the view (its near plane, and a few texels past its sides),
-/// so no rasterizer sees coordinates far outside it (cube faces see edges that pass behind them).
-#[must_use]
-pub fn edge_texel_quads(segments: &[[Vec3; 2]], proj: &LightProjection, res: u32) -> Vec<[Vec4; 3]> {
-    // Clip w is the distance along the axis in a perspective view, 1 in an orthographic one.
-    let near_w = if proj.orthographic { 0.0 } else { proj.near };
-    let reach = std::f32::consts::SQRT_2 / res as f32; // half a texel's diagonal, in NDC (2 / res a texel)
-    let side = 1.0 + 4.0 * reach;
-    let mut out = Vec::with_capacity(segments.len() * 2);
-    for [a, b] in segments {
-        let (ca, cb) = (proj.clip_from_world * a.extend(1.0), proj.clip_from_world * b.extend(1.0));
-        // Liang-Barsky: each plane k . p >= 0 keeps a range of t along ca + t (cb - ca).
-        let planes = [
-            Vec4::W,
-            Vec4::new(-1.0, 0.0, 0.0, side),
-            Vec4::new(1.0, 0.0, 0.0, side),
-            Vec4::new(0.0, -1.0, 0.0, side),
-            Vec4::new(0.0, 1.0, 0.0, side),
-        ];
-        let (mut t0, mut t1) = (0.0f32, 1.0f32);
-        for (k, plane) in planes.iter().enumerate() {
-            let offset = if k == 0 { near_w } else { 0.0 };
-            let (da, db) = (plane.dot(ca) - offset, plane.dot(cb) - offset);
-            if da < 0.0 && db < 0.0 {
-                t0 = 1.0;
-                t1 = 0.0;
-                break;
-            }
-            if da < 0.0 {
-                t0 = t0.max(da / (da - db));
-            } else if db < 0.0 {
-                t1 = t1.min(da / (da - db));
-            }
-        }
-        if t0 > t1 {
-            continue;
-        }
-        let (pa, pb) = (ca.lerp(cb, t0), ca.lerp(cb, t1));
-        let (na, nb) = (pa.truncate() / pa.w, pb.truncate() / pb.w);
-        let along = (nb - na).truncate().try_normalize().unwrap_or(glam::Vec2::X) * reach;
-        let across = along.perp();
-        let corner = |p: Vec3, d: glam::Vec2| Vec4::new(p.x + d.x, p.y + d.y, p.z.clamp(0.0, 1.0), 1.0);
-        let quad = [
-            corner(na, -along - across),
-            corner(nb, along - across),
-            corner(nb, along + across),
-            corner(na, -along + across),
-        ];
-        out.push([quad[0], quad[1], quad[2]]);
-        out.push([quad[0], quad[2], quad[3]]);
-    }
-    out
-}
-
 #[cfg(test)]
 mod tests {
     use std::collections::HashMap;
@@ -279,46 +219,5 @@ mod tests {
         let shared = s.edges.iter().find(|e| (e.a.min(e.b), e.a.max(e.b)) == (0, 1)).unwrap();
         assert_eq!(shared.weight, 2);
         assert!(net_flow(&s.edges).values().all(|&f| f == 0));
-    }
-
-    #[test]
-    fn edge_quads_cover_every_texel_a_segment_touches() {
-        // A diagonal segment across a 16^2 map seen straight on (clip = world): every texel whose square it
-        // crosses has its centre inside one of the quads, at the segment's depth.
-        let res = 16;
-        let seg = [Vec3::new(-0.7, -0.3, 0.25), Vec3::new(0.6, 0.45, 0.25)];
-        let proj = LightProjection {
-            view_from_world: glam::Mat4::IDENTITY,
-            clip_from_view: glam::Mat4::IDENTITY,
-            clip_from_world: glam::Mat4::IDENTITY,
-            clip_plane_from_world_plane: glam::Mat4::IDENTITY,
-            near: 0.0,
-            far: 1.0,
-            orthographic: true,
-        };
-        let tris = edge_texel_quads(&[seg], &proj, res);
-        assert_eq!(tris.len(), 2);
-        let inside = |p: glam::Vec2, t: &[Vec4; 3]| {
-            let c = t.map(|v| v.truncate().truncate());
-            let side = |a: glam::Vec2, b: glam::Vec2| (b - a).perp_dot(p - a);
-            let s = [side(c[0], c[1]), side(c[1], c[2]), side(c[2], c[0])];
-            s.iter().all(|&v| v >= 0.0) || s.iter().all(|&v| v <= 0.0)
-        };
-        let texel = 2.0 / res as f32;
-        for j in 0..res {
-            for i in 0..res {
-                let lo = glam::Vec2::new(-1.0 + i as f32 * texel, -1.0 + j as f32 * texel);
-                // The segment meets the square when its samples come within it.
-                let touches = (0..=1000).any(|k| {
-                    let p = seg[0].lerp(seg[1], k as f32 / 1000.0).truncate();
-                    p.cmpge(lo).all() && p.cmple(lo + texel).all()
-                });
-                let centre = lo + glam::Vec2::splat(texel / 2.0);
-                if touches {
-                    assert!(tris.iter().any(|t| inside(centre, t)), "texel ({i}, {j}) missed");
-                }
-            }
-        }
-        assert!(tris.iter().flatten().all(|v| v.z == 0.25 && v.w == 1.0));
     }
 }

@@ -12,6 +12,11 @@
 //! everywhere else, so the stencil and the picture are the whole mask's, at a fraction of the fragments
 //! where the volumes of many casters cross each other's shadows on screen (cubes, tree, crowd).
 //!
+//! With `edge_texels=paired` (the default; ours) a receiver facing the light is a silhouette pixel too
+//! where two silhouette edges in front of it enter the square between its four texels and may cut off a
+//! part of it that holds none of them (`edge_cells`, `near_edge_pair`): a branch, a gap or a corner thinner
+//! than a texel, which Chan's rule misses; `all` masks every receiver whose texels an edge crosses.
+//!
 //! With `pencil=on` the mask's pixels are also ordered around the light's image
 //! (`ComputationMask::ordered_around`), for the volumes still drawn through the whole mask: every volume
 //! side lies on lines through it, so a side, a sliver hundreds of rows long, is tested only at the few
@@ -28,12 +33,12 @@
 
 use rayon::prelude::*;
 use shadow_core::frame::InstanceVolume;
-use shadow_core::geometry::silhouette::edge_texel_quads;
+use shadow_core::geometry::edge_map::{edge_cells, edge_texel_quads};
 use shadow_core::geometry::volume::Caps;
 use shadow_core::light::LightView;
-use shadow_core::lookup::{MapClass, PixelClass, classify, near_edge};
+use shadow_core::lookup::{MapClass, PixelClass, classify, near_edge, near_edge_pair};
 use shadow_core::stats::ms;
-use shadow_core::technique::hard::{Hybrid, VolumeCounting};
+use shadow_core::technique::hard::{EdgeTexels, Hybrid, VolumeCounting};
 use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
 use shadow_core::{FrameInputs, Image};
 use std::time::Instant;
@@ -50,7 +55,7 @@ use crate::raster::{ComputationMask, CullMode, DepthState, DepthStencil, RasterS
 #[derive(Default)]
 pub struct State {
     maps: Vec<Image<f32>>,
-    /// With `edge_texels=on`: per projection, the nearest silhouette edge's depth in each texel.
+    /// With `edge_texels` on: per projection, the edge map (`edge_maps`).
     edge_maps: Vec<Image<f32>>,
     volumes: Option<Vec<InstanceVolume>>,
     /// With `caster_masks=on`: where each volume piece's shadow can lie.
@@ -79,11 +84,13 @@ impl LastQuery {
     }
 }
 
-/// The map's class of every receiver pixel (`Lit` elsewhere), rows in parallel; with `edge_maps`, a
-/// receiver facing the light near an edge in front of it is a silhouette pixel too.
+/// The map's class of every receiver pixel (`Lit` elsewhere), rows in parallel; with `edge_maps` (of
+/// `edge_texels`), a receiver facing the light near an edge in front of it, or an edge pair, is a
+/// silhouette pixel too.
 fn classify_receivers(
     maps: &[Image<f32>],
     edge_maps: &[Image<f32>],
+    edge_texels: EdgeTexels,
     light: &LightView,
     g: &GBuffer,
     receiver_offset: f32,
@@ -100,17 +107,39 @@ fn classify_receivers(
             // Asked only where it decides: most receivers' four texels agree.
             let faces_light = || g.geometric_normal.data()[i].dot(light.light.to_light(p)) > 0.0;
             let m = map_position(light, p, receiver_offset);
-            *class = match classify(&maps[m.projection], m.uv, m.depth, true) {
+            let map = &maps[m.projection];
+            *class = match classify(map, m.uv, m.depth, true) {
                 MapClass::Silhouette if !faces_light() => MapClass::Shadowed,
                 class => class,
             };
-            let edges = edge_maps.get(m.projection);
-            if *class != MapClass::Silhouette && edges.is_some_and(|e| near_edge(e, m.uv, m.depth)) && faces_light() {
+            let near = |e: &Image<f32>| match edge_texels {
+                EdgeTexels::Paired => near_edge_pair(e, map, m.uv, m.depth),
+                _ => near_edge(e, m.uv, m.depth),
+            };
+            if *class != MapClass::Silhouette && edge_maps.get(m.projection).is_some_and(near) && faces_light() {
                 *class = MapClass::Silhouette;
             }
         }
     });
     classes
+}
+
+/// The edge maps of `edge_texels`, one per projection of `light`: with `all`, the silhouette edges'
+/// texel quads drawn into a map of the nearest edge's depth per texel; with `paired`, their cells
+/// (`edge_cells`).
+fn edge_maps(frame: &FrameInputs, light: &LightView, res: u32, mode: EdgeTexels) -> Vec<Image<f32>> {
+    let segments = frame.silhouette_segments(light);
+    let nearest = RasterState { cull: CullMode::None, depth: Some(DepthState::LESS_WRITE), ..RasterState::default() };
+    let edge_map = |p| match mode {
+        EdgeTexels::Paired => edge_cells(&segments, p, res),
+        _ => {
+            let quads = edge_texel_quads(&segments, p, res);
+            let mut ds = DepthStencil::new(res, res, 1.0, 0);
+            draw_depth(&mut ds, &Soup { triangles: &quads, prim_base: 0, flip: false }, &nearest);
+            ds.into_depth_image()
+        }
+    };
+    light.projections.iter().map(edge_map).collect()
 }
 
 impl ShadowTechnique<CpuBackend> for Hybrid {
@@ -133,19 +162,11 @@ impl ShadowTechnique<CpuBackend> for Hybrid {
         stats: &mut FrameStats,
     ) -> Result<(), CpuError> {
         render_depth_maps(frame, light, self.depth.resolution, self.depth.depth_bias(), &mut state.maps)?;
-        state.edge_maps.clear();
-        if self.edge_texels.is_on() {
-            let segments = frame.silhouette_segments(light);
-            let res = self.depth.resolution;
-            let state_ds =
-                RasterState { cull: CullMode::None, depth: Some(DepthState::LESS_WRITE), ..RasterState::default() };
-            for p in &light.projections {
-                let quads = edge_texel_quads(&segments, p, res);
-                let mut ds = DepthStencil::new(res, res, 1.0, 0);
-                draw_depth(&mut ds, &Soup { triangles: &quads, prim_base: 0, flip: false }, &state_ds);
-                state.edge_maps.push(ds.into_depth_image());
-            }
-        }
+        state.edge_maps = if self.edge_texels.is_on() {
+            edge_maps(frame, light, self.depth.resolution, self.edge_texels)
+        } else {
+            Vec::new()
+        };
         let volumes = build_volumes(frame, light, Caps::Both, stats);
         state.shafts =
             if self.caster_masks.is_on() { CasterShafts::new(frame, light, &volumes) } else { CasterShafts::default() };
@@ -169,7 +190,8 @@ impl ShadowTechnique<CpuBackend> for Hybrid {
         }
         let (w, h) = (g.width(), g.height());
         let t = Instant::now();
-        let map_class = classify_receivers(&state.maps, &state.edge_maps, light, g, self.depth.receiver_offset());
+        let map_class =
+            classify_receivers(&state.maps, &state.edge_maps, self.edge_texels, light, g, self.depth.receiver_offset());
         let silhouette = |x, y| *map_class.get(x, y) == MapClass::Silhouette;
         let mut mask = ComputationMask::from_fn(w, h, self.mask_tile, silhouette);
         if self.pencil.is_on() {

@@ -30,9 +30,11 @@
 //! them (measured in the README: on an H100 from 0.63 to 1.56 times z-fail's query, against 0.67 to 1.30
 //! without).
 //!
-//! With `edge_texels=on` (both backends) the build also draws the casters' silhouette edges into edge
+//! With `edge_texels=all` (both backends) the build also draws the casters' silhouette edges into edge
 //! maps, and the classification masks every receiver facing the light whose texels an edge nearer than it
-//! crosses (hybrid_edges.wgsl), so casters thinner than a texel still get volumes.
+//! crosses (hybrid_edges.wgsl), so casters thinner than a texel still get volumes; with `paired`, only
+//! where two edges enter the square between its four texels and may hide something there (the edge
+//! cells, made by shared code on the CPU and uploaded; hybrid_edge_pairs.wgsl).
 //!
 //! The map's classification runs twice, in the mask pass on every pixel and in the answer outside the
 //! mask: a full-screen pass can write a colour or set the stencil for the pixels it keeps, but not both
@@ -46,7 +48,7 @@
 mod edges;
 mod tiles;
 
-use edges::{edge_maps, edge_pass};
+use edges::{edge_cell_maps, edge_maps, edge_pass};
 use tiles::TileMarks;
 
 use shadow_core::FrameInputs;
@@ -54,7 +56,7 @@ use shadow_core::Image;
 use shadow_core::geometry::volume::Caps;
 use shadow_core::light::LightView;
 use shadow_core::lookup::PixelClass;
-use shadow_core::technique::hard::{GpuMask, Hybrid, ShadowMap, VolumeCounting};
+use shadow_core::technique::hard::{EdgeTexels, GpuMask, Hybrid, ShadowMap, VolumeCounting};
 use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
 
 use super::shadow_map::{LookupParams, MapBindings, QueryExtras};
@@ -66,7 +68,8 @@ use crate::context::{WgpuBackend, WgpuContext, WgpuError};
 use crate::frame::GpuVisibility;
 use crate::gbuffer::GpuGBuffer;
 use crate::pipelines::{
-    DEPTH_STENCIL, FragmentEntry, VISIBILITY, attribute_entry, buffer_entry, depth_array_entry, full_screen_pipeline,
+    DEPTH_STENCIL, FragmentEntry, VISIBILITY, attribute_entry, buffer_entry, depth_array_entry, float_array_entry,
+    full_screen_pipeline,
 };
 use crate::{readback, shaders};
 
@@ -98,8 +101,8 @@ pub struct State {
     far: Option<wgpu::RenderPipeline>,
     /// With `scissor_tile` above 0: the tile marks, at the last view's grid.
     tiles: Option<TileMarks>,
-    /// With `edge_texels=on`: the pass drawing the edge quads, and the edge maps of the last build (a
-    /// layer per projection, the nearest edge's depth per texel).
+    /// With `edge_texels=all`: the pass drawing the edge quads. The edge maps of the last build, a layer
+    /// per projection: with `all` the nearest edge's depth per texel, with `paired` the edge cells.
     edge_pass: Option<wgpu::RenderPipeline>,
     edge_maps: Option<wgpu::Texture>,
     last: Option<LastQuery>,
@@ -277,13 +280,15 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
     fn create_state(&self, cx: &mut WgpuContext) -> Result<State, WgpuError> {
         let map = <ShadowMap as ShadowTechnique<WgpuBackend>>::create_state(&self.depth, cx)?;
         cx.scoped("creating the hybrid pipelines", |cx| {
-            let source = shaders::hybrid(self.edge_texels.is_on(), self.scissor_tile > 0);
+            let source = shaders::hybrid(self.edge_texels, self.scissor_tile > 0);
             let module = shaders::module(&cx.device, "hybrid", source);
             let volume_module = shaders::module(&cx.device, "shadow_volume", shaders::shadow_volume());
             let gpu_mask = self.gpu_mask;
             let mut extras = vec![attribute_entry(4)];
-            if self.edge_texels.is_on() {
-                extras.push(depth_array_entry(6));
+            match self.edge_texels {
+                EdgeTexels::Off => {}
+                EdgeTexels::All => extras.push(depth_array_entry(6)),
+                EdgeTexels::Paired => extras.push(float_array_entry(6)),
             }
             if self.scissor_tile > 0 {
                 let marks = wgpu::BufferBindingType::Storage { read_only: false };
@@ -336,7 +341,7 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
                 scratch: None,
                 far,
                 tiles: None,
-                edge_pass: self.edge_texels.is_on().then(|| edge_pass(cx)),
+                edge_pass: (self.edge_texels == EdgeTexels::All).then(|| edge_pass(cx)),
                 edge_maps: None,
                 last: None,
             }
@@ -352,9 +357,11 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
         stats: &mut FrameStats,
     ) -> Result<(), WgpuError> {
         self.depth.build(cx, &mut state.map, frame, light, stats)?;
+        let res = self.depth.resolution;
         if let Some(pass) = &state.edge_pass {
-            let maps = cx.scoped("the edge maps", |cx| edge_maps(cx, pass, frame, light, self.depth.resolution))?;
-            state.edge_maps = Some(maps);
+            state.edge_maps = Some(cx.scoped("the edge maps", |cx| edge_maps(cx, pass, frame, light, res))?);
+        } else if self.edge_texels == EdgeTexels::Paired {
+            state.edge_maps = Some(cx.scoped("the edge cells", |cx| edge_cell_maps(cx, frame, light, res))?);
         }
         state.draws = Some(build_draws(cx, frame, light, Caps::Both, stats)?);
         Ok(())
@@ -385,7 +392,7 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
         });
         if let Some(view) = &edge_view {
             extras.push(wgpu::BindGroupEntry { binding: 6, resource: wgpu::BindingResource::TextureView(view) });
-        } else if state.edge_pass.is_some() {
+        } else if self.edge_texels.is_on() {
             return Err(not_built().into());
         }
         // The depth-stencil the passes run over: the G-buffer's, or for the depth mask a copy of it that

@@ -1,9 +1,9 @@
-//! hybrid's `edge_texels=on` on the GPU: the casters' silhouette edges drawn as texel-covering quads into
+//! hybrid's `edge_texels=all` on the GPU: the casters' silhouette edges drawn as texel-covering quads into
 //! edge maps, a layer per light projection holding the nearest edge's depth per texel (twin: shadow-cpu's
 //! hybrid build; the test that reads them is hybrid_edges.wgsl's `near_edge`).
 
 use shadow_core::FrameInputs;
-use shadow_core::geometry::silhouette::edge_texel_quads;
+use shadow_core::geometry::edge_map::{edge_cells, edge_texel_quads};
 use shadow_core::light::LightView;
 use wgpu::util::DeviceExt;
 
@@ -56,4 +56,30 @@ pub(super) fn edge_maps(
     }
     cx.queue.submit([enc.finish()]);
     maps
+}
+
+/// The edge cells of a light (`edge_texels=paired`): per projection, shadow-core's `edge_cells` of the
+/// casters' silhouette edges, made on the CPU as the edge quads are and uploaded as a layer of an
+/// `(res + 1)` square float array (twin: shadow-cpu's hybrid build; read by hybrid_edge_pairs.wgsl's
+/// `near_edge`).
+pub(super) fn edge_cell_maps(cx: &WgpuContext, frame: &FrameInputs, light: &LightView, res: u32) -> wgpu::Texture {
+    let segments = frame.silhouette_segments(light);
+    let cells: Vec<f32> =
+        light.projections.iter().flat_map(|p| edge_cells(&segments, p, res).data().to_vec()).collect();
+    let desc = wgpu::TextureDescriptor {
+        label: Some("hybrid edge cells"),
+        size: wgpu::Extent3d { width: res + 1, height: res + 1, depth_or_array_layers: light.projections.len() as u32 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::R32Float,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING,
+        view_formats: &[],
+    };
+    cx.device.create_texture_with_data(
+        &cx.queue,
+        &desc,
+        wgpu::util::TextureDataOrder::LayerMajor,
+        bytemuck::cast_slice(&cells),
+    )
 }
