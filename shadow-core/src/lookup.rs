@@ -235,11 +235,15 @@ pub fn near_edge_pair(cells: &Image<f32>, map: &Image<f32>, uv: Vec2, depth: f32
     }
     let (x, y) = cell_of(map.width(), uv);
     let nearest = *cells.get(x, y);
-    if nearest >= depth - EDGE_MARGIN {
-        return false;
-    }
-    let texels = texels_2x2(map, x as i32 - 1, y as i32 - 1);
-    !texels.iter().all(|&t| t < nearest - EDGE_MARGIN)
+    nearest < depth - EDGE_MARGIN && !hidden(map, x, y, nearest)
+}
+
+/// Whether all four texels of `map` at the corners of cell `(x, y)` ([`cell_of`]) hold a surface nearer the
+/// light than `nearest` by [`EDGE_MARGIN`], hiding every edge of that depth or more in the cell
+/// ([`near_edge_pair`] says why).
+#[must_use]
+pub fn hidden(map: &Image<f32>, x: u32, y: u32, nearest: f32) -> bool {
+    texels_2x2(map, x as i32 - 1, y as i32 - 1).iter().all(|&t| t < nearest - EDGE_MARGIN)
 }
 
 /// How much nearer the light than a receiver (NDC depth) an edge must be to count in [`near_edge`]: a

@@ -12,8 +12,11 @@
 
 use glam::{DVec2, Vec2, Vec3, Vec4};
 
+use rayon::prelude::*;
+
 use crate::image::Image;
 use crate::light::LightProjection;
+use crate::lookup::hidden;
 
 /// A world segment clipped to a projection's view: its ends in NDC, and whether clipping cut each one.
 struct Clipped {
@@ -85,6 +88,9 @@ pub fn edge_texel_quads(segments: &[[Vec3; 2]], proj: &LightProjection, res: u32
     out
 }
 
+/// Stands for a cut end in a cell's first segments: never a segment [`may_hide`] can clear.
+const CUT: u32 = u32::MAX;
+
 /// How far past a square's sides a segment still counts as entering it, in texels: a segment along a
 /// texel row, or through a texel centre, touches the squares on both sides, whichever way rounding goes.
 const CELL_REACH: f32 = 1e-3;
@@ -98,24 +104,35 @@ const CELL_REACH: f32 = 1e-3;
 /// the light's near plane) counts as a second segment at its cell, since its loop's other segment through
 /// that end was cut elsewhere.
 ///
+/// With `map`, the classifying map, cells that [`hidden`] says are hidden behind the surfaces at their
+/// four texels are left out at once, as the lookup would leave them out (the GPU, whose map stays on the
+/// GPU, passes none and leaves them to the lookup).
+///
 /// Every cell a segment touches is visited once: row by row of cells, the columns its stretch in that
 /// row spans; the depth inside a cell comes from the segment's two ends there (NDC depth is affine along
 /// a projected segment).
 #[must_use]
-pub fn edge_cells(segments: &[[Vec3; 2]], proj: &LightProjection, res: u32) -> Image<f32> {
-    /// Stands for a cut end in a cell's first segments: never a segment [`may_hide`] can clear.
-    const CUT: u32 = u32::MAX;
+pub fn edge_cells(segments: &[[Vec3; 2]], proj: &LightProjection, res: u32, map: Option<&Image<f32>>) -> Image<f32> {
     let side = res + 1;
     let cells = (side * side) as usize;
+    // Per cell: the segments entering it (saturating), the least depth any has inside it, and the first two
+    // of them (indices into the clipped segments, or a cut end). Apart, so the walk's hot counts stay in
+    // cache.
     let (mut count, mut depth, mut first) = (vec![0u8; cells], vec![1.0f32; cells], vec![[CUT; 2]; cells]);
+    // The cells two segments or more enter, in the order they were reached.
+    let mut pairs: Vec<u32> = Vec::new();
     let mut enter = |x: i64, y: i64, z: f32, id: u32| {
         if (0..i64::from(side)).contains(&x) && (0..i64::from(side)).contains(&y) {
             let i = (y * i64::from(side) + x) as usize;
-            if let Some(slot) = first[i].get_mut(usize::from(count[i])) {
-                *slot = id;
+            let k = count[i];
+            if k < 2 {
+                first[i][usize::from(k)] = id;
             }
-            count[i] = count[i].saturating_add(1);
+            count[i] = k.saturating_add(1);
             depth[i] = depth[i].min(z.clamp(0.0, 1.0));
+            if k == 1 {
+                pairs.push(i as u32);
+            }
         }
     };
     // NDC to cell coordinates: cell (x, y) spans [x, x + 1] x [y, y + 1].
@@ -129,48 +146,66 @@ pub fn edge_cells(segments: &[[Vec3; 2]], proj: &LightProjection, res: u32) -> I
         let [a, b] = c.ends.map(to_cells);
         let id = kept.len() as u32;
         kept.push([a, b]);
-        let at = |t: f32| a.lerp(b, t);
-        // The parameters where `v(t)`, from `va` to `vb`, lies within [lo, hi].
-        let span = |va: f32, vb: f32, lo: f32, hi: f32| -> Option<(f32, f32)> {
-            if (vb - va).abs() < 1e-12 {
-                return (lo..=hi).contains(&va).then_some((0.0, 1.0));
-            }
-            let (s, t) = ((lo - va) / (vb - va), (hi - va) / (vb - va));
-            let (s, t) = (s.min(t).max(0.0), s.max(t).min(1.0));
-            (s <= t).then_some((s, t))
-        };
-        let cells =
-            |v: f32, w: f32| ((v.min(w) - CELL_REACH).floor() as i64)..=((v.max(w) + CELL_REACH).floor() as i64);
-        for y in cells(a.y, b.y) {
-            let Some((r0, r1)) = span(a.y, b.y, y as f32 - CELL_REACH, y as f32 + 1.0 + CELL_REACH) else {
-                continue;
-            };
-            for x in cells(at(r0).x, at(r1).x) {
-                let Some((s, t)) = span(a.x, b.x, x as f32 - CELL_REACH, x as f32 + 1.0 + CELL_REACH) else {
+        // Row by row: the stretch of the segment within the row (widened by CELL_REACH), then the cells
+        // its x range spans, each with the least depth over its part of the stretch (depth is affine in x
+        // along it).
+        let (dy, last) = (b.y - a.y, i64::from(side) - 1);
+        let rows = floor(a.y.min(b.y) - CELL_REACH).max(0)..=floor(a.y.max(b.y) + CELL_REACH).min(last);
+        for y in rows {
+            let (lo, hi) = (y as f32 - CELL_REACH, y as f32 + 1.0 + CELL_REACH);
+            let (p, q) = if dy.abs() < 1e-12 {
+                (a, b)
+            } else {
+                let (s, t) = ((lo - a.y) / dy, (hi - a.y) / dy);
+                let (s, t) = (s.min(t).max(0.0), s.max(t).min(1.0));
+                if s > t {
                     continue;
-                };
-                let (s, t) = (s.max(r0), t.min(r1));
-                if s <= t {
-                    enter(x, y, at(s).z.min(at(t).z), id);
                 }
+                (a.lerp(b, s), a.lerp(b, t))
+            };
+            let (p, q) = if p.x <= q.x { (p, q) } else { (q, p) };
+            let slope = if q.x - p.x > 1e-12 { (q.z - p.z) / (q.x - p.x) } else { 0.0 };
+            let z = |x: f32| p.z + (x.clamp(p.x, q.x) - p.x) * slope;
+            let columns = floor(p.x - CELL_REACH).max(0)..=floor(q.x + CELL_REACH).min(last);
+            for x in columns {
+                let (u, v) = (x as f32 - CELL_REACH, x as f32 + 1.0 + CELL_REACH);
+                enter(x, y, z(u).min(z(v)), id);
             }
         }
         for (end, cut) in [a, b].into_iter().zip(c.cut) {
             if cut {
-                enter(end.x.floor() as i64, end.y.floor() as i64, end.z, CUT);
+                enter(floor(end.x), floor(end.y), end.z, CUT);
             }
         }
     }
-    let value = |i: usize| {
-        let [s, t] = first[i];
-        let cleared = count[i] == 2 && s != CUT && t != CUT && {
-            let (x, y) = ((i % side as usize) as i64, (i / side as usize) as i64);
-            !may_hide(x, y, [kept[s as usize], kept[t as usize]])
-        };
-        if count[i] < 2 || cleared { 1.0 } else { depth[i] }
-    };
-    Image::from_vec(side, side, (0..cells).map(value).collect())
-        .unwrap_or_else(|| unreachable!("sized by construction"))
+    let marked: Vec<(u32, f32)> = pairs
+        .par_iter()
+        .filter_map(|&i| {
+            let (x, y, nearest) = (i % side, i / side, depth[i as usize]);
+            if map.is_some_and(|m| hidden(m, x, y, nearest)) {
+                return None;
+            }
+            let [s, t] = first[i as usize];
+            let cleared = count[i as usize] == 2
+                && s != CUT
+                && t != CUT
+                && !may_hide(i64::from(x), i64::from(y), [kept[s as usize], kept[t as usize]]);
+            (!cleared).then_some((i, nearest))
+        })
+        .collect();
+    let mut out = Image::new(side, side, 1.0f32);
+    for (i, depth) in marked {
+        out.data_mut()[i as usize] = depth;
+    }
+    out
+}
+
+/// `v.floor() as i64` without the libm call the float rounding makes on a plain x86-64 target (the cell
+/// walk's inner loop).
+#[inline]
+fn floor(v: f32) -> i64 {
+    let i = v as i64;
+    i - i64::from(i as f32 > v)
 }
 
 /// Whether two segments entering cell `(x, y)` (cell coordinates: it spans `[x, x + 1] x [y, y + 1]`, its
@@ -348,7 +383,7 @@ mod tests {
     fn one_segment_or_a_clean_crossing_marks_no_cell_and_a_narrow_crossing_does() {
         let res = 16;
         let a = [Vec3::new(-0.7, -0.3, 0.25), Vec3::new(0.6, 0.45, 0.5)];
-        let one = edge_cells(&[a], &straight_on(), res);
+        let one = edge_cells(&[a], &straight_on(), res, None);
         assert_eq!(one.width(), res + 1);
         assert!(one.data().iter().all(|&d| d == 1.0), "a lone straight segment hides nowhere");
         // Crossing a's line at right angles: the four parts at the crossing each hold a texel centre,
@@ -356,12 +391,12 @@ mod tests {
         let dir = (a[1] - a[0]).truncate().normalize().perp();
         let mid = (a[0] + a[1]) * 0.5;
         let across = [mid - (dir * 0.6).extend(0.0), mid + (dir * 0.6).extend(0.0)].map(|p| Vec3::new(p.x, p.y, 0.75));
-        let square = edge_cells(&[a, across], &straight_on(), res);
+        let square = edge_cells(&[a, across], &straight_on(), res, None);
         assert!(square.data().iter().filter(|&&d| d < 1.0).count() <= 1);
         // A line through a's crossing point at a tenth of a texel's angle: the thin wedges between them
         // miss every centre somewhere along the way.
         let narrow = [Vec3::new(-0.7, -0.3 - 0.02, 0.75), Vec3::new(0.6, 0.45 + 0.02, 0.75)];
-        let cells = edge_cells(&[a, narrow], &straight_on(), res);
+        let cells = edge_cells(&[a, narrow], &straight_on(), res, None);
         let marked: Vec<f32> = cells.data().iter().copied().filter(|&d| d < 1.0).collect();
         assert!(marked.len() >= 2, "{} cells", marked.len());
         // The nearer segment's depth there: a's, between its ends' 0.25 and 0.5.
@@ -375,12 +410,12 @@ mod tests {
         // A square loop many texels a side: each corner turns through two different sides of its cell.
         let corners = [Vec2::new(-0.51, -0.43), Vec2::new(0.47, -0.43), Vec2::new(0.47, 0.39), Vec2::new(-0.51, 0.39)];
         let seg = |k: usize| [corners[k].extend(0.5), corners[(k + 1) % 4].extend(0.5)];
-        let square = edge_cells(&[seg(0), seg(1), seg(2), seg(3)], &straight_on(), res);
+        let square = edge_cells(&[seg(0), seg(1), seg(2), seg(3)], &straight_on(), res, None);
         assert!(square.data().iter().all(|&d| d == 1.0));
         // A triangle's tip a tenth of a texel wide: its two sides leave the tip's cell through one side.
         let tip = [Vec3::new(0.2, 0.13, 0.5), Vec3::new(-0.6, 0.13 + 0.1 * texel, 0.5)];
         let back = [Vec3::new(-0.6, 0.13 - 0.1 * texel, 0.5), Vec3::new(0.2, 0.13, 0.5)];
-        let cells = edge_cells(&[tip, back], &straight_on(), res);
+        let cells = edge_cells(&[tip, back], &straight_on(), res, None);
         let long = (0.8 / texel).ceil() as usize;
         let marked = cells.data().iter().filter(|&&d| d < 1.0).count();
         assert!((long..=long + 2).contains(&marked), "{marked} cells along a sliver {long} cells long");
@@ -502,7 +537,7 @@ mod tests {
             ..straight_on()
         };
         let seg = [Vec3::new(0.3, 0.1, 0.2), Vec3::new(0.0, 0.0, -5.0)];
-        let cells = edge_cells(&[seg], &proj, 64);
+        let cells = edge_cells(&[seg], &proj, 64, None);
         let marked: Vec<f32> = cells.data().iter().copied().filter(|&d| d < 1.0).collect();
         assert_eq!(marked.len(), 1, "the cut end's cell alone");
         assert!(marked[0] < 0.05, "at the near plane's depth: {}", marked[0]);

@@ -28,8 +28,9 @@
 //! them `caster_pieces_skipped` (no silhouette pixel in their shadow) and `caster_pieces_listed` (counted
 //! at their own `caster_listed_pixels`), the rest drawn through the whole mask; `mask_tiles` and
 //! `mask_tiles_total`; with `unmasked_fill=on`, `unmasked_volume_fragments`, what `shadow-volume-zfail`
-//! rasterizes, from a second pass without the mask (timed as `count_fragments`). Sub-phases: `classify`
-//! (the map test and the mask), `caster_lists` (each piece's pixels) and `volumes` (lists included).
+//! rasterizes, from a second pass without the mask (timed as `count_fragments`). Sub-phases: `edge_maps`
+//! (in the build), `classify` (the map test and the mask), `caster_lists` (each piece's pixels) and
+//! `volumes` (lists included).
 
 use rayon::prelude::*;
 use shadow_core::frame::InstanceVolume;
@@ -127,11 +128,17 @@ fn classify_receivers(
 /// The edge maps of `edge_texels`, one per projection of `light`: with `all`, the silhouette edges'
 /// texel quads drawn into a map of the nearest edge's depth per texel; with `paired`, their cells
 /// (`edge_cells`).
-fn edge_maps(frame: &FrameInputs, light: &LightView, res: u32, mode: EdgeTexels) -> Vec<Image<f32>> {
+fn edge_maps(
+    frame: &FrameInputs,
+    light: &LightView,
+    maps: &[Image<f32>],
+    res: u32,
+    mode: EdgeTexels,
+) -> Vec<Image<f32>> {
     let segments = frame.silhouette_segments(light);
     let nearest = RasterState { cull: CullMode::None, depth: Some(DepthState::LESS_WRITE), ..RasterState::default() };
-    let edge_map = |p| match mode {
-        EdgeTexels::Paired => edge_cells(&segments, p, res),
+    let edge_map = |(p, map)| match mode {
+        EdgeTexels::Paired => edge_cells(&segments, p, res, Some(map)),
         _ => {
             let quads = edge_texel_quads(&segments, p, res);
             let mut ds = DepthStencil::new(res, res, 1.0, 0);
@@ -139,7 +146,7 @@ fn edge_maps(frame: &FrameInputs, light: &LightView, res: u32, mode: EdgeTexels)
             ds.into_depth_image()
         }
     };
-    light.projections.iter().map(edge_map).collect()
+    light.projections.iter().zip(maps).map(edge_map).collect()
 }
 
 impl ShadowTechnique<CpuBackend> for Hybrid {
@@ -162,11 +169,12 @@ impl ShadowTechnique<CpuBackend> for Hybrid {
         stats: &mut FrameStats,
     ) -> Result<(), CpuError> {
         render_depth_maps(frame, light, self.depth.resolution, self.depth.depth_bias(), &mut state.maps)?;
-        state.edge_maps = if self.edge_texels.is_on() {
-            edge_maps(frame, light, self.depth.resolution, self.edge_texels)
-        } else {
-            Vec::new()
-        };
+        state.edge_maps.clear();
+        if self.edge_texels.is_on() {
+            let t = Instant::now();
+            state.edge_maps = edge_maps(frame, light, &state.maps, self.depth.resolution, self.edge_texels);
+            stats.timings.extra.insert("edge_maps".into(), ms(t.elapsed()));
+        }
         let volumes = build_volumes(frame, light, Caps::Both, stats);
         state.shafts =
             if self.caster_masks.is_on() { CasterShafts::new(frame, light, &volumes) } else { CasterShafts::default() };

@@ -65,7 +65,7 @@ pub(super) fn edge_maps(
 pub(super) fn edge_cell_maps(cx: &WgpuContext, frame: &FrameInputs, light: &LightView, res: u32) -> wgpu::Texture {
     let segments = frame.silhouette_segments(light);
     let cells: Vec<f32> =
-        light.projections.iter().flat_map(|p| edge_cells(&segments, p, res).data().to_vec()).collect();
+        light.projections.iter().flat_map(|p| edge_cells(&segments, p, res, None).data().to_vec()).collect();
     let desc = wgpu::TextureDescriptor {
         label: Some("hybrid edge cells"),
         size: wgpu::Extent3d { width: res + 1, height: res + 1, depth_or_array_layers: light.projections.len() as u32 },
