@@ -116,8 +116,7 @@ pub fn edge_cells(segments: &[[Vec3; 2]], proj: &LightProjection, res: u32, map:
     let side = res + 1;
     let cells = (side * side) as usize;
     // Per cell: the segments entering it (saturating), the least depth any has inside it, and the first two
-    // of them (indices into the clipped segments, or a cut end). Apart, so the walk's hot counts stay in
-    // cache.
+    // of them (indices into the clipped segments, or a cut end), which the tests of pairs read.
     let (mut count, mut depth, mut first) = (vec![0u8; cells], vec![1.0f32; cells], vec![[CUT; 2]; cells]);
     // The cells two segments or more enter, in the order they were reached.
     let mut pairs: Vec<u32> = Vec::new();

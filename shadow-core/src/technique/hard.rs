@@ -686,8 +686,8 @@ pub struct Hybrid {
     /// Which receivers facing the light are also silhouette pixels because of the casters' silhouette
     /// edges (drawn into a map of edge depths), so casters and gaps thinner than a texel, which the map
     /// misses (Chan's Fig. 3-8), still get volumes; off: Chan's rule alone. `paired` by default (ours):
-    /// the only setting that keeps `tree` under 0.1% at 512^2, at about a third more silhouette pixels
-    /// than Chan's rule on cubes and tree, where `all` doubles them.
+    /// it keeps `tree` under 0.1% at 512^2 as `all` does, with a third more silhouette pixels than Chan's
+    /// rule on tree and nine tenths more on cubes, where `all` has twice and ten times as many.
     pub edge_texels: EdgeTexels,
     /// Whether the query also counts the volumes' unmasked fill (what `shadow-volume-zfail` rasterizes),
     /// the counter `unmasked_volume_fragments`, in a pass of its own timed as `count_fragments`; off, the
