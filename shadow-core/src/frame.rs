@@ -17,6 +17,7 @@ use crate::geometry::volume::{Caps, ShadowVolume, extrude};
 use crate::light::{LightView, LightViewError};
 use crate::mesh::Mesh;
 use crate::scene::{Camera, CameraKey, Light, MeshKey, NodeKey, Scene, SceneError};
+use crate::stats::Counters;
 
 /// One drawn mesh in world space.
 #[derive(Clone, Debug)]
@@ -58,6 +59,14 @@ pub struct InstanceVolume {
     pub volume: ShadowVolume,
     /// Number of silhouette edges (before weights).
     pub silhouette_edges: usize,
+}
+
+impl InstanceVolume {
+    /// Sets the counters a volume build reports, `silhouette_edges` and `volume_triangles`, from `volumes`.
+    pub fn count(volumes: &[Self], counters: &mut Counters) {
+        counters.silhouette_edges = Some(volumes.iter().map(|v| v.silhouette_edges as u64).sum());
+        counters.volume_triangles = Some(volumes.iter().map(|v| v.volume.triangle_count() as u64).sum());
+    }
 }
 
 /// Why a frame could not be assembled.
@@ -169,12 +178,28 @@ impl FrameInputs {
     pub fn shadow_volumes(&self, light: &LightView, caps: Caps) -> Vec<InstanceVolume> {
         self.silhouettes(light)
             .filter(|(i, ..)| self.instances[*i].casts_shadow)
-            .map(|(i, local_light, sil)| InstanceVolume {
-                instance: i,
-                silhouette_edges: sil.edges.len(),
-                volume: extrude(&self.instances[i].adjacency, &sil, local_light, caps),
-            })
+            .map(|(i, local_light, sil)| self.volume(i, local_light, &sil, caps))
             .collect()
+    }
+
+    /// [`Self::shadow_volumes`] and [`Self::silhouette_segments`] from one silhouette pass (`hybrid`'s edge
+    /// maps need both).
+    #[must_use]
+    pub fn shadow_volumes_and_segments(&self, light: &LightView, caps: Caps) -> (Vec<InstanceVolume>, Vec<[Vec3; 2]>) {
+        let (volumes, segments): (Vec<_>, Vec<_>) = self
+            .silhouettes(light)
+            .filter(|(i, ..)| self.instances[*i].casts_shadow)
+            .map(|(i, local_light, sil)| (self.volume(i, local_light, &sil, caps), self.world_segments(i, &sil)))
+            .unzip();
+        (volumes, segments.concat())
+    }
+
+    fn volume(&self, i: usize, local_light: LightSource, sil: &Silhouette, caps: Caps) -> InstanceVolume {
+        InstanceVolume {
+            instance: i,
+            silhouette_edges: sil.edges.len(),
+            volume: extrude(&self.instances[i].adjacency, sil, local_light, caps),
+        }
     }
 
     /// The silhouette of every casting instance for the light, in instance order: its index in
@@ -189,14 +214,15 @@ impl FrameInputs {
     /// (what silhouette maps rasterize; the edges' weights do not matter there).
     #[must_use]
     pub fn silhouette_segments(&self, light: &LightView) -> Vec<[Vec3; 2]> {
-        let per_instance: Vec<Vec<[Vec3; 2]>> = self
-            .silhouettes(light)
-            .map(|(i, _, sil)| {
-                let inst = &self.instances[i];
-                let at = |v: u32| inst.world_from_local.transform_point3(inst.adjacency.positions()[v as usize]);
-                sil.edges.iter().map(|e| [at(e.a), at(e.b)]).collect()
-            })
-            .collect();
+        let per_instance: Vec<Vec<[Vec3; 2]>> =
+            self.silhouettes(light).map(|(i, _, sil)| self.world_segments(i, &sil)).collect();
         per_instance.concat()
+    }
+
+    /// Instance `i`'s silhouette edges in world space.
+    fn world_segments(&self, i: usize, sil: &Silhouette) -> Vec<[Vec3; 2]> {
+        let inst = &self.instances[i];
+        let at = |v: u32| inst.world_from_local.transform_point3(inst.adjacency.positions()[v as usize]);
+        sil.edges.iter().map(|e| [at(e.a), at(e.b)]).collect()
     }
 }

@@ -32,6 +32,7 @@
 //! (in the build), `classify` (the map test and the mask), `caster_lists` (each piece's pixels) and
 //! `volumes` (lists included).
 
+use glam::Vec3;
 use rayon::prelude::*;
 use shadow_core::frame::InstanceVolume;
 use shadow_core::geometry::edge_map::{edge_cells, edge_texel_quads};
@@ -45,7 +46,7 @@ use shadow_core::{FrameInputs, Image};
 use std::time::Instant;
 
 use super::caster_masks::{CasterShafts, count_volumes};
-use super::shadow_volume::{build_volumes, rasterize_volumes};
+use super::shadow_volume::rasterize_volumes;
 use super::{map_position, per_receiver, render_depth_maps};
 use crate::context::{CpuBackend, CpuContext, CpuError};
 use crate::gbuffer::GBuffer;
@@ -125,22 +126,21 @@ fn classify_receivers(
     classes
 }
 
-/// The edge maps of `edge_texels`, one per projection of `light`: with `all`, the silhouette edges'
-/// texel quads drawn into a map of the nearest edge's depth per texel; with `paired`, their cells
+/// The edge maps of `edge_texels`, one per projection of `light`, from the casters' silhouette `segments`
+/// (world space): with `all`, their texel quads drawn into a map of the nearest edge's depth per texel; with `paired`, their cells
 /// (`edge_cells`).
 fn edge_maps(
-    frame: &FrameInputs,
+    segments: &[[Vec3; 2]],
     light: &LightView,
     maps: &[Image<f32>],
     res: u32,
     mode: EdgeTexels,
 ) -> Vec<Image<f32>> {
-    let segments = frame.silhouette_segments(light);
     let nearest = RasterState { cull: CullMode::None, depth: Some(DepthState::LESS_WRITE), ..RasterState::default() };
     let edge_map = |(p, map)| match mode {
-        EdgeTexels::Paired => edge_cells(&segments, p, res, Some(map)),
+        EdgeTexels::Paired => edge_cells(segments, p, res, Some(map)),
         _ => {
-            let quads = edge_texel_quads(&segments, p, res);
+            let quads = edge_texel_quads(segments, p, res);
             let mut ds = DepthStencil::new(res, res, 1.0, 0);
             draw_depth(&mut ds, &Soup { triangles: &quads, prim_base: 0, flip: false }, &nearest);
             ds.into_depth_image()
@@ -169,13 +169,19 @@ impl ShadowTechnique<CpuBackend> for Hybrid {
         stats: &mut FrameStats,
     ) -> Result<(), CpuError> {
         render_depth_maps(frame, light, self.depth.resolution, self.depth.depth_bias(), &mut state.maps)?;
+        // The edge maps' segments come from the volumes' own silhouette pass.
+        let (volumes, segments) = if self.edge_texels.is_on() {
+            frame.shadow_volumes_and_segments(light, Caps::Both)
+        } else {
+            (frame.shadow_volumes(light, Caps::Both), Vec::new())
+        };
+        InstanceVolume::count(&volumes, &mut stats.counters);
         state.edge_maps.clear();
         if self.edge_texels.is_on() {
             let t = Instant::now();
-            state.edge_maps = edge_maps(frame, light, &state.maps, self.depth.resolution, self.edge_texels);
+            state.edge_maps = edge_maps(&segments, light, &state.maps, self.depth.resolution, self.edge_texels);
             stats.timings.extra.insert("edge_maps".into(), ms(t.elapsed()));
         }
-        let volumes = build_volumes(frame, light, Caps::Both, stats);
         state.shafts =
             if self.caster_masks.is_on() { CasterShafts::new(frame, light, &volumes) } else { CasterShafts::default() };
         state.volumes = Some(volumes);

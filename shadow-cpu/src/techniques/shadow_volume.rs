@@ -43,9 +43,7 @@ pub fn build_volumes(
     stats: &mut FrameStats,
 ) -> Vec<InstanceVolume> {
     let volumes = frame.shadow_volumes(light, caps);
-    let c = &mut stats.counters;
-    c.silhouette_edges = Some(volumes.iter().map(|v| v.silhouette_edges as u64).sum());
-    c.volume_triangles = Some(volumes.iter().map(|v| v.volume.triangle_count() as u64).sum());
+    InstanceVolume::count(&volumes, &mut stats.counters);
     volumes
 }
 

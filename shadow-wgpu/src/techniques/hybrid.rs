@@ -61,7 +61,7 @@ use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueEr
 
 use super::shadow_map::{LookupParams, MapBindings, QueryExtras};
 use super::shadow_volume::{
-    VolumeDraw, VolumePass, build_draws, count_all_pipeline, counting_state, occlusion_query, read_query,
+    VolumeDraw, VolumePass, count_all_pipeline, counting_state, occlusion_query, read_query, upload_draws,
     volume_pipeline,
 };
 use crate::context::{WgpuBackend, WgpuContext, WgpuError};
@@ -358,12 +358,18 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
     ) -> Result<(), WgpuError> {
         self.depth.build(cx, &mut state.map, frame, light, stats)?;
         let res = self.depth.resolution;
+        // The edge maps' segments come from the volumes' own silhouette pass.
+        let (volumes, segments) = if self.edge_texels.is_on() {
+            frame.shadow_volumes_and_segments(light, Caps::Both)
+        } else {
+            (frame.shadow_volumes(light, Caps::Both), Vec::new())
+        };
         if let Some(pass) = &state.edge_pass {
-            state.edge_maps = Some(cx.scoped("the edge maps", |cx| edge_maps(cx, pass, frame, light, res))?);
+            state.edge_maps = Some(cx.scoped("the edge maps", |cx| edge_maps(cx, pass, &segments, light, res))?);
         } else if self.edge_texels == EdgeTexels::Paired {
-            state.edge_maps = Some(cx.scoped("the edge cells", |cx| edge_cell_maps(cx, frame, light, res))?);
+            state.edge_maps = Some(cx.scoped("the edge cells", |cx| edge_cell_maps(cx, &segments, light, res))?);
         }
-        state.draws = Some(build_draws(cx, frame, light, Caps::Both, stats)?);
+        state.draws = Some(upload_draws(cx, frame, &volumes, stats)?);
         Ok(())
     }
 

@@ -269,12 +269,19 @@ pub(crate) fn build_draws(
     caps: Caps,
     stats: &mut FrameStats,
 ) -> Result<Vec<VolumeDraw>, WgpuError> {
-    let volumes = frame.shadow_volumes(light, caps);
-    let c = &mut stats.counters;
-    c.silhouette_edges = Some(volumes.iter().map(|v| v.silhouette_edges as u64).sum());
-    c.volume_triangles = Some(volumes.iter().map(|v| v.volume.triangle_count() as u64).sum());
+    upload_draws(cx, frame, &frame.shadow_volumes(light, caps), stats)
+}
+
+/// [`build_draws`] from volumes already found (`hybrid` finds them with its edge maps' segments).
+pub(crate) fn upload_draws(
+    cx: &mut WgpuContext,
+    frame: &FrameInputs,
+    volumes: &[InstanceVolume],
+    stats: &mut FrameStats,
+) -> Result<Vec<VolumeDraw>, WgpuError> {
+    InstanceVolume::count(volumes, &mut stats.counters);
     cx.cache.upload_meshes(&cx.device, frame);
-    cx.scoped("uploading shadow volumes", |cx| upload(cx, frame, &volumes))
+    cx.scoped("uploading shadow volumes", |cx| upload(cx, frame, volumes))
 }
 
 /// Uploads the volumes: sides and far caps as homogeneous vertices, near caps as index lists into the

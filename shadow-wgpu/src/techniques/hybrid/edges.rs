@@ -2,7 +2,7 @@
 //! edge maps, a layer per light projection holding the nearest edge's depth per texel (twin: shadow-cpu's
 //! hybrid build; the test that reads them is hybrid_edges.wgsl's `near_edge`).
 
-use shadow_core::FrameInputs;
+use glam::Vec3;
 use shadow_core::geometry::edge_map::{edge_cells, edge_texel_quads};
 use shadow_core::light::LightView;
 use wgpu::util::DeviceExt;
@@ -31,16 +31,15 @@ pub(super) fn edge_pass(cx: &WgpuContext) -> wgpu::RenderPipeline {
 pub(super) fn edge_maps(
     cx: &WgpuContext,
     pass: &wgpu::RenderPipeline,
-    frame: &FrameInputs,
+    segments: &[[Vec3; 2]],
     light: &LightView,
     res: u32,
 ) -> wgpu::Texture {
-    let segments = frame.silhouette_segments(light);
     let maps = layered(cx, "hybrid edge maps", res, res, light.projections.len() as u32, MAP_DEPTH);
     let mut enc = cx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("edge maps") });
     for (k, p) in light.projections.iter().enumerate() {
         let quads: Vec<[f32; 4]> =
-            edge_texel_quads(&segments, p, res).iter().flat_map(|t| t.map(|v| v.to_array())).collect();
+            edge_texel_quads(segments, p, res).iter().flat_map(|t| t.map(|v| v.to_array())).collect();
         let view = layer_view(&maps, k as u32);
         let mut rp = depth_pass(&mut enc, &view, "edge map");
         if !quads.is_empty() {
@@ -62,10 +61,11 @@ pub(super) fn edge_maps(
 /// casters' silhouette edges, made on the CPU as the edge quads are and uploaded as a layer of an
 /// `(res + 1)` square float array (twin: shadow-cpu's hybrid build; read by hybrid_edge_pairs.wgsl's
 /// `near_edge`).
-pub(super) fn edge_cell_maps(cx: &WgpuContext, frame: &FrameInputs, light: &LightView, res: u32) -> wgpu::Texture {
-    let segments = frame.silhouette_segments(light);
-    let cells: Vec<f32> =
-        light.projections.iter().flat_map(|p| edge_cells(&segments, p, res, None).data().to_vec()).collect();
+pub(super) fn edge_cell_maps(cx: &WgpuContext, segments: &[[Vec3; 2]], light: &LightView, res: u32) -> wgpu::Texture {
+    let mut cells = Vec::with_capacity(((res + 1) * (res + 1)) as usize * light.projections.len());
+    for p in &light.projections {
+        cells.extend_from_slice(edge_cells(segments, p, res, None).data());
+    }
     let desc = wgpu::TextureDescriptor {
         label: Some("hybrid edge cells"),
         size: wgpu::Extent3d { width: res + 1, height: res + 1, depth_or_array_layers: light.projections.len() as u32 },
