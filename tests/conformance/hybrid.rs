@@ -45,8 +45,9 @@ fn silhouette_pixels_get_shadow_volume_accuracy() {
     let (mut rows, mut failures) = (Vec::new(), Vec::new());
     for scene in scenes::names() {
         let chan = if scene == "tree" { "hybrid:res=1024,edge_texels=off" } else { "hybrid:res=512,edge_texels=off" };
-        let r = run(scene, &["hybrid:res=512", chan]);
-        for (spec, result) in ["hybrid:res=512", chan].iter().zip(&r) {
+        let specs = ["hybrid:res=512", chan];
+        let r = run(scene, &specs);
+        for (spec, result) in specs.iter().zip(&r) {
             let m = result.vs_reference["mismatch"];
             rows.push(format!("{scene:<14} {spec} {:.3}%", m * 100.0));
             if m > 0.001 {

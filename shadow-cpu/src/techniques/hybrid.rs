@@ -127,8 +127,8 @@ fn classify_receivers(
 }
 
 /// The edge maps of `edge_texels`, one per projection of `light`, from the casters' silhouette `segments`
-/// (world space): with `all`, their texel quads drawn into a map of the nearest edge's depth per texel; with `paired`, their cells
-/// (`edge_cells`).
+/// (world space): with `all`, their texel quads drawn into a map of the nearest edge's depth per texel;
+/// with `paired`, their cells (`edge_cells`).
 fn edge_maps(
     segments: &[[Vec3; 2]],
     light: &LightView,
@@ -169,12 +169,9 @@ impl ShadowTechnique<CpuBackend> for Hybrid {
         stats: &mut FrameStats,
     ) -> Result<(), CpuError> {
         render_depth_maps(frame, light, self.depth.resolution, self.depth.depth_bias(), &mut state.maps)?;
-        // The edge maps' segments come from the volumes' own silhouette pass.
-        let (volumes, segments) = if self.edge_texels.is_on() {
-            frame.shadow_volumes_and_segments(light, Caps::Both)
-        } else {
-            (frame.shadow_volumes(light, Caps::Both), Vec::new())
-        };
+        // The edge maps' segments come from the volumes' own silhouette pass (unused with
+        // `edge_texels=off`, where they cost two transforms per silhouette edge).
+        let (volumes, segments) = frame.shadow_volumes_and_segments(light, Caps::Both);
         InstanceVolume::count(&volumes, &mut stats.counters);
         state.edge_maps.clear();
         if self.edge_texels.is_on() {

@@ -358,12 +358,9 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
     ) -> Result<(), WgpuError> {
         self.depth.build(cx, &mut state.map, frame, light, stats)?;
         let res = self.depth.resolution;
-        // The edge maps' segments come from the volumes' own silhouette pass.
-        let (volumes, segments) = if self.edge_texels.is_on() {
-            frame.shadow_volumes_and_segments(light, Caps::Both)
-        } else {
-            (frame.shadow_volumes(light, Caps::Both), Vec::new())
-        };
+        // The edge maps' segments come from the volumes' own silhouette pass (unused with
+        // `edge_texels=off`, where they cost two transforms per silhouette edge).
+        let (volumes, segments) = frame.shadow_volumes_and_segments(light, Caps::Both);
         if let Some(pass) = &state.edge_pass {
             state.edge_maps = Some(cx.scoped("the edge maps", |cx| edge_maps(cx, pass, &segments, light, res))?);
         } else if self.edge_texels == EdgeTexels::Paired {
