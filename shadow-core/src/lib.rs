@@ -22,6 +22,7 @@ pub mod procedural;
 pub mod reconstruction;
 pub mod scene;
 pub mod scenes;
+pub mod shafts;
 pub mod stats;
 pub mod technique;
 pub mod text;

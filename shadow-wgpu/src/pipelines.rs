@@ -125,7 +125,7 @@ impl Shared {
     /// Creates the shared pipelines.
     #[must_use]
     pub fn new(device: &wgpu::Device) -> Self {
-        let all = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
+        let all = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
         let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("frame"),
             entries: &[

@@ -60,17 +60,60 @@ pub fn silhouette_query() -> String {
     with_shadow_map(include_str!("shaders/silhouette_query.wgsl"))
 }
 
-/// Hybrid maps and volumes: the classification, the mask and the answer, after the shadow-map shader.
+/// Hybrid maps and volumes: the classification, the mask and the answer, after the shadow-map shader;
+/// with `caster_masks`, the mask pass also lists the silhouette pixels and the answer reads their counts.
 #[must_use]
-pub fn hybrid(edge_texels: EdgeTexels, tile_marks: bool) -> String {
+pub fn hybrid(edge_texels: EdgeTexels, tile_marks: bool, caster_masks: bool) -> String {
     let edges = match edge_texels {
         EdgeTexels::Off => NEAR_EDGE_OFF,
         EdgeTexels::All => include_str!("shaders/hybrid_edges.wgsl"),
         EdgeTexels::Paired => include_str!("shaders/hybrid_edge_pairs.wgsl"),
     };
     let tiles = if tile_marks { TILE_MARKS } else { TILE_MARKS_OFF };
-    with_shadow_map(&format!("{edges}\n{tiles}\n{}", include_str!("shaders/hybrid.wgsl")))
+    let lists = if caster_masks { format!("{CASTER_LISTS}\n{LISTED_COUNTS}") } else { LISTED_OFF.to_string() };
+    with_shadow_map(&format!("{edges}\n{tiles}\n{lists}\n{}", include_str!("shaders/hybrid.wgsl")))
 }
+
+/// hybrid's caster masks: the compute passes that count the small volume pieces at the listed pixels.
+#[must_use]
+pub fn hybrid_casters() -> String {
+    with_shadow_map(&format!("{CASTER_LISTS}\n{}", include_str!("shaders/hybrid_casters.wgsl")))
+}
+
+/// hybrid's caster masks: the silhouette pixels the mask pass lists (`y * width + x`), with the counters
+/// the compute pass adds to (the fragments its triangles make at them, its stencil updates and its
+/// pixel-triangle tests).
+const CASTER_LISTS: &str = "
+struct Listed {
+    pixels: atomic<u32>,
+    fragments: atomic<u32>,
+    updates: atomic<u32>,
+    tests: atomic<u32>,
+    at: array<u32>,
+};
+
+@group(1) @binding(8) var<storage, read_write> listed: Listed;
+";
+
+/// hybrid's fragment passes with caster masks: the mask pass lists its pixels, and a listed pixel the
+/// compute pass gave a count other than 0 is shadowed.
+const LISTED_COUNTS: &str = "
+@group(1) @binding(9) var<storage, read> counts: array<i32>;
+
+fn list_pixel(px: vec2<i32>) {
+    listed.at[atomicAdd(&listed.pixels, 1u)] = u32(px.y) * u32(view.size.x) + u32(px.x);
+}
+
+fn listed_shadowed(px: vec2<i32>) -> bool {
+    return counts[u32(px.y) * u32(view.size.x) + u32(px.x)] != 0;
+}
+";
+
+/// hybrid's `list_pixel` and `listed_shadowed` with `caster_masks=off`: nothing and never.
+const LISTED_OFF: &str = "
+fn list_pixel(px: vec2<i32>) {}
+fn listed_shadowed(px: vec2<i32>) -> bool { return false; }
+";
 
 /// hybrid's `scissor_tile`: the mask pass marks the tile of each silhouette pixel (map.extra: x the tile
 /// side in pixels, y the tiles per row).
@@ -123,9 +166,10 @@ pub fn all() -> Vec<(&'static str, String)> {
         ("depth_layers", depth_layers()),
         ("silhouette_build", silhouette_build()),
         ("silhouette_query", silhouette_query()),
-        ("hybrid", hybrid(EdgeTexels::Off, false)),
-        ("hybrid edge_texels=all, tile marks", hybrid(EdgeTexels::All, true)),
-        ("hybrid edge_texels=paired", hybrid(EdgeTexels::Paired, false)),
+        ("hybrid", hybrid(EdgeTexels::Off, false, false)),
+        ("hybrid edge_texels=all, tile marks", hybrid(EdgeTexels::All, true, false)),
+        ("hybrid edge_texels=paired, caster masks", hybrid(EdgeTexels::Paired, false, true)),
+        ("hybrid caster masks", hybrid_casters()),
         ("hybrid edge pass", HYBRID_EDGE_PASS.to_string()),
     ]
 }

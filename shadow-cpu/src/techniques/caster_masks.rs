@@ -1,13 +1,10 @@
 //! Caster masks for `hybrid` (ours, in the spirit of Chan's per-blocker culling, thesis 3.4.3): each
 //! connected component's shadow volume is counted only at the silhouette pixels its shadow can hold.
 //!
-//! A component's volume is closed by itself ([`shadow_core::geometry::volume::VolumePiece`]), so its count
-//! is zero at every point outside it. Every point inside lies on a ray from the light through one of the
-//! component's casting faces, beyond it: in light space (where rays from the light are points) within the
-//! convex hull of those faces' corners, so within any outline of the corners, and farther from the light
-//! than the nearest corner. A silhouette pixel outside that shaft (widened by the pixel's own depth and
-//! position precision, see `tolerance`) would only ever get increments that cancel, so the piece is not
-//! drawn there. Among a tree's thousand twigs or a cloud of cubes, a piece's volume crosses many silhouette
+//! A component's volume is closed by itself, so its count is zero outside its *shaft*
+//! ([`shadow_core::shafts`], shared with the GPU's caster masks): a silhouette pixel outside it (widened
+//! by the pixel's own depth and position precision, [`shadow_core::shafts::tolerance`]) would only ever get
+//! increments that cancel, so the piece is not drawn there. Among a tree's thousand twigs or a cloud of cubes, a piece's volume crosses many silhouette
 //! pixels on screen (the shadows of the others, seen through it) and can shadow only a few.
 //!
 //! Per frame: each piece's shaft (per light projection) goes into the cells of a grid over the silhouette pixels' light-space positions; each pixel tests the pieces of its
@@ -23,8 +20,9 @@ use std::time::Instant;
 use rayon::prelude::*;
 use shadow_core::FrameInputs;
 use shadow_core::frame::InstanceVolume;
-use shadow_core::glam::{Vec2, Vec3, Vec4, Vec4Swizzles};
-use shadow_core::light::{LightProjection, LightView};
+use shadow_core::glam::{Vec2, Vec4, Vec4Swizzles};
+use shadow_core::light::LightView;
+use shadow_core::shafts::{CasterShafts, Shaft, light_coords, light_tolerance, outline, tolerance};
 use shadow_core::stats::ms;
 use shadow_core::technique::hard::VolumeCounting;
 
@@ -38,101 +36,6 @@ use crate::raster::{ComputationMask, DepthStencil, ListedDraw, RasterCounters, c
 /// primitives' is fastest from 2^20 (1.3-1.5 ms against 2.0-2.4 at 2^16); a sphere of 200 000 triangles
 /// is drawn through the whole mask at either end.
 const LISTED_TESTS: usize = 1 << 20;
-
-/// Where a piece's shadow can lie in one light projection: the light-space bounds of its finite corners
-/// along x, y and both diagonals (an 8-sided outline, so a twig lying across the light's view gets a
-/// narrow strip rather than its bounding square), and their least distance from the light.
-#[derive(Clone, Copy, Debug)]
-struct Shaft {
-    lo: Vec4,
-    hi: Vec4,
-    near: f32,
-}
-
-/// A light-space position `(x, y)` along x, y and both diagonals: `(x, y, x + y, x - y)`.
-fn outline(xy: Vec2) -> Vec4 {
-    Vec4::new(xy.x, xy.y, xy.x + xy.y, xy.x - xy.y)
-}
-
-/// A point in a projection's light space: `(x / d, y / d)` for a perspective light, `(x, y)` for an
-/// orthographic one, and the distance `d` along the projection's axis; `None` at or behind a perspective
-/// light's plane.
-fn light_coords(proj: &LightProjection, p: Vec3) -> Option<(Vec2, f32)> {
-    let v = proj.view_from_world.transform_point3(p);
-    let d = -v.z;
-    if proj.orthographic { Some((Vec2::new(v.x, v.y), d)) } else { (d > 0.0).then(|| (Vec2::new(v.x, v.y) / d, d)) }
-}
-
-/// The shafts of every piece of every volume, per projection (`None` where a corner reaches the light's
-/// plane: the piece may then shadow any pixel of that projection).
-#[derive(Default)]
-pub struct CasterShafts {
-    /// Every piece as (volume, piece within it), in volume order.
-    pieces: Vec<(usize, usize)>,
-    /// Per piece, per projection.
-    shafts: Vec<Vec<Option<Shaft>>>,
-}
-
-impl CasterShafts {
-    /// The shafts of `volumes` for `light`.
-    #[must_use]
-    pub fn new(frame: &FrameInputs, light: &LightView, volumes: &[InstanceVolume]) -> Self {
-        let pieces: Vec<(usize, usize)> =
-            volumes.iter().enumerate().flat_map(|(v, iv)| (0..iv.volume.pieces.len()).map(move |p| (v, p))).collect();
-        let shafts = pieces
-            .par_iter()
-            .map(|&(v, p)| {
-                let iv = &volumes[v];
-                let inst = &frame.instances[iv.instance];
-                let (tris, positions) = (inst.mesh.triangles(), inst.mesh.positions());
-                let (vol, piece) = (&iv.volume, &iv.volume.pieces[p]);
-                let at = |m: Vec3| inst.world_from_local.transform_point3(m);
-                // The piece's finite corners, in world space: its caps' (every silhouette edge borders a
-                // casting face), or its sides' without caps.
-                let caps = vol.caps_forward[piece.caps_forward.start as usize..piece.caps_forward.end as usize]
-                    .iter()
-                    .chain(&vol.caps_reversed[piece.caps_reversed.start as usize..piece.caps_reversed.end as usize]);
-                let mut corners: Vec<Vec3> =
-                    caps.flat_map(|&f| tris[f as usize].map(|v| at(positions[v as usize]))).collect();
-                if corners.is_empty() {
-                    let sides = &vol.sides[piece.sides.start as usize..piece.sides.end as usize];
-                    corners = sides.iter().flatten().filter(|v| v.w != 0.0).map(|v| at(v.truncate())).collect();
-                }
-                // Widened for the rounding of the transforms.
-                let b = piece.bounds.transformed(inst.world_from_local);
-                let pad = 1e-5 * (b.size().length() + b.min.abs().max(b.max.abs()).max_element());
-                light.projections.iter().map(|proj| shaft(proj, &corners, pad)).collect()
-            })
-            .collect();
-        Self { pieces, shafts }
-    }
-}
-
-/// The shaft of `corners` (world space) in `proj`, widened by `pad` world units.
-fn shaft(proj: &LightProjection, corners: &[Vec3], pad: f32) -> Option<Shaft> {
-    let mut s = Shaft { lo: Vec4::INFINITY, hi: Vec4::NEG_INFINITY, near: f32::INFINITY };
-    for &c in corners {
-        let (xy, d) = light_coords(proj, c)?;
-        let o = outline(xy);
-        (s.lo, s.hi, s.near) = (s.lo.min(o), s.hi.max(o), s.near.min(d));
-    }
-    // Corners this close to a perspective light's plane do not bound its view.
-    if !proj.orthographic && s.near <= pad {
-        return None;
-    }
-    let side = if proj.orthographic { pad } else { pad / s.near };
-    let widen = Vec4::new(side, side, 2.0 * side, 2.0 * side);
-    Some(Shaft { lo: s.lo - widen, hi: s.hi + widen, near: s.near - pad })
-}
-
-/// How far, in world units, the point a pixel's count is taken at may lie from its G-buffer position, at
-/// distance `r` from an eye with near plane `near`: the depth buffer's step there (an infinite
-/// projection's depth is `1 - near / z`, so a step of 2^-24 is `z^2 / near * 2^-24`) and a sixth of a
-/// pixel sideways (a 512-row view of 45 degrees), both with a wide margin. Also covers the volumes' own
-/// snapping and depth rounding, which are of the same size.
-fn tolerance(r: f32, near: f32) -> f32 {
-    r * (1.0 / 4096.0) + r * r / near * (1.0 / 262_144.0)
-}
 
 /// A silhouette pixel in light space.
 #[derive(Clone, Copy)]
@@ -218,8 +121,7 @@ impl Grid {
 
 /// Whether a pixel lies within its tolerance of a shaft.
 fn in_shaft(s: &Shaft, p: &LightPixel) -> bool {
-    let tol = Vec4::new(p.side, p.side, 2.0 * p.side, 2.0 * p.side);
-    p.d >= s.near - p.along && p.dop.cmpge(s.lo - tol).all() && p.dop.cmple(s.hi + tol).all()
+    s.holds(p.dop, p.d, p.side, p.along)
 }
 
 /// Per piece, the silhouette pixels its shadow may hold, ascending. `pixels` are the mask's in target
@@ -361,12 +263,9 @@ fn light_pixels(light: &LightView, g: &GBuffer, mask: &ComputationMask) -> Vec<(
                     let j = light.projection_index(p);
                     let proj = &light.projections[j];
                     let tol = tolerance(p.distance(eye), near);
-                    let pixel = light_coords(proj, p).map(|(xy, d)| LightPixel {
-                        xy,
-                        dop: outline(xy),
-                        d,
-                        side: if proj.orthographic { 2.0 * tol } else { 2.0 * tol / d },
-                        along: tol,
+                    let pixel = light_coords(proj, p).map(|(xy, d)| {
+                        let (side, along) = light_tolerance(proj, tol, d);
+                        LightPixel { xy, dop: outline(xy), d, side, along }
                     });
                     row.push((j, pixel, at));
                 }

@@ -45,12 +45,13 @@ use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueEr
 use shadow_core::{FrameInputs, Image};
 use std::time::Instant;
 
-use super::caster_masks::{CasterShafts, count_volumes};
+use super::caster_masks::count_volumes;
 use super::shadow_volume::rasterize_volumes;
 use super::{map_position, per_receiver, render_depth_maps};
 use crate::context::{CpuBackend, CpuContext, CpuError};
 use crate::gbuffer::GBuffer;
 use crate::raster::{ComputationMask, CullMode, DepthState, DepthStencil, RasterState, Soup, draw_depth};
+use shadow_core::shafts::CasterShafts;
 
 /// The maps and volumes of the last build; what the last query decided with (for the debug view, which
 /// derives the classes from it only when asked).

@@ -1,7 +1,8 @@
 // hybrid (Chan, thesis chapter 3): the map's classification of each receiver, the computation mask it
 // makes in the stencil's bit 7, and the passes that answer from the mask (twin: shadow-cpu's
 // techniques/hybrid.rs). Follows shadow_map.wgsl, whose bindings 0 to 3 it shares, one of the two
-// `near_edge` (hybrid_edges.wgsl, or never) and one of the two `mark_tile` (shaders.rs).
+// `near_edge` (hybrid_edges.wgsl, or never), one of the two `mark_tile` and one of the two pairs
+// `list_pixel` and `listed_shadowed` (caster masks; shaders.rs).
 
 @group(1) @binding(4) var g_geometric_normal: texture_2d<f32>;
 
@@ -53,6 +54,7 @@ fn fs_hybrid_mask(in: FullScreen) {
         discard;
     }
     mark_tile(vec2<i32>(in.pos.xy));
+    list_pixel(vec2<i32>(in.pos.xy));
 }
 
 // The depth mask's far triangle (gpu_mask=depth): full screen at depth 1, rasterized, no fragment stage.
@@ -78,14 +80,26 @@ fn fs_hybrid_shadowed(in: FullScreen) -> @location(0) vec4<f32> {
     return vec4<f32>(0.0);
 }
 
+// With caster masks, drawn under the stencil test "inside the mask and a count of 0": shadowed where the
+// pieces counted at the listed pixels gave a count other than 0.
+@fragment
+fn fs_hybrid_listed(in: FullScreen) -> @location(0) vec4<f32> {
+    if (!listed_shadowed(vec2<i32>(in.pos.xy))) {
+        discard;
+    }
+    return vec4<f32>(0.0);
+}
+
 // The debug view's codes (shadow_core::lookup::PixelClass discriminants), drawn under the same stencil
-// tests as the answer: CODE 0 writes the map's class (outside the mask), any other CODE itself.
+// tests as the answer: CODE 0 writes the map's class (outside the mask), any other CODE itself, or
+// SHADOWED_CODE where the caster masks' count shadows the pixel.
 override CODE: u32 = 0u;
+override SHADOWED_CODE: u32 = 0u;
 
 @fragment
 fn fs_hybrid_code(in: FullScreen) -> @location(0) u32 {
     if (CODE != 0u) {
-        return CODE;
+        return select(CODE, SHADOWED_CODE, listed_shadowed(vec2<i32>(in.pos.xy)));
     }
     let c = receiver_class(vec2<i32>(in.pos.xy));
     if (c == NOT_RECEIVER) {

@@ -36,6 +36,11 @@
 //! where two edges enter the square between its four texels and may hide something there (the edge
 //! cells, made by shared code on the CPU and uploaded; hybrid_edge_pairs.wgsl).
 //!
+//! With `caster_masks=on` (the default, as on the CPU; ours) each small piece of the volumes (one connected
+//! component's) is counted only at the silhouette pixels its shaft holds, by compute passes over the
+//! pixels the mask pass lists ([`casters`]); the pieces too large for that are rasterized as above, and
+//! the answer's third draw shadows the silhouette pixels whose listed count is not 0.
+//!
 //! The map's classification runs twice, in the mask pass on every pixel and in the answer outside the
 //! mask: a full-screen pass can write a colour or set the stencil for the pixels it keeps, but not both
 //! for different pixels, and one more 4-texel lookup costs less than a class target written and read.
@@ -43,26 +48,31 @@
 //! Counters come from occlusion queries: the mask pass's samples are `silhouette_pixels`; after the
 //! answer, a pass with the depth test off and the mask's stencil test counts `volume_fragments` (those the
 //! mask lets through), and with `unmasked_fill=on` one without the stencil test counts
-//! `unmasked_volume_fragments`; both are timed as the sub-phase `count_fragments`.
+//! `unmasked_volume_fragments`; both are timed as the sub-phase `count_fragments`. With caster masks the
+//! compute passes count their own fragments and stencil updates, read back in the same sub-phase.
 
+mod casters;
 mod edges;
 mod tiles;
 
+use casters::{CasterPasses, CasterPieces, LISTED_TRIANGLES, ListedPixels, Split};
 use edges::{edge_cell_maps, edge_maps, edge_pass};
 use tiles::TileMarks;
 
 use shadow_core::FrameInputs;
 use shadow_core::Image;
+use shadow_core::frame::InstanceVolume;
 use shadow_core::geometry::volume::Caps;
 use shadow_core::light::LightView;
 use shadow_core::lookup::PixelClass;
+use shadow_core::shafts::CasterShafts;
 use shadow_core::technique::hard::{EdgeTexels, GpuMask, Hybrid, ShadowMap, VolumeCounting};
 use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
 
 use super::shadow_map::{LookupParams, MapBindings, QueryExtras};
 use super::shadow_volume::{
     VolumeDraw, VolumePass, count_all_pipeline, counting_state, occlusion_query, read_query, upload_draws,
-    volume_pipeline,
+    upload_volumes, volume_pipeline,
 };
 use crate::context::{WgpuBackend, WgpuContext, WgpuError};
 use crate::frame::GpuVisibility;
@@ -94,7 +104,15 @@ pub struct State {
     answer_shadowed: wgpu::RenderPipeline,
     count_masked: wgpu::RenderPipeline,
     count_all: wgpu::RenderPipeline,
+    /// The volumes rasterized through the mask: all of them, or with caster masks the large pieces.
     draws: Option<Vec<VolumeDraw>>,
+    /// With caster masks and `unmasked_fill=on`: every volume, for the unmasked fill.
+    all_draws: Option<Vec<VolumeDraw>>,
+    /// With caster masks: the compute passes, the answer's draw for the listed pixels, the last build's
+    /// small pieces and the listed pixels at the last view's size.
+    casters: Option<(CasterPasses, wgpu::RenderPipeline)>,
+    pieces: Option<CasterPieces>,
+    listed: Option<ListedPixels>,
     /// With `gpu_mask=depth`: the scratch depth-stencil the mask is written into, at the view's size, and
     /// the draw that sets depth 1 outside the mask.
     scratch: Option<wgpu::Texture>,
@@ -280,7 +298,8 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
     fn create_state(&self, cx: &mut WgpuContext) -> Result<State, WgpuError> {
         let map = <ShadowMap as ShadowTechnique<WgpuBackend>>::create_state(&self.depth, cx)?;
         cx.scoped("creating the hybrid pipelines", |cx| {
-            let source = shaders::hybrid(self.edge_texels, self.scissor_tile > 0);
+            let caster_masks = self.caster_masks.is_on();
+            let source = shaders::hybrid(self.edge_texels, self.scissor_tile > 0, caster_masks);
             let module = shaders::module(&cx.device, "hybrid", source);
             let volume_module = shaders::module(&cx.device, "shadow_volume", shaders::shadow_volume());
             let gpu_mask = self.gpu_mask;
@@ -290,9 +309,13 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
                 EdgeTexels::All => extras.push(depth_array_entry(6)),
                 EdgeTexels::Paired => extras.push(float_array_entry(6)),
             }
+            let storage = |read_only| wgpu::BufferBindingType::Storage { read_only };
             if self.scissor_tile > 0 {
-                let marks = wgpu::BufferBindingType::Storage { read_only: false };
-                extras.push(buffer_entry(7, marks, wgpu::ShaderStages::FRAGMENT));
+                extras.push(buffer_entry(7, storage(false), wgpu::ShaderStages::FRAGMENT));
+            }
+            if caster_masks {
+                extras.push(buffer_entry(8, storage(false), wgpu::ShaderStages::FRAGMENT));
+                extras.push(buffer_entry(9, storage(true), wgpu::ShaderStages::FRAGMENT));
             }
             let bindings = MapBindings::new(cx, &extras);
             let groups = [&cx.shared.frame_layout, bindings.layout()];
@@ -326,6 +349,7 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
             };
             let answer_map = answer("fs_hybrid_map", OUTSIDE);
             let answer_shadowed = answer("fs_hybrid_shadowed", SHADOWED);
+            let casters = caster_masks.then(|| (CasterPasses::new(cx), answer("fs_hybrid_listed", LIT)));
             State {
                 map,
                 bindings,
@@ -338,6 +362,10 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
                 count_masked,
                 count_all,
                 draws: None,
+                all_draws: None,
+                casters,
+                pieces: None,
+                listed: None,
                 scratch: None,
                 far,
                 tiles: None,
@@ -366,7 +394,17 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
         } else if self.edge_texels == EdgeTexels::Paired {
             state.edge_maps = Some(cx.scoped("the edge cells", |cx| edge_cell_maps(cx, &segments, light, res))?);
         }
-        state.draws = Some(upload_draws(cx, frame, &volumes, stats)?);
+        if state.casters.is_some() {
+            // The small pieces go to the compute passes, the rest to the rasterizer.
+            InstanceVolume::count(&volumes, &mut stats.counters);
+            let shafts = CasterShafts::new(frame, light, &volumes);
+            let split = Split::new(frame, &volumes, &shafts, LISTED_TRIANGLES);
+            state.pieces = Some(CasterPasses::upload(cx, frame, light, &split, &shafts));
+            state.draws = Some(upload_volumes(cx, frame, &split.raster)?);
+            state.all_draws = self.unmasked_fill.is_on().then(|| upload_volumes(cx, frame, &volumes)).transpose()?;
+        } else {
+            state.draws = Some(upload_draws(cx, frame, &volumes, stats)?);
+        }
         Ok(())
     }
 
@@ -422,6 +460,24 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
             extras.push(wgpu::BindGroupEntry { binding: 7, resource: t.marks.as_entire_binding() });
         }
         let tile_settings = [tile as f32, tiles.map_or(0.0, |t| t.columns as f32), 0.0, 0.0];
+        let casters = match (&state.casters, &state.pieces) {
+            (Some((passes, answer)), Some(pieces)) => {
+                if state.listed.as_ref().is_none_or(|l| l.size != (g.width, g.height) || l.pieces != pieces.pieces) {
+                    let size = (g.width, g.height);
+                    let listed =
+                        cx.scoped("the hybrid listed pixels", |cx| ListedPixels::new(cx, size, pieces.pieces))?;
+                    state.listed = Some(listed);
+                }
+                Some((passes, answer, pieces))
+            }
+            (Some(_), None) => return Err(not_built().into()),
+            _ => None,
+        };
+        let listed = state.listed.as_ref().filter(|_| casters.is_some());
+        if let Some(l) = listed {
+            extras.push(wgpu::BindGroupEntry { binding: 8, resource: l.listed.as_entire_binding() });
+            extras.push(wgpu::BindGroupEntry { binding: 9, resource: l.counts.as_entire_binding() });
+        }
         let mut mask_draws = vec![(&state.mask, MASK)];
         if let Some(far) = &state.far {
             mask_draws.push((far, 0));
@@ -450,6 +506,9 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
             if let Some(t) = tiles {
                 enc.clear_buffer(&t.marks, 0, None);
             }
+            if let Some(l) = listed {
+                l.clear(&mut enc);
+            }
             cx.queue.submit([enc.finish()]);
             let mask = full_screen_draws(
                 cx,
@@ -461,6 +520,11 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
                 Some(&silhouettes),
             );
             cx.queue.submit([mask]);
+            if let (Some((passes, _, pieces)), Some(l)) = (casters, listed) {
+                let mut enc = cx.device.create_command_encoder(&Default::default());
+                passes.record(cx, &mut enc, pieces, l, g);
+                cx.queue.submit([enc.finish()]);
+            }
             let rects = tiles.map(|t| t.rectangles(cx, tile, (g.width, g.height))).transpose()?;
             let counting = VolumePass {
                 label: "hybrid volumes",
@@ -471,13 +535,17 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
                 scissors: rects.as_deref(),
             };
             let passed = counting.run(cx, draws, frame, g, &depth);
+            let mut answers = vec![(&state.answer_map, OUTSIDE.2), (&state.answer_shadowed, SHADOWED.2)];
+            if let Some((_, answer, _)) = casters {
+                answers.push((answer, LIT.2));
+            }
             let answer = full_screen_draws(
                 cx,
                 "hybrid answer",
                 Some((&out.view, wgpu::Color::WHITE)),
                 (&depth, wgpu::LoadOp::Load, wgpu::LoadOp::Load),
                 groups,
-                &[(&state.answer_map, OUTSIDE.2), (&state.answer_shadowed, SHADOWED.2)],
+                &answers,
                 None,
             );
             cx.queue.submit([answer]);
@@ -495,12 +563,24 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
         }
         c.silhouette_pixels = Some(read_query(cx, &silhouettes)?);
         let processed = read_query(cx, &processed)?;
-        c.volume_fragments = Some(processed);
         // Z-fail updates the count where the depth test fails.
-        c.stencil_updates = Some(processed - read_query(cx, &passed)?.min(processed));
+        let updates = processed - read_query(cx, &passed)?.min(processed);
+        let listed = match (casters, listed) {
+            (Some((_, _, pieces)), Some(l)) => {
+                let [pixels, fragments, updates, tests] = l.counters(cx)?;
+                c.extra.insert("listed_pieces".into(), pieces.pieces as f64);
+                c.extra.insert("listed_pixels".into(), pixels as f64);
+                c.extra.insert("listed_tests".into(), tests as f64);
+                [fragments, updates]
+            }
+            _ => [0, 0],
+        };
+        c.volume_fragments = Some(processed + listed[0]);
+        c.stencil_updates = Some(updates + listed[1]);
         if self.unmasked_fill.is_on() {
             let every = VolumePass::count(&state.count_all, "count volume fragments");
-            let all = cx.scoped("the volume fragment count", |cx| every.run(cx, draws, frame, g, &depth))?;
+            let all_draws = state.all_draws.as_deref().unwrap_or(draws);
+            let all = cx.scoped("the volume fragment count", |cx| every.run(cx, all_draws, frame, g, &depth))?;
             stats.counters.extra.insert("unmasked_volume_fragments".into(), read_query(cx, &all)? as f64);
         }
         stats.timings.extra.insert("count_fragments".into(), shadow_core::stats::ms(t.elapsed()));
@@ -532,7 +612,7 @@ fn classes(cx: &WgpuContext, state: &State, last: &LastQuery) -> Result<Image<u3
         view_formats: &[],
     });
     let code = |test: (wgpu::CompareFunction, u32, u32), class: u32| {
-        let constants = [("CODE", f64::from(class))];
+        let constants = [("CODE", f64::from(class)), ("SHADOWED_CODE", f64::from(PixelClass::VolumeShadowed as u32))];
         let entry = FragmentEntry { name: "fs_hybrid_code", constants: &constants };
         let groups = [&cx.shared.frame_layout, state.bindings.layout()];
         let depth_stencil = Some(stencil_test(test.0, test.1));

@@ -280,6 +280,15 @@ pub(crate) fn upload_draws(
     stats: &mut FrameStats,
 ) -> Result<Vec<VolumeDraw>, WgpuError> {
     InstanceVolume::count(volumes, &mut stats.counters);
+    upload_volumes(cx, frame, volumes)
+}
+
+/// Uploads `volumes` (and the meshes their near caps are drawn from) without recording counters.
+pub(crate) fn upload_volumes(
+    cx: &mut WgpuContext,
+    frame: &FrameInputs,
+    volumes: &[InstanceVolume],
+) -> Result<Vec<VolumeDraw>, WgpuError> {
     cx.cache.upload_meshes(&cx.device, frame);
     cx.scoped("uploading shadow volumes", |cx| upload(cx, frame, volumes))
 }

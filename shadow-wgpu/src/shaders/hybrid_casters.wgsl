@@ -1,0 +1,414 @@
+// hybrid's caster masks on the GPU (ours; twin: shadow-cpu's techniques/caster_masks.rs): each small
+// piece of the z-fail volumes (one connected component's, closed by itself) is counted only at the
+// silhouette pixels inside its shaft (shadow_core::shafts), by compute passes instead of the rasterizer.
+// Follows shadow_map.wgsl (for g_position and cube_face) and the listed pixels' declarations
+// (CASTER_LISTS in shaders.rs), which the mask pass appends to.
+//
+// The passes: cs_setup sets each triangle up for the view; cs_tally finds each listed pixel's pieces
+// (those of its light-space grid cell whose shafts hold it) and counts the pixels of each piece;
+// cs_offsets gives each piece its run of pairs; cs_fill writes them; cs_pieces counts each piece at its
+// pixels, a workgroup per piece (its invocations read one triangle at a time, the same for all); cs_alone
+// counts the pixels whose pairs did not fit, every piece of theirs, as one invocation per pixel. A first
+// version counted every pixel as cs_alone does, its invocations each reading their own pieces' triangles:
+// on lavapipe it cost about what the rasterized volumes do.
+//
+// The count at a pixel is the rasterizer's, taken by homogeneous rasterization (Olano and Greer 1997): a
+// triangle with clip-space corners a, b, c (columns of M, in x, y, w) covers the pixel at NDC point p
+// where the three rows of adj(M) = (b x c, c x a, a x b) dotted with (p, 1) all have the sign of det(M):
+// the point of the triangle seen there is in front of the eye, corners at infinity (w = 0) and behind it
+// included, with no clipping; its facing is det(M)'s sign, and its depth there (z . adj(M) p) / det(M),
+// used only to leave out what the near plane clips. Whether a side lies behind the receiver is not read
+// from that depth, which loses most of its digits to cancellation where a side meets the receiver (at
+// the shadow's edge: a first version took hundreds of pixels there the wrong way on tree), but from the
+// side's plane in world space: the eye ray meets it behind the receiver's G-buffer position exactly
+// where the eye and that position lie on one side of it.
+// Watertight: two triangles sharing an edge compute its row from the same two corners in one order (the
+// lesser first, see `edge_row`), so they get exactly opposite values at every pixel, and a pixel exactly
+// on it goes to the side its row's gradient points to along x (y where x is 0): as if every pixel were
+// moved by the same infinitesimal step, each is covered exactly once by triangles that tile around it.
+
+struct CasterParams {
+    // Per projection: world to the light's view (shadow_core::shafts::light_coords).
+    view_from_world: array<mat4x4<f32>, 6>,
+    // Per projection: the grid's origin (xy) and cells per light-space unit (zw).
+    grid: array<vec4<f32>, 6>,
+    // Per projection: x the grid's side in cells, y its first cell in `grid_cells`, z 1 if orthographic.
+    cells: array<vec4<u32>, 6>,
+    // x: 1 for a point light (cube faces), y: projections, z: pieces, w: triangles.
+    counts: vec4<u32>,
+    // xyz: the light's position (point lights); w: the camera's near plane.
+    light: vec4<f32>,
+    // x: where the piece lists start in `grid_cells`.
+    lists: vec4<u32>,
+};
+
+// A piece's shaft in one projection and its run of triangles.
+struct PieceShaft {
+    lo: vec4<f32>,
+    hi: vec4<f32>,
+    near: f32,
+    // 0 where the piece reaches the light's plane: it may shadow any pixel of the projection.
+    bounded: u32,
+    first: u32,
+    count: u32,
+};
+
+@group(1) @binding(9) var<storage, read_write> counts: array<atomic<i32>>;
+@group(1) @binding(11) var<uniform> casters: CasterParams;
+// Per triangle four vec4: its corners as homogeneous points in its mesh's space, wound so its front face
+// is counter-clockwise, then x: bitcast of instance * 2 + 1 for a cap (near or far), + 0 for a side.
+@group(1) @binding(12) var<storage, read> triangles: array<vec4<f32>>;
+// Per triangle SETUP vec4, set up for the view: the rows of adj(M) with det(M) in the first's w, the depth
+// row (z . adj(M)) with the cap flag in w, and the world plane through the triangle, turned so the eye
+// lies on its positive side.
+@group(1) @binding(13) var<storage, read_write> setups: array<vec4<f32>>;
+// Per piece, per projection.
+@group(1) @binding(14) var<storage, read> shafts: array<PieceShaft>;
+// Per cell of every projection's grid, where its pieces start (and one more), then the piece lists.
+@group(1) @binding(15) var<storage, read> grid_cells: array<u32>;
+
+const GROUP: u32 = 64u;
+const SETUP: u32 = 5u;
+
+// The invocation's index over a dispatch of (x, y) workgroups of GROUP (y > 1 past 65 535 groups).
+fn invocation(wg: vec3<u32>, groups: vec3<u32>, local: u32) -> u32 {
+    return (wg.y * groups.x + wg.x) * GROUP + local;
+}
+
+// The homogeneous line through u and v, computed with the lesser corner first so that the edge's two
+// triangles get exact negatives of each other.
+fn edge_row(u: vec3<f32>, v: vec3<f32>) -> vec3<f32> {
+    let u_first = u.x < v.x || (u.x == v.x && (u.y < v.y || (u.y == v.y && u.z < v.z)));
+    if (u_first) {
+        return cross(u, v);
+    }
+    return -cross(v, u);
+}
+
+// The plane through three homogeneous points (x, y, z, w): each component the cofactor of a 4 x 4
+// determinant with the points as rows, so the plane's dot product with each of them is 0.
+fn plane_through(a: vec4<f32>, b: vec4<f32>, c: vec4<f32>) -> vec4<f32> {
+    return vec4<f32>(
+        dot(a.yzw, cross(b.yzw, c.yzw)),
+        -dot(a.xzw, cross(b.xzw, c.xzw)),
+        dot(a.xyw, cross(b.xyw, c.xyw)),
+        -dot(a.xyz, cross(b.xyz, c.xyz)),
+    );
+}
+
+@compute @workgroup_size(64)
+fn cs_setup(
+    @builtin(workgroup_id) wg: vec3<u32>,
+    @builtin(num_workgroups) groups: vec3<u32>,
+    @builtin(local_invocation_index) local: u32,
+) {
+    let t = invocation(wg, groups, local);
+    if (t >= casters.counts.w) {
+        return;
+    }
+    let info = bitcast<u32>(triangles[4u * t + 3u].x);
+    let world_from_local = instances[info >> 1u].world_from_local;
+    let wa = world_from_local * triangles[4u * t];
+    let wb = world_from_local * triangles[4u * t + 1u];
+    let wc = world_from_local * triangles[4u * t + 2u];
+    // clip_position's own product, so that corners shared by triangles agree to the bit.
+    let a = view.clip_from_world * wa;
+    let b = view.clip_from_world * wb;
+    let c = view.clip_from_world * wc;
+    let e0 = edge_row(b.xyw, c.xyw);
+    let e1 = edge_row(c.xyw, a.xyw);
+    let e2 = edge_row(a.xyw, b.xyw);
+    let plane = plane_through(wa, wb, wc);
+    let eye_side = dot(plane, vec4<f32>(view.eye.xyz, 1.0));
+    setups[SETUP * t] = vec4<f32>(e0, dot(a.xyw, e0));
+    setups[SETUP * t + 1u] = vec4<f32>(e1, 0.0);
+    setups[SETUP * t + 2u] = vec4<f32>(e2, 0.0);
+    setups[SETUP * t + 3u] = vec4<f32>(a.z * e0 + b.z * e1 + c.z * e2, f32(info & 1u));
+    setups[SETUP * t + 4u] = select(plane, -plane, eye_side < 0.0);
+}
+
+// Whether an edge's oriented value `e` at the pixel covers it, ties going by the row's gradient `r`.
+fn inside(e: f32, r: vec3<f32>) -> bool {
+    return e > 0.0 || (e == 0.0 && (r.x > 0.0 || (r.x == 0.0 && r.y > 0.0)));
+}
+
+// What one piece adds at a pixel: the count, the fragments the rasterizer would make there, and the
+// stencil updates (z-fail's: where the depth test fails).
+struct Tally {
+    count: i32,
+    fragments: u32,
+    updates: u32,
+    tests: u32,
+};
+
+// Piece `k`'s triangles at NDC point `p` over the receiver at world position `receiver`: z-fail's count,
+// each fragment behind the receiver (or at it: `Less` fails) adding 1 for a back face and -1 for a front
+// face. Caps always count where they are behind the near plane: a near cap is the caster's own surface,
+// never in front of the receiver but at it only up to rounding, and a far cap is at infinity.
+fn add_piece(k: u32, p: vec3<f32>, receiver: vec4<f32>, tally: ptr<function, Tally>) {
+    let s = shafts[k * casters.counts.y];
+    (*tally).tests += s.count;
+    for (var t = s.first; t < s.first + s.count; t++) {
+        let r0 = setups[SETUP * t];
+        let det = r0.w;
+        // Each edge read and tested in turn: most triangles fail the first or second.
+        let o = select(-1.0, 1.0, det > 0.0);
+        let e0 = r0.xyz * o;
+        if (det == 0.0 || !inside(dot(e0, p), e0)) {
+            continue;
+        }
+        let e1 = setups[SETUP * t + 1u].xyz * o;
+        if (!inside(dot(e1, p), e1)) {
+            continue;
+        }
+        let e2 = setups[SETUP * t + 2u].xyz * o;
+        if (!inside(dot(e2, p), e2)) {
+            continue;
+        }
+        let zr = setups[SETUP * t + 3u];
+        if (dot(zr.xyz, p) * o < 0.0) {
+            continue;
+        }
+        (*tally).fragments += 1u;
+        if (zr.w != 0.0 || dot(setups[SETUP * t + 4u], receiver) >= 0.0) {
+            (*tally).count += select(1, -1, det > 0.0);
+            (*tally).updates += 1u;
+        }
+    }
+}
+
+// Twin: shadow_core::shafts::tolerance.
+fn tolerance(r: f32, near: f32) -> f32 {
+    return r * (1.0 / 4096.0) + r * r / near * (1.0 / 262144.0);
+}
+
+// Twin: shadow_core::shafts::Shaft::holds, for a point with outline `o`, distance `d` and tolerances.
+fn holds(s: PieceShaft, o: vec4<f32>, d: f32, side: f32, along: f32) -> bool {
+    let tol = vec4<f32>(side, side, 2.0 * side, 2.0 * side);
+    return d >= s.near - along && all(o >= s.lo - tol) && all(o <= s.hi + tol);
+}
+
+// Where a listed pixel's candidate pieces are: the pieces of its light-space cell (entries `first` to
+// `end` of the cell lists), each kept where its shaft holds the pixel, or every piece (`all`) where the
+// pixel lies at or behind a perspective light's plane.
+struct Candidates {
+    first: u32,
+    end: u32,
+    all: bool,
+    projection: u32,
+    o: vec4<f32>,
+    d: f32,
+    side: f32,
+    along: f32,
+};
+
+const NONE: u32 = 0xffffffffu;
+
+// A listed pixel's world position and its NDC point (its centre).
+fn pixel_position(at: u32) -> vec3<f32> {
+    let width = u32(view.size.x);
+    return textureLoad(g_position, vec2<u32>(at % width, at / width), 0).xyz;
+}
+
+fn pixel_ndc(at: u32) -> vec3<f32> {
+    let width = u32(view.size.x);
+    let px = vec2<f32>(f32(at % width), f32(at / width)) + 0.5;
+    return vec3<f32>(px.x * 2.0 * view.size.z - 1.0, 1.0 - px.y * 2.0 * view.size.w, 1.0);
+}
+
+fn candidates(pos: vec3<f32>) -> Candidates {
+    var j = 0u;
+    if (casters.counts.x == 1u) {
+        j = u32(cube_face(pos - casters.light.xyz));
+    }
+    let v = casters.view_from_world[j] * vec4<f32>(pos, 1.0);
+    let d = -v.z;
+    let orthographic = casters.cells[j].z == 1u;
+    if (!orthographic && d <= 0.0) {
+        return Candidates(0u, casters.counts.z, true, j, vec4<f32>(0.0), d, 0.0, 0.0);
+    }
+    let xy = select(v.xy / d, v.xy, orthographic);
+    let tol = tolerance(distance(pos, view.eye.xyz), casters.light.w);
+    let side = select(2.0 * tol / d, 2.0 * tol, orthographic);
+    let g = casters.grid[j];
+    let n = i32(casters.cells[j].x);
+    let cell = clamp(vec2<i32>(floor((xy - g.xy) * g.zw)), vec2<i32>(0), vec2<i32>(n - 1));
+    let c = casters.cells[j].y + u32(cell.y * n + cell.x);
+    let o = vec4<f32>(xy, xy.x + xy.y, xy.x - xy.y);
+    return Candidates(grid_cells[c], grid_cells[c + 1u], false, j, o, d, side, tol);
+}
+
+// Entry `e` of a pixel's candidates: the piece, or NONE where its shaft does not hold the pixel.
+fn candidate(c: Candidates, e: u32) -> u32 {
+    if (c.all) {
+        return e;
+    }
+    let k = grid_cells[casters.lists.x + e];
+    let s = shafts[k * casters.counts.y + c.projection];
+    if (s.bounded == 0u || holds(s, c.o, c.d, c.side, c.along)) {
+        return k;
+    }
+    return NONE;
+}
+
+// The work buffer: per piece its pixel count, its first pair and its cursor (PIECE words each), then per
+// listed pixel a flag (1: too many pairs, the pixel counts every piece itself), then the pairs, each a
+// listed pixel's index, a run per piece.
+@group(1) @binding(16) var<storage, read_write> work: array<atomic<u32>>;
+
+const PIECE: u32 = 3u;
+
+fn flags_start() -> u32 {
+    return PIECE * casters.counts.z;
+}
+
+fn pairs_start() -> u32 {
+    return flags_start() + u32(view.size.x) * u32(view.size.y);
+}
+
+// Pass 1, per listed pixel: its count set to 0, its flag cleared, and 1 added to each candidate's pixels.
+@compute @workgroup_size(64)
+fn cs_tally(
+    @builtin(workgroup_id) wg: vec3<u32>,
+    @builtin(num_workgroups) groups: vec3<u32>,
+    @builtin(local_invocation_index) local: u32,
+) {
+    let n = atomicLoad(&listed.pixels);
+    for (var i = invocation(wg, groups, local); i < n; i += groups.x * groups.y * GROUP) {
+        let at = listed.at[i];
+        atomicStore(&counts[at], 0);
+        atomicStore(&work[flags_start() + i], 0u);
+        let c = candidates(pixel_position(at));
+        for (var e = c.first; e < c.end; e++) {
+            let k = candidate(c, e);
+            if (k != NONE) {
+                atomicAdd(&work[PIECE * k], 1u);
+            }
+        }
+    }
+}
+
+var<workgroup> sums: array<u32, 256>;
+
+// Pass 2, one workgroup of 256: each piece's first pair and cursor, by a prefix sum of the counts.
+@compute @workgroup_size(256)
+fn cs_offsets(@builtin(local_invocation_index) local: u32) {
+    let pieces = casters.counts.z;
+    let chunk = (pieces + 255u) / 256u;
+    let lo = min(local * chunk, pieces);
+    let hi = min(lo + chunk, pieces);
+    var total = 0u;
+    for (var k = lo; k < hi; k++) {
+        total += atomicLoad(&work[PIECE * k]);
+    }
+    sums[local] = total;
+    workgroupBarrier();
+    // Hillis-Steele, inclusive.
+    for (var step = 1u; step < 256u; step *= 2u) {
+        var add = 0u;
+        if (local >= step) {
+            add = sums[local - step];
+        }
+        workgroupBarrier();
+        sums[local] += add;
+        workgroupBarrier();
+    }
+    var start = sums[local] - total;
+    for (var k = lo; k < hi; k++) {
+        atomicStore(&work[PIECE * k + 1u], start);
+        atomicStore(&work[PIECE * k + 2u], start);
+        start += atomicLoad(&work[PIECE * k]);
+    }
+}
+
+// Pass 3, per listed pixel: its index written into each candidate's run; a pixel with a pair past the
+// room there is flagged and counts every piece itself (pass 5).
+@compute @workgroup_size(64)
+fn cs_fill(
+    @builtin(workgroup_id) wg: vec3<u32>,
+    @builtin(num_workgroups) groups: vec3<u32>,
+    @builtin(local_invocation_index) local: u32,
+) {
+    let n = atomicLoad(&listed.pixels);
+    let room = arrayLength(&work) - pairs_start();
+    for (var i = invocation(wg, groups, local); i < n; i += groups.x * groups.y * GROUP) {
+        let c = candidates(pixel_position(listed.at[i]));
+        for (var e = c.first; e < c.end; e++) {
+            let k = candidate(c, e);
+            if (k == NONE) {
+                continue;
+            }
+            let slot = atomicAdd(&work[PIECE * k + 2u], 1u);
+            if (slot < room) {
+                atomicStore(&work[pairs_start() + slot], i);
+            } else {
+                atomicStore(&work[flags_start() + i], 1u);
+            }
+        }
+    }
+}
+
+// Adds a tally's count to a pixel and its work to the counters.
+fn settle(at: u32, tally: Tally) {
+    if (tally.count != 0) {
+        atomicAdd(&counts[at], tally.count);
+    }
+    if (tally.tests > 0u) {
+        atomicAdd(&listed.fragments, tally.fragments);
+        atomicAdd(&listed.updates, tally.updates);
+        atomicAdd(&listed.tests, tally.tests);
+    }
+}
+
+// Pass 4, a workgroup per piece: the piece counted at each of its pixels, the invocations going through
+// its pixels together, so they read the same triangle at the same time.
+@compute @workgroup_size(64)
+fn cs_pieces(
+    @builtin(workgroup_id) wg: vec3<u32>,
+    @builtin(num_workgroups) groups: vec3<u32>,
+    @builtin(local_invocation_index) local: u32,
+) {
+    let k = wg.y * groups.x + wg.x;
+    if (k >= casters.counts.z) {
+        return;
+    }
+    let room = arrayLength(&work) - pairs_start();
+    let first = atomicLoad(&work[PIECE * k + 1u]);
+    let end = min(first + atomicLoad(&work[PIECE * k]), room);
+    for (var slot = first + local; slot < end; slot += GROUP) {
+        let i = atomicLoad(&work[pairs_start() + slot]);
+        if (atomicLoad(&work[flags_start() + i]) != 0u) {
+            continue;
+        }
+        let at = listed.at[i];
+        var tally = Tally(0, 0u, 0u, 0u);
+        add_piece(k, pixel_ndc(at), vec4<f32>(pixel_position(at), 1.0), &tally);
+        settle(at, tally);
+    }
+}
+
+// Pass 5, per flagged pixel: every candidate counted there.
+@compute @workgroup_size(64)
+fn cs_alone(
+    @builtin(workgroup_id) wg: vec3<u32>,
+    @builtin(num_workgroups) groups: vec3<u32>,
+    @builtin(local_invocation_index) local: u32,
+) {
+    let n = atomicLoad(&listed.pixels);
+    for (var i = invocation(wg, groups, local); i < n; i += groups.x * groups.y * GROUP) {
+        if (atomicLoad(&work[flags_start() + i]) == 0u) {
+            continue;
+        }
+        let at = listed.at[i];
+        let pos = pixel_position(at);
+        let c = candidates(pos);
+        var tally = Tally(0, 0u, 0u, 0u);
+        for (var e = c.first; e < c.end; e++) {
+            let k = candidate(c, e);
+            if (k != NONE) {
+                add_piece(k, pixel_ndc(at), vec4<f32>(pos, 1.0), &tally);
+            }
+        }
+        settle(at, tally);
+    }
+}

@@ -1,0 +1,543 @@
+//! hybrid's caster masks on the GPU (`caster_masks=on`, ours; twin: shadow-cpu's
+//! techniques/caster_masks.rs): each small piece of the z-fail volumes is counted only at the silhouette
+//! pixels its shaft holds ([`shadow_core::shafts`]), by compute passes instead of the rasterizer.
+//!
+//! The rasterizer cannot do this: the mask is a stencil bit, the same for every draw, and a piece's
+//! pixels are known only once the classification has run on the GPU (read back, they would stall the
+//! frame; as scissor rectangles, measured on the CPU, they would still leave 10% of tree's fill). So:
+//!
+//! - **Build** (CPU): the pieces of at most [`LISTED_TRIANGLES`] volume triangles (a tree's twigs, a
+//!   cloud's cubes) are written out as triangles, each piece's shafts beside its run of them, and a grid
+//!   per light projection lists the pieces whose shafts, widened by the largest tolerance a pixel there can
+//!   have, meet each cell. Larger pieces (a single big mesh) stay rasterized through the stencil mask.
+//! - **Query**: the mask pass lists its silhouette pixels; `cs_setup` sets each triangle up for the view
+//!   (its rows of adj(M), homogeneous rasterization), and `cs_count` takes
+//!   each listed pixel's count over the pieces of its light-space cell whose shafts hold it, testing their
+//!   triangles at the pixel's centre as the rasterizer would (hybrid_casters.wgsl), and writes it beside
+//!   the pixel. The answer shadows a silhouette pixel whose stencil count or listed count is not 0: every
+//!   piece is closed and wound alike, so the pieces' counts at a point have one sign and cannot cancel.
+//!
+//! The work is the CPU's caster masks' (a listed pixel times its pieces' triangles, every fragment those
+//! would make counted), with the same shafts: `volume_fragments` is what the compute pass covers plus what
+//! the stencil lets through of the rasterized pieces.
+
+use std::ops::Range;
+
+use bytemuck::{Pod, Zeroable};
+use shadow_core::FrameInputs;
+use shadow_core::LightKind;
+use shadow_core::frame::InstanceVolume;
+use shadow_core::geometry::volume::ShadowVolume;
+use shadow_core::glam::{Vec2, Vec4, Vec4Swizzles};
+use shadow_core::light::LightView;
+use shadow_core::shafts::{CasterShafts, Shaft, tolerance};
+use wgpu::util::DeviceExt;
+
+use crate::context::{WgpuContext, WgpuError};
+use crate::gbuffer::GpuGBuffer;
+use crate::pipelines::buffer_entry;
+use crate::{readback, shaders};
+
+/// Pieces of at most this many volume triangles are counted by the compute passes at the pixels their
+/// shafts hold; larger ones are rasterized through the whole mask, where a pixel's cost does not grow
+/// with them.
+pub(super) const LISTED_TRIANGLES: usize = 1024;
+
+/// The most projections a light has (a point light's cube faces).
+const PROJECTIONS: usize = 6;
+
+/// vec4 per triangle set up for the view (hybrid_casters.wgsl's `SETUP`).
+const SETUP: u64 = 5;
+
+/// Invocations per workgroup of the compute passes (hybrid_casters.wgsl's `GROUP`).
+const GROUP: u32 = 64;
+
+/// The most workgroups along one dimension of a dispatch.
+const MAX_GROUPS: u32 = 65_535;
+
+/// Bytes of the listed pixels' header (`Listed` in shaders.rs: four counters).
+const HEADER: u64 = 16;
+
+/// Listed pixels per invocation of `cs_count` in a view all of whose pixels are listed: the dispatch is
+/// sized by the view (the list's length is known only on the GPU), each invocation taking every so many.
+const PIXELS_PER_INVOCATION: u32 = 16;
+
+/// hybrid_casters.wgsl's `CasterParams`.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct Params {
+    view_from_world: [[[f32; 4]; 4]; PROJECTIONS],
+    grid: [[f32; 4]; PROJECTIONS],
+    cells: [[u32; 4]; PROJECTIONS],
+    counts: [u32; 4],
+    light: [f32; 4],
+    lists: [u32; 4],
+}
+
+/// hybrid_casters.wgsl's `PieceShaft`.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct PieceShaft {
+    lo: [f32; 4],
+    hi: [f32; 4],
+    near: f32,
+    bounded: u32,
+    first: u32,
+    count: u32,
+}
+
+/// The volumes of a build split for the caster masks.
+pub(super) struct Split {
+    /// The small pieces' triangles, four vec4 each (hybrid_casters.wgsl's `triangles`).
+    triangles: Vec<Vec4>,
+    /// Per small piece, its index in the shafts and its run of triangles.
+    pieces: Vec<(usize, Range<u32>)>,
+    /// What is left to rasterize: the large pieces, a volume per instance that has any.
+    pub(super) raster: Vec<InstanceVolume>,
+}
+
+impl Split {
+    /// Splits `volumes` (whose pieces `shafts` lists in order) into the pieces of at most `limit` volume
+    /// triangles, written out for the compute passes, and the rest.
+    pub(super) fn new(frame: &FrameInputs, volumes: &[InstanceVolume], shafts: &CasterShafts, limit: usize) -> Self {
+        let mut split = Self { triangles: Vec::new(), pieces: Vec::new(), raster: Vec::new() };
+        let mut k = 0;
+        for iv in volumes {
+            let inst = &frame.instances[iv.instance];
+            let vol = &iv.volume;
+            let mut rest = ShadowVolume {
+                sides: Vec::new(),
+                caps_forward: Vec::new(),
+                caps_reversed: Vec::new(),
+                light: vol.light,
+                pieces: Vec::new(),
+            };
+            for piece in &vol.pieces {
+                let r = |r: &Range<u32>| r.start as usize..r.end as usize;
+                let (sides, forward, reversed) = (
+                    &vol.sides[r(&piece.sides)],
+                    &vol.caps_forward[r(&piece.caps_forward)],
+                    &vol.caps_reversed[r(&piece.caps_reversed)],
+                );
+                if sides.len() + 2 * (forward.len() + reversed.len()) > limit {
+                    rest.sides.extend_from_slice(sides);
+                    rest.caps_forward.extend_from_slice(forward);
+                    rest.caps_reversed.extend_from_slice(reversed);
+                } else {
+                    let first = split.triangle_count();
+                    split.write_piece(iv, inst, sides, forward, reversed);
+                    split.pieces.push((k, first..split.triangle_count()));
+                }
+                k += 1;
+            }
+            if rest.triangle_count() > 0 {
+                split.raster.push(InstanceVolume { instance: iv.instance, volume: rest, silhouette_edges: 0 });
+            }
+        }
+        debug_assert_eq!(k, shafts.pieces.len(), "the shafts list every piece");
+        split
+    }
+
+    fn triangle_count(&self) -> u32 {
+        (self.triangles.len() / 4) as u32
+    }
+
+    /// Writes one piece's triangles as the rasterizer would draw them (shadow_volume.rs's `upload`):
+    /// sides as built, near caps from the mesh's vertices, far caps extruded and turned around for faces
+    /// that cast as wound; each wound so its front face is counter-clockwise.
+    fn write_piece(
+        &mut self,
+        iv: &InstanceVolume,
+        inst: &shadow_core::Instance,
+        sides: &[[Vec4; 3]],
+        forward: &[u32],
+        reversed: &[u32],
+    ) {
+        let m = inst.mirrored;
+        let (tris, positions) = (inst.mesh.triangles(), inst.mesh.positions());
+        let instance = iv.instance as u32;
+        let mut push = |[a, b, c]: [Vec4; 3], cw: bool, cap: bool| {
+            let (b, c) = if cw { (c, b) } else { (b, c) };
+            let info = f32::from_bits(instance * 2 + u32::from(cap));
+            self.triangles.extend([a, b, c, Vec4::new(info, 0.0, 0.0, 0.0)]);
+        };
+        for &s in sides {
+            push(s, m, false);
+        }
+        let light = iv.volume.light;
+        for (ids, near_cw, far_reverse) in [(forward, m, true), (reversed, !m, false)] {
+            for &f in ids {
+                let [a, b, c] = tris[f as usize].map(|v| positions[v as usize]);
+                push([a.extend(1.0), b.extend(1.0), c.extend(1.0)], near_cw, true);
+                let far = [a, b, c].map(|p| light.extrude(p));
+                push(if far_reverse { [far[0], far[2], far[1]] } else { far }, m, true);
+            }
+        }
+    }
+}
+
+/// Per projection, a grid over the light-space bounds of the small pieces' shafts within the
+/// projection's view (`windows`: silhouette pixels lie in it, the map classifying nothing else), each
+/// cell listing the pieces whose shafts, widened by the largest sideways tolerance a pixel they can hold
+/// may have, meet it; a piece unbounded in the projection is listed in every cell. A shaft beyond the
+/// grid is listed in its border cells, which is where a pixel beyond it looks. Returns the cells' starts
+/// (every projection's, one after another, and one more) followed by the lists, and per projection its
+/// origin, scale and side.
+fn grids(
+    shafts: &[&[Option<Shaft>]],
+    windows: &[(Vec2, Vec2)],
+    widest: f32,
+    orthographic: &[bool],
+) -> (Vec<u32>, Vec<(Vec2, Vec2, usize)>) {
+    // The box of a bounded shaft, widened; `None` where a pixel's tolerance cannot be bounded.
+    let widened = |s: &Shaft, j: usize| -> Option<(Vec2, Vec2)> {
+        let side = if orthographic[j] {
+            2.0 * widest
+        } else {
+            let d = s.near - widest;
+            if d <= 0.0 {
+                return None;
+            }
+            2.0 * widest / d
+        };
+        Some((s.lo.xy() - side, s.hi.xy() + side))
+    };
+    let mut frames = Vec::with_capacity(windows.len());
+    let mut cells: Vec<Vec<u32>> = Vec::new();
+    for (j, window) in windows.iter().enumerate() {
+        let boxes: Vec<Option<(Vec2, Vec2)>> =
+            shafts.iter().map(|s| s[j].as_ref().and_then(|s| widened(s, j))).collect();
+        let (lo, hi) =
+            boxes.iter().flatten().fold((Vec2::INFINITY, Vec2::NEG_INFINITY), |(lo, hi), b| (lo.min(b.0), hi.max(b.1)));
+        let (lo, hi) = (lo.max(window.0), hi.min(window.1));
+        let side = if lo.x <= hi.x { ((shafts.len() as f64).sqrt() * 2.0).clamp(1.0, 256.0) as usize } else { 1 };
+        let (origin, scale) =
+            if lo.x <= hi.x { (lo, side as f32 / (hi - lo).max(Vec2::splat(1e-30))) } else { (Vec2::ZERO, Vec2::ZERO) };
+        let cell = |v: f32| (v.max(0.0) as usize).min(side - 1);
+        let mut lists = vec![Vec::new(); side * side];
+        for (k, b) in boxes.iter().enumerate() {
+            let ((x0, x1), (y0, y1)) = match b {
+                Some((a, b)) => {
+                    let (a, b) = ((*a - origin) * scale, (*b - origin) * scale);
+                    ((cell(a.x), cell(b.x)), (cell(a.y), cell(b.y)))
+                }
+                None => ((0, side - 1), (0, side - 1)),
+            };
+            for y in y0..=y1 {
+                for list in &mut lists[y * side + x0..=y * side + x1] {
+                    list.push(k as u32);
+                }
+            }
+        }
+        frames.push((origin, scale, side));
+        cells.extend(lists);
+    }
+    let mut out = Vec::with_capacity(cells.len() + 1 + cells.iter().map(Vec::len).sum::<usize>());
+    let mut start = 0u32;
+    for list in &cells {
+        out.push(start);
+        start += list.len() as u32;
+    }
+    out.push(start);
+    for list in &cells {
+        out.extend_from_slice(list);
+    }
+    (out, frames)
+}
+
+/// A projection's view in its light space ([`shadow_core::shafts::light_coords`]), with a margin of a
+/// hundredth of its size.
+fn window(proj: &shadow_core::light::LightProjection) -> (Vec2, Vec2) {
+    let view_from_clip = proj.clip_from_view.inverse();
+    let (lo, hi) = [(-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0), (1.0, 1.0)].iter().fold(
+        (Vec2::INFINITY, Vec2::NEG_INFINITY),
+        |(lo, hi), &(x, y)| {
+            let v = view_from_clip.project_point3(shadow_core::glam::Vec3::new(x, y, 0.5));
+            let xy = if proj.orthographic { v.truncate() } else { v.truncate() / -v.z };
+            (lo.min(xy), hi.max(xy))
+        },
+    );
+    let margin = (hi - lo) * 0.01;
+    (lo - margin, hi + margin)
+}
+
+/// The compute passes' pipelines and their group-1 layout.
+pub(super) struct CasterPasses {
+    layout: wgpu::BindGroupLayout,
+    setup: wgpu::ComputePipeline,
+    tally: wgpu::ComputePipeline,
+    offsets: wgpu::ComputePipeline,
+    fill: wgpu::ComputePipeline,
+    pieces: wgpu::ComputePipeline,
+    alone: wgpu::ComputePipeline,
+}
+
+/// One build's small pieces on the GPU.
+pub(super) struct CasterPieces {
+    params: wgpu::Buffer,
+    triangles: wgpu::Buffer,
+    setups: wgpu::Buffer,
+    shafts: wgpu::Buffer,
+    grid: wgpu::Buffer,
+    triangle_count: u32,
+    /// Pieces counted by the compute passes.
+    pub(super) pieces: usize,
+}
+
+/// The listed pixels and their counts, for one view size, and the compute passes' work buffer, for one
+/// number of pieces too.
+pub(super) struct ListedPixels {
+    /// The header (counters) and the pixels.
+    pub(super) listed: wgpu::Buffer,
+    /// Per pixel of the view, its count (written at the listed pixels only).
+    pub(super) counts: wgpu::Buffer,
+    /// Per piece its pixel count, first pair and cursor, per listed pixel a flag, then the pairs
+    /// (hybrid_casters.wgsl's `work`).
+    work: wgpu::Buffer,
+    staging: wgpu::Buffer,
+    /// The view's size and the pieces the work buffer was made for.
+    pub(super) size: (u32, u32),
+    pub(super) pieces: usize,
+}
+
+/// Words of the work buffer per piece (hybrid_casters.wgsl's `PIECE`).
+const PIECE: u64 = 3;
+
+/// Pairs of a listed pixel and a piece the work buffer has room for, per pixel of the view: tree has
+/// about 4 per silhouette pixel. A pixel whose pairs do not fit is counted by itself, more slowly.
+const PAIRS_PER_PIXEL: u64 = 8;
+
+impl ListedPixels {
+    pub(super) fn new(cx: &WgpuContext, (width, height): (u32, u32), pieces: usize) -> Self {
+        use wgpu::BufferUsages as U;
+        let pixels = u64::from(width) * u64::from(height);
+        let buffer = |label, size, usage| {
+            cx.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size,
+                usage,
+                mapped_at_creation: false,
+            })
+        };
+        let fixed = PIECE * pieces as u64 + pixels;
+        let largest = {
+            let limits = cx.device.limits();
+            limits.max_storage_buffer_binding_size.min(limits.max_buffer_size) / 4
+        };
+        let pairs = (PAIRS_PER_PIXEL * pixels).min(largest.saturating_sub(fixed)).max(1);
+        Self {
+            listed: buffer("hybrid listed pixels", HEADER + 4 * pixels, U::STORAGE | U::COPY_SRC | U::COPY_DST),
+            counts: buffer("hybrid listed counts", 4 * pixels.max(1), U::STORAGE),
+            work: buffer("hybrid caster work", 4 * (fixed + pairs), U::STORAGE | U::COPY_DST),
+            staging: buffer("hybrid listed readback", 16, U::COPY_DST | U::MAP_READ),
+            size: (width, height),
+            pieces,
+        }
+    }
+
+    /// Empties the list (before the mask pass).
+    pub(super) fn clear(&self, enc: &mut wgpu::CommandEncoder) {
+        enc.clear_buffer(&self.listed, 0, Some(HEADER));
+    }
+
+    /// Reads back the pixels listed, the fragments the compute pass's triangles made at them, its stencil
+    /// updates and its pixel-triangle tests.
+    pub(super) fn counters(&self, cx: &WgpuContext) -> Result<[u64; 4], WgpuError> {
+        let mut enc = cx.device.create_command_encoder(&Default::default());
+        enc.copy_buffer_to_buffer(&self.listed, 0, &self.staging, 0, 16);
+        cx.queue.submit([enc.finish()]);
+        let d = readback::map_read(cx, &self.staging, "reading the hybrid caster counters")?;
+        let word = |i: usize| u64::from(u32::from_le_bytes([d[4 * i], d[4 * i + 1], d[4 * i + 2], d[4 * i + 3]]));
+        Ok([word(0), word(1), word(2), word(3)])
+    }
+}
+
+/// A compute-stage binding of group 1.
+fn compute_entry(binding: u32, ty: wgpu::BindingType) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry { binding, visibility: wgpu::ShaderStages::COMPUTE, ty, count: None }
+}
+
+fn storage(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
+    buffer_entry(binding, wgpu::BufferBindingType::Storage { read_only }, wgpu::ShaderStages::COMPUTE)
+}
+
+impl CasterPasses {
+    pub(super) fn new(cx: &WgpuContext) -> Self {
+        let position = wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: false },
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        };
+        let layout = cx.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("hybrid casters"),
+            entries: &[
+                compute_entry(0, position),
+                storage(8, false),
+                storage(9, false),
+                buffer_entry(11, wgpu::BufferBindingType::Uniform, wgpu::ShaderStages::COMPUTE),
+                storage(12, true),
+                storage(13, false),
+                storage(14, true),
+                storage(15, true),
+                storage(16, false),
+            ],
+        });
+        let module = shaders::module(&cx.device, "hybrid casters", shaders::hybrid_casters());
+        let pipeline_layout = cx.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("hybrid casters"),
+            bind_group_layouts: &[Some(&cx.shared.frame_layout), Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipeline = |entry: &str| {
+            cx.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(entry),
+                layout: Some(&pipeline_layout),
+                module: &module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        };
+        Self {
+            setup: pipeline("cs_setup"),
+            tally: pipeline("cs_tally"),
+            offsets: pipeline("cs_offsets"),
+            fill: pipeline("cs_fill"),
+            pieces: pipeline("cs_pieces"),
+            alone: pipeline("cs_alone"),
+            layout,
+        }
+    }
+
+    /// Uploads a build's small pieces: their triangles, shafts and grids.
+    pub(super) fn upload(
+        cx: &WgpuContext,
+        frame: &FrameInputs,
+        light: &LightView,
+        split: &Split,
+        shafts: &CasterShafts,
+    ) -> CasterPieces {
+        let projections = light.projections.len().min(PROJECTIONS);
+        let piece_shafts: Vec<&[Option<Shaft>]> =
+            split.pieces.iter().map(|(k, _)| shafts.shafts[*k].as_slice()).collect();
+        // The largest world tolerance of any pixel: the farthest corner of the frame's bounds from the eye.
+        let (lo, hi) = (frame.bounds.min, frame.bounds.max);
+        let far = (0..8)
+            .map(|c| {
+                let corner = shadow_core::glam::Vec3::new(
+                    if c & 1 == 0 { lo.x } else { hi.x },
+                    if c & 2 == 0 { lo.y } else { hi.y },
+                    if c & 4 == 0 { lo.z } else { hi.z },
+                );
+                corner.distance(frame.camera.eye)
+            })
+            .fold(0.0f32, f32::max);
+        let widest = tolerance(far, frame.camera.near);
+        let orthographic: Vec<bool> = light.projections.iter().map(|p| p.orthographic).collect();
+        let windows: Vec<(Vec2, Vec2)> = light.projections[..projections].iter().map(window).collect();
+        let (grid, frames) = grids(&piece_shafts, &windows, widest, &orthographic);
+        let mut params = Params::zeroed();
+        let mut first_cell = 0u32;
+        for (j, (proj, (origin, scale, side))) in light.projections.iter().zip(&frames).enumerate() {
+            params.view_from_world[j] = proj.view_from_world.to_cols_array_2d();
+            params.grid[j] = [origin.x, origin.y, scale.x, scale.y];
+            params.cells[j] = [*side as u32, first_cell, u32::from(proj.orthographic), 0];
+            first_cell += (side * side) as u32;
+        }
+        let point = match light.light.kind {
+            LightKind::Point { position } => Some(position),
+            _ => None,
+        };
+        params.counts =
+            [u32::from(point.is_some()), projections as u32, split.pieces.len() as u32, split.triangle_count()];
+        params.light = point.unwrap_or_default().extend(frame.camera.near).to_array();
+        params.lists = [first_cell + 1, 0, 0, 0];
+        let records: Vec<PieceShaft> = split
+            .pieces
+            .iter()
+            .flat_map(|(k, run)| {
+                shafts.shafts[*k][..projections].iter().map(move |s| {
+                    let bounded = s.is_some();
+                    let s = s.unwrap_or(Shaft { lo: Vec4::ZERO, hi: Vec4::ZERO, near: 0.0 });
+                    PieceShaft {
+                        lo: s.lo.to_array(),
+                        hi: s.hi.to_array(),
+                        near: s.near,
+                        bounded: u32::from(bounded),
+                        first: run.start,
+                        count: run.end - run.start,
+                    }
+                })
+            })
+            .collect();
+        let init = |label, contents: &[u8], usage| {
+            cx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
+        };
+        use wgpu::BufferUsages as U;
+        let nonempty = |bytes: &[u8]| if bytes.is_empty() { vec![0u8; 16] } else { bytes.to_vec() };
+        CasterPieces {
+            params: init("hybrid caster params", bytemuck::bytes_of(&params), U::UNIFORM),
+            triangles: init("hybrid caster triangles", &nonempty(bytemuck::cast_slice(&split.triangles)), U::STORAGE),
+            setups: cx.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("hybrid caster setups"),
+                size: (u64::from(split.triangle_count()) * SETUP * 16).max(16),
+                usage: U::STORAGE,
+                mapped_at_creation: false,
+            }),
+            shafts: init("hybrid caster shafts", &nonempty(bytemuck::cast_slice(&records)), U::STORAGE),
+            grid: init("hybrid caster grid", &nonempty(bytemuck::cast_slice(&grid)), U::STORAGE),
+            triangle_count: split.triangle_count(),
+            pieces: split.pieces.len(),
+        }
+    }
+
+    /// Records the compute passes (hybrid_casters.wgsl): set up the triangles for `g`'s view, pair each
+    /// listed pixel with its pieces, count each piece at its pixels.
+    pub(super) fn record(
+        &self,
+        cx: &WgpuContext,
+        enc: &mut wgpu::CommandEncoder,
+        pieces: &CasterPieces,
+        listed: &ListedPixels,
+        g: &GpuGBuffer,
+    ) {
+        fn buffer(binding: u32, b: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
+            wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() }
+        }
+        let group = cx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("hybrid casters"),
+            layout: &self.layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&g.position) },
+                buffer(8, &listed.listed),
+                buffer(9, &listed.counts),
+                buffer(11, &pieces.params),
+                buffer(12, &pieces.triangles),
+                buffer(13, &pieces.setups),
+                buffer(14, &pieces.shafts),
+                buffer(15, &pieces.grid),
+                buffer(16, &listed.work),
+            ],
+        });
+        enc.clear_buffer(&listed.work, 0, Some(4 * PIECE * pieces.pieces as u64));
+        let mut pass = enc
+            .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("hybrid casters"), timestamp_writes: None });
+        pass.set_bind_group(0, &g.frame_group, &[]);
+        pass.set_bind_group(1, &group, &[]);
+        let spread = |pass: &mut wgpu::ComputePass<'_>, pipeline, groups: u32| {
+            pass.set_pipeline(pipeline);
+            pass.dispatch_workgroups(groups.clamp(1, MAX_GROUPS), groups.div_ceil(MAX_GROUPS).max(1), 1);
+        };
+        if pieces.triangle_count > 0 {
+            spread(&mut pass, &self.setup, pieces.triangle_count.div_ceil(GROUP));
+        }
+        // The passes over the listed pixels, whose number only the GPU knows, are sized by the view.
+        let (w, h) = listed.size;
+        let over_pixels = (w * h).div_ceil(GROUP * PIXELS_PER_INVOCATION);
+        spread(&mut pass, &self.tally, over_pixels);
+        spread(&mut pass, &self.offsets, 1);
+        spread(&mut pass, &self.fill, over_pixels);
+        spread(&mut pass, &self.pieces, pieces.pieces as u32);
+        spread(&mut pass, &self.alone, over_pixels);
+    }
+}
