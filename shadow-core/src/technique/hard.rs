@@ -672,9 +672,12 @@ pub struct Hybrid {
     /// through it); off, walked row by row under the tiled mask. Same fragments either way. Off by default:
     /// with caster masks the ordering costs more than it saves.
     pub pencil: OnOff,
-    /// CPU: on, each connected component's volume is counted only at the silhouette pixels within the
-    /// light-space bounds of its shadow (a per-caster mask; its count is zero everywhere else); off, every
-    /// volume through the whole mask. Same picture either way.
+    /// On, each connected component's volume is counted only at the silhouette pixels within the
+    /// light-space bounds of its shadow ([`crate::shafts`]; its count is zero everywhere else): on the CPU
+    /// by listed draws, on the GPU by compute passes over the pixels the mask pass lists (pieces of more
+    /// than a thousand triangles stay rasterized under the mask); off, every volume through the whole
+    /// mask. Same picture either way, on the GPU but for the odd pixel where a volume side meets its
+    /// receiver to within rounding.
     pub caster_masks: OnOff,
     /// Where the GPU keeps the computation mask (the CPU always uses its tiles).
     pub gpu_mask: GpuMask,
@@ -751,7 +754,7 @@ const HYBRID_KEYS: [SettingKey; 12] = [
     SettingKey {
         key: "caster_masks",
         default: "on",
-        help: "CPU: on, each caster's volume is counted only at the silhouette pixels its shadow's bounds hold; off, through the whole mask",
+        help: "on, each caster's volume is counted only at the silhouette pixels its shadow's bounds hold (GPU: by compute passes); off, through the whole mask",
     },
     SettingKey {
         key: "gpu_mask",

@@ -541,3 +541,115 @@ impl CasterPasses {
         spread(&mut pass, &self.alone, over_pixels);
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use std::collections::HashMap;
+
+    use shadow_core::geometry::volume::Caps;
+    use shadow_core::glam::{Vec2, Vec4};
+    use shadow_core::scenes::{self, SceneParams};
+    use shadow_core::shafts::{CasterShafts, Shaft, outline};
+
+    use super::{Split, grids};
+
+    /// The cell a light-space point looks in (hybrid_casters.wgsl's `candidates`).
+    fn cell_of(frame: (Vec2, Vec2, usize), first: usize, xy: Vec2) -> usize {
+        let (origin, scale, side) = frame;
+        let c = ((xy - origin) * scale).floor();
+        let clamp = |v: f32| (v.max(0.0) as usize).min(side - 1);
+        first + clamp(c.y) * side + clamp(c.x)
+    }
+
+    #[test]
+    fn split_writes_closed_pieces_and_leaves_the_large_ones_to_rasterize() {
+        // primitives: a sphere of more volume triangles than the limit, and smaller casters.
+        let s = scenes::build("primitives", &SceneParams::default()).expect("scene");
+        let frame = shadow_core::FrameInputs::from_scene(&s, s.cameras().next().expect("camera").0).expect("frame");
+        let light = frame.light_view(&frame.lights[0]).expect("light view");
+        let volumes = frame.shadow_volumes(&light, Caps::Both);
+        let shafts = CasterShafts::new(&frame, &light, &volumes);
+        let limit = 256;
+        let split = Split::new(&frame, &volumes, &shafts, limit);
+        let sizes: Vec<usize> = volumes
+            .iter()
+            .flat_map(|iv| {
+                iv.volume.pieces.iter().map(|p| p.sides.len() + 2 * (p.caps_forward.len() + p.caps_reversed.len()))
+            })
+            .collect();
+        let (small, large): (Vec<usize>, Vec<usize>) = sizes.iter().partition(|&&n| n <= limit);
+        assert!(!small.is_empty() && !large.is_empty(), "primitives has pieces on both sides of {limit}: {sizes:?}");
+        assert_eq!(split.pieces.len(), small.len());
+        assert_eq!(split.triangle_count() as usize, small.iter().sum::<usize>());
+        assert_eq!(split.raster.iter().map(|v| v.volume.triangle_count()).sum::<usize>(), large.iter().sum::<usize>());
+        // Each piece written out is closed and wound alike: every directed edge between two corners comes
+        // with its reverse (far caps turned around, mirrored instances turned back).
+        let key = |v: Vec4| v.to_array().map(f32::to_bits);
+        for (k, run) in &split.pieces {
+            let mut edges: HashMap<([u32; 4], [u32; 4]), i32> = HashMap::new();
+            for t in run.clone() {
+                let c = &split.triangles[4 * t as usize..4 * t as usize + 3];
+                for (a, b) in [(c[0], c[1]), (c[1], c[2]), (c[2], c[0])] {
+                    *edges.entry((key(a), key(b))).or_default() += 1;
+                    *edges.entry((key(b), key(a))).or_default() -= 1;
+                }
+            }
+            let open = edges.values().filter(|&&n| n != 0).count();
+            assert_eq!(open, 0, "piece {k}: {open} directed edges without their reverse");
+        }
+    }
+
+    #[test]
+    fn every_point_a_shaft_holds_finds_its_piece_in_its_cell() {
+        // Random shafts, some unbounded, some far outside the view, and random points with tolerances no
+        // larger than the grid was widened for.
+        let mut seed = 0x2545_f491_u32;
+        let mut next = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 17;
+            seed ^= seed << 5;
+            seed as f32 / u32::MAX as f32
+        };
+        let widest = 0.01;
+        let mut shafts: Vec<Vec<Option<Shaft>>> = Vec::new();
+        for k in 0..300 {
+            let centre = Vec2::new(next() * 3.0 - 1.5, next() * 3.0 - 1.5) * if k % 10 == 0 { 8.0 } else { 1.0 };
+            let half = Vec2::new(next(), next()) * 0.2;
+            let (a, b) = (outline(centre - half), outline(centre + half));
+            let shaft = Shaft {
+                lo: a.min(b).min(outline(centre + half * Vec2::new(1.0, -1.0))),
+                hi: a.max(b).max(outline(centre + half * Vec2::new(-1.0, 1.0))),
+                near: 0.5 + next(),
+            };
+            shafts.push(vec![(k % 37 != 0).then_some(shaft)]);
+        }
+        let refs: Vec<&[Option<Shaft>]> = shafts.iter().map(Vec::as_slice).collect();
+        let window = (Vec2::splat(-1.0), Vec2::splat(1.0));
+        let (cells, frames) = grids(&refs, &[window], widest, &[false]);
+        let lists = frames[0].2 * frames[0].2 + 1;
+        let (mut held, mut missed) = (0, Vec::new());
+        for _ in 0..20_000 {
+            let xy = Vec2::new(next() * 4.0 - 2.0, next() * 4.0 - 2.0);
+            let (tol, d) = (next() * widest, 0.3 + next() * 2.0);
+            let side = 2.0 * tol / d;
+            let c = cell_of(frames[0], 0, xy);
+            let listed = &cells[lists + cells[c] as usize..lists + cells[c + 1] as usize];
+            for (k, s) in shafts.iter().enumerate() {
+                let holds = s[0].is_none_or(|s| s.holds(outline(xy), d, side, tol));
+                if holds {
+                    held += 1;
+                    if !listed.contains(&(k as u32)) {
+                        missed.push((k, xy));
+                    }
+                }
+            }
+        }
+        assert!(held > 20_000, "the points fall in some shafts: {held}");
+        assert!(
+            missed.is_empty(),
+            "{} points held by a shaft not listed in their cell: {:?}",
+            missed.len(),
+            &missed[..missed.len().min(5)]
+        );
+    }
+}
