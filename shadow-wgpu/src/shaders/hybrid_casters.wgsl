@@ -42,7 +42,8 @@ struct CasterParams {
     lists: vec4<u32>,
 };
 
-// A piece's shaft in one projection and its run of triangles.
+// A piece's shaft in one projection and its run of triangles: `sides` sides, then `caps` near caps and
+// as many far caps.
 struct PieceShaft {
     lo: vec4<f32>,
     hi: vec4<f32>,
@@ -51,12 +52,16 @@ struct PieceShaft {
     bounded: u32,
     first: u32,
     count: u32,
+    sides: u32,
+    caps: u32,
+    unused: vec2<u32>,
 };
 
 @group(1) @binding(9) var<storage, read_write> counts: array<atomic<i32>>;
 @group(1) @binding(11) var<uniform> casters: CasterParams;
 // Per triangle four vec4: its corners as homogeneous points in its mesh's space, wound so its front face
-// is counter-clockwise, then x: bitcast of instance * 2 + 1 for a cap (near or far), + 0 for a side.
+// is counter-clockwise, then bitcasts of x: instance * 2 + 1 for a cap (near or far), + 0 for a side;
+// y: its piece; z: its group (0 side, 1 near cap, 2 far cap).
 @group(1) @binding(12) var<storage, read> triangles: array<vec4<f32>>;
 // Per triangle SETUP vec4, set up for the view: the rows of adj(M) with det(M) in the first's w, the depth
 // row (z . adj(M)) with the cap flag in w, and the world plane through the triangle, turned so the eye
@@ -125,6 +130,48 @@ fn cs_setup(
     setups[SETUP * t + 2u] = vec4<f32>(e2, 0.0);
     setups[SETUP * t + 3u] = vec4<f32>(a.z * e0 + b.z * e1 + c.z * e2, f32(info & 1u));
     setups[SETUP * t + 4u] = select(plane, -plane, eye_side < 0.0);
+    let group = bitcast<u32>(triangles[4u * t + 3u].z);
+    if (group != 0u) {
+        widen_bounds(PIECE * bitcast<u32>(triangles[4u * t + 3u].y) + 3u + 4u * (group - 1u), a, b, c);
+    }
+}
+
+// A float's bits in an order atomicMax keeps: negatives below positives, each in its own order.
+fn ordered(f: f32) -> u32 {
+    let b = bitcast<u32>(f);
+    return select(b | 0x80000000u, ~b, (b & 0x80000000u) != 0u);
+}
+
+fn unordered(u: u32) -> f32 {
+    return bitcast<f32>(select(~u, u & 0x7fffffffu, (u & 0x80000000u) != 0u));
+}
+
+// Adds a triangle with clip-space corners a, b, c to the screen bounds at `at` in the work buffer: four
+// words, ~ordered(least x), ~ordered(least y), ordered(greatest x), ordered(greatest y), so that all four
+// grow by atomicMax and 0 (cleared) is empty. A corner at or behind the eye's plane makes them the whole
+// plane: the triangle's picture is then not within its corners'.
+fn widen_bounds(at: u32, a: vec4<f32>, b: vec4<f32>, c: vec4<f32>) {
+    var lo = vec2<f32>(-3.0e38);
+    var hi = vec2<f32>(3.0e38);
+    if (a.w > 0.0 && b.w > 0.0 && c.w > 0.0) {
+        let pa = a.xy / a.w;
+        let pb = b.xy / b.w;
+        let pc = c.xy / c.w;
+        lo = min(pa, min(pb, pc));
+        hi = max(pa, max(pb, pc));
+    }
+    atomicMax(&work[at], ~ordered(lo.x));
+    atomicMax(&work[at + 1u], ~ordered(lo.y));
+    atomicMax(&work[at + 2u], ordered(hi.x));
+    atomicMax(&work[at + 3u], ordered(hi.y));
+}
+
+// Whether NDC point `p` lies within the bounds at `at` (widened for rounding).
+fn within_bounds(at: u32, p: vec3<f32>) -> bool {
+    let lo = vec2<f32>(unordered(~atomicLoad(&work[at])), unordered(~atomicLoad(&work[at + 1u])));
+    let hi = vec2<f32>(unordered(atomicLoad(&work[at + 2u])), unordered(atomicLoad(&work[at + 3u])));
+    let margin = 1.0e-4 * (1.0 + max(abs(lo), abs(hi)));
+    return all(p.xy >= lo - margin) && all(p.xy <= hi + margin);
 }
 
 // Whether an edge's oriented value `e` at the pixel covers it, ties going by the row's gradient `r`.
@@ -141,14 +188,13 @@ struct Tally {
     tests: u32,
 };
 
-// Piece `k`'s triangles at NDC point `p` over the receiver at world position `receiver`: z-fail's count,
+// Triangles `first` to `end` at NDC point `p` over the receiver at world position `receiver`: z-fail's count,
 // each fragment behind the receiver (or at it: `Less` fails) adding 1 for a back face and -1 for a front
 // face. Caps always count where they are behind the near plane: a near cap is the caster's own surface,
 // never in front of the receiver but at it only up to rounding, and a far cap is at infinity.
-fn add_piece(k: u32, p: vec3<f32>, receiver: vec4<f32>, tally: ptr<function, Tally>) {
-    let s = shafts[k * casters.counts.y];
-    (*tally).tests += s.count;
-    for (var t = s.first; t < s.first + s.count; t++) {
+fn add_triangles(first: u32, end: u32, p: vec3<f32>, receiver: vec4<f32>, tally: ptr<function, Tally>) {
+    (*tally).tests += end - first;
+    for (var t = first; t < end; t++) {
         let r0 = setups[SETUP * t];
         let det = r0.w;
         // Each edge read and tested in turn: most triangles fail the first or second.
@@ -174,6 +220,22 @@ fn add_piece(k: u32, p: vec3<f32>, receiver: vec4<f32>, tally: ptr<function, Tal
             (*tally).count += select(1, -1, det > 0.0);
             (*tally).updates += 1u;
         }
+    }
+}
+
+// Piece `k` at NDC point `p` over the receiver at world position `receiver`: its sides, and its near and
+// far caps where their bounds on screen hold the pixel (a twig's caps are a few pixels across, its sides
+// reach its shadow).
+fn add_piece(k: u32, p: vec3<f32>, receiver: vec4<f32>, tally: ptr<function, Tally>) {
+    let s = shafts[k * casters.counts.y];
+    let near = s.first + s.sides;
+    let far = near + s.caps;
+    add_triangles(s.first, near, p, receiver, tally);
+    if (within_bounds(PIECE * k + 3u, p)) {
+        add_triangles(near, far, p, receiver, tally);
+    }
+    if (within_bounds(PIECE * k + 7u, p)) {
+        add_triangles(far, far + s.caps, p, receiver, tally);
     }
 }
 
@@ -251,12 +313,13 @@ fn candidate(c: Candidates, e: u32) -> u32 {
     return NONE;
 }
 
-// The work buffer: per piece its pixel count, its first pair and its cursor (PIECE words each), then per
+// The work buffer: per piece its pixel count, its first pair, its cursor and the screen bounds of its
+// near caps and of its far caps (`widen_bounds`; PIECE words in all), then per
 // listed pixel a flag (1: too many pairs, the pixel counts every piece itself), then the pairs, each a
 // listed pixel's index, a run per piece.
 @group(1) @binding(16) var<storage, read_write> work: array<atomic<u32>>;
 
-const PIECE: u32 = 3u;
+const PIECE: u32 = 11u;
 
 fn flags_start() -> u32 {
     return PIECE * casters.counts.z;

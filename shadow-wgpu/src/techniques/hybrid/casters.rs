@@ -84,14 +84,18 @@ struct PieceShaft {
     bounded: u32,
     first: u32,
     count: u32,
+    sides: u32,
+    caps: u32,
+    unused: [u32; 2],
 }
 
 /// The volumes of a build split for the caster masks.
 pub(super) struct Split {
     /// The small pieces' triangles, four vec4 each (hybrid_casters.wgsl's `triangles`).
     triangles: Vec<Vec4>,
-    /// Per small piece, its index in the shafts and its run of triangles.
-    pieces: Vec<(usize, Range<u32>)>,
+    /// Per small piece, its index in the shafts, its run of triangles and how many of them are sides (the
+    /// rest: near caps, then as many far caps).
+    pieces: Vec<(usize, Range<u32>, u32)>,
     /// What is left to rasterize: the large pieces, a volume per instance that has any.
     pub(super) raster: Vec<InstanceVolume>,
 }
@@ -126,7 +130,7 @@ impl Split {
                 } else {
                     let first = split.triangle_count();
                     split.write_piece(iv, inst, sides, forward, reversed);
-                    split.pieces.push((k, first..split.triangle_count()));
+                    split.pieces.push((k, first..split.triangle_count(), sides.len() as u32));
                 }
                 k += 1;
             }
@@ -144,7 +148,9 @@ impl Split {
 
     /// Writes one piece's triangles as the rasterizer would draw them (shadow_volume.rs's `upload`):
     /// sides as built, near caps from the mesh's vertices, far caps extruded and turned around for faces
-    /// that cast as wound; each wound so its front face is counter-clockwise.
+    /// that cast as wound; each wound so its front face is counter-clockwise. In that order, sides, near
+    /// caps and far caps each in a run of their own, with the piece's index, so the caps can be passed
+    /// over together where their bounds on screen are away from a pixel.
     fn write_piece(
         &mut self,
         iv: &InstanceVolume,
@@ -155,25 +161,39 @@ impl Split {
     ) {
         let m = inst.mirrored;
         let (tris, positions) = (inst.mesh.triangles(), inst.mesh.positions());
-        let instance = iv.instance as u32;
-        let mut push = |[a, b, c]: [Vec4; 3], cw: bool, cap: bool| {
+        let (instance, piece) = (iv.instance as u32, self.pieces.len() as u32);
+        let mut push = |[a, b, c]: [Vec4; 3], cw: bool, group: Group| {
             let (b, c) = if cw { (c, b) } else { (b, c) };
-            let info = f32::from_bits(instance * 2 + u32::from(cap));
-            self.triangles.extend([a, b, c, Vec4::new(info, 0.0, 0.0, 0.0)]);
+            let info = Vec4::new(
+                f32::from_bits(instance * 2 + u32::from(group != Group::Side)),
+                f32::from_bits(piece),
+                f32::from_bits(group as u32),
+                0.0,
+            );
+            self.triangles.extend([a, b, c, info]);
         };
         for &s in sides {
-            push(s, m, false);
+            push(s, m, Group::Side);
         }
         let light = iv.volume.light;
-        for (ids, near_cw, far_reverse) in [(forward, m, true), (reversed, !m, false)] {
-            for &f in ids {
-                let [a, b, c] = tris[f as usize].map(|v| positions[v as usize]);
-                push([a.extend(1.0), b.extend(1.0), c.extend(1.0)], near_cw, true);
-                let far = [a, b, c].map(|p| light.extrude(p));
-                push(if far_reverse { [far[0], far[2], far[1]] } else { far }, m, true);
-            }
+        let faces = || forward.iter().map(|&f| (f, m, true)).chain(reversed.iter().map(|&f| (f, !m, false)));
+        let corners = |f: u32| tris[f as usize].map(|v| positions[v as usize]);
+        for (f, near_cw, _) in faces() {
+            push(corners(f).map(|p| p.extend(1.0)), near_cw, Group::Near);
+        }
+        for (f, _, far_reverse) in faces() {
+            let far = corners(f).map(|p| light.extrude(p));
+            push(if far_reverse { [far[0], far[2], far[1]] } else { far }, m, Group::Far);
         }
     }
+}
+
+/// The runs a piece's triangles come in (hybrid_casters.wgsl's `group` of a triangle).
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Group {
+    Side = 0,
+    Near = 1,
+    Far = 2,
 }
 
 /// Per projection, a grid over the light-space bounds of the small pieces' shafts within the
@@ -300,8 +320,9 @@ pub(super) struct ListedPixels {
     pub(super) pieces: usize,
 }
 
-/// Words of the work buffer per piece (hybrid_casters.wgsl's `PIECE`).
-const PIECE: u64 = 3;
+/// Words of the work buffer per piece (hybrid_casters.wgsl's `PIECE`): its pixels, first pair and
+/// cursor, and the screen bounds of its near and of its far caps.
+const PIECE: u64 = 11;
 
 /// Pairs of a listed pixel and a piece the work buffer has room for, per pixel of the view: tree has
 /// about 4 per silhouette pixel. A pixel whose pairs do not fit is counted by itself, more slowly.
@@ -419,7 +440,7 @@ impl CasterPasses {
     ) -> CasterPieces {
         let projections = light.projections.len().min(PROJECTIONS);
         let piece_shafts: Vec<&[Option<Shaft>]> =
-            split.pieces.iter().map(|(k, _)| shafts.shafts[*k].as_slice()).collect();
+            split.pieces.iter().map(|(k, ..)| shafts.shafts[*k].as_slice()).collect();
         // The largest world tolerance of any pixel: the farthest corner of the frame's bounds from the eye.
         let (lo, hi) = (frame.bounds.min, frame.bounds.max);
         let far = (0..8)
@@ -455,7 +476,7 @@ impl CasterPasses {
         let records: Vec<PieceShaft> = split
             .pieces
             .iter()
-            .flat_map(|(k, run)| {
+            .flat_map(|(k, run, sides)| {
                 shafts.shafts[*k][..projections].iter().map(move |s| {
                     let bounded = s.is_some();
                     let s = s.unwrap_or(Shaft { lo: Vec4::ZERO, hi: Vec4::ZERO, near: 0.0 });
@@ -466,6 +487,9 @@ impl CasterPasses {
                         bounded: u32::from(bounded),
                         first: run.start,
                         count: run.end - run.start,
+                        sides: *sides,
+                        caps: (run.end - run.start - sides) / 2,
+                        unused: [0; 2],
                     }
                 })
             })
@@ -585,7 +609,13 @@ mod tests {
         // Each piece written out is closed and wound alike: every directed edge between two corners comes
         // with its reverse (far caps turned around, mirrored instances turned back).
         let key = |v: Vec4| v.to_array().map(f32::to_bits);
-        for (k, run) in &split.pieces {
+        for (k, run, sides) in &split.pieces {
+            // Sides, near caps, as many far caps, in runs.
+            let groups: Vec<u32> = run.clone().map(|t| split.triangles[4 * t as usize + 3].z.to_bits()).collect();
+            let caps = (groups.len() - *sides as usize) / 2;
+            let runs = [(0, *sides as usize), (1, caps), (2, caps)];
+            let expected: Vec<u32> = runs.iter().flat_map(|&(g, n)| std::iter::repeat_n(g, n)).collect();
+            assert_eq!(groups, expected, "piece {k}: triangles out of their runs");
             let mut edges: HashMap<([u32; 4], [u32; 4]), i32> = HashMap::new();
             for t in run.clone() {
                 let c = &split.triangles[4 * t as usize..4 * t as usize + 3];
