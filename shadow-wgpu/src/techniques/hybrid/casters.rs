@@ -40,7 +40,9 @@ use crate::{readback, shaders};
 
 /// Pieces of at most this many volume triangles are counted by the compute passes at the pixels their
 /// shafts hold; larger ones are rasterized through the whole mask, where a pixel's cost does not grow
-/// with them.
+/// with them. Measured on lavapipe (8 frames, two runs): double-torus's query is 31 to 33 ms with 256 or
+/// 1024 here and 71 to 73 with every piece counted by the compute passes; cylinder and primitives do not
+/// move measurably between 256, 1024 and every piece.
 pub(super) const LISTED_TRIANGLES: usize = 1024;
 
 /// The most projections a light has (a point light's cube faces).
