@@ -10,16 +10,19 @@
 //!   cloud's cubes) are written out as triangles, each piece's shafts beside its run of them, and a grid
 //!   per light projection lists the pieces whose shafts, widened by the largest tolerance a pixel there can
 //!   have, meet each cell. Larger pieces (a single big mesh) stay rasterized through the stencil mask.
-//! - **Query**: the mask pass lists its silhouette pixels; `cs_setup` sets each triangle up for the view
-//!   (its rows of adj(M), homogeneous rasterization), and `cs_count` takes
-//!   each listed pixel's count over the pieces of its light-space cell whose shafts hold it, testing their
-//!   triangles at the pixel's centre as the rasterizer would (hybrid_casters.wgsl), and writes it beside
-//!   the pixel. The answer shadows a silhouette pixel whose stencil count or listed count is not 0: every
-//!   piece is closed and wound alike, so the pieces' counts at a point have one sign and cannot cancel.
+//! - **Query**: the mask pass lists its silhouette pixels, and the compute passes (hybrid_casters.wgsl)
+//!   set each triangle up for the view (its rows of adj(M): homogeneous rasterization) and gather each
+//!   piece's caps' screen bounds; pair each listed pixel with the pieces of its light-space cell whose
+//!   shafts hold it (counted, given runs by a prefix sum, written); count each piece at its pixels, a
+//!   workgroup per piece, testing its triangles at each pixel's centre as the rasterizer would, and add the
+//!   count beside the pixel. The answer shadows a silhouette pixel whose stencil count or listed count is
+//!   not 0: every piece is closed and wound alike, so the pieces' counts at a point have one sign and
+//!   cannot cancel.
 //!
 //! The work is the CPU's caster masks' (a listed pixel times its pieces' triangles, every fragment those
-//! would make counted), with the same shafts: `volume_fragments` is what the compute pass covers plus what
-//! the stencil lets through of the rasterized pieces.
+//! would make counted), with the same shafts: `volume_fragments` is what the compute passes cover plus
+//! what the stencil lets through of the rasterized pieces; `listed_tests` counts the pixel-triangle pairs
+//! tested.
 
 use std::ops::Range;
 
@@ -60,8 +63,9 @@ const MAX_GROUPS: u32 = 65_535;
 /// Bytes of the listed pixels' header (`Listed` in shaders.rs: four counters).
 const HEADER: u64 = 16;
 
-/// Listed pixels per invocation of `cs_count` in a view all of whose pixels are listed: the dispatch is
-/// sized by the view (the list's length is known only on the GPU), each invocation taking every so many.
+/// Listed pixels per invocation of the passes over them, were every pixel of the view listed: their
+/// dispatches are sized by the view (the list's length is known only on the GPU), each invocation taking
+/// every so many.
 const PIXELS_PER_INVOCATION: u32 = 16;
 
 /// hybrid_casters.wgsl's `CasterParams`.
@@ -232,9 +236,14 @@ fn grids(
         let (lo, hi) =
             boxes.iter().flatten().fold((Vec2::INFINITY, Vec2::NEG_INFINITY), |(lo, hi), b| (lo.min(b.0), hi.max(b.1)));
         let (lo, hi) = (lo.max(window.0), hi.min(window.1));
-        let side = if lo.x <= hi.x { ((shafts.len() as f64).sqrt() * 2.0).clamp(1.0, 256.0) as usize } else { 1 };
-        let (origin, scale) =
-            if lo.x <= hi.x { (lo, side as f32 / (hi - lo).max(Vec2::splat(1e-30))) } else { (Vec2::ZERO, Vec2::ZERO) };
+        // About four cells a piece: a pixel tests the pieces of its own cell only. No shaft within the
+        // view: one cell holding them all.
+        let (side, origin, scale) = if lo.cmple(hi).all() {
+            let side = ((shafts.len() as f64).sqrt() * 2.0).clamp(1.0, 256.0) as usize;
+            (side, lo, side as f32 / (hi - lo).max(Vec2::splat(1e-30)))
+        } else {
+            (1, Vec2::ZERO, Vec2::ZERO)
+        };
         let cell = |v: f32| (v.max(0.0) as usize).min(side - 1);
         let mut lists = vec![Vec::new(); side * side];
         for (k, b) in boxes.iter().enumerate() {
