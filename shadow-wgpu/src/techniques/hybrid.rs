@@ -462,7 +462,7 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
         let tile_settings = [tile as f32, tiles.map_or(0.0, |t| t.columns as f32), 0.0, 0.0];
         let casters = match (&state.casters, &state.pieces) {
             (Some((passes, answer)), Some(pieces)) => {
-                if state.listed.as_ref().is_none_or(|l| l.size != (g.width, g.height) || l.pieces != pieces.pieces) {
+                if state.listed.as_ref().is_none_or(|l| l.size != (g.width, g.height) || l.capacity < pieces.pieces) {
                     let size = (g.width, g.height);
                     let listed =
                         cx.scoped("the hybrid listed pixels", |cx| ListedPixels::new(cx, size, pieces.pieces))?;

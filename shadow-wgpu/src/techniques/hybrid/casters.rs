@@ -315,8 +315,8 @@ pub(super) struct CasterPieces {
     pub(super) pieces: usize,
 }
 
-/// The listed pixels and their counts, for one view size, and the compute passes' work buffer, for one
-/// number of pieces too.
+/// The listed pixels and their counts, for one view size, and the compute passes' work buffer, for up to
+/// so many pieces too.
 pub(super) struct ListedPixels {
     /// The header (counters) and the pixels.
     pub(super) listed: wgpu::Buffer,
@@ -326,9 +326,10 @@ pub(super) struct ListedPixels {
     /// (hybrid_casters.wgsl's `work`).
     work: wgpu::Buffer,
     staging: wgpu::Buffer,
-    /// The view's size and the pieces the work buffer was made for.
+    /// The view's size, and the pieces the work buffer has room for (at least those of the build it was
+    /// made for, rounded up to a power of two, so builds under a moving light reuse it).
     pub(super) size: (u32, u32),
-    pub(super) pieces: usize,
+    pub(super) capacity: usize,
 }
 
 /// Words of the work buffer per piece (hybrid_casters.wgsl's `PIECE`): its pixels, first pair and
@@ -351,7 +352,8 @@ impl ListedPixels {
                 mapped_at_creation: false,
             })
         };
-        let fixed = PIECE * pieces as u64 + pixels;
+        let capacity = pieces.next_power_of_two();
+        let fixed = PIECE * capacity as u64 + pixels;
         let largest = {
             let limits = cx.device.limits();
             limits.max_storage_buffer_binding_size.min(limits.max_buffer_size) / 4
@@ -363,7 +365,7 @@ impl ListedPixels {
             work: buffer("hybrid caster work", 4 * (fixed + pairs), U::STORAGE | U::COPY_DST),
             staging: buffer("hybrid listed readback", 16, U::COPY_DST | U::MAP_READ),
             size: (width, height),
-            pieces,
+            capacity,
         }
     }
 
