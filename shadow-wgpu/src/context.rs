@@ -155,6 +155,22 @@ fn rank(info: &wgpu::AdapterInfo) -> u8 {
     }
 }
 
+/// What an adapter lacks of what shadowlab renders with, if anything: the Depth32FloatStencil8 format,
+/// and the float and integer formats of the G-buffer and the techniques' targets as render attachments
+/// (an OpenGL adapter such as llvmpipe's cannot render to Rgba32Float).
+fn missing(adapter: &wgpu::Adapter) -> Option<String> {
+    if !adapter.features().contains(wgpu::Features::DEPTH32FLOAT_STENCIL8) {
+        return Some("the Depth32FloatStencil8 format".into());
+    }
+    use wgpu::TextureFormat as F;
+    [F::Rgba32Float, F::Rg32Float, F::R32Float, F::R32Uint, F::Rgba8Unorm]
+        .into_iter()
+        .find(|&f| {
+            !adapter.get_texture_format_features(f).allowed_usages.contains(wgpu::TextureUsages::RENDER_ATTACHMENT)
+        })
+        .map(|f| format!("rendering to {f:?}"))
+}
+
 impl WgpuContext {
     /// Opens an adapter and a device.
     ///
@@ -176,14 +192,28 @@ impl WgpuContext {
                 })?
             }
             None => {
+                let unfit: Vec<String> = adapters
+                    .iter()
+                    .filter_map(|a| {
+                        missing(a)
+                            .map(|what| format!("{} ({:?}) lacks {what}", a.get_info().name, a.get_info().backend))
+                    })
+                    .collect();
                 let mut candidates: Vec<wgpu::Adapter> = adapters
                     .into_iter()
                     .filter(|a| choice.allow_software || a.get_info().device_type != wgpu::DeviceType::Cpu)
+                    .filter(|a| missing(a).is_none())
                     .collect();
                 candidates.sort_by_key(|a| rank(&a.get_info()));
                 candidates.into_iter().next().ok_or_else(|| {
                     WgpuError::NoAdapter(if all.is_empty() {
                         "no adapter at all (install a Vulkan driver; mesa-vulkan-drivers gives a software one)".into()
+                    } else if unfit.len() == all.len() {
+                        format!(
+                            "no adapter can render shadowlab's targets: {} (install a Vulkan driver; \
+                             mesa-vulkan-drivers gives a software one)",
+                            unfit.join(", ")
+                        )
                     } else {
                         format!("no hardware adapter (software ones: {}; ask for one by name)", all.join(", "))
                     })
@@ -194,11 +224,8 @@ impl WgpuContext {
         let summary = AdapterSummary::of(&info);
         let features = adapter.features();
         let needed = wgpu::Features::DEPTH32FLOAT_STENCIL8;
-        if !features.contains(needed) {
-            return Err(WgpuError::MissingFeature {
-                adapter: info.name,
-                what: "the Depth32FloatStencil8 format".into(),
-            });
+        if let Some(what) = missing(&adapter) {
+            return Err(WgpuError::MissingFeature { adapter: info.name, what });
         }
         let timestamps = features.contains(wgpu::Features::TIMESTAMP_QUERY);
         let required_features =
