@@ -511,13 +511,18 @@ impl CasterPasses {
             cx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
         };
         use wgpu::BufferUsages as U;
-        let nonempty = |bytes: &[u8]| if bytes.is_empty() { vec![0u8; 16] } else { bytes.to_vec() };
+        // A build with no small piece still binds its buffers: at least one element each.
+        let nonempty = |bytes: &[u8]| {
+            let mut v = bytes.to_vec();
+            v.resize(v.len().max(std::mem::size_of::<PieceShaft>()), 0);
+            v
+        };
         CasterPieces {
             params: init("hybrid caster params", bytemuck::bytes_of(&params), U::UNIFORM),
             triangles: init("hybrid caster triangles", &nonempty(bytemuck::cast_slice(&split.triangles)), U::STORAGE),
             setups: cx.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("hybrid caster setups"),
-                size: (u64::from(split.triangle_count()) * SETUP * 16).max(16),
+                size: (u64::from(split.triangle_count()).max(1) * SETUP * 16),
                 usage: U::STORAGE,
                 mapped_at_creation: false,
             }),
