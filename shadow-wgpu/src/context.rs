@@ -184,7 +184,12 @@ impl WgpuContext {
         let adapter = match &wanted {
             Some(name) => {
                 let n = name.to_lowercase();
-                adapters.into_iter().find(|a| a.get_info().name.to_lowercase().contains(&n)).ok_or_else(|| {
+                // Of the adapters so named (llvmpipe is both a Vulkan and an OpenGL one), one that can
+                // render shadowlab's targets; else the first, refused below with what it lacks.
+                let mut named: Vec<wgpu::Adapter> =
+                    adapters.into_iter().filter(|a| a.get_info().name.to_lowercase().contains(&n)).collect();
+                named.sort_by_key(|a| missing(a).is_some());
+                named.into_iter().next().ok_or_else(|| {
                     WgpuError::NoAdapter(format!(
                         "none named like '{name}' (adapters: {})",
                         if all.is_empty() { "none".into() } else { all.join(", ") }
