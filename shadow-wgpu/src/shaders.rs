@@ -95,10 +95,19 @@ struct Listed {
 @group(1) @binding(8) var<storage, read_write> listed: Listed;
 ";
 
-/// hybrid's fragment passes with caster masks: the mask pass lists its pixels, and a listed pixel the
-/// compute pass gave a count other than 0 is shadowed.
+/// hybrid's fragment passes with caster masks: the mask pass lists its pixels and leaves every pixel's
+/// class in `counts`, where the answer reads it outside the mask; a listed pixel the compute passes gave
+/// a count other than 0 is shadowed.
 const LISTED_COUNTS: &str = "
-@group(1) @binding(9) var<storage, read> counts: array<i32>;
+@group(1) @binding(9) var<storage, read_write> counts: array<i32>;
+
+fn remember_class(px: vec2<i32>, c: u32) {
+    counts[u32(px.y) * u32(view.size.x) + u32(px.x)] = i32(c);
+}
+
+fn remembered_class(px: vec2<i32>) -> u32 {
+    return u32(counts[u32(px.y) * u32(view.size.x) + u32(px.x)]);
+}
 
 fn list_pixel(px: vec2<i32>) {
     listed.at[atomicAdd(&listed.pixels, 1u)] = u32(px.y) * u32(view.size.x) + u32(px.x);
@@ -109,10 +118,13 @@ fn listed_shadowed(px: vec2<i32>) -> bool {
 }
 ";
 
-/// hybrid's `list_pixel` and `listed_shadowed` with `caster_masks=off`: nothing and never.
+/// hybrid's `list_pixel`, `listed_shadowed` and the class left for the answer with `caster_masks=off`:
+/// nothing, never, and the class found again.
 const LISTED_OFF: &str = "
 fn list_pixel(px: vec2<i32>) {}
 fn listed_shadowed(px: vec2<i32>) -> bool { return false; }
+fn remember_class(px: vec2<i32>, c: u32) {}
+fn remembered_class(px: vec2<i32>) -> u32 { return receiver_class(px); }
 ";
 
 /// hybrid's `scissor_tile`: the mask pass marks the tile of each silhouette pixel (map.extra: x the tile

@@ -1,8 +1,8 @@
 // hybrid (Chan, thesis chapter 3): the map's classification of each receiver, the computation mask it
 // makes in the stencil's bit 7, and the passes that answer from the mask (twin: shadow-cpu's
 // techniques/hybrid.rs). Follows shadow_map.wgsl, whose bindings 0 to 3 it shares, one of the two
-// `near_edge` (hybrid_edges.wgsl, or never), one of the two `mark_tile` and one of the two pairs
-// `list_pixel` and `listed_shadowed` (caster masks; shaders.rs).
+// `near_edge` (hybrid_edges.wgsl, or never), one of the two `mark_tile` and one of the two sets of
+// `list_pixel`, `listed_shadowed`, `remember_class` and `remembered_class` (caster masks; shaders.rs).
 
 @group(1) @binding(4) var g_geometric_normal: texture_2d<f32>;
 
@@ -50,7 +50,9 @@ fn receiver_class(px: vec2<i32>) -> u32 {
 // pixel is discarded.
 @fragment
 fn fs_hybrid_mask(in: FullScreen) {
-    if (receiver_class(vec2<i32>(in.pos.xy)) != SILHOUETTE) {
+    let c = receiver_class(vec2<i32>(in.pos.xy));
+    remember_class(vec2<i32>(in.pos.xy), c);
+    if (c != SILHOUETTE) {
         discard;
     }
     mark_tile(vec2<i32>(in.pos.xy));
@@ -67,7 +69,7 @@ fn vs_hybrid_far(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> 
 // The map's answer, drawn under the stencil test "outside the mask"; non-receivers keep the cleared 1.
 @fragment
 fn fs_hybrid_map(in: FullScreen) -> @location(0) vec4<f32> {
-    let c = receiver_class(vec2<i32>(in.pos.xy));
+    let c = remembered_class(vec2<i32>(in.pos.xy));
     if (c == NOT_RECEIVER) {
         discard;
     }

@@ -320,7 +320,8 @@ pub(super) struct CasterPieces {
 pub(super) struct ListedPixels {
     /// The header (counters) and the pixels.
     pub(super) listed: wgpu::Buffer,
-    /// Per pixel of the view, its count (written at the listed pixels only).
+    /// Per pixel of the view, the map's class the mask pass found there, or at the listed pixels the
+    /// count the compute passes found.
     pub(super) counts: wgpu::Buffer,
     /// Per piece its pixel count, first pair and cursor, per listed pixel a flag, then the pairs
     /// (hybrid_casters.wgsl's `work`).
