@@ -133,3 +133,84 @@ fn shaft(proj: &LightProjection, corners: &[Vec3], pad: f32) -> Option<Shaft> {
     let widen = Vec4::new(side, side, 2.0 * side, 2.0 * side);
     Some(Shaft { lo: s.lo - widen, hi: s.hi + widen, near: s.near - pad })
 }
+
+/// A grid over a light-space rectangle, each cell listing the pieces whose boxes meet it; a box reaching
+/// beyond the grid is listed in its border cells, which is where a point beyond it looks. Both backends'
+/// caster masks bin their shafts in one, each box widened by the largest tolerance of the points that
+/// look: the CPU over its silhouette pixels' bounds, the GPU (which cannot see those) over the light's
+/// view.
+#[derive(Clone, Debug)]
+pub struct ShaftGrid {
+    /// The rectangle's least corner.
+    pub origin: Vec2,
+    /// Cells per light-space unit.
+    pub scale: Vec2,
+    /// Cells along each side.
+    pub side: usize,
+    /// Per cell (row by row), where its run of `pieces` starts, and one more.
+    pub starts: Vec<u32>,
+    /// The cells' pieces, a run per cell, ascending.
+    pub pieces: Vec<u32>,
+}
+
+impl ShaftGrid {
+    /// `side` x `side` cells over `lo..=hi` (one cell where that is empty), listing piece `k` in the cells
+    /// `boxes[k]` meets (nowhere for `None`).
+    #[must_use]
+    pub fn new(lo: Vec2, hi: Vec2, side: usize, boxes: &[Option<(Vec2, Vec2)>]) -> Self {
+        let (origin, scale, side) = if lo.cmple(hi).all() {
+            let side = side.max(1);
+            (lo, side as f32 / (hi - lo).max(Vec2::splat(1e-30)), side)
+        } else {
+            (Vec2::ZERO, Vec2::ZERO, 1)
+        };
+        let mut grid = Self { origin, scale, side, starts: vec![0; side * side + 1], pieces: Vec::new() };
+        let cells: Vec<_> = boxes.iter().map(|b| b.map(|(lo, hi)| grid.cell_range(lo, hi))).collect();
+        // A counting sort: the runs' lengths, their starts, then the pieces in order.
+        for ((x0, x1), (y0, y1)) in cells.iter().flatten() {
+            for y in *y0..=*y1 {
+                for x in *x0..=*x1 {
+                    grid.starts[y * side + x + 1] += 1;
+                }
+            }
+        }
+        for k in 0..side * side {
+            grid.starts[k + 1] += grid.starts[k];
+        }
+        let mut next = grid.starts.clone();
+        grid.pieces = vec![0; grid.starts[side * side] as usize];
+        for (piece, range) in cells.iter().enumerate() {
+            let Some(((x0, x1), (y0, y1))) = range else { continue };
+            for y in *y0..=*y1 {
+                for x in *x0..=*x1 {
+                    grid.pieces[next[y * side + x] as usize] = piece as u32;
+                    next[y * side + x] += 1;
+                }
+            }
+        }
+        grid
+    }
+
+    /// The cells meeting the box `lo..=hi` (a point when they are equal), as inclusive column and row
+    /// ranges, clamped to the grid.
+    #[must_use]
+    pub fn cell_range(&self, lo: Vec2, hi: Vec2) -> ((usize, usize), (usize, usize)) {
+        let cell = |v: f32| (v.max(0.0) as usize).min(self.side - 1);
+        let (a, b) = ((lo - self.origin) * self.scale, (hi - self.origin) * self.scale);
+        ((cell(a.x), cell(b.x)), (cell(a.y), cell(b.y)))
+    }
+
+    /// The cell holding `xy` (hybrid_casters.wgsl's lookup is its twin).
+    #[must_use]
+    pub fn cell_of(&self, xy: Vec2) -> usize {
+        let ((x, _), (y, _)) = self.cell_range(xy, xy);
+        y * self.side + x
+    }
+
+    /// The pieces of the cell holding `xy`.
+    #[must_use]
+    pub fn pieces_at(&self, xy: Vec2) -> &[u32] {
+        let cell = self.cell_of(xy);
+        &self.pieces[self.starts[cell] as usize..self.starts[cell + 1] as usize]
+    }
+}

@@ -22,7 +22,7 @@ use shadow_core::FrameInputs;
 use shadow_core::frame::InstanceVolume;
 use shadow_core::glam::{Vec2, Vec4, Vec4Swizzles};
 use shadow_core::light::LightView;
-use shadow_core::shafts::{CasterShafts, Shaft, light_coords, light_tolerance, outline, tolerance};
+use shadow_core::shafts::{CasterShafts, Shaft, ShaftGrid, light_coords, light_tolerance, outline, tolerance};
 use shadow_core::stats::ms;
 use shadow_core::technique::hard::VolumeCounting;
 
@@ -49,74 +49,22 @@ struct LightPixel {
     along: f32,
 }
 
-/// A grid over one projection's silhouette pixels in light space, each cell listing the pieces whose
-/// shafts, widened by the largest tolerance of those pixels, meet it.
-struct Grid {
-    origin: Vec2,
-    scale: Vec2,
-    side: usize,
-    /// Per cell, its run of `pieces`.
-    starts: Vec<u32>,
-    pieces: Vec<u32>,
-}
-
-impl Grid {
-    /// The grid of `pixels` (some 8 a cell) with the pieces of `shafts` (this projection's shaft of each
-    /// piece; the unbounded ones are left out).
-    fn new(pixels: &[LightPixel], shafts: &[Option<Shaft>]) -> Self {
-        let (lo, hi, widest) = pixels.iter().fold((Vec2::INFINITY, Vec2::NEG_INFINITY, 0.0f32), |(lo, hi, w), p| {
-            (lo.min(p.xy), hi.max(p.xy), w.max(p.side))
-        });
-        let side = ((pixels.len() / 8) as f64).sqrt().clamp(1.0, 256.0) as usize;
-        let scale = if pixels.is_empty() { Vec2::ZERO } else { side as f32 / (hi - lo).max(Vec2::splat(1e-30)) };
-        let mut grid = Self { origin: lo, scale, side, starts: vec![0; side * side + 1], pieces: Vec::new() };
-        if pixels.is_empty() {
-            return grid;
-        }
-        // A pixel within its tolerance of a shaft lies in the shaft widened by the widest tolerance, so
-        // the pieces of the pixel's own cell are all it needs to test.
-        let cells: Vec<_> = shafts
-            .iter()
-            .map(|s| s.as_ref().map(|s| grid.cell_range(s.lo.xy() - widest, s.hi.xy() + widest)))
-            .collect();
-        for ((x0, x1), (y0, y1)) in cells.iter().flatten() {
-            for y in *y0..=*y1 {
-                for x in *x0..=*x1 {
-                    grid.starts[y * side + x + 1] += 1;
-                }
-            }
-        }
-        for k in 0..side * side {
-            grid.starts[k + 1] += grid.starts[k];
-        }
-        let mut next = grid.starts.clone();
-        grid.pieces = vec![0; grid.starts[side * side] as usize];
-        for (piece, range) in cells.iter().enumerate() {
-            let Some(((x0, x1), (y0, y1))) = range else { continue };
-            for y in *y0..=*y1 {
-                for x in *x0..=*x1 {
-                    grid.pieces[next[y * side + x] as usize] = piece as u32;
-                    next[y * side + x] += 1;
-                }
-            }
-        }
-        grid
-    }
-
-    /// The cells meeting the box `lo..=hi` (a point when they are equal), as inclusive column and row
-    /// ranges, clamped to the grid.
-    fn cell_range(&self, lo: Vec2, hi: Vec2) -> ((usize, usize), (usize, usize)) {
-        let cell = |v: f32| (v.max(0.0) as usize).min(self.side - 1);
-        let (a, b) = ((lo - self.origin) * self.scale, (hi - self.origin) * self.scale);
-        ((cell(a.x), cell(b.x)), (cell(a.y), cell(b.y)))
-    }
-
-    /// The pieces of the cell holding `xy`.
-    fn pieces_at(&self, xy: Vec2) -> &[u32] {
-        let ((x, _), (y, _)) = self.cell_range(xy, xy);
-        let cell = y * self.side + x;
-        &self.pieces[self.starts[cell] as usize..self.starts[cell + 1] as usize]
-    }
+/// The grid of one projection's silhouette `pixels` in light space (some 8 a cell) with the pieces of
+/// `shafts` (this projection's shaft of each piece; the unbounded ones are left out), each widened by the
+/// largest tolerance of those pixels: a pixel within its tolerance of a shaft lies in the widened shaft,
+/// so the pieces of the pixel's own cell are all it needs to test.
+fn pixel_grid(pixels: &[LightPixel], shafts: &[Option<Shaft>]) -> ShaftGrid {
+    let (lo, hi, widest) = pixels.iter().fold((Vec2::INFINITY, Vec2::NEG_INFINITY, 0.0f32), |(lo, hi, w), p| {
+        (lo.min(p.xy), hi.max(p.xy), w.max(p.side))
+    });
+    let side = ((pixels.len() / 8) as f64).sqrt().clamp(1.0, 256.0) as usize;
+    // No pixel looks in a grid without pixels: nothing to list.
+    let boxes: Vec<_> = if pixels.is_empty() {
+        Vec::new()
+    } else {
+        shafts.iter().map(|s| s.as_ref().map(|s| (s.lo.xy() - widest, s.hi.xy() + widest))).collect()
+    };
+    ShaftGrid::new(lo, hi, side, &boxes)
 }
 
 /// Whether a pixel lies within its tolerance of a shaft.
@@ -134,10 +82,10 @@ fn piece_lists(pixels: &[(usize, Option<LightPixel>, u32)], shafts: &[&[Option<S
     for (j, p, _) in pixels {
         per_projection[*j].extend(p);
     }
-    let grids: Vec<Grid> = per_projection
+    let grids: Vec<ShaftGrid> = per_projection
         .iter()
         .enumerate()
-        .map(|(j, pixels)| Grid::new(pixels, &shafts.iter().map(|s| s[j]).collect::<Vec<_>>()))
+        .map(|(j, pixels)| pixel_grid(pixels, &shafts.iter().map(|s| s[j]).collect::<Vec<_>>()))
         .collect();
     let unbounded: Vec<Vec<u32>> = (0..projections)
         .map(|j| (0..shafts.len() as u32).filter(|&k| shafts[k as usize][j].is_none()).collect())

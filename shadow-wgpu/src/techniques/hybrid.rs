@@ -109,13 +109,8 @@ pub struct State {
     count_all: wgpu::RenderPipeline,
     /// The volumes rasterized through the mask: all of them, or with caster masks the large pieces.
     draws: Option<Vec<VolumeDraw>>,
-    /// With caster masks and `unmasked_fill=on`: every volume, for the unmasked fill.
-    all_draws: Option<Vec<VolumeDraw>>,
-    /// With caster masks: the compute passes, the answer's draw for the listed pixels, the last build's
-    /// small pieces and the listed pixels at the last view's size.
-    casters: Option<(CasterPasses, wgpu::RenderPipeline)>,
-    pieces: Option<CasterPieces>,
-    listed: Option<ListedPixels>,
+    /// With caster masks.
+    casters: Option<Casters>,
     /// With `gpu_mask=depth`: the scratch depth-stencil the mask is written into, at the view's size, and
     /// the draw that sets depth 1 outside the mask.
     scratch: Option<wgpu::Texture>,
@@ -127,6 +122,17 @@ pub struct State {
     edge_pass: Option<wgpu::RenderPipeline>,
     edge_maps: Option<wgpu::Texture>,
     last: Option<LastQuery>,
+}
+
+/// What the caster masks keep: the compute passes, the answer's draw for the listed pixels, the last
+/// build's small pieces (and with `unmasked_fill=on` every volume, for the unmasked fill), and the listed
+/// pixels at the last view's size.
+struct Casters {
+    passes: CasterPasses,
+    answer: wgpu::RenderPipeline,
+    pieces: Option<CasterPieces>,
+    all_draws: Option<Vec<VolumeDraw>>,
+    listed: Option<ListedPixels>,
 }
 
 /// The volumes' depth-stencil state: z-fail counting in [`COUNT`]. The stencil mask: under the stencil
@@ -352,7 +358,13 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
             };
             let answer_map = answer("fs_hybrid_map", OUTSIDE);
             let answer_shadowed = answer("fs_hybrid_shadowed", SHADOWED);
-            let casters = caster_masks.then(|| (CasterPasses::new(cx), answer("fs_hybrid_listed", LIT)));
+            let casters = caster_masks.then(|| Casters {
+                passes: CasterPasses::new(cx),
+                answer: answer("fs_hybrid_listed", LIT),
+                pieces: None,
+                all_draws: None,
+                listed: None,
+            });
             State {
                 map,
                 bindings,
@@ -365,10 +377,7 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
                 count_masked,
                 count_all,
                 draws: None,
-                all_draws: None,
                 casters,
-                pieces: None,
-                listed: None,
                 scratch: None,
                 far,
                 tiles: None,
@@ -397,14 +406,14 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
         } else if self.edge_texels == EdgeTexels::Paired {
             state.edge_maps = Some(cx.scoped("the edge cells", |cx| edge_cell_maps(cx, &segments, light, res))?);
         }
-        if state.casters.is_some() {
+        if let Some(casters) = &mut state.casters {
             // The small pieces go to the compute passes, the rest to the rasterizer.
             InstanceVolume::count(&volumes, &mut stats.counters);
             let shafts = CasterShafts::new(frame, light, &volumes);
             let split = Split::new(frame, &volumes, &shafts, LISTED_TRIANGLES);
-            state.pieces = Some(CasterPasses::upload(cx, frame, light, &split, &shafts));
+            casters.pieces = Some(CasterPasses::upload(cx, frame, light, &split, &shafts));
             state.draws = Some(upload_volumes(cx, frame, &split.raster)?);
-            state.all_draws = self.unmasked_fill.is_on().then(|| upload_volumes(cx, frame, &volumes)).transpose()?;
+            casters.all_draws = self.unmasked_fill.is_on().then(|| upload_volumes(cx, frame, &volumes)).transpose()?;
         } else {
             state.draws = Some(upload_draws(cx, frame, &volumes, stats)?);
         }
@@ -463,20 +472,21 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
             extras.push(wgpu::BindGroupEntry { binding: 7, resource: t.marks.as_entire_binding() });
         }
         let tile_settings = [tile as f32, tiles.map_or(0.0, |t| t.columns as f32), 0.0, 0.0];
-        let casters = match (&state.casters, &state.pieces) {
-            (Some((passes, answer)), Some(pieces)) => {
-                if state.listed.as_ref().is_none_or(|l| l.size != (g.width, g.height) || l.capacity < pieces.pieces) {
-                    let size = (g.width, g.height);
-                    let listed =
-                        cx.scoped("the hybrid listed pixels", |cx| ListedPixels::new(cx, size, pieces.pieces))?;
-                    state.listed = Some(listed);
-                }
-                Some((passes, answer, pieces))
+        // With caster masks: their passes, the answer's draw, the build's pieces and the listed pixels,
+        // made anew for a new view size or more pieces.
+        let casters = match &mut state.casters {
+            Some(c) => {
+                let pieces = c.pieces.as_ref().ok_or_else(not_built)?;
+                let size = (g.width, g.height);
+                let listed = match c.listed.take() {
+                    Some(l) if l.size == size && l.capacity >= pieces.pieces => l,
+                    _ => cx.scoped("the hybrid listed pixels", |cx| ListedPixels::new(cx, size, pieces.pieces))?,
+                };
+                Some((&c.passes, &c.answer, pieces, &*c.listed.insert(listed)))
             }
-            (Some(_), None) => return Err(not_built().into()),
-            _ => None,
+            None => None,
         };
-        let listed = state.listed.as_ref().filter(|_| casters.is_some());
+        let listed = casters.map(|c| c.3);
         if let Some(l) = listed {
             extras.push(wgpu::BindGroupEntry { binding: 8, resource: l.listed.as_entire_binding() });
             extras.push(wgpu::BindGroupEntry { binding: 9, resource: l.counts.as_entire_binding() });
@@ -523,7 +533,7 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
                 Some(&silhouettes),
             );
             cx.queue.submit([mask]);
-            if let (Some((passes, _, pieces)), Some(l)) = (casters, listed) {
+            if let Some((passes, _, pieces, l)) = casters {
                 let mut enc = cx.device.create_command_encoder(&Default::default());
                 passes.record(cx, &mut enc, pieces, l, g);
                 cx.queue.submit([enc.finish()]);
@@ -539,7 +549,7 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
             };
             let passed = counting.run(cx, draws, frame, g, &depth);
             let mut answers = vec![(&state.answer_map, OUTSIDE.2), (&state.answer_shadowed, SHADOWED.2)];
-            if let Some((_, answer, _)) = casters {
+            if let Some((_, answer, ..)) = casters {
                 answers.push((answer, LIT.2));
             }
             let answer = full_screen_draws(
@@ -567,22 +577,23 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
         c.silhouette_pixels = Some(read_query(cx, &silhouettes)?);
         let processed = read_query(cx, &processed)?;
         // Z-fail updates the count where the depth test fails.
-        let updates = processed - read_query(cx, &passed)?.min(processed);
-        let listed = match (casters, listed) {
-            (Some((_, _, pieces)), Some(l)) => {
+        let rasterized_updates = processed - read_query(cx, &passed)?.min(processed);
+        // What the compute passes covered and updated at the listed pixels.
+        let [computed, computed_updates] = match casters {
+            Some((_, _, pieces, l)) => {
                 let [pixels, fragments, updates, tests] = l.counters(cx)?;
                 c.extra.insert("listed_pieces".into(), pieces.pieces as f64);
                 c.extra.insert("listed_pixels".into(), pixels as f64);
                 c.extra.insert("listed_tests".into(), tests as f64);
                 [fragments, updates]
             }
-            _ => [0, 0],
+            None => [0, 0],
         };
-        c.volume_fragments = Some(processed + listed[0]);
-        c.stencil_updates = Some(updates + listed[1]);
+        c.volume_fragments = Some(processed + computed);
+        c.stencil_updates = Some(rasterized_updates + computed_updates);
         if self.unmasked_fill.is_on() {
             let every = VolumePass::count(&state.count_all, "count volume fragments");
-            let all_draws = state.all_draws.as_deref().unwrap_or(draws);
+            let all_draws = state.casters.as_ref().and_then(|c| c.all_draws.as_deref()).unwrap_or(draws);
             let all = cx.scoped("the volume fragment count", |cx| every.run(cx, all_draws, frame, g, &depth))?;
             stats.counters.extra.insert("unmasked_volume_fragments".into(), read_query(cx, &all)? as f64);
         }

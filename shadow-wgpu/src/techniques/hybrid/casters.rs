@@ -33,7 +33,7 @@ use shadow_core::frame::InstanceVolume;
 use shadow_core::geometry::volume::ShadowVolume;
 use shadow_core::glam::{Vec2, Vec4, Vec4Swizzles};
 use shadow_core::light::LightView;
-use shadow_core::shafts::{CasterShafts, Shaft, tolerance};
+use shadow_core::shafts::{CasterShafts, Shaft, ShaftGrid, tolerance};
 use wgpu::util::DeviceExt;
 
 use crate::context::{WgpuContext, WgpuError};
@@ -95,13 +95,22 @@ struct PieceShaft {
     unused: [u32; 2],
 }
 
+/// A piece counted by the compute passes.
+struct SmallPiece {
+    /// Its index in the shafts ([`CasterShafts::pieces`]).
+    shaft: usize,
+    /// Its run of [`Split::triangles`] (four vec4 each): `sides` sides, then near caps, then as many far
+    /// caps.
+    triangles: Range<u32>,
+    sides: u32,
+}
+
 /// The volumes of a build split for the caster masks.
 pub(super) struct Split {
     /// The small pieces' triangles, four vec4 each (hybrid_casters.wgsl's `triangles`).
     triangles: Vec<Vec4>,
-    /// Per small piece, its index in the shafts, its run of triangles and how many of them are sides (the
-    /// rest: near caps, then as many far caps).
-    pieces: Vec<(usize, Range<u32>, u32)>,
+    /// The small pieces, in the order of their runs.
+    pieces: Vec<SmallPiece>,
     /// What is left to rasterize: the large pieces, a volume per instance that has any.
     pub(super) raster: Vec<InstanceVolume>,
 }
@@ -136,7 +145,8 @@ impl Split {
                 } else {
                     let first = split.triangle_count();
                     split.write_piece(iv, inst, sides, forward, reversed);
-                    split.pieces.push((k, first..split.triangle_count(), sides.len() as u32));
+                    let triangles = first..split.triangle_count();
+                    split.pieces.push(SmallPiece { shaft: k, triangles, sides: sides.len() as u32 });
                 }
                 k += 1;
             }
@@ -202,19 +212,11 @@ enum Group {
     Far = 2,
 }
 
-/// Per projection, a grid over the light-space bounds of the small pieces' shafts within the
-/// projection's view (`windows`: silhouette pixels lie in it, the map classifying nothing else), each
-/// cell listing the pieces whose shafts, widened by the largest sideways tolerance a pixel they can hold
-/// may have, meet it; a piece unbounded in the projection is listed in every cell. A shaft beyond the
-/// grid is listed in its border cells, which is where a pixel beyond it looks. Returns the cells' starts
-/// (every projection's, one after another, and one more) followed by the lists, and per projection its
-/// origin, scale and side.
-fn grids(
-    shafts: &[&[Option<Shaft>]],
-    windows: &[(Vec2, Vec2)],
-    widest: f32,
-    orthographic: &[bool],
-) -> (Vec<u32>, Vec<(Vec2, Vec2, usize)>) {
+/// Per projection, a grid ([`ShaftGrid`]) over the light-space bounds of the small pieces' shafts within
+/// the projection's view (`windows`: silhouette pixels lie in it, the map classifying nothing else), each
+/// shaft widened by the largest sideways tolerance a pixel it can hold may have; a piece unbounded in the
+/// projection, or whose widening cannot be bounded, is listed in every cell.
+fn grids(shafts: &[&[Option<Shaft>]], windows: &[(Vec2, Vec2)], widest: f32, orthographic: &[bool]) -> Vec<ShaftGrid> {
     // The box of a bounded shaft, widened; `None` where a pixel's tolerance cannot be bounded.
     let widened = |s: &Shaft, j: usize| -> Option<(Vec2, Vec2)> {
         let side = if orthographic[j] {
@@ -228,52 +230,39 @@ fn grids(
         };
         Some((s.lo.xy() - side, s.hi.xy() + side))
     };
-    let mut frames = Vec::with_capacity(windows.len());
-    let mut cells: Vec<Vec<u32>> = Vec::new();
-    for (j, window) in windows.iter().enumerate() {
-        let boxes: Vec<Option<(Vec2, Vec2)>> =
-            shafts.iter().map(|s| s[j].as_ref().and_then(|s| widened(s, j))).collect();
-        let (lo, hi) =
-            boxes.iter().flatten().fold((Vec2::INFINITY, Vec2::NEG_INFINITY), |(lo, hi), b| (lo.min(b.0), hi.max(b.1)));
-        let (lo, hi) = (lo.max(window.0), hi.min(window.1));
-        // About four cells a piece: a pixel tests the pieces of its own cell only. No shaft within the
-        // view: one cell holding them all.
-        let (side, origin, scale) = if lo.cmple(hi).all() {
-            let side = ((shafts.len() as f64).sqrt() * 2.0).clamp(1.0, 256.0) as usize;
-            (side, lo, side as f32 / (hi - lo).max(Vec2::splat(1e-30)))
-        } else {
-            (1, Vec2::ZERO, Vec2::ZERO)
-        };
-        let cell = |v: f32| (v.max(0.0) as usize).min(side - 1);
-        let mut lists = vec![Vec::new(); side * side];
-        for (k, b) in boxes.iter().enumerate() {
-            let ((x0, x1), (y0, y1)) = match b {
-                Some((a, b)) => {
-                    let (a, b) = ((*a - origin) * scale, (*b - origin) * scale);
-                    ((cell(a.x), cell(b.x)), (cell(a.y), cell(b.y)))
-                }
-                None => ((0, side - 1), (0, side - 1)),
-            };
-            for y in y0..=y1 {
-                for list in &mut lists[y * side + x0..=y * side + x1] {
-                    list.push(k as u32);
-                }
-            }
-        }
-        frames.push((origin, scale, side));
-        cells.extend(lists);
+    let everywhere = (Vec2::NEG_INFINITY, Vec2::INFINITY);
+    // About four cells a piece: a pixel tests the pieces of its own cell only.
+    let side = ((shafts.len() as f64).sqrt() * 2.0).clamp(1.0, 256.0) as usize;
+    windows
+        .iter()
+        .enumerate()
+        .map(|(j, window)| {
+            let boxes: Vec<Option<(Vec2, Vec2)>> =
+                shafts.iter().map(|s| s[j].as_ref().and_then(|s| widened(s, j))).collect();
+            let (lo, hi) = boxes
+                .iter()
+                .flatten()
+                .fold((Vec2::INFINITY, Vec2::NEG_INFINITY), |(lo, hi), b| (lo.min(b.0), hi.max(b.1)));
+            let listed: Vec<_> = boxes.iter().map(|b| Some(b.unwrap_or(everywhere))).collect();
+            ShaftGrid::new(lo.max(window.0), hi.min(window.1), side, &listed)
+        })
+        .collect()
+}
+
+/// `grids` as hybrid_casters.wgsl reads them: every grid's cell starts, one after another and counted
+/// across all of them, one more, then every grid's lists.
+fn flattened(grids: &[ShaftGrid]) -> Vec<u32> {
+    let mut out = Vec::new();
+    let mut before = 0;
+    for g in grids {
+        out.extend(g.starts[..g.starts.len() - 1].iter().map(|s| s + before));
+        before += g.pieces.len() as u32;
     }
-    let mut out = Vec::with_capacity(cells.len() + 1 + cells.iter().map(Vec::len).sum::<usize>());
-    let mut start = 0u32;
-    for list in &cells {
-        out.push(start);
-        start += list.len() as u32;
+    out.push(before);
+    for g in grids {
+        out.extend_from_slice(&g.pieces);
     }
-    out.push(start);
-    for list in &cells {
-        out.extend_from_slice(list);
-    }
-    (out, frames)
+    out
 }
 
 /// A projection's view in its light space ([`shadow_core::shafts::light_coords`]), with a margin of a
@@ -454,30 +443,21 @@ impl CasterPasses {
     ) -> CasterPieces {
         let projections = light.projections.len().min(PROJECTIONS);
         let piece_shafts: Vec<&[Option<Shaft>]> =
-            split.pieces.iter().map(|(k, ..)| shafts.shafts[*k].as_slice()).collect();
+            split.pieces.iter().map(|p| shafts.shafts[p.shaft].as_slice()).collect();
         // The largest world tolerance of any pixel: the farthest corner of the frame's bounds from the eye.
-        let (lo, hi) = (frame.bounds.min, frame.bounds.max);
-        let far = (0..8)
-            .map(|c| {
-                let corner = shadow_core::glam::Vec3::new(
-                    if c & 1 == 0 { lo.x } else { hi.x },
-                    if c & 2 == 0 { lo.y } else { hi.y },
-                    if c & 4 == 0 { lo.z } else { hi.z },
-                );
-                corner.distance(frame.camera.eye)
-            })
-            .fold(0.0f32, f32::max);
+        let far = frame.bounds.corners().iter().map(|c| c.distance(frame.camera.eye)).fold(0.0f32, f32::max);
         let widest = tolerance(far, frame.camera.near);
         let orthographic: Vec<bool> = light.projections.iter().map(|p| p.orthographic).collect();
         let windows: Vec<(Vec2, Vec2)> = light.projections[..projections].iter().map(window).collect();
-        let (grid, frames) = grids(&piece_shafts, &windows, widest, &orthographic);
+        let per_projection = grids(&piece_shafts, &windows, widest, &orthographic);
+        let grid = flattened(&per_projection);
         let mut params = Params::zeroed();
         let mut first_cell = 0u32;
-        for (j, (proj, (origin, scale, side))) in light.projections.iter().zip(&frames).enumerate() {
+        for (j, (proj, g)) in light.projections.iter().zip(&per_projection).enumerate() {
             params.view_from_world[j] = proj.view_from_world.to_cols_array_2d();
-            params.grid[j] = [origin.x, origin.y, scale.x, scale.y];
-            params.cells[j] = [*side as u32, first_cell, u32::from(proj.orthographic), 0];
-            first_cell += (side * side) as u32;
+            params.grid[j] = [g.origin.x, g.origin.y, g.scale.x, g.scale.y];
+            params.cells[j] = [g.side as u32, first_cell, u32::from(proj.orthographic), 0];
+            first_cell += (g.side * g.side) as u32;
         }
         let point = match light.light.kind {
             LightKind::Point { position } => Some(position),
@@ -490,8 +470,9 @@ impl CasterPasses {
         let records: Vec<PieceShaft> = split
             .pieces
             .iter()
-            .flat_map(|(k, run, sides)| {
-                shafts.shafts[*k][..projections].iter().map(move |s| {
+            .flat_map(|piece| {
+                let (run, sides) = (&piece.triangles, piece.sides);
+                shafts.shafts[piece.shaft][..projections].iter().map(move |s| {
                     let bounded = s.is_some();
                     let s = s.unwrap_or(Shaft { lo: Vec4::ZERO, hi: Vec4::ZERO, near: 0.0 });
                     PieceShaft {
@@ -501,7 +482,7 @@ impl CasterPasses {
                         bounded: u32::from(bounded),
                         first: run.start,
                         count: run.end - run.start,
-                        sides: *sides,
+                        sides,
                         caps: (run.end - run.start - sides) / 2,
                         unused: [0; 2],
                     }
@@ -594,7 +575,7 @@ mod tests {
     use shadow_core::scenes::{self, SceneParams};
     use shadow_core::shafts::{CasterShafts, Shaft, outline};
 
-    use super::{Split, grids};
+    use super::{Split, flattened, grids};
 
     /// The cell a light-space point looks in (hybrid_casters.wgsl's `candidates`).
     fn cell_of(frame: (Vec2, Vec2, usize), first: usize, xy: Vec2) -> usize {
@@ -628,11 +609,12 @@ mod tests {
         // Each piece written out is closed and wound alike: every directed edge between two corners comes
         // with its reverse (far caps turned around, mirrored instances turned back).
         let key = |v: Vec4| v.to_array().map(f32::to_bits);
-        for (k, run, sides) in &split.pieces {
+        for piece in &split.pieces {
+            let (k, run, sides) = (piece.shaft, &piece.triangles, piece.sides as usize);
             // Sides, near caps, as many far caps, in runs.
             let groups: Vec<u32> = run.clone().map(|t| split.triangles[4 * t as usize + 3].z.to_bits()).collect();
-            let caps = (groups.len() - *sides as usize) / 2;
-            let runs = [(0, *sides as usize), (1, caps), (2, caps)];
+            let caps = (groups.len() - sides) / 2;
+            let runs = [(0, sides), (1, caps), (2, caps)];
             let expected: Vec<u32> = runs.iter().flat_map(|&(g, n)| std::iter::repeat_n(g, n)).collect();
             assert_eq!(groups, expected, "piece {k}: triangles out of their runs");
             let mut edges: HashMap<([u32; 4], [u32; 4]), i32> = HashMap::new();
@@ -650,8 +632,9 @@ mod tests {
 
     #[test]
     fn every_point_a_shaft_holds_finds_its_piece_in_its_cell() {
-        // Random shafts, some unbounded, some far outside the view, and random points with tolerances no
-        // larger than the grid was widened for.
+        // Random shafts in two projections (a second view, shifted), some unbounded, some far outside the
+        // view, and random points with tolerances no larger than the grids were widened for, looked up in
+        // the flattened grids as the shader does.
         let mut seed = 0x2545_f491_u32;
         let mut next = move || {
             seed ^= seed << 13;
@@ -661,30 +644,38 @@ mod tests {
         };
         let widest = 0.01;
         let mut shafts: Vec<Vec<Option<Shaft>>> = Vec::new();
+        let windows = [(Vec2::splat(-1.0), Vec2::splat(1.0)), (Vec2::splat(-0.5), Vec2::splat(1.5))];
         for k in 0..300 {
-            let centre = Vec2::new(next() * 3.0 - 1.5, next() * 3.0 - 1.5) * if k % 10 == 0 { 8.0 } else { 1.0 };
-            let half = Vec2::new(next(), next()) * 0.2;
-            let (a, b) = (outline(centre - half), outline(centre + half));
-            let shaft = Shaft {
-                lo: a.min(b).min(outline(centre + half * Vec2::new(1.0, -1.0))),
-                hi: a.max(b).max(outline(centre + half * Vec2::new(-1.0, 1.0))),
-                near: 0.5 + next(),
+            let mut shaft = || {
+                let centre = Vec2::new(next() * 3.0 - 1.5, next() * 3.0 - 1.5) * if k % 10 == 0 { 8.0 } else { 1.0 };
+                let half = Vec2::new(next(), next()) * 0.2;
+                let (a, b) = (outline(centre - half), outline(centre + half));
+                Shaft {
+                    lo: a.min(b).min(outline(centre + half * Vec2::new(1.0, -1.0))),
+                    hi: a.max(b).max(outline(centre + half * Vec2::new(-1.0, 1.0))),
+                    near: 0.5 + next(),
+                }
             };
-            shafts.push(vec![(k % 37 != 0).then_some(shaft)]);
+            let (first, second) = (shaft(), shaft());
+            shafts.push(vec![(k % 37 != 0).then_some(first), (k % 23 != 0).then_some(second)]);
         }
         let refs: Vec<&[Option<Shaft>]> = shafts.iter().map(Vec::as_slice).collect();
-        let window = (Vec2::splat(-1.0), Vec2::splat(1.0));
-        let (cells, frames) = grids(&refs, &[window], widest, &[false]);
-        let lists = frames[0].2 * frames[0].2 + 1;
+        let per_projection = grids(&refs, &windows, widest, &[false, false]);
+        let cells = flattened(&per_projection);
+        let g = |j: usize| &per_projection[j];
+        let first_cells = [0, g(0).side * g(0).side];
+        let lists = first_cells[1] + g(1).side * g(1).side + 1;
         let (mut held, mut missed) = (0, Vec::new());
-        for _ in 0..20_000 {
+        for i in 0..40_000 {
+            let j = i % 2;
             let xy = Vec2::new(next() * 4.0 - 2.0, next() * 4.0 - 2.0);
             let (tol, d) = (next() * widest, 0.3 + next() * 2.0);
             let side = 2.0 * tol / d;
-            let c = cell_of(frames[0], 0, xy);
+            let c = cell_of((g(j).origin, g(j).scale, g(j).side), first_cells[j], xy);
+            assert_eq!(c - first_cells[j], g(j).cell_of(xy), "the shader's cell is the grid's");
             let listed = &cells[lists + cells[c] as usize..lists + cells[c + 1] as usize];
             for (k, s) in shafts.iter().enumerate() {
-                let holds = s[0].is_none_or(|s| s.holds(outline(xy), d, side, tol));
+                let holds = s[j].is_none_or(|s| s.holds(outline(xy), d, side, tol));
                 if holds {
                     held += 1;
                     if !listed.contains(&(k as u32)) {
@@ -693,7 +684,7 @@ mod tests {
                 }
             }
         }
-        assert!(held > 20_000, "the points fall in some shafts: {held}");
+        assert!(held > 40_000, "the points fall in some shafts: {held}");
         assert!(
             missed.is_empty(),
             "{} points held by a shaft not listed in their cell: {:?}",
