@@ -14,15 +14,7 @@ pub const SPOT_SOFT_EDGE: f32 = 0.2;
 /// Spot-cone falloff at a point (1 inside the inner cone, smoothly 0 at the rim); 1 for other lights.
 #[must_use]
 pub fn cone_falloff(light: &Light, p: Vec3) -> f32 {
-    match light.kind {
-        LightKind::Spot { position, direction, cone_angle } => {
-            let cos_angle = (p - position).normalize_or_zero().dot(direction.normalize_or_zero());
-            let outer = (cone_angle * 0.5).cos();
-            let inner = (cone_angle * 0.5 * (1.0 - SPOT_SOFT_EDGE)).cos();
-            smoothstep(outer, inner, cos_angle)
-        }
-        _ => 1.0,
-    }
+    LightTerms::new(light).falloff(p)
 }
 
 /// Hermite smoothstep of `x` between `e0` and `e1`.
@@ -36,15 +28,61 @@ pub fn smoothstep(e0: f32, e1: f32, x: f32) -> f32 {
 /// intensity times max(n . l, 0) times the cone falloff.
 #[must_use]
 pub fn direct(light: &Light, p: Vec3, n: Vec3) -> Vec3 {
-    let l = light.to_light(p);
-    light.color * light.intensity * n.dot(l).max(0.0) * cone_falloff(light, p)
+    LightTerms::new(light).direct(p, n)
+}
+
+/// What shading needs of a light that is the same at every point: its colour times intensity, and a spot's
+/// cone as a unit axis and the cosines of its rim and of its inner cone. Worked out once a frame instead of
+/// once a pixel (the GPU backend hands its shader the same cosines); the same values either way.
+#[derive(Clone, Copy, Debug)]
+pub struct LightTerms {
+    light: Light,
+    radiance: Vec3,
+    cone: Option<Cone>,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct Cone {
+    apex: Vec3,
+    axis: Vec3,
+    outer: f32,
+    inner: f32,
+}
+
+impl LightTerms {
+    /// The terms of `light`.
+    #[must_use]
+    pub fn new(light: &Light) -> Self {
+        let cone = match light.kind {
+            LightKind::Spot { position, direction, cone_angle } => Some(Cone {
+                apex: position,
+                axis: direction.normalize_or_zero(),
+                outer: (cone_angle * 0.5).cos(),
+                inner: (cone_angle * 0.5 * (1.0 - SPOT_SOFT_EDGE)).cos(),
+            }),
+            _ => None,
+        };
+        Self { light: *light, radiance: light.color * light.intensity, cone }
+    }
+
+    /// [`cone_falloff`] at `p`.
+    #[must_use]
+    pub fn falloff(&self, p: Vec3) -> f32 {
+        self.cone.map_or(1.0, |c| smoothstep(c.outer, c.inner, (p - c.apex).normalize_or_zero().dot(c.axis)))
+    }
+
+    /// [`direct`] at `p` with unit normal `n`.
+    #[must_use]
+    pub fn direct(&self, p: Vec3, n: Vec3) -> Vec3 {
+        self.radiance * n.dot(self.light.to_light(p)).max(0.0) * self.falloff(p)
+    }
 }
 
 /// Linear radiance of a surface: albedo times (ambient plus the sum of each light's direct term times its
 /// visibility).
 #[must_use]
-pub fn shade<'a>(albedo: Vec3, p: Vec3, n: Vec3, lit: impl IntoIterator<Item = (&'a Light, f32)>) -> Vec3 {
-    let direct: Vec3 = lit.into_iter().map(|(l, v)| direct(l, p, n) * v).sum();
+pub fn shade<'a>(albedo: Vec3, p: Vec3, n: Vec3, lit: impl IntoIterator<Item = (&'a LightTerms, f32)>) -> Vec3 {
+    let direct: Vec3 = lit.into_iter().map(|(l, v)| l.direct(p, n) * v).sum();
     albedo * (Vec3::splat(AMBIENT) + direct)
 }
 

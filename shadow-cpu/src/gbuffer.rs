@@ -12,7 +12,7 @@ use shadow_core::scene::Camera;
 use shadow_core::{FrameInputs, Image};
 
 use crate::context::{CpuError, check_size};
-use crate::raster::{DepthStencil, Indexed, RasterState, draw};
+use crate::raster::{Batch, DepthStencil, Indexed, RasterState, draw_flat};
 
 /// No instance at this pixel.
 pub const NO_INSTANCE: u32 = u32::MAX;
@@ -40,8 +40,9 @@ pub struct GBuffer {
     pub receiver: Image<bool>,
     /// Clip-space vertices of every instance, exactly as rasterized.
     pub clip_vertices: Vec<Vec<Vec4>>,
-    /// The visibility buffer, kept so a recycled G-buffer reuses its storage.
-    samples: Vec<Sample>,
+    /// The visibility buffer (each pixel's primitive in the frame's one draw, [`NO_INSTANCE`] for none),
+    /// kept so a recycled G-buffer reuses its storage.
+    visible: Vec<u32>,
 }
 
 impl GBuffer {
@@ -68,7 +69,8 @@ struct Storage {
     vec3: [Option<Vec<Vec3>>; 4],
     depth: Option<Vec<f32>>,
     receiver: Option<Vec<bool>>,
-    samples: Option<Vec<Sample>>,
+    visible: Option<Vec<u32>>,
+    instance: Option<Vec<u32>>,
 }
 
 impl GBuffer {
@@ -82,15 +84,10 @@ impl GBuffer {
             ],
             depth: Some(self.depth.into_vec()),
             receiver: Some(self.receiver.into_vec()),
-            samples: Some(self.samples),
+            visible: Some(self.visible),
+            instance: Some(self.instance.into_vec()),
         }
     }
-}
-
-#[derive(Clone, Copy, Debug)]
-struct Sample {
-    instance: u32,
-    triangle: u32,
 }
 
 /// Where the ray `origin + t dir` meets the plane of triangle `c`, with that point's barycentrics. The
@@ -108,6 +105,34 @@ fn ray_triangle(origin: Vec3, dir: Vec3, c: [Vec3; 3]) -> (Vec3, [f32; 3]) {
     let q = s.cross(e1);
     let v = dir.dot(q) / det;
     (c[0] + e1 * u + e2 * v, [1.0 - u - v, u, v])
+}
+
+/// What the resolve needs of a visible triangle, the same for all its pixels.
+#[derive(Clone, Copy)]
+struct Triangle {
+    instance: usize,
+    /// World-space corners.
+    corners: [Vec3; 3],
+    /// Object-space vertex normals.
+    normals: [Vec3; 3],
+    normal_from_local: Mat3,
+    /// Unit world-space face normal, `None` for a degenerate triangle.
+    face: Option<Vec3>,
+}
+
+impl Triangle {
+    fn new(frame: &FrameInputs, instance: usize, triangle: usize, normal_from_local: Mat3) -> Self {
+        let inst = &frame.instances[instance];
+        let t = inst.mesh.triangles()[triangle];
+        let (p, nn) = (inst.mesh.positions(), inst.mesh.normals());
+        Self {
+            instance,
+            corners: t.map(|k| inst.world_from_local.transform_point3(p[k as usize])),
+            normals: t.map(|k| nn[k as usize]),
+            normal_from_local,
+            face: (normal_from_local * shadow_core::mesh::face_normal(t.map(|k| p[k as usize]))).try_normalize(),
+        }
+    }
 }
 
 /// Clip-space vertices of an instance under `clip_from_world`: the one transform every pass shares.
@@ -163,57 +188,68 @@ pub fn render_reusing(
     );
     let old = old.unwrap_or_default();
     let mut ds = DepthStencil::from_parts(width, height, refill(old.depth, n, 1.0), vec![0; n]);
-    let none = Sample { instance: NO_INSTANCE, triangle: 0 };
-    let mut samples =
-        Image::from_vec(width, height, refill(old.samples, n, none)).unwrap_or_else(|| unreachable!("n pixels"));
+    let mut visible =
+        Image::from_vec(width, height, refill(old.visible, n, NO_INSTANCE)).unwrap_or_else(|| unreachable!("n pixels"));
     let mut receiver = refill(old.receiver, n, false);
-    let state = RasterState::default();
-    for (i, inst) in frame.instances.iter().enumerate() {
-        let src = Indexed { positions: &clip[i], triangles: inst.mesh.triangles(), prim_base: 0, flip: inst.mirrored };
-        draw(
-            &mut ds,
-            &mut samples,
-            &src,
-            &state,
-            |f| Some(Sample { instance: i as u32, triangle: f.prim }),
-            |d, s| *d = s,
-        );
-    }
+    // Every instance in one draw, in order (the same fragments as a draw each, without a draw's fixed cost
+    // per instance), each pixel left with its primitive's id.
+    let all = Batch::new(
+        frame
+            .instances
+            .iter()
+            .zip(&clip)
+            .map(|(inst, clip)| Indexed {
+                positions: clip,
+                triangles: inst.mesh.triangles(),
+                prim_base: 0,
+                flip: inst.mirrored,
+            })
+            .collect(),
+    );
+    draw_flat(&mut ds, &mut visible, &all, &RasterState::default(), |prim| prim);
 
-    // Resolve: each pixel's sample to the surface attributes, every image written in one pass.
+    // Resolve: each pixel's primitive to the surface attributes, every image written in one pass. The
+    // triangle's world corners and face normal are those of the pixel before on most pixels of a row.
     let normal_from_local: Vec<Mat3> =
         frame.instances.iter().map(|i| Mat3::from_mat4(i.world_from_local).inverse().transpose()).collect();
     let (mut position, mut normal, mut geometric_normal, mut albedo) = (position, normal, geometric_normal, albedo);
     let w = width as usize;
     let world_from_clip = clip_from_world.inverse();
+    let mut instance = refill(old.instance, n, NO_INSTANCE);
     position
         .par_chunks_mut(w)
         .zip(normal.par_chunks_mut(w))
         .zip(geometric_normal.par_chunks_mut(w))
         .zip(albedo.par_chunks_mut(w))
         .zip(receiver.par_chunks_mut(w))
-        .zip(samples.data().par_chunks(w))
+        .zip(instance.par_chunks_mut(w))
+        .zip(visible.data().par_chunks(w))
         .enumerate()
-        .for_each(|(y, (((((pos, nrm), geo), alb), rec), smp))| {
-            for (x, s) in smp.iter().enumerate() {
-                if s.instance == NO_INSTANCE {
+        .for_each(|(y, ((((((pos, nrm), geo), alb), rec), ins), vis))| {
+            let mut last: Option<(u32, Triangle)> = None;
+            for (x, &prim) in vis.iter().enumerate() {
+                if prim == NO_INSTANCE {
                     continue;
                 }
-                let inst = &frame.instances[s.instance as usize];
-                let t = inst.mesh.triangles()[s.triangle as usize];
-                let (p, nn) = (inst.mesh.positions(), inst.mesh.normals());
-                let corners = t.map(|k| inst.world_from_local.transform_point3(p[k as usize]));
+                let t = match last {
+                    Some((p, t)) if p == prim => t,
+                    _ => {
+                        let (k, triangle) = all.part_of(prim);
+                        let t = Triangle::new(frame, k, triangle as usize, normal_from_local[k]);
+                        last = Some((prim, t));
+                        t
+                    }
+                };
+                let inst = &frame.instances[t.instance];
                 let ndc = glam::Vec2::new(
                     (x as f32 + 0.5) / width as f32 * 2.0 - 1.0,
                     1.0 - (y as f32 + 0.5) / height as f32 * 2.0,
                 );
                 let dir = world_from_clip.project_point3(ndc.extend(0.5)) - camera.eye;
-                let (world, b) = ray_triangle(camera.eye, dir, corners);
-                let nm = normal_from_local[s.instance as usize];
-                let interp = nn[t[0] as usize] * b[0] + nn[t[1] as usize] * b[1] + nn[t[2] as usize] * b[2];
-                let mut shading = (nm * interp).normalize_or(Vec3::Y);
-                let face = shadow_core::mesh::face_normal(t.map(|k| p[k as usize]));
-                let mut geometric = (nm * face).normalize_or(shading);
+                let (world, b) = ray_triangle(camera.eye, dir, t.corners);
+                let interp = t.normals[0] * b[0] + t.normals[1] * b[1] + t.normals[2] * b[2];
+                let mut shading = (t.normal_from_local * interp).normalize_or(Vec3::Y);
+                let mut geometric = t.face.unwrap_or(shading);
                 if inst.mirrored {
                     geometric = -geometric;
                 }
@@ -224,22 +260,24 @@ pub fn render_reusing(
                         shading = -shading;
                     }
                 }
-                (pos[x], nrm[x], geo[x], alb[x], rec[x]) =
-                    (world, shading, geometric, inst.base_color, inst.receives_shadow);
+                (pos[x], nrm[x], geo[x], alb[x], rec[x], ins[x]) =
+                    (world, shading, geometric, inst.base_color, inst.receives_shadow, t.instance as u32);
             }
         });
-    let image = |data| Image::from_vec(width, height, data).unwrap_or_else(|| unreachable!("one entry per pixel"));
+    fn image<T>(w: u32, h: u32, data: Vec<T>) -> Image<T> {
+        Image::from_vec(w, h, data).unwrap_or_else(|| unreachable!("one entry per pixel"))
+    }
     Ok(GBuffer {
         camera,
         clip_from_world,
-        position: image(position),
-        normal: image(normal),
-        geometric_normal: image(geometric_normal),
-        albedo: image(albedo),
-        receiver: Image::from_vec(width, height, receiver).unwrap_or_else(|| unreachable!("one entry per pixel")),
-        instance: samples.map(|s| s.instance),
+        position: image(width, height, position),
+        normal: image(width, height, normal),
+        geometric_normal: image(width, height, geometric_normal),
+        albedo: image(width, height, albedo),
+        receiver: image(width, height, receiver),
+        instance: image(width, height, instance),
         depth: ds.into_depth_image(),
         clip_vertices: clip,
-        samples: samples.into_vec(),
+        visible: visible.into_vec(),
     })
 }

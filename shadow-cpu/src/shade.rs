@@ -11,6 +11,7 @@ use crate::gbuffer::{GBuffer, NO_INSTANCE};
 #[must_use]
 pub fn shade(g: &GBuffer, lights: &[Light], visibility: &[&Image<f32>]) -> Image<Rgb8> {
     let n = g.depth.data().len();
+    let terms: Vec<shading::LightTerms> = lights.iter().map(shading::LightTerms::new).collect();
     let to8 = |c: glam::Vec3| [linear_to_srgb8(c.x), linear_to_srgb8(c.y), linear_to_srgb8(c.z)];
     let data: Vec<Rgb8> = (0..n)
         .into_par_iter()
@@ -19,7 +20,7 @@ pub fn shade(g: &GBuffer, lights: &[Light], visibility: &[&Image<f32>]) -> Image
             if g.instance.data()[i] == NO_INSTANCE {
                 return to8(shading::BACKGROUND);
             }
-            let lit = lights.iter().zip(visibility.iter().map(|v| v.data()[i]));
+            let lit = terms.iter().zip(visibility.iter().map(|v| v.data()[i]));
             to8(shading::shade(g.albedo.data()[i], g.position.data()[i], g.normal.data()[i], lit))
         })
         .collect();

@@ -191,6 +191,53 @@ impl TriangleSource for Indexed<'_> {
     }
 }
 
+/// Several indexed meshes drawn as one source, in order: one draw sets them all up and walks every band
+/// once, where a draw per mesh pays a draw's fixed cost (its bins, its parallel setup and band passes) per
+/// mesh, which is most of the time of a scene of many small instances (cubes' thousand boxes of twelve
+/// triangles). Primitive ids run on from one part to the next ([`Batch::part_of`] turns one back); each
+/// part keeps its own `flip`. The fragments, and so the pictures, are those of the draws in turn.
+pub struct Batch<'a> {
+    parts: Vec<Indexed<'a>>,
+    /// The id of each part's first triangle, and the total at the end.
+    starts: Vec<u32>,
+}
+
+impl<'a> Batch<'a> {
+    /// The parts, drawn in this order (their `prim_base` is not used).
+    ///
+    /// # Panics
+    /// Past `u32::MAX` triangles in all, more than a draw can number.
+    #[must_use]
+    pub fn new(parts: Vec<Indexed<'a>>) -> Self {
+        let mut starts = Vec::with_capacity(parts.len() + 1);
+        let mut n = 0u32;
+        starts.push(0);
+        for p in &parts {
+            n = u32::try_from(p.triangles.len()).ok().and_then(|k| n.checked_add(k)).expect("under 2^32 triangles");
+            starts.push(n);
+        }
+        Self { parts, starts }
+    }
+
+    /// The part a primitive id of this source is in, and its triangle there.
+    #[must_use]
+    pub fn part_of(&self, prim: u32) -> (usize, u32) {
+        let part = self.starts.partition_point(|&s| s <= prim) - 1;
+        (part, prim - self.starts[part])
+    }
+}
+
+impl TriangleSource for Batch<'_> {
+    fn len(&self) -> usize {
+        self.starts.last().map_or(0, |&n| n as usize)
+    }
+    #[inline]
+    fn get(&self, i: usize) -> SourceTriangle {
+        let (part, local) = self.part_of(i as u32);
+        SourceTriangle { prim: i as u32, ..self.parts[part].get(local as usize) }
+    }
+}
+
 /// Triangles given corner by corner.
 pub struct Soup<'a> {
     /// Clip-space corners.
@@ -414,12 +461,40 @@ pub fn draw<T, S, F, B>(
     blend: B,
 ) -> RasterCounters
 where
-    T: Send,
+    T: Copy + Send,
     S: TriangleSource + ?Sized,
     F: Fn(&Fragment) -> Option<T> + Sync,
     B: Fn(&mut T, T) + Sync,
 {
-    draw_with(ds, color, src, st, None, None, shader, blend)
+    draw_with(ds, color, src, st, Path::General, None, shader, blend)
+}
+
+/// A draw whose colour is one value per primitive, `value(prim)`: a visibility buffer of primitive ids, an
+/// object-ID map. Depth tests and writes take the fast kernel's branch-free loop and store the triangle's
+/// value where they pass, with no fragment closure and no interpolation per fragment. The same depths and
+/// colours as [`draw`] with `|f| Some(value(f.prim))`, early tests and plain assignment, which it falls
+/// back to for a state the fast kernel does not take (a stencil test, a depth test that does not write).
+///
+/// # Panics
+/// When `color` is not the size of `ds`: a caller bug.
+pub fn draw_flat<T, S, V>(
+    ds: &mut DepthStencil,
+    color: &mut Image<T>,
+    src: &S,
+    st: &RasterState,
+    value: V,
+) -> RasterCounters
+where
+    T: Copy + Send,
+    S: TriangleSource + ?Sized,
+    V: Fn(u32) -> T + Sync,
+{
+    let shader = |f: &Fragment| Some(value(f.prim));
+    let path = match DepthKernel::for_state(st) {
+        Some(k @ DepthKernel::Depth { write: true, .. }) => Path::Flat(k),
+        _ => Path::General,
+    };
+    draw_with(ds, color, src, st, path, None, shader, |d, v| *d = v)
 }
 
 /// Depth (and stencil) only: shadow-map renders and shadow-volume counting take branch-free inner loops.
@@ -448,7 +523,8 @@ pub fn draw_depth_masked<S: TriangleSource + ?Sized>(
         assert_eq!(m.size(), (ds.width, ds.height), "a computation mask the size of the target");
     }
     let mut none = Image::new(ds.width, ds.height, ());
-    draw_with(ds, &mut none, src, st, DepthKernel::for_state(st), mask, |_| Some(()), |_, _| {})
+    let path = DepthKernel::for_state(st).map_or(Path::General, Path::Depth);
+    draw_with(ds, &mut none, src, st, path, mask, |_| Some(()), |_, _| {})
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -457,13 +533,13 @@ fn draw_with<T, S, F, B>(
     color: &mut Image<T>,
     src: &S,
     st: &RasterState,
-    fast: Option<DepthKernel>,
+    path: Path,
     mask: Option<&ComputationMask>,
     shader: F,
     blend: B,
 ) -> RasterCounters
 where
-    T: Send,
+    T: Copy + Send,
     S: TriangleSource + ?Sized,
     F: Fn(&Fragment) -> Option<T> + Sync,
     B: Fn(&mut T, T) + Sync,
@@ -499,8 +575,8 @@ where
         }
         // A counting draw under a mask in pencil order leaves to the walk only what the pencil can't bound
         // cheaply.
-        let counting = match fast {
-            Some(DepthKernel::Count { compare, front, back }) => Some((compare, front, back)),
+        let counting = match path {
+            Path::Depth(DepthKernel::Count { compare, front, back }) => Some((compare, front, back)),
             _ => None,
         };
         let mut pencil = mask.and_then(ComputationMask::pencil).zip(counting).map(|(p, k)| (p, k, p.plan(&setups)));
@@ -529,7 +605,7 @@ where
                 let y0 = band as i32 * BAND_ROWS as i32;
                 let mut rows = BandRows { depth, stencil, color: col, y0, width: w as usize };
                 for &t in bin {
-                    raster_band(&setups[t as usize], &mut rows, st, fast, mask, &shader, &blend, &mut c);
+                    raster_band(&setups[t as usize], &mut rows, st, path, mask, &shader, &blend, &mut c);
                 }
                 c
             })
@@ -624,6 +700,53 @@ struct RowStart {
     xs: i32,
 }
 
+/// How a draw treats its fragments.
+#[derive(Clone, Copy)]
+enum Path {
+    /// One at a time through the fragment closure and every test of the state.
+    General,
+    /// Depth (and stencil) only, through a fast kernel.
+    Depth(DepthKernel),
+    /// Depth tests that write, through the fast kernel, and where they pass the colour the fragment
+    /// closure gives the primitive ([`draw_flat`]); other kernels take the general path.
+    Flat(DepthKernel),
+}
+
+impl Fragment {
+    /// The fragment a flat draw's closure is asked about: only `prim` and `front_facing` are the
+    /// triangle's.
+    fn of_primitive(t: &Setup) -> Self {
+        Self { x: 0, y: 0, depth: 0.0, prim: t.prim, front_facing: t.front, bary: [1.0 / 3.0; 3] }
+    }
+}
+
+/// One row of a flat draw ([`draw_flat`]): a writing depth test and the primitive's `value` where it
+/// passes. Branch-free, as [`row_fast`].
+#[inline(always)]
+fn row_flat<T>(
+    t: &Setup,
+    compare: CompareFn,
+    row: RowStart,
+    depth: &mut [f32],
+    color: &mut [T],
+    value: T,
+    c: &mut RasterCounters,
+) where
+    T: Copy,
+{
+    let RowStart { z_row, clamp, xs } = row;
+    let mut passed = 0u64;
+    for (i, (d, col)) in depth.iter_mut().zip(color).enumerate() {
+        let z = depth_at(t, z_row, xs + i as i32, clamp);
+        let pass = compare.test(z, *d);
+        *d = if pass { z } else { *d };
+        *col = if pass { value } else { *col };
+        passed += u64::from(pass);
+    }
+    c.fragments += depth.len() as u64;
+    c.passed += passed;
+}
+
 /// One row of a depth-only draw with a fast kernel. Branch-free, so the compiler can vectorize it.
 #[inline(always)]
 fn row_fast(t: &Setup, k: DepthKernel, row: RowStart, depth: &mut [f32], stencil: &mut [u8], c: &mut RasterCounters) {
@@ -685,12 +808,13 @@ fn raster_band<T, F, B>(
     t: &Setup,
     rows: &mut BandRows<'_, T>,
     st: &RasterState,
-    fast: Option<DepthKernel>,
+    path: Path,
     mask: Option<&ComputationMask>,
     shader: &F,
     blend: &B,
     c: &mut RasterCounters,
 ) where
+    T: Copy,
     F: Fn(&Fragment) -> Option<T>,
     B: Fn(&mut T, T),
 {
@@ -698,7 +822,7 @@ fn raster_band<T, F, B>(
     let y_lo = t.min_y.max(rows.y0);
     let y_hi = t.max_y.min(rows.y0 + band_rows - 1);
     let clamp = st.depth.is_some_and(|d| d.clamp);
-    if let (Some(m), Some(k)) = (mask, fast) {
+    if let (Some(m), Path::Depth(k)) = (mask, path) {
         masked_rows(t, rows, k, clamp, m, (y_lo, y_hi), c);
         return;
     }
@@ -709,12 +833,16 @@ fn raster_band<T, F, B>(
         let z_row = row_base(t, py);
         let row = (y - rows.y0) as usize * rows.width;
         let mut run = |a: i32, b: i32| {
-            if let Some(k) = fast {
-                let (lo, hi) = (row + a as usize, row + b as usize + 1);
-                let start = RowStart { z_row, clamp, xs: a };
-                row_fast(t, k, start, &mut rows.depth[lo..hi], &mut rows.stencil[lo..hi], c);
-            } else {
-                row_general(t, rows, st, (y, py, row), (a, b, z_row, clamp), shader, blend, c);
+            let (lo, hi) = (row + a as usize, row + b as usize + 1);
+            let start = RowStart { z_row, clamp, xs: a };
+            match path {
+                Path::Depth(k) => row_fast(t, k, start, &mut rows.depth[lo..hi], &mut rows.stencil[lo..hi], c),
+                Path::Flat(DepthKernel::Depth { compare, write: true }) => {
+                    if let Some(v) = shader(&Fragment::of_primitive(t)) {
+                        row_flat(t, compare, start, &mut rows.depth[lo..hi], &mut rows.color[lo..hi], v, c);
+                    }
+                }
+                _ => row_general(t, rows, st, (y, py, row), (a, b, z_row, clamp), shader, blend, c),
             }
         };
         match mask {

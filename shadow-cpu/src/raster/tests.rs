@@ -324,6 +324,50 @@ fn fast_kernels_match_the_general_loop() {
 }
 
 #[test]
+fn a_batch_draws_what_its_parts_draw_in_turn_and_flat_draws_what_the_general_loop_does() {
+    // Three overlapping layers as three meshes, the middle one turned around: drawn one after the other
+    // with the general loop (each fragment's colour its layer and triangle), then as one batch through the
+    // flat path (the colour from the batch's primitive id).
+    let grid = jittered_grid(17, 4, 1.5);
+    let positions: Vec<Vec4> = grid.iter().flatten().copied().collect();
+    // Tilted differently, so each layer is nearest somewhere.
+    let tilts = [Vec4::new(0.2, 0.0, 0.0, 0.0), Vec4::new(-0.2, 0.0, 0.0, 0.0), Vec4::new(0.0, 0.25, 0.0, 0.0)];
+    let layers: Vec<Vec<Vec4>> = tilts
+        .iter()
+        .map(|t| positions.iter().map(|v| Vec4::new(v.x, v.y, v.z + t.dot(*v), v.w)).collect())
+        .collect();
+    let triangles: Vec<[u32; 3]> = (0..grid.len() as u32).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect();
+    let part = |k: usize| Indexed { positions: &layers[k], triangles: &triangles, prim_base: 0, flip: k == 1 };
+    let bias = DepthBias { constant: 2.0, slope: 1.0, clamp: 0.0 };
+    let st = RasterState { depth: Some(DepthState { bias, ..DepthState::LESS_WRITE }), ..RasterState::default() };
+    let none = (u32::MAX, u32::MAX);
+
+    let mut a = DepthStencil::new(101, 67, 1.0, 0);
+    let mut by_parts = Image::new(101, 67, none);
+    let mut general = RasterCounters::default();
+    for k in 0..3 {
+        general += draw(&mut a, &mut by_parts, &part(k), &st, |f| Some((k as u32, f.prim)), |d, s| *d = s);
+    }
+
+    let batch = Batch::new((0..3).map(part).collect());
+    assert_eq!(batch.len(), 3 * triangles.len());
+    assert_eq!(batch.part_of(triangles.len() as u32 + 5), (1, 5));
+    let mut b = DepthStencil::new(101, 67, 1.0, 0);
+    let mut flat = Image::new(101, 67, none);
+    let counters = draw_flat(&mut b, &mut flat, &batch, &st, |prim| {
+        let (k, t) = batch.part_of(prim);
+        (k as u32, t)
+    });
+    assert_eq!(a, b);
+    assert_eq!(by_parts, flat);
+    assert_eq!(general, counters);
+    // Every layer shows somewhere, so the comparison saw every part and the order they are drawn in.
+    for k in 0..3 {
+        assert!(flat.data().iter().any(|&(layer, _)| layer == k), "layer {k} shows nowhere");
+    }
+}
+
+#[test]
 fn a_computation_mask_confines_stencil_work_to_its_pixels() {
     // Counting volumes (both ops incrementing) over a jittered mesh with perspective and clipping, once
     // unmasked and once under a mask of scattered pixels and a block, in tiles of several sides: ones

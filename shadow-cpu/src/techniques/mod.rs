@@ -11,14 +11,17 @@ pub mod silhouette_map;
 pub mod volume_reconstruction;
 
 use rayon::prelude::*;
-use shadow_core::glam::{Vec2, Vec3};
+use shadow_core::frame::Instance;
+use shadow_core::glam::{Vec2, Vec3, Vec4};
 use shadow_core::light::{LightProjection, LightView};
 use shadow_core::technique::settings::DepthBias;
 use shadow_core::{FrameInputs, Image};
 
 use crate::context::{CpuError, MAX_MAP_TEXELS, check_size};
 use crate::gbuffer::{GBuffer, clip_vertices};
-use crate::raster::{CullMode, DepthState, DepthStencil, Indexed, RasterCounters, RasterState, draw, draw_depth};
+use crate::raster::{
+    Batch, CullMode, DepthState, DepthStencil, Indexed, RasterCounters, RasterState, draw_depth, draw_flat,
+};
 
 /// Refuses a set of `count` square maps of side `res` before anything is allocated.
 ///
@@ -56,15 +59,16 @@ pub fn render_depth_map(
     let mut ds = DepthStencil::from_parts(res, res, depth, vec![0; n]);
     let state =
         RasterState { cull, depth: Some(DepthState { bias, ..DepthState::LESS_WRITE }), ..RasterState::default() };
-    let mut counters = RasterCounters::default();
-    for inst in frame.instances.iter().filter(|i| i.casts_shadow) {
-        let clip = clip_vertices(inst.mesh.positions(), proj.clip_from_world * inst.world_from_local);
-        counters += draw_depth(
-            &mut ds,
-            &Indexed { positions: &clip, triangles: inst.mesh.triangles(), prim_base: 0, flip: inst.mirrored },
-            &state,
-        );
-    }
+    let casters: Vec<_> = frame.instances.iter().filter(|i| i.casts_shadow).collect();
+    let clip: Vec<Vec<Vec4>> =
+        casters.iter().map(|i| clip_vertices(i.mesh.positions(), proj.clip_from_world * i.world_from_local)).collect();
+    let parts = casters.iter().zip(&clip).map(|(inst, clip)| Indexed {
+        positions: clip,
+        triangles: inst.mesh.triangles(),
+        prim_base: 0,
+        flip: inst.mirrored,
+    });
+    let counters = draw_depth(&mut ds, &Batch::new(parts.collect()), &state);
     (ds.into_depth_image(), counters)
 }
 
@@ -108,12 +112,20 @@ pub fn render_depth_and_id_maps(
     for p in &light.projections {
         let mut ds = DepthStencil::new(res, res, 1.0, 0);
         let mut id = Image::new(res, res, 0u32);
-        for (k, inst) in frame.instances.iter().enumerate().filter(|(_, i)| i.casts_shadow) {
-            let clip = clip_vertices(inst.mesh.positions(), p.clip_from_world * inst.world_from_local);
-            let src = Indexed { positions: &clip, triangles: inst.mesh.triangles(), prim_base: 0, flip: inst.mirrored };
-            let value = k as u32 + 1;
-            let _ = draw(&mut ds, &mut id, &src, &state, |_| Some(value), |d, s| *d = s);
-        }
+        let casters: Vec<(usize, &Instance)> =
+            frame.instances.iter().enumerate().filter(|(_, i)| i.casts_shadow).collect();
+        let clip: Vec<Vec<Vec4>> = casters
+            .iter()
+            .map(|(_, i)| clip_vertices(i.mesh.positions(), p.clip_from_world * i.world_from_local))
+            .collect();
+        let parts = casters.iter().zip(&clip).map(|((_, inst), clip)| Indexed {
+            positions: clip,
+            triangles: inst.mesh.triangles(),
+            prim_base: 0,
+            flip: inst.mirrored,
+        });
+        let all = Batch::new(parts.collect());
+        draw_flat(&mut ds, &mut id, &all, &state, |prim| casters[all.part_of(prim).0].0 as u32 + 1);
         maps.push(ds.into_depth_image());
         ids.push(id);
     }
