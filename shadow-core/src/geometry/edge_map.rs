@@ -16,7 +16,7 @@ use rayon::prelude::*;
 
 use crate::image::Image;
 use crate::light::LightProjection;
-use crate::lookup::hidden;
+use crate::lookup::{floor, hidden};
 
 /// A world segment clipped to a projection's view: its ends in NDC, and whether clipping cut each one.
 struct Clipped {
@@ -114,15 +114,40 @@ const CELL_REACH: f32 = 1e-3;
 #[must_use]
 pub fn edge_cells(segments: &[[Vec3; 2]], proj: &LightProjection, res: u32, map: Option<&Image<f32>>) -> Image<f32> {
     let side = res + 1;
-    let cells = (side * side) as usize;
+    // NDC to cell coordinates: cell (x, y) spans [x, x + 1] x [y, y + 1].
+    let n = res as f32;
+    let to_cells = |p: Vec3| Vec3::new((p.x * 0.5 + 0.5) * n + 0.5, (0.5 - p.y * 0.5) * n + 0.5, p.z);
+    // The segments in view, in cell coordinates, and which of their ends clipping made.
+    let kept: Vec<([Vec3; 2], [bool; 2])> = segments
+        .par_iter()
+        .with_min_len(1024)
+        .filter_map(|&segment| clip_to_view(proj, segment, 8.0 / n).map(|c| (c.ends.map(to_cells), c.cut)))
+        .collect();
+    // Strips of cell rows, each walked by one task over every segment that reaches it: a cell belongs to
+    // one strip, which meets its segments in their order, so each cell's first two are the same as one
+    // walk over the whole map would find.
+    let strip_rows = side.div_ceil(4 * rayon::current_num_threads() as u32).max(16) as usize;
+    let mut out = Image::new(side, side, 1.0f32);
+    out.data_mut().par_chunks_mut(strip_rows * side as usize).enumerate().for_each(|(k, strip)| {
+        let y0 = (k * strip_rows) as i64;
+        cell_strip(&kept, side, y0, strip, map);
+    });
+    out
+}
+
+/// [`edge_cells`] over the rows of cells from `y0` that `strip` holds.
+fn cell_strip(kept: &[([Vec3; 2], [bool; 2])], side: u32, y0: i64, strip: &mut [f32], map: Option<&Image<f32>>) {
+    let width = i64::from(side);
+    let y1 = y0 + strip.len() as i64 / width; // one past the strip's last row
+    let cells = strip.len();
     // Per cell: the segments entering it (saturating), the least depth any has inside it, and the first two
-    // of them (indices into the clipped segments, or a cut end), which the tests of pairs read.
+    // of them (indices into `kept`, or a cut end), which the tests of pairs read.
     let (mut count, mut depth, mut first) = (vec![0u8; cells], vec![1.0f32; cells], vec![[CUT; 2]; cells]);
     // The cells two segments or more enter, in the order they were reached.
     let mut pairs: Vec<u32> = Vec::new();
     let mut enter = |x: i64, y: i64, z: f32, id: u32| {
-        if (0..i64::from(side)).contains(&x) && (0..i64::from(side)).contains(&y) {
-            let i = (y * i64::from(side) + x) as usize;
+        if (0..width).contains(&x) && (y0..y1).contains(&y) {
+            let i = ((y - y0) * width + x) as usize;
             let k = count[i];
             if k < 2 {
                 first[i][usize::from(k)] = id;
@@ -134,22 +159,13 @@ pub fn edge_cells(segments: &[[Vec3; 2]], proj: &LightProjection, res: u32, map:
             }
         }
     };
-    // NDC to cell coordinates: cell (x, y) spans [x, x + 1] x [y, y + 1].
-    let n = res as f32;
-    let to_cells = |p: Vec3| Vec3::new((p.x * 0.5 + 0.5) * n + 0.5, (0.5 - p.y * 0.5) * n + 0.5, p.z);
-    let mut kept: Vec<[Vec3; 2]> = Vec::with_capacity(segments.len());
-    for &segment in segments {
-        let Some(c) = clip_to_view(proj, segment, 8.0 / n) else {
-            continue;
-        };
-        let [a, b] = c.ends.map(to_cells);
-        let id = kept.len() as u32;
-        kept.push([a, b]);
+    for (id, &([a, b], cut)) in kept.iter().enumerate() {
+        let id = id as u32;
         // Row by row: the stretch of the segment within the row (widened by CELL_REACH), then the cells
         // its x range spans, each with the least depth over its part of the stretch (depth is affine in x
         // along it).
-        let (dy, last) = (b.y - a.y, i64::from(side) - 1);
-        let rows = floor(a.y.min(b.y) - CELL_REACH).max(0)..=floor(a.y.max(b.y) + CELL_REACH).min(last);
+        let dy = b.y - a.y;
+        let rows = floor(a.y.min(b.y) - CELL_REACH).max(y0)..=floor(a.y.max(b.y) + CELL_REACH).min(y1 - 1);
         for y in rows {
             let (lo, hi) = (y as f32 - CELL_REACH, y as f32 + 1.0 + CELL_REACH);
             let (p, q) = if dy.abs() < 1e-12 {
@@ -165,46 +181,32 @@ pub fn edge_cells(segments: &[[Vec3; 2]], proj: &LightProjection, res: u32, map:
             let (p, q) = if p.x <= q.x { (p, q) } else { (q, p) };
             let slope = if q.x - p.x > 1e-12 { (q.z - p.z) / (q.x - p.x) } else { 0.0 };
             let z = |x: f32| p.z + (x.clamp(p.x, q.x) - p.x) * slope;
-            let columns = floor(p.x - CELL_REACH).max(0)..=floor(q.x + CELL_REACH).min(last);
+            let columns = floor(p.x - CELL_REACH).max(0)..=floor(q.x + CELL_REACH).min(width - 1);
             for x in columns {
                 let (u, v) = (x as f32 - CELL_REACH, x as f32 + 1.0 + CELL_REACH);
                 enter(x, y, z(u).min(z(v)), id);
             }
         }
-        for (end, cut) in [a, b].into_iter().zip(c.cut) {
+        for (end, cut) in [a, b].into_iter().zip(cut) {
             if cut {
                 enter(floor(end.x), floor(end.y), end.z, CUT);
             }
         }
     }
-    let marked: Vec<(u32, f32)> = pairs
-        .par_iter()
-        .filter_map(|&i| {
-            let (x, y, nearest) = (i % side, i / side, depth[i as usize]);
-            if map.is_some_and(|m| hidden(m, x, y, nearest)) {
-                return None;
-            }
-            let [s, t] = first[i as usize];
-            let cleared = count[i as usize] == 2
-                && s != CUT
-                && t != CUT
-                && !may_hide(i64::from(x), i64::from(y), [kept[s as usize], kept[t as usize]]);
-            (!cleared).then_some((i, nearest))
-        })
-        .collect();
-    let mut out = Image::new(side, side, 1.0f32);
-    for (i, depth) in marked {
-        out.data_mut()[i as usize] = depth;
+    for i in pairs {
+        let (x, y, nearest) = (i % side, y0 as u32 + i / side, depth[i as usize]);
+        if map.is_some_and(|m| hidden(m, x, y, nearest)) {
+            continue;
+        }
+        let [s, t] = first[i as usize];
+        let cleared = count[i as usize] == 2
+            && s != CUT
+            && t != CUT
+            && !may_hide(i64::from(x), i64::from(y), [kept[s as usize].0, kept[t as usize].0]);
+        if !cleared {
+            strip[i as usize] = nearest;
+        }
     }
-    out
-}
-
-/// `v.floor() as i64` without the libm call the float rounding makes on a plain x86-64 target (the cell
-/// walk's inner loop).
-#[inline]
-fn floor(v: f32) -> i64 {
-    let i = v as i64;
-    i - i64::from(i as f32 > v)
 }
 
 /// Whether two segments entering cell `(x, y)` (cell coordinates: it spans `[x, x + 1] x [y, y + 1]`, its

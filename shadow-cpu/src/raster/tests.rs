@@ -332,10 +332,8 @@ fn a_batch_draws_what_its_parts_draw_in_turn_and_flat_draws_what_the_general_loo
     let positions: Vec<Vec4> = grid.iter().flatten().copied().collect();
     // Tilted differently, so each layer is nearest somewhere.
     let tilts = [Vec4::new(0.2, 0.0, 0.0, 0.0), Vec4::new(-0.2, 0.0, 0.0, 0.0), Vec4::new(0.0, 0.25, 0.0, 0.0)];
-    let layers: Vec<Vec<Vec4>> = tilts
-        .iter()
-        .map(|t| positions.iter().map(|v| Vec4::new(v.x, v.y, v.z + t.dot(*v), v.w)).collect())
-        .collect();
+    let layers: Vec<Vec<Vec4>> =
+        tilts.iter().map(|t| positions.iter().map(|v| Vec4::new(v.x, v.y, v.z + t.dot(*v), v.w)).collect()).collect();
     let triangles: Vec<[u32; 3]> = (0..grid.len() as u32).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect();
     let part = |k: usize| Indexed { positions: &layers[k], triangles: &triangles, prim_base: 0, flip: k == 1 };
     let bias = DepthBias { constant: 2.0, slope: 1.0, clamp: 0.0 };
