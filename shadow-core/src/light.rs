@@ -67,6 +67,7 @@ impl LightProjection {
 
     /// Map coordinates and depth of a world point: `uv` with (0, 0) at the top-left of the map.
     #[must_use]
+    #[inline]
     pub fn uv_depth(&self, p: Vec3) -> (Vec2, f32) {
         let c = self.clip_from_world * p.extend(1.0);
         let ndc = c.xyz() / c.w;
@@ -277,6 +278,7 @@ impl LightView {
 
     /// Index of the projection that covers world point `p` (the cube face for point lights).
     #[must_use]
+    #[inline]
     pub fn projection_index(&self, p: Vec3) -> usize {
         match self.light.kind {
             LightKind::Point { position } => cube_face(p - position),

@@ -186,6 +186,7 @@ impl PixelClass {
 /// for the far row is 0, is still a silhouette pixel when that row disagrees, on both backends alike.
 /// Outside the map a receiver is lit, as in [`shadow_lookup`].
 #[must_use]
+#[inline]
 pub fn classify(map: &Image<f32>, uv: Vec2, depth: f32, faces_light: bool) -> MapClass {
     if uv.x < 0.0 || uv.x > 1.0 || uv.y < 0.0 || uv.y > 1.0 {
         return MapClass::Lit;
@@ -205,6 +206,7 @@ pub fn classify(map: &Image<f32>, uv: Vec2, depth: f32, faces_light: bool) -> Ma
 /// `edges`, a map of the nearest edge's NDC depth per texel (1 where none; `hybrid`'s `edge_texels`; WGSL
 /// twin: `near_edge` in shadow-wgpu's hybrid_edges.wgsl). Outside the map, no.
 #[must_use]
+#[inline]
 pub fn near_edge(edges: &Image<f32>, uv: Vec2, depth: f32) -> bool {
     if !on_map(uv) {
         return false;
@@ -242,6 +244,7 @@ pub fn cell_of(res: u32, uv: Vec2) -> (u32, u32) {
 /// through a sub-texel countersunk hole, whose silhouette is its far rim, deeper than the face the four
 /// texels see around it, would be missed.
 #[must_use]
+#[inline]
 pub fn near_edge_pair(cells: &Image<f32>, map: &Image<f32>, uv: Vec2, depth: f32) -> bool {
     if !on_map(uv) {
         return false;
@@ -255,6 +258,7 @@ pub fn near_edge_pair(cells: &Image<f32>, map: &Image<f32>, uv: Vec2, depth: f32
 /// light than `nearest` by [`EDGE_MARGIN`], hiding every edge of that depth or more in the cell
 /// ([`near_edge_pair`] says why).
 #[must_use]
+#[inline]
 pub fn hidden(map: &Image<f32>, x: u32, y: u32, nearest: f32) -> bool {
     texels_2x2(map, x as i32 - 1, y as i32 - 1).iter().all(|&t| t < nearest - EDGE_MARGIN)
 }

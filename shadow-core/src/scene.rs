@@ -170,6 +170,7 @@ impl Light {
 
     /// Unit vector from `p` towards the light.
     #[must_use]
+    #[inline]
     pub fn to_light(&self, p: Vec3) -> Vec3 {
         match self.kind {
             LightKind::Spot { position, .. } | LightKind::Point { position } => (position - p).normalize_or_zero(),

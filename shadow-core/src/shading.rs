@@ -19,6 +19,7 @@ pub fn cone_falloff(light: &Light, p: Vec3) -> f32 {
 
 /// Hermite smoothstep of `x` between `e0` and `e1`.
 #[must_use]
+#[inline]
 pub fn smoothstep(e0: f32, e1: f32, x: f32) -> f32 {
     let t = ((x - e0) / (e1 - e0)).clamp(0.0, 1.0);
     t * t * (3.0 - 2.0 * t)
@@ -67,12 +68,14 @@ impl LightTerms {
 
     /// [`cone_falloff`] at `p`.
     #[must_use]
+    #[inline]
     pub fn falloff(&self, p: Vec3) -> f32 {
         self.cone.map_or(1.0, |c| smoothstep(c.outer, c.inner, (p - c.apex).normalize_or_zero().dot(c.axis)))
     }
 
     /// [`direct`] at `p` with unit normal `n`.
     #[must_use]
+    #[inline]
     pub fn direct(&self, p: Vec3, n: Vec3) -> Vec3 {
         self.radiance * n.dot(self.light.to_light(p)).max(0.0) * self.falloff(p)
     }
@@ -81,6 +84,7 @@ impl LightTerms {
 /// Linear radiance of a surface: albedo times (ambient plus the sum of each light's direct term times its
 /// visibility).
 #[must_use]
+#[inline]
 pub fn shade<'a>(albedo: Vec3, p: Vec3, n: Vec3, lit: impl IntoIterator<Item = (&'a LightTerms, f32)>) -> Vec3 {
     let direct: Vec3 = lit.into_iter().map(|(l, v)| l.direct(p, n) * v).sum();
     albedo * (Vec3::splat(AMBIENT) + direct)
