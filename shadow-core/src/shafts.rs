@@ -31,6 +31,7 @@ pub struct Shaft {
 
 /// A light-space position `(x, y)` along x, y and both diagonals: `(x, y, x + y, x - y)`.
 #[must_use]
+#[inline]
 pub fn outline(xy: Vec2) -> Vec4 {
     Vec4::new(xy.x, xy.y, xy.x + xy.y, xy.x - xy.y)
 }
@@ -39,6 +40,7 @@ pub fn outline(xy: Vec2) -> Vec4 {
 /// orthographic one, and the distance `d` along the projection's axis; `None` at or behind a perspective
 /// light's plane.
 #[must_use]
+#[inline]
 pub fn light_coords(proj: &LightProjection, p: Vec3) -> Option<(Vec2, f32)> {
     let v = proj.view_from_world.transform_point3(p);
     let d = -v.z;
@@ -51,6 +53,7 @@ pub fn light_coords(proj: &LightProjection, p: Vec3) -> Option<(Vec2, f32)> {
 /// pixel sideways (a 512-row view of 45 degrees), both with a wide margin. Also covers the volumes' own
 /// snapping and depth rounding, which are of the same size.
 #[must_use]
+#[inline]
 pub fn tolerance(r: f32, near: f32) -> f32 {
     r * (1.0 / 4096.0) + r * r / near * (1.0 / 262_144.0)
 }
@@ -58,6 +61,7 @@ pub fn tolerance(r: f32, near: f32) -> f32 {
 /// The light-space tolerance of a point at distance `d` along a projection from the light whose world
 /// tolerance is `tol`: sideways in the projection's `xy` units, and along the light.
 #[must_use]
+#[inline]
 pub fn light_tolerance(proj: &LightProjection, tol: f32, d: f32) -> (f32, f32) {
     (if proj.orthographic { 2.0 * tol } else { 2.0 * tol / d }, tol)
 }
@@ -66,6 +70,7 @@ impl Shaft {
     /// Whether a point whose light-space position has the [`outline`] `o`, at distance `d`, with
     /// light-space tolerances `side` and `along` ([`light_tolerance`]), lies within them of the shaft.
     #[must_use]
+    #[inline]
     pub fn holds(&self, o: Vec4, d: f32, side: f32, along: f32) -> bool {
         let tol = Vec4::new(side, side, 2.0 * side, 2.0 * side);
         d >= self.near - along && o.cmpge(self.lo - tol).all() && o.cmple(self.hi + tol).all()
@@ -202,6 +207,7 @@ impl ShaftGrid {
 
     /// The cell holding `xy` (hybrid_casters.wgsl's lookup is its twin).
     #[must_use]
+    #[inline]
     pub fn cell_of(&self, xy: Vec2) -> usize {
         let ((x, _), (y, _)) = self.cell_range(xy, xy);
         y * self.side + x
@@ -209,6 +215,7 @@ impl ShaftGrid {
 
     /// The pieces of the cell holding `xy`.
     #[must_use]
+    #[inline]
     pub fn pieces_at(&self, xy: Vec2) -> &[u32] {
         let cell = self.cell_of(xy);
         &self.pieces[self.starts[cell] as usize..self.starts[cell + 1] as usize]
