@@ -158,6 +158,12 @@ fn refill<T: Clone>(old: Option<Vec<T>>, n: usize, value: T) -> Vec<T> {
     v
 }
 
+/// A vector of `n` entries for a pass that writes every one of them, `old` as it is when it has that length
+/// (no pass over it first), else `n` copies of `value`.
+fn overwritten<T: Clone>(old: Option<Vec<T>>, n: usize, value: T) -> Vec<T> {
+    old.filter(|v| v.len() == n).unwrap_or_else(|| vec![value; n])
+}
+
 /// [`render`], reusing the storage of a previous frame's G-buffer.
 ///
 /// # Errors
@@ -181,16 +187,16 @@ pub fn render_reusing(
     let mut old = spare.map(GBuffer::into_storage);
     let mut take = |k: usize| old.as_mut().and_then(|o: &mut Storage| o.vec3[k].take());
     let (position, normal, geometric_normal, albedo) = (
-        refill(take(0), n, Vec3::ZERO),
-        refill(take(1), n, Vec3::Y),
-        refill(take(2), n, Vec3::Y),
-        refill(take(3), n, Vec3::ZERO),
+        overwritten(take(0), n, Vec3::ZERO),
+        overwritten(take(1), n, Vec3::Y),
+        overwritten(take(2), n, Vec3::Y),
+        overwritten(take(3), n, Vec3::ZERO),
     );
     let old = old.unwrap_or_default();
     let mut ds = DepthStencil::from_parts(width, height, refill(old.depth, n, 1.0), vec![0; n]);
     let mut visible =
         Image::from_vec(width, height, refill(old.visible, n, NO_INSTANCE)).unwrap_or_else(|| unreachable!("n pixels"));
-    let mut receiver = refill(old.receiver, n, false);
+    let mut receiver = overwritten(old.receiver, n, false);
     // Every instance in one draw, in order (the same fragments as a draw each, without a draw's fixed cost
     // per instance), each pixel left with its primitive's id.
     let all = Batch::new(
@@ -208,14 +214,15 @@ pub fn render_reusing(
     );
     draw_flat(&mut ds, &mut visible, &all, &RasterState::default(), |prim| prim);
 
-    // Resolve: each pixel's primitive to the surface attributes, every image written in one pass. The
-    // triangle's world corners and face normal are those of the pixel before on most pixels of a row.
+    // Resolve: each pixel's primitive to the surface attributes, every pixel of every image written in one
+    // pass (the background's too: the buffers are not cleared first). The triangle's world corners and face
+    // normal are those of the pixel before on most pixels of a row.
     let normal_from_local: Vec<Mat3> =
         frame.instances.iter().map(|i| Mat3::from_mat4(i.world_from_local).inverse().transpose()).collect();
     let (mut position, mut normal, mut geometric_normal, mut albedo) = (position, normal, geometric_normal, albedo);
     let w = width as usize;
     let world_from_clip = clip_from_world.inverse();
-    let mut instance = refill(old.instance, n, NO_INSTANCE);
+    let mut instance = overwritten(old.instance, n, NO_INSTANCE);
     position
         .par_chunks_mut(w)
         .zip(normal.par_chunks_mut(w))
@@ -229,6 +236,8 @@ pub fn render_reusing(
             let mut last: Option<(u32, Triangle)> = None;
             for (x, &prim) in vis.iter().enumerate() {
                 if prim == NO_INSTANCE {
+                    (pos[x], nrm[x], geo[x], alb[x], rec[x], ins[x]) =
+                        (Vec3::ZERO, Vec3::Y, Vec3::Y, Vec3::ZERO, false, NO_INSTANCE);
                     continue;
                 }
                 let t = match last {
@@ -280,4 +289,38 @@ pub fn render_reusing(
         clip_vertices: clip,
         visible: visible.into_vec(),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use shadow_core::scenes::{self, SceneParams};
+
+    use super::*;
+
+    fn frame(name: &str) -> FrameInputs {
+        let scene = scenes::build(name, &SceneParams::default()).expect("built-in scene");
+        let camera = scene.cameras().next().expect("a camera").0;
+        FrameInputs::from_scene(&scene, camera).expect("a valid frame")
+    }
+
+    /// The buffers of a recycled G-buffer are overwritten, not cleared: whatever another scene left in
+    /// them, at the same size or another, must not show through.
+    #[test]
+    fn a_recycled_g_buffer_is_a_fresh_one() {
+        let (cubes, cylinder) = (frame("cubes"), frame("cylinder"));
+        for (w, h) in [(96, 64), (80, 80)] {
+            let fresh = render(&cylinder, w, h).expect("G-buffer");
+            let spare = render(&cubes, 96, 64).expect("G-buffer");
+            let reused = render_reusing(&cylinder, w, h, Some(spare)).expect("G-buffer");
+            assert_eq!(fresh.depth, reused.depth);
+            assert_eq!(fresh.position, reused.position);
+            assert_eq!(fresh.normal, reused.normal);
+            assert_eq!(fresh.geometric_normal, reused.geometric_normal);
+            assert_eq!(fresh.albedo, reused.albedo);
+            assert_eq!(fresh.instance, reused.instance);
+            assert_eq!(fresh.receiver, reused.receiver);
+            // Background and surface both in view, so both branches of the resolve were compared.
+            assert!(fresh.instance.data().contains(&NO_INSTANCE) && fresh.covered_pixels() > 0);
+        }
+    }
 }
