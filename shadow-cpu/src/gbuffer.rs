@@ -197,8 +197,8 @@ pub fn render_reusing(
     let mut visible =
         Image::from_vec(width, height, refill(old.visible, n, NO_INSTANCE)).unwrap_or_else(|| unreachable!("n pixels"));
     let mut receiver = overwritten(old.receiver, n, false);
-    // Every instance in one draw, in order (the same fragments as a draw each, without a draw's fixed cost
-    // per instance), each pixel left with its primitive's id.
+    // Every instance in one draw, in order (the same fragments as a draw each), each pixel left with the id
+    // of its primitive in the batch.
     let all = Batch::new(
         frame
             .instances

@@ -6,14 +6,22 @@
 //! [`WgpuContext::end_of_work`] once its own work is submitted: the frame driver then reports the GPU time
 //! up to that marker as the phase's and the rest as `gpu_counters`, so the waits and passes of the
 //! counters do not land in the technique's time.
+//!
+//! A technique may also end named steps of its phase with [`WgpuContext::step`] after submitting each
+//! one's work: the driver reports the GPU time from the phase's start or the step before as
+//! `gpu_<phase>.<name>` (per-pass times for a profile; their sum is the phase's own time).
+
+use std::cell::{Cell, RefCell};
 
 use crate::context::{WgpuContext, WgpuError};
 
 /// Markers of one frame.
 pub struct PhaseClock {
     set: wgpu::QuerySet,
-    count: u32,
+    /// Markers written so far (a cell, so a step can be marked through a shared context).
+    count: Cell<u32>,
     work_end: Option<u32>,
+    steps: RefCell<Vec<(&'static str, u32)>>,
 }
 
 /// Most markers a frame writes.
@@ -29,8 +37,9 @@ impl PhaseClock {
                 ty: wgpu::QueryType::Timestamp,
                 count: CAPACITY,
             }),
-            count: 0,
+            count: Cell::new(0),
             work_end: None,
+            steps: RefCell::new(Vec::new()),
         })
     }
 
@@ -49,11 +58,23 @@ impl PhaseClock {
         self.work_end.take()
     }
 
-    fn mark_on(&mut self, device: &wgpu::Device, queue: &wgpu::Queue) -> Option<u32> {
-        if self.count >= CAPACITY {
+    /// Submits the marker that ends the named step of the phase under way (see the module docs).
+    pub(crate) fn mark_step(&self, device: &wgpu::Device, queue: &wgpu::Queue, name: &'static str) {
+        if let Some(index) = self.mark_on(device, queue) {
+            self.steps.borrow_mut().push((name, index));
+        }
+    }
+
+    /// The named steps' end markers submitted since the last call, in order.
+    pub fn take_steps(&mut self) -> Vec<(&'static str, u32)> {
+        self.steps.take()
+    }
+
+    fn mark_on(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Option<u32> {
+        if self.count.get() >= CAPACITY {
             return None;
         }
-        let index = self.count;
+        let index = self.count.get();
         let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("phase marker") });
         drop(enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("phase marker"),
@@ -64,7 +85,7 @@ impl PhaseClock {
             }),
         }));
         queue.submit([enc.finish()]);
-        self.count += 1;
+        self.count.set(index + 1);
         Some(index)
     }
 
@@ -73,10 +94,11 @@ impl PhaseClock {
     /// # Errors
     /// A GPU failure while reading the queries back.
     pub fn read(&self, cx: &WgpuContext) -> Result<Vec<f64>, WgpuError> {
-        if self.count == 0 {
+        let count = self.count.get();
+        if count == 0 {
             return Ok(Vec::new());
         }
-        let size = u64::from(self.count) * 8;
+        let size = u64::from(count) * 8;
         let resolve = cx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("timestamps"),
             size,
@@ -90,7 +112,7 @@ impl PhaseClock {
             mapped_at_creation: false,
         });
         let mut enc = cx.device.create_command_encoder(&Default::default());
-        enc.resolve_query_set(&self.set, 0..self.count, &resolve, 0);
+        enc.resolve_query_set(&self.set, 0..count, &resolve, 0);
         enc.copy_buffer_to_buffer(&resolve, 0, &staging, 0, size);
         cx.queue.submit([enc.finish()]);
         let ticks = crate::readback::map_read(cx, &staging, "reading timestamps")?;

@@ -311,6 +311,15 @@ impl WgpuContext {
         }
     }
 
+    /// Ends the named step of the phase under way once its work is submitted: where the adapter has
+    /// timestamps, the frame reports the GPU time since the phase began or the last step ended as
+    /// `gpu_<phase>.<name>` (see [`crate::clock`]). Does nothing outside a frame or without timestamps.
+    pub fn step(&self, name: &'static str) {
+        if let Some(clock) = &self.clock {
+            clock.mark_step(&self.device, &self.queue, name);
+        }
+    }
+
     /// Waits for all submitted work.
     ///
     /// # Errors

@@ -131,7 +131,7 @@ pub fn render_frame(
 
 /// A phase and its clock markers, for GPU times: start, end of the technique's own work (see
 /// [`WgpuContext::end_of_work`]) and end.
-type Span = (Phase, Option<u32>, Option<u32>, Option<u32>);
+type Span = (Phase, Option<u32>, Option<u32>, Option<u32>, Vec<(&'static str, u32)>);
 
 /// [`render_frame`]'s phases, with the clock in the context.
 fn frame_phases(
@@ -151,11 +151,12 @@ fn frame_phases(
         index
     };
     let work_end = |cx: &mut WgpuContext| cx.clock.as_mut().and_then(PhaseClock::take_work_end);
+    let steps = |cx: &mut WgpuContext| cx.clock.as_mut().map(PhaseClock::take_steps).unwrap_or_default();
 
     let t = Instant::now();
     let m0 = mark(cx);
     let g = gbuffer::render(cx, frame, width, height)?;
-    spans.push((Phase::GBuffer, m0, None, mark(cx)));
+    spans.push((Phase::GBuffer, m0, None, mark(cx), steps(cx)));
     cx.wait()?;
     stats.timings.add(Phase::GBuffer, ms(t.elapsed()));
 
@@ -168,14 +169,14 @@ fn frame_phases(
         let t = Instant::now();
         let m0 = mark(cx);
         technique.build(cx, frame, &view, &mut light_stats)?;
-        spans.push((Phase::Build, m0, work_end(cx), mark(cx)));
+        spans.push((Phase::Build, m0, work_end(cx), mark(cx), steps(cx)));
         cx.wait()?;
         stats.timings.add(Phase::Build, ms(t.elapsed()));
         let mut out = GpuVisibility { view: layer_view(&vis_tex, k as u32), width, height };
         let t = Instant::now();
         let m0 = mark(cx);
         technique.query(cx, frame, &view, &g, &mut out, &mut light_stats)?;
-        spans.push((Phase::Query, m0, work_end(cx), mark(cx)));
+        spans.push((Phase::Query, m0, work_end(cx), mark(cx), steps(cx)));
         cx.wait()?;
         stats.timings.add(Phase::Query, ms(t.elapsed()));
         stats.counters.merge(&light_stats.counters);
@@ -188,7 +189,7 @@ fn frame_phases(
     let t = Instant::now();
     let m0 = mark(cx);
     let (color_tex, covered) = shade(cx, frame, &g, &vis_tex)?;
-    spans.push((Phase::Shade, m0, None, mark(cx)));
+    spans.push((Phase::Shade, m0, None, mark(cx), steps(cx)));
     cx.wait()?;
     stats.timings.add(Phase::Shade, ms(t.elapsed()));
     stats.timings.total = ms(start.elapsed());
@@ -198,9 +199,14 @@ fn frame_phases(
         let mut add = |key: String, a: u32, b: u32| {
             *stats.timings.extra.entry(key).or_insert(0.0) += at[b as usize] - at[a as usize];
         };
-        for (phase, a, work, b) in spans {
+        for (phase, a, work, b, steps) in spans {
             if let (Some(a), Some(b)) = (a, b) {
                 let key = format!("gpu_{}", phase.key());
+                let mut from = a;
+                for (name, end) in steps {
+                    add(format!("{key}.{name}"), from, end);
+                    from = end;
+                }
                 match work {
                     Some(w) => {
                         add(key, a, w);

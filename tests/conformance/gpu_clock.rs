@@ -7,17 +7,24 @@ use shadow_core::scenes::{self, SceneParams};
 use shadow_core::technique::TechniqueSpec;
 use shadowlab::{BackendKind, Renderer, TechniqueRegistry};
 
-#[test]
-fn counter_passes_are_timed_apart_from_the_query() {
+/// A renderer with a wgpu adapter and the `cubes` frame, or `None` (and a note) without an adapter, which
+/// `SHADOWLAB_REQUIRE_GPU=1` turns into a failure.
+fn on_wgpu() -> Option<(Renderer, FrameInputs)> {
     let mut renderer = Renderer::new(TechniqueRegistry::builtin());
     let require = std::env::var("SHADOWLAB_REQUIRE_GPU").is_ok_and(|v| v == "1");
     if let Err(e) = renderer.resolve(shadowlab::BackendChoice::Wgpu) {
         assert!(!require, "SHADOWLAB_REQUIRE_GPU=1 but no wgpu adapter: {e}");
         eprintln!("skipped: no wgpu adapter ({e})");
-        return;
+        return None;
     }
     let scene = scenes::build("cubes", &SceneParams::default()).expect("scene");
     let frame = FrameInputs::from_scene(&scene, scene.cameras().next().expect("camera").0).expect("frame");
+    Some((renderer, frame))
+}
+
+#[test]
+fn counter_passes_are_timed_apart_from_the_query() {
+    let Some((mut renderer, frame)) = on_wgpu() else { return };
     let mut extras = |spec: &str| {
         let spec = TechniqueSpec::parse(spec).expect("spec");
         renderer.run(BackendKind::Wgpu, &frame, 128, 128, &spec).expect("a frame").stats.timings.extra
@@ -32,4 +39,31 @@ fn counter_passes_are_timed_apart_from_the_query() {
     }
     assert!(zfail.contains_key("gpu_counters"), "z-fail's counter passes are not timed apart: {zfail:?}");
     assert!(!map.contains_key("gpu_counters"), "shadow-map has no counter passes: {map:?}");
+}
+
+/// A technique's named steps (`WgpuContext::step`) come back as `gpu_<phase>.<name>`, in GPU time that
+/// adds up to no more than the phase's own.
+#[test]
+fn named_steps_split_a_phase() {
+    let Some((mut renderer, frame)) = on_wgpu() else { return };
+    let spec = TechniqueSpec::parse("hybrid:res=256").expect("spec");
+    let extra = renderer.run(BackendKind::Wgpu, &frame, 128, 128, &spec).expect("a frame").stats.timings.extra;
+    if !extra.contains_key("gpu_gbuffer") {
+        eprintln!("skipped: the adapter has no timestamp queries");
+        return;
+    }
+    for (phase, steps) in [
+        ("gpu_build", &["map", "edges", "pieces"][..]),
+        ("gpu_query", &["setup", "mask", "casters", "volumes", "answer"][..]),
+    ] {
+        let whole = extra[phase];
+        let mut sum = 0.0;
+        for step in steps {
+            let key = format!("{phase}.{step}");
+            let t = *extra.get(&key).unwrap_or_else(|| panic!("{key} missing: {extra:?}"));
+            assert!(t >= 0.0, "{key} = {t}");
+            sum += t;
+        }
+        assert!(sum > 0.0 && sum <= whole + 1e-6, "{phase}: steps {sum} ms against {whole} ms");
+    }
 }

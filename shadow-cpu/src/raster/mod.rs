@@ -191,11 +191,11 @@ impl TriangleSource for Indexed<'_> {
     }
 }
 
-/// Several indexed meshes drawn as one source, in order: one draw sets them all up and walks every band
-/// once, where a draw per mesh pays a draw's fixed cost (its bins, its parallel setup and band passes) per
-/// mesh, which is most of the time of a scene of many small instances (cubes' thousand boxes of twelve
-/// triangles). Primitive ids run on from one part to the next ([`Batch::part_of`] turns one back); each
-/// part keeps its own `flip`. The fragments, and so the pictures, are those of the draws in turn.
+/// Several indexed meshes drawn as one source, in order, under one numbering: primitive ids run on from one
+/// part to the next, so a visibility buffer of a whole frame ([`draw_flat`]) holds one id per pixel, which
+/// [`Batch::part_of`] turns back into the mesh and its triangle. Each part keeps its own `flip`; the
+/// fragments, and so the pictures, are those of the parts drawn in turn. (A draw's fixed cost per mesh is
+/// not what it saves: on cubes' thousand boxes, one draw and a thousand took the same time.)
 pub struct Batch<'a> {
     parts: Vec<Indexed<'a>>,
     /// The id of each part's first triangle, and the total at the end.

@@ -397,6 +397,7 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
         stats: &mut FrameStats,
     ) -> Result<(), WgpuError> {
         self.depth.build(cx, &mut state.map, frame, light, stats)?;
+        cx.step("map");
         let res = self.depth.resolution;
         // The edge maps' segments come from the volumes' own silhouette pass (unused with
         // `edge_texels=off`, where they cost two transforms per silhouette edge).
@@ -406,6 +407,7 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
         } else if self.edge_texels == EdgeTexels::Paired {
             state.edge_maps = Some(cx.scoped("the edge cells", |cx| edge_cell_maps(cx, &segments, light, res))?);
         }
+        cx.step("edges");
         if let Some(casters) = &mut state.casters {
             // The small pieces go to the compute passes, the rest to the rasterizer.
             InstanceVolume::count(&volumes, &mut stats.counters);
@@ -417,6 +419,7 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
         } else {
             state.draws = Some(upload_draws(cx, frame, &volumes, stats)?);
         }
+        cx.step("pieces");
         Ok(())
     }
 
@@ -523,6 +526,7 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
                 l.clear(&mut enc);
             }
             cx.queue.submit([enc.finish()]);
+            cx.step("setup");
             let mask = full_screen_draws(
                 cx,
                 "hybrid mask",
@@ -533,10 +537,12 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
                 Some(&silhouettes),
             );
             cx.queue.submit([mask]);
+            cx.step("mask");
             if let Some((passes, _, pieces, l)) = casters {
                 let mut enc = cx.device.create_command_encoder(&Default::default());
                 passes.record(cx, &mut enc, pieces, l, g);
                 cx.queue.submit([enc.finish()]);
+                cx.step("casters");
             }
             let rects = tiles.map(|t| t.rectangles(cx, tile, (g.width, g.height))).transpose()?;
             let counting = VolumePass {
@@ -548,6 +554,7 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
                 scissors: rects.as_deref(),
             };
             let passed = counting.run(cx, draws, frame, g, &depth);
+            cx.step("volumes");
             let mut answers = vec![(&state.answer_map, OUTSIDE.2), (&state.answer_shadowed, SHADOWED.2)];
             if let Some((_, answer, ..)) = casters {
                 answers.push((answer, LIT.2));
@@ -562,6 +569,7 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
                 None,
             );
             cx.queue.submit([answer]);
+            cx.step("answer");
             Ok::<_, WgpuError>((silhouettes, passed, rects.map(|r| r.len())))
         })??;
         // The counters are not the technique's work: after it is done, a sub-phase of their own.
