@@ -99,7 +99,7 @@ const CELL_REACH: f32 = 1e-3;
 /// `edge_texels=paired`; read by [`crate::lookup::near_edge_pair`]): `(res + 1)` square, pixel `(x, y)` the
 /// square whose corners are texels `(x - 1, y - 1)` and `(x, y)` ([`crate::lookup::cell_of`]; those along
 /// the sides are half outside the map, where a lookup's texels clamp). Where two segments or more enter a
-/// cell and may cut off a part of it that holds none of its corners ([`may_hide`]), it holds the least NDC
+/// cell and may cut off a part of it that holds none of its corners (`may_hide`), it holds the least NDC
 /// depth any of them has inside it; 1 elsewhere. An end that clipping to the view made (a segment through
 /// the light's near plane) counts as a second segment at its cell, since its loop's other segment through
 /// that end was cut elsewhere.

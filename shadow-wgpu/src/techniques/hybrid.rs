@@ -38,7 +38,7 @@
 //!
 //! With `caster_masks=on` (the default, as on the CPU; ours) each small piece of the volumes (one connected
 //! component's) is counted only at the silhouette pixels its shaft holds, by compute passes over the
-//! pixels the mask pass lists ([`casters`]); the pieces too large for that are rasterized as above, and
+//! pixels the mask pass lists (`casters`); the pieces too large for that are rasterized as above, and
 //! the answer's third draw shadows the silhouette pixels whose listed count is not 0.
 //!
 //! Without caster masks the map's classification runs twice, in the mask pass on every pixel and in the
