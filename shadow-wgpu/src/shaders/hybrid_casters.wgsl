@@ -315,22 +315,38 @@ fn candidate(c: Candidates, e: u32) -> u32 {
 }
 
 // The work buffer: per piece its pixel count, its first pair, its cursor and the screen bounds of its
-// near caps and of its far caps (`widen_bounds`; PIECE words in all), then per
+// near caps and of its far caps (`widen_bounds`; PIECE words in all), the number of staged pairs, then per
 // listed pixel a flag (1: too many pairs, the pixel counts every piece itself), then the pairs, each a
-// listed pixel's index, a run per piece.
+// listed pixel's index, a run per piece, then the staged pairs (a listed pixel's index and a piece, in the
+// order the tally found them, twice the pairs' room).
 @group(1) @binding(16) var<storage, read_write> work: array<atomic<u32>>;
 
 const PIECE: u32 = 11u;
 
-fn flags_start() -> u32 {
+fn staged_count() -> u32 {
     return PIECE * casters.counts.z;
+}
+
+fn flags_start() -> u32 {
+    return staged_count() + 1u;
 }
 
 fn pairs_start() -> u32 {
     return flags_start() + u32(view.size.x) * u32(view.size.y);
 }
 
-// Pass 1, per listed pixel: its count set to 0, its flag cleared, and 1 added to each candidate's pixels.
+// How many pairs the work buffer has room for (and staged pairs).
+fn pair_room() -> u32 {
+    return (arrayLength(&work) - pairs_start()) / 3u;
+}
+
+fn staging_start() -> u32 {
+    return pairs_start() + pair_room();
+}
+
+// Pass 1, per listed pixel: its count set to 0, its flag cleared, and each pair of it and a candidate
+// staged and counted in the candidate's pixels; a pixel with a pair past the room is flagged and counts
+// every piece itself (pass 5). The pairs are found once: pass 3 only moves them into their runs.
 @compute @workgroup_size(64)
 fn cs_tally(
     @builtin(workgroup_id) wg: vec3<u32>,
@@ -338,17 +354,27 @@ fn cs_tally(
     @builtin(local_invocation_index) local: u32,
 ) {
     let n = atomicLoad(&listed.pixels);
+    let room = pair_room();
     for (var i = invocation(wg, groups, local); i < n; i += groups.x * groups.y * GROUP) {
         let at = listed.at[i];
         atomicStore(&counts[at], 0);
-        atomicStore(&work[flags_start() + i], 0u);
+        var flag = 0u;
         let c = candidates(pixel_position(at));
         for (var e = c.first; e < c.end; e++) {
             let k = candidate(c, e);
-            if (k != NONE) {
+            if (k == NONE) {
+                continue;
+            }
+            let s = atomicAdd(&work[staged_count()], 1u);
+            if (s < room) {
+                atomicStore(&work[staging_start() + 2u * s], i);
+                atomicStore(&work[staging_start() + 2u * s + 1u], k);
                 atomicAdd(&work[PIECE * k], 1u);
+            } else {
+                flag = 1u;
             }
         }
+        atomicStore(&work[flags_start() + i], flag);
     }
 }
 
@@ -385,30 +411,19 @@ fn cs_offsets(@builtin(local_invocation_index) local: u32) {
     }
 }
 
-// Pass 3, per listed pixel: its index written into each candidate's run; a pixel with a pair past the
-// room there is flagged and counts every piece itself (pass 5).
+// Pass 3, per staged pair: the pixel written into its piece's run.
 @compute @workgroup_size(64)
 fn cs_fill(
     @builtin(workgroup_id) wg: vec3<u32>,
     @builtin(num_workgroups) groups: vec3<u32>,
     @builtin(local_invocation_index) local: u32,
 ) {
-    let n = atomicLoad(&listed.pixels);
-    let room = arrayLength(&work) - pairs_start();
-    for (var i = invocation(wg, groups, local); i < n; i += groups.x * groups.y * GROUP) {
-        let c = candidates(pixel_position(listed.at[i]));
-        for (var e = c.first; e < c.end; e++) {
-            let k = candidate(c, e);
-            if (k == NONE) {
-                continue;
-            }
-            let slot = atomicAdd(&work[PIECE * k + 2u], 1u);
-            if (slot < room) {
-                atomicStore(&work[pairs_start() + slot], i);
-            } else {
-                atomicStore(&work[flags_start() + i], 1u);
-            }
-        }
+    let n = min(atomicLoad(&work[staged_count()]), pair_room());
+    for (var s = invocation(wg, groups, local); s < n; s += groups.x * groups.y * GROUP) {
+        let i = atomicLoad(&work[staging_start() + 2u * s]);
+        let k = atomicLoad(&work[staging_start() + 2u * s + 1u]);
+        let slot = atomicAdd(&work[PIECE * k + 2u], 1u);
+        atomicStore(&work[pairs_start() + slot], i);
     }
 }
 
@@ -436,9 +451,8 @@ fn cs_pieces(
     if (k >= casters.counts.z) {
         return;
     }
-    let room = arrayLength(&work) - pairs_start();
     let first = atomicLoad(&work[PIECE * k + 1u]);
-    let end = min(first + atomicLoad(&work[PIECE * k]), room);
+    let end = min(first + atomicLoad(&work[PIECE * k]), pair_room());
     for (var slot = first + local; slot < end; slot += GROUP) {
         let i = atomicLoad(&work[pairs_start() + slot]);
         if (atomicLoad(&work[flags_start() + i]) != 0u) {

@@ -13,7 +13,8 @@
 //! - **Query**: the mask pass lists its silhouette pixels, and the compute passes (hybrid_casters.wgsl)
 //!   set each triangle up for the view (its rows of adj(M): homogeneous rasterization) and gather each
 //!   piece's caps' screen bounds; pair each listed pixel with the pieces of its light-space cell whose
-//!   shafts hold it (counted, given runs by a prefix sum, written); count each piece at its pixels, a
+//!   shafts hold it (each pair staged and counted as it is found, then given runs by a prefix sum and
+//!   moved into them, so the shaft grid is searched once a pixel); count each piece at its pixels, a
 //!   workgroup per piece, testing its triangles at each pixel's centre as the rasterizer would, and add the
 //!   count beside the pixel. The answer shadows a silhouette pixel whose stencil count or listed count is
 //!   not 0: every piece is closed and wound alike, so the pieces' counts at a point have one sign and
@@ -312,8 +313,8 @@ pub(super) struct ListedPixels {
     /// Per pixel of the view, the map's class the mask pass found there, or at the listed pixels the
     /// count the compute passes found.
     pub(super) counts: wgpu::Buffer,
-    /// Per piece its pixel count, first pair and cursor, per listed pixel a flag, then the pairs
-    /// (hybrid_casters.wgsl's `work`).
+    /// Per piece its pixel count, first pair and cursor, the staged pairs' count, per listed pixel a flag,
+    /// then the pairs and the staged pairs (hybrid_casters.wgsl's `work`).
     work: wgpu::Buffer,
     staging: wgpu::Buffer,
     /// The view's size, and the pieces the work buffer has room for (at least those of the build it was
@@ -343,16 +344,18 @@ impl ListedPixels {
             })
         };
         let capacity = pieces.next_power_of_two();
-        let fixed = PIECE * capacity as u64 + pixels;
+        // The pieces' words, the staged pairs' count and the pixels' flags.
+        let fixed = PIECE * capacity as u64 + 1 + pixels;
         let largest = {
             let limits = cx.device.limits();
             limits.max_storage_buffer_binding_size.min(limits.max_buffer_size) / 4
         };
-        let pairs = (PAIRS_PER_PIXEL * pixels).min(largest.saturating_sub(fixed)).max(1);
+        // Each pair's room is three words: its place in a run and, staged, its pixel and piece.
+        let pairs = (PAIRS_PER_PIXEL * pixels).min(largest.saturating_sub(fixed) / 3).max(1);
         Self {
             listed: buffer("hybrid listed pixels", HEADER + 4 * pixels, U::STORAGE | U::COPY_SRC | U::COPY_DST),
             counts: buffer("hybrid listed counts", 4 * pixels.max(1), U::STORAGE),
-            work: buffer("hybrid caster work", 4 * (fixed + pairs), U::STORAGE | U::COPY_DST),
+            work: buffer("hybrid caster work", 4 * (fixed + 3 * pairs), U::STORAGE | U::COPY_DST),
             staging: buffer("hybrid listed readback", 16, U::COPY_DST | U::MAP_READ),
             size: (width, height),
             capacity,
@@ -543,7 +546,8 @@ impl CasterPasses {
                 buffer(16, &listed.work),
             ],
         });
-        enc.clear_buffer(&listed.work, 0, Some(4 * PIECE * pieces.pieces as u64));
+        // The pieces' words and the staged pairs' count.
+        enc.clear_buffer(&listed.work, 0, Some(4 * (PIECE * pieces.pieces as u64 + 1)));
         let mut pass = enc
             .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("hybrid casters"), timestamp_writes: None });
         pass.set_bind_group(0, &g.frame_group, &[]);
