@@ -199,19 +199,7 @@ pub fn render_reusing(
     let mut receiver = overwritten(old.receiver, n, false);
     // Every instance in one draw, in order (the same fragments as a draw each), each pixel left with the id
     // of its primitive in the batch.
-    let all = Batch::new(
-        frame
-            .instances
-            .iter()
-            .zip(&clip)
-            .map(|(inst, clip)| Indexed {
-                positions: clip,
-                triangles: inst.mesh.triangles(),
-                prim_base: 0,
-                flip: inst.mirrored,
-            })
-            .collect(),
-    );
+    let all = Batch::new(frame.instances.iter().zip(&clip).map(|(inst, clip)| Indexed::instance(inst, clip)).collect());
     draw_flat(&mut ds, &mut visible, &all, &RasterState::default(), |prim| prim);
 
     // Resolve: each pixel's primitive to the surface attributes, every pixel of every image written in one

@@ -11,7 +11,6 @@ pub mod silhouette_map;
 pub mod volume_reconstruction;
 
 use rayon::prelude::*;
-use shadow_core::frame::Instance;
 use shadow_core::glam::{Vec2, Vec3, Vec4};
 use shadow_core::light::{LightProjection, LightView};
 use shadow_core::technique::settings::DepthBias;
@@ -59,17 +58,28 @@ pub fn render_depth_map(
     let mut ds = DepthStencil::from_parts(res, res, depth, vec![0; n]);
     let state =
         RasterState { cull, depth: Some(DepthState { bias, ..DepthState::LESS_WRITE }), ..RasterState::default() };
-    let casters: Vec<_> = frame.instances.iter().filter(|i| i.casts_shadow).collect();
-    let clip: Vec<Vec<Vec4>> =
-        casters.iter().map(|i| clip_vertices(i.mesh.positions(), proj.clip_from_world * i.world_from_local)).collect();
-    let parts = casters.iter().zip(&clip).map(|(inst, clip)| Indexed {
-        positions: clip,
-        triangles: inst.mesh.triangles(),
-        prim_base: 0,
-        flip: inst.mirrored,
-    });
-    let counters = draw_depth(&mut ds, &Batch::new(parts.collect()), &state);
+    let (casters, clip) = casters_clipped(frame, proj);
+    let counters = draw_depth(&mut ds, &casters_batch(frame, &casters, &clip), &state);
     (ds.into_depth_image(), counters)
+}
+
+/// The shadow casters of `frame` (indices into its instances) and their vertices in the clip space of
+/// `proj`.
+fn casters_clipped(frame: &FrameInputs, proj: &LightProjection) -> (Vec<usize>, Vec<Vec<Vec4>>) {
+    let casters: Vec<usize> = (0..frame.instances.len()).filter(|&k| frame.instances[k].casts_shadow).collect();
+    let clip = casters
+        .iter()
+        .map(|&k| {
+            let inst = &frame.instances[k];
+            clip_vertices(inst.mesh.positions(), proj.clip_from_world * inst.world_from_local)
+        })
+        .collect();
+    (casters, clip)
+}
+
+/// The casters of [`casters_clipped`] as one draw; its parts are in the order of `casters`.
+fn casters_batch<'a>(frame: &'a FrameInputs, casters: &[usize], clip: &'a [Vec<Vec4>]) -> Batch<'a> {
+    Batch::new(casters.iter().zip(clip).map(|(&k, clip)| Indexed::instance(&frame.instances[k], clip)).collect())
 }
 
 /// Renders one depth map per projection of `light` (after checking their size), each in the storage of the
@@ -112,20 +122,9 @@ pub fn render_depth_and_id_maps(
     for p in &light.projections {
         let mut ds = DepthStencil::new(res, res, 1.0, 0);
         let mut id = Image::new(res, res, 0u32);
-        let casters: Vec<(usize, &Instance)> =
-            frame.instances.iter().enumerate().filter(|(_, i)| i.casts_shadow).collect();
-        let clip: Vec<Vec<Vec4>> = casters
-            .iter()
-            .map(|(_, i)| clip_vertices(i.mesh.positions(), p.clip_from_world * i.world_from_local))
-            .collect();
-        let parts = casters.iter().zip(&clip).map(|((_, inst), clip)| Indexed {
-            positions: clip,
-            triangles: inst.mesh.triangles(),
-            prim_base: 0,
-            flip: inst.mirrored,
-        });
-        let all = Batch::new(parts.collect());
-        draw_flat(&mut ds, &mut id, &all, &state, |prim| casters[all.part_of(prim).0].0 as u32 + 1);
+        let (casters, clip) = casters_clipped(frame, p);
+        let all = casters_batch(frame, &casters, &clip);
+        draw_flat(&mut ds, &mut id, &all, &state, |prim| casters[all.part_of(prim).0] as u32 + 1);
         maps.push(ds.into_depth_image());
         ids.push(id);
     }
