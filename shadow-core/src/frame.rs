@@ -81,7 +81,16 @@ pub enum FrameError {
     /// The scene draws nothing.
     #[error("the scene has no meshes to draw")]
     Empty,
+    /// More triangles than a frame can number: both backends give each drawn triangle a 32-bit id.
+    #[error("the scene draws {triangles} triangles, over the limit of {} a frame can number", MAX_FRAME_TRIANGLES)]
+    TooManyTriangles {
+        /// Triangles the frame would draw.
+        triangles: u64,
+    },
 }
+
+/// The most triangles one frame may draw: primitive ids are 32-bit, with `u32::MAX` kept for "none".
+pub const MAX_FRAME_TRIANGLES: u64 = u32::MAX as u64;
 
 /// Everything a technique may read about the scene for one frame.
 #[derive(Clone, Debug)]
@@ -100,7 +109,7 @@ impl FrameInputs {
     /// Collects the scene's instances (building any missing adjacency) with the given camera and lights.
     ///
     /// # Errors
-    /// An invalid camera or light, or an empty scene.
+    /// An invalid camera or light, an empty scene, or one of more than [`MAX_FRAME_TRIANGLES`] triangles.
     pub fn new(scene: &Scene, camera: Camera, lights: Vec<Light>) -> Result<Self, FrameError> {
         camera.validate()?;
         for l in &lights {
@@ -130,6 +139,10 @@ impl FrameInputs {
             .collect();
         if instances.is_empty() {
             return Err(FrameError::Empty);
+        }
+        let triangles: u64 = instances.iter().map(|i| i.mesh.triangle_count() as u64).sum();
+        if triangles > MAX_FRAME_TRIANGLES {
+            return Err(FrameError::TooManyTriangles { triangles });
         }
         let bounds = instances.iter().fold(Aabb::EMPTY, |b, i| b.union(i.bounds));
         Ok(Self { instances, bounds, camera, lights })
@@ -224,5 +237,50 @@ impl FrameInputs {
         let inst = &self.instances[i];
         let at = |v: u32| inst.world_from_local.transform_point3(inst.adjacency.positions()[v as usize]);
         sil.edges.iter().map(|e| [at(e.a), at(e.b)]).collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::{Mat4, Vec3};
+
+    use super::{FrameError, FrameInputs, MAX_FRAME_TRIANGLES};
+    use crate::{Camera, Light, Material, Mesh, Scene};
+
+    /// A flat grid of `2 * columns * rows` triangles.
+    fn grid(columns: u32, rows: u32) -> Mesh {
+        let positions = (0..=rows)
+            .flat_map(|y| (0..=columns).map(move |x| Vec3::new(x as f32 / columns as f32, 0.0, y as f32 / rows as f32)))
+            .collect();
+        let at = |x: u32, y: u32| y * (columns + 1) + x;
+        let triangles = (0..rows)
+            .flat_map(|y| {
+                (0..columns).flat_map(move |x| {
+                    [[at(x, y), at(x, y + 1), at(x + 1, y)], [at(x + 1, y), at(x, y + 1), at(x + 1, y + 1)]]
+                })
+            })
+            .collect();
+        Mesh::new(positions, triangles).expect("a grid")
+    }
+
+    #[test]
+    fn a_frame_of_more_triangles_than_32_bit_ids_can_number_is_refused() {
+        // One mesh of 2^16 triangles drawn by 2^16 - 1 nodes numbers within u32; one node more does not.
+        let mut scene = Scene::new();
+        let mesh = scene.add_mesh(grid(256, 128));
+        let material = scene.add_material(Material::default());
+        let n = 1u64 << 16;
+        for k in 0..n - 1 {
+            scene.add_instance(&format!("tile {k}"), mesh, material, Mat4::IDENTITY).expect("instance");
+        }
+        let camera = Camera::look_at(Vec3::new(0.0, 2.0, 2.0), Vec3::ZERO, 45.0);
+        let lights = vec![Light::spot(Vec3::new(0.0, 4.0, 0.0), Vec3::ZERO, 60.0)];
+        let frame = FrameInputs::new(&scene, camera, lights.clone()).expect("at the limit");
+        assert_eq!(frame.triangle_count() as u64, n * (n - 1));
+        assert!(n * (n - 1) <= MAX_FRAME_TRIANGLES);
+        scene.add_instance("one too many", mesh, material, Mat4::IDENTITY).expect("instance");
+        let err = FrameInputs::new(&scene, camera, lights).expect_err("over the limit");
+        assert_eq!(err, FrameError::TooManyTriangles { triangles: n * n });
+        assert!(err.to_string().contains(&(n * n).to_string()), "{err}");
     }
 }

@@ -70,6 +70,8 @@ pub struct Mesh {
     positions: Vec<Vec3>,
     normals: Vec<Vec3>,
     triangles: Vec<[u32; 3]>,
+    /// The positions' bounds, kept with them: a frame reads them once per instance of the mesh.
+    bounds: Aabb,
 }
 
 impl Mesh {
@@ -80,7 +82,8 @@ impl Mesh {
     pub fn new(positions: Vec<Vec3>, triangles: Vec<[u32; 3]>) -> Result<Self, MeshError> {
         Self::check(&positions, &triangles)?;
         let normals = vertex_normals(&positions, &triangles);
-        Ok(Self { positions, normals, triangles })
+        let bounds = Aabb::from_points(positions.iter().copied());
+        Ok(Self { positions, normals, triangles, bounds })
     }
 
     /// A mesh with the given shading normals (normalized here; zero normals are replaced by computed ones).
@@ -97,7 +100,8 @@ impl Mesh {
         }
         let computed = vertex_normals(&positions, &triangles);
         let normals = normals.iter().zip(&computed).map(|(n, c)| n.try_normalize().unwrap_or(*c)).collect();
-        Ok(Self { positions, normals, triangles })
+        let bounds = Aabb::from_points(positions.iter().copied());
+        Ok(Self { positions, normals, triangles, bounds })
     }
 
     fn check(positions: &[Vec3], triangles: &[[u32; 3]]) -> Result<(), MeshError> {
@@ -158,7 +162,7 @@ impl Mesh {
     /// Bounding box of the positions.
     #[must_use]
     pub fn bounds(&self) -> Aabb {
-        Aabb::from_points(self.positions.iter().copied())
+        self.bounds
     }
 
     /// A copy with every position and normal moved by an affine transform (normals by its inverse transpose).
@@ -167,8 +171,10 @@ impl Mesh {
     pub fn transformed(&self, m: glam::Mat4) -> Self {
         let normal_m = glam::Mat3::from_mat4(m).inverse().transpose();
         let mirror = glam::Mat3::from_mat4(m).determinant() < 0.0;
+        let positions: Vec<Vec3> = self.positions.iter().map(|&p| m.transform_point3(p)).collect();
         Self {
-            positions: self.positions.iter().map(|&p| m.transform_point3(p)).collect(),
+            bounds: Aabb::from_points(positions.iter().copied()),
+            positions,
             normals: self.normals.iter().map(|&n| (normal_m * n).normalize_or_zero()).collect(),
             triangles: if mirror {
                 self.triangles.iter().map(|&[a, b, c]| [a, c, b]).collect()
@@ -184,6 +190,7 @@ impl Mesh {
         self.positions.extend_from_slice(&other.positions);
         self.normals.extend_from_slice(&other.normals);
         self.triangles.extend(other.triangles.iter().map(|t| t.map(|i| i + base)));
+        self.bounds = self.bounds.union(other.bounds);
     }
 
     /// Several meshes as one.

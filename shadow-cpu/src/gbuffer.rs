@@ -144,7 +144,7 @@ pub fn clip_vertices(positions: &[Vec3], clip_from_local: Mat4) -> Vec<Vec4> {
 /// Renders the G-buffer of a frame at `width x height`.
 ///
 /// # Errors
-/// A zero or oversized view.
+/// A zero or oversized view, or a frame of more triangles than a draw can number.
 pub fn render(frame: &FrameInputs, width: u32, height: u32) -> Result<GBuffer, CpuError> {
     render_reusing(frame, width, height, None)
 }
@@ -167,7 +167,7 @@ fn overwritten<T: Clone>(old: Option<Vec<T>>, n: usize, value: T) -> Vec<T> {
 /// [`render`], reusing the storage of a previous frame's G-buffer.
 ///
 /// # Errors
-/// A zero or oversized view.
+/// A zero or oversized view, or a frame of more triangles than a draw can number.
 pub fn render_reusing(
     frame: &FrameInputs,
     width: u32,
@@ -199,7 +199,8 @@ pub fn render_reusing(
     let mut receiver = overwritten(old.receiver, n, false);
     // Every instance in one draw, in order (the same fragments as a draw each), each pixel left with the id
     // of its primitive in the batch.
-    let all = Batch::new(frame.instances.iter().zip(&clip).map(|(inst, clip)| Indexed::instance(inst, clip)).collect());
+    let all =
+        Batch::new(frame.instances.iter().zip(&clip).map(|(inst, clip)| Indexed::instance(inst, clip)).collect())?;
     draw_flat(&mut ds, &mut visible, &all, &RasterState::default(), |prim| prim);
 
     // Resolve: each pixel's primitive to the surface attributes, every pixel of every image written in one

@@ -2,7 +2,7 @@
 //! [`Batch`]) or given corner by corner ([`Soup`]).
 
 use glam::Vec4;
-use shadow_core::frame::Instance;
+use shadow_core::frame::{FrameError, Instance, MAX_FRAME_TRIANGLES};
 
 /// One triangle as a draw sees it.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -73,18 +73,23 @@ pub struct Batch<'a> {
 impl<'a> Batch<'a> {
     /// The parts, drawn in this order (their `prim_base` is not used).
     ///
-    /// # Panics
-    /// Past `u32::MAX` triangles in all, more than a draw can number.
-    #[must_use]
-    pub fn new(parts: Vec<Indexed<'a>>) -> Self {
+    /// # Errors
+    /// [`FrameError::TooManyTriangles`] past [`MAX_FRAME_TRIANGLES`] in all, more than a draw can number.
+    pub fn new(parts: Vec<Indexed<'a>>) -> Result<Self, FrameError> {
         let mut starts = Vec::with_capacity(parts.len() + 1);
-        let mut n = 0u32;
+        let mut n = 0u64;
         starts.push(0);
         for p in &parts {
-            n = u32::try_from(p.triangles.len()).ok().and_then(|k| n.checked_add(k)).expect("under 2^32 triangles");
-            starts.push(n);
+            n += p.triangles.len() as u64;
+            match u32::try_from(n) {
+                Ok(end) if n <= MAX_FRAME_TRIANGLES => starts.push(end),
+                _ => {
+                    let triangles = parts.iter().map(|p| p.triangles.len() as u64).sum();
+                    return Err(FrameError::TooManyTriangles { triangles });
+                }
+            }
         }
-        Self { parts, starts }
+        Ok(Self { parts, starts })
     }
 
     /// The part a primitive id of this source is in, and its triangle there.

@@ -347,7 +347,7 @@ fn a_batch_draws_what_its_parts_draw_in_turn_and_flat_draws_what_the_general_loo
         general += draw(&mut a, &mut by_parts, &part(k), &st, |f| Some((k as u32, f.prim)), |d, s| *d = s);
     }
 
-    let batch = Batch::new((0..3).map(part).collect());
+    let batch = Batch::new((0..3).map(part).collect()).expect("three small parts");
     assert_eq!(batch.len(), 3 * triangles.len());
     assert_eq!(batch.part_of(triangles.len() as u32 + 5), (1, 5));
     let mut b = DepthStencil::new(101, 67, 1.0, 0);

@@ -11,6 +11,7 @@ pub mod silhouette_map;
 pub mod volume_reconstruction;
 
 use rayon::prelude::*;
+use shadow_core::frame::FrameError;
 use shadow_core::glam::{Vec2, Vec3, Vec4};
 use shadow_core::light::{LightProjection, LightView};
 use shadow_core::technique::settings::DepthBias;
@@ -42,7 +43,9 @@ pub fn check_maps(res: u32, count: usize) -> Result<(), CpuError> {
 
 /// Renders the depth of every casting instance from one light projection into a `res x res` map, in the
 /// storage of `reuse` when given (last frame's map: its pages are already mapped).
-#[must_use]
+///
+/// # Errors
+/// [`FrameError::TooManyTriangles`] for casters of more triangles than a draw can number.
 pub fn render_depth_map(
     frame: &FrameInputs,
     proj: &LightProjection,
@@ -50,7 +53,7 @@ pub fn render_depth_map(
     bias: DepthBias,
     cull: CullMode,
     reuse: Option<Image<f32>>,
-) -> (Image<f32>, RasterCounters) {
+) -> Result<(Image<f32>, RasterCounters), FrameError> {
     let n = res as usize * res as usize;
     let mut depth = reuse.map(Image::into_vec).unwrap_or_default();
     depth.clear();
@@ -59,8 +62,8 @@ pub fn render_depth_map(
     let state =
         RasterState { cull, depth: Some(DepthState { bias, ..DepthState::LESS_WRITE }), ..RasterState::default() };
     let (casters, clip) = casters_clipped(frame, proj);
-    let counters = draw_depth(&mut ds, &casters_batch(frame, &casters, &clip), &state);
-    (ds.into_depth_image(), counters)
+    let counters = draw_depth(&mut ds, &casters_batch(frame, &casters, &clip)?, &state);
+    Ok((ds.into_depth_image(), counters))
 }
 
 /// The shadow casters of `frame` (indices into its instances) and their vertices in the clip space of
@@ -78,7 +81,11 @@ fn casters_clipped(frame: &FrameInputs, proj: &LightProjection) -> (Vec<usize>, 
 }
 
 /// The casters of [`casters_clipped`] as one draw; its parts are in the order of `casters`.
-fn casters_batch<'a>(frame: &'a FrameInputs, casters: &[usize], clip: &'a [Vec<Vec4>]) -> Batch<'a> {
+fn casters_batch<'a>(
+    frame: &'a FrameInputs,
+    casters: &[usize],
+    clip: &'a [Vec<Vec4>],
+) -> Result<Batch<'a>, FrameError> {
     Batch::new(casters.iter().zip(clip).map(|(&k, clip)| Indexed::instance(&frame.instances[k], clip)).collect())
 }
 
@@ -86,7 +93,7 @@ fn casters_batch<'a>(frame: &'a FrameInputs, casters: &[usize], clip: &'a [Vec<V
 /// map it replaces in `maps`.
 ///
 /// # Errors
-/// [`CpuError::BadSize`] over the limits.
+/// [`CpuError::BadSize`] over the limits, [`FrameError::TooManyTriangles`] for casters a draw cannot number.
 pub fn render_depth_maps(
     frame: &FrameInputs,
     light: &LightView,
@@ -96,8 +103,11 @@ pub fn render_depth_maps(
 ) -> Result<(), CpuError> {
     check_maps(res, light.projections.len())?;
     let mut old = std::mem::take(maps).into_iter();
-    *maps =
-        light.projections.iter().map(|p| render_depth_map(frame, p, res, bias, CullMode::None, old.next()).0).collect();
+    *maps = light
+        .projections
+        .iter()
+        .map(|p| Ok(render_depth_map(frame, p, res, bias, CullMode::None, old.next())?.0))
+        .collect::<Result<_, CpuError>>()?;
     Ok(())
 }
 
@@ -106,7 +116,7 @@ pub fn render_depth_maps(
 /// channel, section 3.2; the GPU backend's light pass writes the same values).
 ///
 /// # Errors
-/// [`CpuError::BadSize`] over the limits.
+/// As [`render_depth_maps`].
 pub fn render_depth_and_id_maps(
     frame: &FrameInputs,
     light: &LightView,
@@ -123,7 +133,7 @@ pub fn render_depth_and_id_maps(
         let mut ds = DepthStencil::new(res, res, 1.0, 0);
         let mut id = Image::new(res, res, 0u32);
         let (casters, clip) = casters_clipped(frame, p);
-        let all = casters_batch(frame, &casters, &clip);
+        let all = casters_batch(frame, &casters, &clip)?;
         draw_flat(&mut ds, &mut id, &all, &state, |prim| casters[all.part_of(prim).0] as u32 + 1);
         maps.push(ds.into_depth_image());
         ids.push(id);
