@@ -81,14 +81,15 @@ pub fn hybrid_casters() -> String {
 }
 
 /// hybrid's caster masks: the silhouette pixels the mask pass lists (`y * width + x`), with the counters
-/// the compute pass adds to (the fragments its triangles make at them, its stencil updates and its
-/// pixel-triangle tests).
+/// the compute pass adds to (the fragments its triangles make at them, its stencil updates, its
+/// pixel-triangle tests and the pixels whose pairs did not fit, counted alone).
 const CASTER_LISTS: &str = "
 struct Listed {
     pixels: atomic<u32>,
     fragments: atomic<u32>,
     updates: atomic<u32>,
     tests: atomic<u32>,
+    alone: atomic<u32>,
     at: array<u32>,
 };
 

@@ -262,3 +262,56 @@ fn caster_masks_keep_the_picture_on_both_backends() {
     eprintln!("{}", rows.join("\n"));
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
+
+/// The GPU caster masks' room for pixel-piece pairs (`pair_room`) changes where a pixel is counted, never
+/// its count: with no room nearly every listed pixel counts its pieces alone (one invocation over all of
+/// them; those with none are not counted at all), with a little room fewer do, and the visibility and the counters are those of the default room,
+/// where none does. Without a wgpu adapter this prints one line and passes, unless SHADOWLAB_REQUIRE_GPU=1.
+#[test]
+fn the_pair_room_changes_where_a_pixel_is_counted_never_its_count() {
+    let mut renderer = Renderer::new(TechniqueRegistry::builtin());
+    if let Err(e) = renderer.resolve(shadowlab::BackendChoice::Wgpu) {
+        let require = std::env::var("SHADOWLAB_REQUIRE_GPU").is_ok_and(|v| v == "1");
+        assert!(!require, "SHADOWLAB_REQUIRE_GPU=1 but no wgpu adapter: {e}");
+        eprintln!("pair room skipped: no wgpu adapter ({e})");
+        return;
+    }
+    for name in ["cubes", "tree"] {
+        let s = scenes::build(name, &SceneParams::default()).expect("scene");
+        let frame = FrameInputs::from_scene(&s, s.cameras().next().expect("camera").0).expect("frame");
+        let mut run = |spec: &str| {
+            let spec = TechniqueSpec::parse(spec).expect("spec");
+            renderer.run(BackendKind::Wgpu, &frame, 256, 256, &spec).unwrap_or_else(|e| panic!("{name}: {e}"))
+        };
+        let whole = run("hybrid:res=512");
+        let extra =
+            |f: &shadowlab::renderer::RunOutput, key: &str| f.stats.counters.extra.get(key).copied().unwrap_or(-1.0);
+        let listed = extra(&whole, "listed_pixels");
+        assert!(listed > 0.0, "{name}: no listed pixel");
+        assert_eq!(extra(&whole, "listed_alone"), 0.0, "{name}: pixels counted alone with the default room");
+        // No room: every listed pixel with a piece at all (a few have none) is counted alone; a little
+        // room: fewer, but some.
+        let mut alone_without_room = listed;
+        for room in [0, 2000] {
+            let small = run(&format!("hybrid:res=512,pair_room={room}"));
+            let n = extra(&small, "listed_alone");
+            if room == 0 {
+                assert!(n > 0.0 && n <= listed, "{name}, no room: {n} of {listed} pixels counted alone");
+                alone_without_room = n;
+            } else {
+                assert!(n > 0.0 && n < alone_without_room, "{name}, room {room}: {n} pixels counted alone");
+            }
+            let differ = small.visibility[0].data().iter().zip(whole.visibility[0].data()).filter(|(a, b)| a != b);
+            assert_eq!(differ.count(), 0, "{name}, room {room}: the picture changed");
+            let (a, b) = (&small.stats.counters, &whole.stats.counters);
+            let tests = |f: &shadowlab::renderer::RunOutput| Some(extra(f, "listed_tests") as u64);
+            for (what, x, y) in [
+                ("volume_fragments", a.volume_fragments, b.volume_fragments),
+                ("stencil_updates", a.stencil_updates, b.stencil_updates),
+                ("listed_tests", tests(&small), tests(&whole)),
+            ] {
+                assert_eq!(x, y, "{name}, room {room}: {what} changed");
+            }
+        }
+    }
+}

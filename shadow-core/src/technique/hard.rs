@@ -696,7 +696,16 @@ pub struct Hybrid {
     /// the counter `unmasked_volume_fragments`, in a pass of its own timed as `count_fragments`; off, the
     /// frame costs what the technique costs.
     pub unmasked_fill: OnOff,
+    /// GPU caster masks: how many pairs of a silhouette pixel and a piece whose shaft holds it the compute
+    /// passes have room for; `None`, eight per pixel of the view. A pixel whose pairs do not all fit counts
+    /// every one of its pieces by itself, in one invocation (slower, same count), so a small room changes
+    /// the time, never the picture.
+    pub pair_room: Option<u32>,
 }
+
+/// The most pairs `hybrid`'s `pair_room` may ask for: 2^28, what a 4 GiB storage binding holds at three
+/// words a pair (the device's own limits may allow fewer, and then bound the room).
+pub const MAX_PAIR_ROOM: u32 = 1 << 28;
 
 crate::named_enum! {
     /// Which receivers `hybrid` masks in because of the silhouette edges near them (besides Chan's rule).
@@ -735,7 +744,7 @@ crate::named_enum! {
     }
 }
 
-const HYBRID_KEYS: [SettingKey; 12] = [
+const HYBRID_KEYS: [SettingKey; 13] = [
     SettingKey { key: "res", default: "512", help: "classifying map side in texels (16 to 16384)" },
     MAP_KEYS[1],
     MAP_KEYS[2],
@@ -776,6 +785,11 @@ const HYBRID_KEYS: [SettingKey; 12] = [
         default: "off",
         help: "on: also count the volumes' fill without the mask (unmasked_volume_fragments), in an extra pass",
     },
+    SettingKey {
+        key: "pair_room",
+        default: "auto",
+        help: "GPU caster masks: room for pixel-piece pairs, auto (8 per view pixel) or 0 to 268435456; a pixel whose pairs do not fit counts its pieces alone, more slowly",
+    },
 ];
 
 impl TechniqueSettings for Hybrid {
@@ -795,6 +809,13 @@ impl TechniqueSettings for Hybrid {
             },
             edge_texels: v.get("edge_texels")?,
             unmasked_fill: v.get("unmasked_fill")?,
+            pair_room: match v.text("pair_room") {
+                "auto" => None,
+                _ => Some(
+                    v.ranged("pair_room", 0, MAX_PAIR_ROOM)
+                        .map_err(|_| v.bad("pair_room", "auto, or 0 to 268435456"))?,
+                ),
+            },
         })
     }
     fn to_values(&self) -> Vec<String> {
@@ -807,6 +828,7 @@ impl TechniqueSettings for Hybrid {
             self.scissor_tile.to_string(),
             self.edge_texels.to_string(),
             self.unmasked_fill.to_string(),
+            self.pair_room.map_or_else(|| "auto".to_string(), |n| n.to_string()),
         ]);
         v
     }

@@ -375,6 +375,9 @@ fn cs_tally(
             }
         }
         atomicStore(&work[flags_start() + i], flag);
+        if (flag != 0u) {
+            atomicAdd(&listed.alone, 1u);
+        }
     }
 }
 

@@ -482,8 +482,10 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
                 let pieces = c.pieces.as_ref().ok_or_else(not_built)?;
                 let size = (g.width, g.height);
                 let listed = match c.listed.take() {
-                    Some(l) if l.size == size && l.capacity >= pieces.pieces => l,
-                    _ => cx.scoped("the hybrid listed pixels", |cx| ListedPixels::new(cx, size, pieces.pieces))?,
+                    Some(l) if l.size == size && l.capacity >= pieces.pieces && l.asked == self.pair_room => l,
+                    _ => cx.scoped("the hybrid listed pixels", |cx| {
+                        ListedPixels::new(cx, size, pieces.pieces, self.pair_room)
+                    })?,
                 };
                 Some((&c.passes, &c.answer, pieces, &*c.listed.insert(listed)))
             }
@@ -589,10 +591,11 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
         // What the compute passes covered and updated at the listed pixels.
         let [computed, computed_updates] = match casters {
             Some((_, _, pieces, l)) => {
-                let [pixels, fragments, updates, tests] = l.counters(cx)?;
+                let [pixels, fragments, updates, tests, alone] = l.counters(cx)?;
                 c.extra.insert("listed_pieces".into(), pieces.pieces as f64);
                 c.extra.insert("listed_pixels".into(), pixels as f64);
                 c.extra.insert("listed_tests".into(), tests as f64);
+                c.extra.insert("listed_alone".into(), alone as f64);
                 [fragments, updates]
             }
             None => [0, 0],

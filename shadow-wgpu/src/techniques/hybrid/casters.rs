@@ -23,7 +23,8 @@
 //! The work is the CPU's caster masks' (a listed pixel times its pieces' triangles, every fragment those
 //! would make counted), with the same shafts: `volume_fragments` is what the compute passes cover plus
 //! what the stencil lets through of the rasterized pieces; `listed_tests` counts the pixel-triangle pairs
-//! tested.
+//! tested, and `listed_alone` the listed pixels whose pairs did not fit in the room for them (the
+//! setting `pair_room`), each counted by one invocation over all its pieces.
 
 use std::ops::Range;
 
@@ -61,8 +62,8 @@ const GROUP: u32 = 64;
 /// The most workgroups along one dimension of a dispatch.
 const MAX_GROUPS: u32 = 65_535;
 
-/// Bytes of the listed pixels' header (`Listed` in shaders.rs: four counters).
-const HEADER: u64 = 16;
+/// Bytes of the listed pixels' header (`Listed` in shaders.rs: five counters).
+const HEADER: u64 = 20;
 
 /// Listed pixels per invocation of the passes over them, were every pixel of the view listed: their
 /// dispatches are sized by the view (the list's length is known only on the GPU), each invocation taking
@@ -321,18 +322,22 @@ pub(super) struct ListedPixels {
     /// made for, rounded up to a power of two, so builds under a moving light reuse it).
     pub(super) size: (u32, u32),
     pub(super) capacity: usize,
+    /// The room for pairs asked for (`Hybrid::pair_room`).
+    pub(super) asked: Option<u32>,
 }
 
 /// Words of the work buffer per piece (hybrid_casters.wgsl's `PIECE`): its pixels, first pair and
 /// cursor, and the screen bounds of its near and of its far caps.
 const PIECE: u64 = 11;
 
-/// Pairs of a listed pixel and a piece the work buffer has room for, per pixel of the view: tree has
-/// about 4 per silhouette pixel. A pixel whose pairs do not fit is counted by itself, more slowly.
+/// Pairs of a listed pixel and a piece the work buffer has room for by default, per pixel of the view:
+/// tree has about 4 per silhouette pixel. A pixel whose pairs do not fit is counted by itself, more slowly.
 const PAIRS_PER_PIXEL: u64 = 8;
 
 impl ListedPixels {
-    pub(super) fn new(cx: &WgpuContext, (width, height): (u32, u32), pieces: usize) -> Self {
+    /// Buffers for a view of `width x height`, `pieces` pieces and room for `asked` pairs (by default
+    /// [`PAIRS_PER_PIXEL`] per pixel), within the device's limits.
+    pub(super) fn new(cx: &WgpuContext, (width, height): (u32, u32), pieces: usize, asked: Option<u32>) -> Self {
         use wgpu::BufferUsages as U;
         let pixels = u64::from(width) * u64::from(height);
         let buffer = |label, size, usage| {
@@ -351,14 +356,15 @@ impl ListedPixels {
             limits.max_storage_buffer_binding_size.min(limits.max_buffer_size) / 4
         };
         // Each pair's room is three words: its place in a run and, staged, its pixel and piece.
-        let pairs = (PAIRS_PER_PIXEL * pixels).min(largest.saturating_sub(fixed) / 3).max(1);
+        let pairs = asked.map_or(PAIRS_PER_PIXEL * pixels, u64::from).min(largest.saturating_sub(fixed) / 3);
         Self {
             listed: buffer("hybrid listed pixels", HEADER + 4 * pixels, U::STORAGE | U::COPY_SRC | U::COPY_DST),
             counts: buffer("hybrid listed counts", 4 * pixels.max(1), U::STORAGE),
             work: buffer("hybrid caster work", 4 * (fixed + 3 * pairs), U::STORAGE | U::COPY_DST),
-            staging: buffer("hybrid listed readback", 16, U::COPY_DST | U::MAP_READ),
+            staging: buffer("hybrid listed readback", HEADER, U::COPY_DST | U::MAP_READ),
             size: (width, height),
             capacity,
+            asked,
         }
     }
 
@@ -368,14 +374,14 @@ impl ListedPixels {
     }
 
     /// Reads back the pixels listed, the fragments the compute pass's triangles made at them, its stencil
-    /// updates and its pixel-triangle tests.
-    pub(super) fn counters(&self, cx: &WgpuContext) -> Result<[u64; 4], WgpuError> {
+    /// updates, its pixel-triangle tests and the pixels counted alone.
+    pub(super) fn counters(&self, cx: &WgpuContext) -> Result<[u64; 5], WgpuError> {
         let mut enc = cx.device.create_command_encoder(&Default::default());
-        enc.copy_buffer_to_buffer(&self.listed, 0, &self.staging, 0, 16);
+        enc.copy_buffer_to_buffer(&self.listed, 0, &self.staging, 0, HEADER);
         cx.queue.submit([enc.finish()]);
         let d = readback::map_read(cx, &self.staging, "reading the hybrid caster counters")?;
         let word = |i: usize| u64::from(u32::from_le_bytes([d[4 * i], d[4 * i + 1], d[4 * i + 2], d[4 * i + 3]]));
-        Ok([word(0), word(1), word(2), word(3)])
+        Ok([word(0), word(1), word(2), word(3), word(4)])
     }
 }
 
