@@ -68,6 +68,18 @@ struct PieceShaft {
 // row (z . adj(M)) with the cap flag in w, and the world plane through the triangle, turned so the eye
 // lies on its positive side.
 @group(1) @binding(13) var<storage, read_write> setups: array<vec4<f32>>;
+// The same, copied into a texture (SETUP_ROW texels a row) after cs_setup, for the passes that read them.
+// On lavapipe (Mesa 22.3.6, which loads from a storage buffer lane by lane) two more texel fetches per
+// triangle test added 15 ms to tree's cs_pieces where two more storage loads added 65, and reading the
+// setups from the texture took that pass from 118-142 ms to 47.
+@group(1) @binding(17) var setup_texels: texture_2d<f32>;
+
+// Setup vec4 `i` from the texture, SETUP_ROW a row.
+fn setup_at(i: u32) -> vec4<f32> {
+    return textureLoad(setup_texels, vec2<u32>(i % SETUP_ROW, i / SETUP_ROW), 0);
+}
+
+const SETUP_ROW: u32 = 4096u;
 // Per piece, per projection.
 @group(1) @binding(14) var<storage, read> shafts: array<PieceShaft>;
 // Per cell of every projection's grid, where its pieces start (and one more), then the piece lists.
@@ -196,7 +208,7 @@ struct Tally {
 fn add_triangles(first: u32, end: u32, p: vec3<f32>, receiver: vec4<f32>, tally: ptr<function, Tally>) {
     (*tally).tests += end - first;
     for (var t = first; t < end; t++) {
-        let r0 = setups[SETUP * t];
+        let r0 = setup_at(SETUP * t);
         let det = r0.w;
         // Each edge read and tested in turn: most triangles fail the first or second.
         let o = select(-1.0, 1.0, det > 0.0);
@@ -204,20 +216,20 @@ fn add_triangles(first: u32, end: u32, p: vec3<f32>, receiver: vec4<f32>, tally:
         if (det == 0.0 || !inside(dot(e0, p), e0)) {
             continue;
         }
-        let e1 = setups[SETUP * t + 1u].xyz * o;
+        let e1 = setup_at(SETUP * t + 1u).xyz * o;
         if (!inside(dot(e1, p), e1)) {
             continue;
         }
-        let e2 = setups[SETUP * t + 2u].xyz * o;
+        let e2 = setup_at(SETUP * t + 2u).xyz * o;
         if (!inside(dot(e2, p), e2)) {
             continue;
         }
-        let zr = setups[SETUP * t + 3u];
+        let zr = setup_at(SETUP * t + 3u);
         if (dot(zr.xyz, p) * o < 0.0) {
             continue;
         }
         (*tally).fragments += 1u;
-        if (zr.w != 0.0 || dot(setups[SETUP * t + 4u], receiver) >= 0.0) {
+        if (zr.w != 0.0 || dot(setup_at(SETUP * t + 4u), receiver) >= 0.0) {
             (*tally).count += select(1, -1, det > 0.0);
             (*tally).updates += 1u;
         }

@@ -58,7 +58,7 @@ mod casters;
 mod edges;
 mod tiles;
 
-use casters::{CasterPasses, CasterPieces, LISTED_TRIANGLES, ListedPixels, Split};
+use casters::{CasterPasses, CasterPieces, LISTED_TRIANGLES, ListedPixels, Split, setup_room};
 use edges::{edge_cell_maps, edge_maps, edge_pass};
 use tiles::TileMarks;
 
@@ -409,10 +409,11 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
         }
         cx.step("edges");
         if let Some(casters) = &mut state.casters {
-            // The small pieces go to the compute passes, the rest to the rasterizer.
+            // The small pieces go to the compute passes (as many as the device lets them set up), the rest
+            // to the rasterizer.
             InstanceVolume::count(&volumes, &mut stats.counters);
             let shafts = CasterShafts::new(frame, light, &volumes);
-            let split = Split::new(frame, &volumes, &shafts, LISTED_TRIANGLES);
+            let split = Split::new(frame, &volumes, &shafts, LISTED_TRIANGLES, setup_room(cx));
             casters.pieces = Some(CasterPasses::upload(cx, frame, light, &split, &shafts));
             state.draws = Some(upload_volumes(cx, frame, &split.raster)?);
             casters.all_draws = self.unmasked_fill.is_on().then(|| upload_volumes(cx, frame, &volumes)).transpose()?;

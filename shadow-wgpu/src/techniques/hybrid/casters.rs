@@ -11,7 +11,8 @@
 //!   per light projection lists the pieces whose shafts, widened by the largest tolerance a pixel there can
 //!   have, meet each cell. Larger pieces (a single big mesh) stay rasterized through the stencil mask.
 //! - **Query**: the mask pass lists its silhouette pixels, and the compute passes (hybrid_casters.wgsl)
-//!   set each triangle up for the view (its rows of adj(M): homogeneous rasterization) and gather each
+//!   set each triangle up for the view (its rows of adj(M): homogeneous rasterization; copied into a
+//!   texture, which later passes fetch from faster than from a storage buffer on lavapipe) and gather each
 //!   piece's caps' screen bounds; pair each listed pixel with the pieces of its light-space cell whose
 //!   shafts hold it (each pair staged and counted as it is found, then given runs by a prefix sum and
 //!   moved into them, so the shaft grid is searched once a pixel); count each piece at its pixels, a
@@ -55,6 +56,15 @@ const PROJECTIONS: usize = 6;
 
 /// vec4 per triangle set up for the view (hybrid_casters.wgsl's `SETUP`).
 const SETUP: u64 = 5;
+
+/// Texels per row of the setup texture (hybrid_casters.wgsl's `SETUP_ROW`).
+const SETUP_ROW: u32 = 4096;
+
+/// The most triangles the compute passes can set up on `cx`'s device: as many as fill the tallest setup
+/// texture it allows.
+pub(super) fn setup_room(cx: &WgpuContext) -> usize {
+    cx.device.limits().max_texture_dimension_2d as usize * SETUP_ROW as usize / SETUP as usize
+}
 
 /// Invocations per workgroup of the compute passes (hybrid_casters.wgsl's `GROUP`).
 const GROUP: u32 = 64;
@@ -119,8 +129,15 @@ pub(super) struct Split {
 
 impl Split {
     /// Splits `volumes` (whose pieces `shafts` lists in order) into the pieces of at most `limit` volume
-    /// triangles, written out for the compute passes, and the rest.
-    pub(super) fn new(frame: &FrameInputs, volumes: &[InstanceVolume], shafts: &CasterShafts, limit: usize) -> Self {
+    /// triangles, written out for the compute passes while their triangles number at most `room` in all,
+    /// and the rest.
+    pub(super) fn new(
+        frame: &FrameInputs,
+        volumes: &[InstanceVolume],
+        shafts: &CasterShafts,
+        limit: usize,
+        room: usize,
+    ) -> Self {
         let mut split = Self { triangles: Vec::new(), pieces: Vec::new(), raster: Vec::new() };
         let mut k = 0;
         for iv in volumes {
@@ -140,7 +157,8 @@ impl Split {
                     &vol.caps_forward[r(&piece.caps_forward)],
                     &vol.caps_reversed[r(&piece.caps_reversed)],
                 );
-                if sides.len() + 2 * (forward.len() + reversed.len()) > limit {
+                let n = sides.len() + 2 * (forward.len() + reversed.len());
+                if n > limit || split.triangle_count() as usize + n > room {
                     rest.sides.extend_from_slice(sides);
                     rest.caps_forward.extend_from_slice(forward);
                     rest.caps_reversed.extend_from_slice(reversed);
@@ -299,6 +317,7 @@ pub(super) struct CasterPieces {
     params: wgpu::Buffer,
     triangles: wgpu::Buffer,
     setups: wgpu::Buffer,
+    setup_texels: wgpu::Texture,
     shafts: wgpu::Buffer,
     grid: wgpu::Buffer,
     triangle_count: u32,
@@ -413,6 +432,14 @@ impl CasterPasses {
                 storage(14, true),
                 storage(15, true),
                 storage(16, false),
+                compute_entry(
+                    17,
+                    wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                ),
             ],
         });
         let module = shaders::module(&cx.device, "hybrid casters", shaders::hybrid_casters());
@@ -508,14 +535,25 @@ impl CasterPasses {
             v.resize(v.len().max(std::mem::size_of::<PieceShaft>()), 0);
             v
         };
+        let setup_rows = (u64::from(split.triangle_count()) * SETUP).div_ceil(u64::from(SETUP_ROW)).max(1) as u32;
         CasterPieces {
             params: init("hybrid caster params", bytemuck::bytes_of(&params), U::UNIFORM),
             triangles: init("hybrid caster triangles", &nonempty(bytemuck::cast_slice(&split.triangles)), U::STORAGE),
             setups: cx.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("hybrid caster setups"),
-                size: (u64::from(split.triangle_count()).max(1) * SETUP * 16),
-                usage: U::STORAGE,
+                size: u64::from(setup_rows) * u64::from(SETUP_ROW) * 16,
+                usage: U::STORAGE | U::COPY_SRC,
                 mapped_at_creation: false,
+            }),
+            setup_texels: cx.device.create_texture(&wgpu::TextureDescriptor {
+                label: Some("hybrid caster setup texels"),
+                size: wgpu::Extent3d { width: SETUP_ROW, height: setup_rows, depth_or_array_layers: 1 },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: wgpu::TextureFormat::Rgba32Float,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+                view_formats: &[],
             }),
             shafts: init("hybrid caster shafts", &nonempty(bytemuck::cast_slice(&records)), U::STORAGE),
             grid: init("hybrid caster grid", &nonempty(bytemuck::cast_slice(&grid)), U::STORAGE),
@@ -537,6 +575,7 @@ impl CasterPasses {
         fn buffer(binding: u32, b: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
             wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() }
         }
+        let texels = pieces.setup_texels.create_view(&Default::default());
         let group = cx.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("hybrid casters"),
             layout: &self.layout,
@@ -550,21 +589,43 @@ impl CasterPasses {
                 buffer(14, &pieces.shafts),
                 buffer(15, &pieces.grid),
                 buffer(16, &listed.work),
+                wgpu::BindGroupEntry { binding: 17, resource: wgpu::BindingResource::TextureView(&texels) },
             ],
         });
         // The pieces' words and the staged pairs' count.
         enc.clear_buffer(&listed.work, 0, Some(4 * (PIECE * pieces.pieces as u64 + 1)));
-        let mut pass = enc
-            .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("hybrid casters"), timestamp_writes: None });
-        pass.set_bind_group(0, &g.frame_group, &[]);
-        pass.set_bind_group(1, &group, &[]);
+        let begin = |enc: &mut wgpu::CommandEncoder| {
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("hybrid casters"),
+                timestamp_writes: None,
+            });
+            pass.set_bind_group(0, &g.frame_group, &[]);
+            pass.set_bind_group(1, &group, &[]);
+            pass.forget_lifetime()
+        };
         let spread = |pass: &mut wgpu::ComputePass<'_>, pipeline, groups: u32| {
             pass.set_pipeline(pipeline);
             pass.dispatch_workgroups(groups.clamp(1, MAX_GROUPS), groups.div_ceil(MAX_GROUPS).max(1), 1);
         };
         if pieces.triangle_count > 0 {
+            let mut pass = begin(enc);
             spread(&mut pass, &self.setup, pieces.triangle_count.div_ceil(GROUP));
+            drop(pass);
+            let size = pieces.setup_texels.size();
+            enc.copy_buffer_to_texture(
+                wgpu::TexelCopyBufferInfo {
+                    buffer: &pieces.setups,
+                    layout: wgpu::TexelCopyBufferLayout {
+                        offset: 0,
+                        bytes_per_row: Some(SETUP_ROW * 16),
+                        rows_per_image: None,
+                    },
+                },
+                pieces.setup_texels.as_image_copy(),
+                size,
+            );
         }
+        let mut pass = begin(enc);
         // The passes over the listed pixels, whose number only the GPU knows, are sized by the view.
         let (w, h) = listed.size;
         let over_pixels = (w * h).div_ceil(GROUP * PIXELS_PER_INVOCATION);
@@ -604,7 +665,7 @@ mod tests {
         let volumes = frame.shadow_volumes(&light, Caps::Both);
         let shafts = CasterShafts::new(&frame, &light, &volumes);
         let limit = 256;
-        let split = Split::new(&frame, &volumes, &shafts, limit);
+        let split = Split::new(&frame, &volumes, &shafts, limit, usize::MAX);
         let sizes: Vec<usize> = volumes
             .iter()
             .flat_map(|iv| {
@@ -615,7 +676,14 @@ mod tests {
         assert!(!small.is_empty() && !large.is_empty(), "primitives has pieces on both sides of {limit}: {sizes:?}");
         assert_eq!(split.pieces.len(), small.len());
         assert_eq!(split.triangle_count() as usize, small.iter().sum::<usize>());
-        assert_eq!(split.raster.iter().map(|v| v.volume.triangle_count()).sum::<usize>(), large.iter().sum::<usize>());
+        let rasterized = |s: &Split| s.raster.iter().map(|v| v.volume.triangle_count()).sum::<usize>();
+        assert_eq!(rasterized(&split), large.iter().sum::<usize>());
+        // With room for half the small pieces' triangles, those that do not fit are rasterized too.
+        let room = small.iter().sum::<usize>() / 2;
+        let half = Split::new(&frame, &volumes, &shafts, limit, room);
+        assert!(half.triangle_count() as usize <= room, "{} triangles in a room of {room}", half.triangle_count());
+        assert!(!half.pieces.is_empty() && half.pieces.len() < small.len(), "{} pieces", half.pieces.len());
+        assert_eq!(half.triangle_count() as usize + rasterized(&half), sizes.iter().sum::<usize>());
         // Each piece written out is closed and wound alike: every directed edge between two corners comes
         // with its reverse (far caps turned around, mirrored instances turned back).
         let key = |v: Vec4| v.to_array().map(f32::to_bits);
