@@ -33,29 +33,22 @@ struct CasterParams {
     view_from_world: array<mat4x4<f32>, 6>,
     // Per projection: the grid's origin (xy) and cells per light-space unit (zw).
     grid: array<vec4<f32>, 6>,
-    // Per projection: x the grid's side in cells, y its first cell in `grid_cells`, z 1 if orthographic.
+    // Per projection: x the grid's side in cells, y its first cell in `grid_texels`, z 1 if orthographic.
     cells: array<vec4<u32>, 6>,
     // x: 1 for a point light (cube faces), y: projections, z: pieces, w: triangles.
     counts: vec4<u32>,
     // xyz: the light's position (point lights); w: the camera's near plane.
     light: vec4<f32>,
-    // x: where the piece lists start in `grid_cells`.
+    // x: where the piece lists start in `grid_texels`.
     lists: vec4<u32>,
 };
 
-// A piece's shaft in one projection and its run of triangles: `sides` sides, then `caps` near caps and
-// as many far caps.
-struct PieceShaft {
-    lo: vec4<f32>,
-    hi: vec4<f32>,
-    near: f32,
-    // 0 where the piece reaches the light's plane: it may shadow any pixel of the projection.
-    bounded: u32,
+// A piece's run of triangles: from `first`, `sides` sides, then `caps` near caps and as many far caps.
+struct PieceRun {
     first: u32,
-    count: u32,
     sides: u32,
     caps: u32,
-    unused: vec2<u32>,
+    unused: u32,
 };
 
 @group(1) @binding(9) var<storage, read_write> counts: array<atomic<i32>>;
@@ -74,16 +67,29 @@ struct PieceShaft {
 // setups from the texture took that pass from 118-142 ms to 47.
 @group(1) @binding(17) var setup_texels: texture_2d<f32>;
 
-// Setup vec4 `i` from the texture, SETUP_ROW a row.
-fn setup_at(i: u32) -> vec4<f32> {
-    return textureLoad(setup_texels, vec2<u32>(i % SETUP_ROW, i / SETUP_ROW), 0);
+// Per piece, per projection, the shaft as `holds` reads it, in three texels: its least and greatest
+// outline (lo, hi), then x its near distance and y 1 where it is bounded (0: the piece reaches the
+// light's plane and may shadow any pixel of the projection).
+@group(1) @binding(18) var shaft_texels: texture_2d<f32>;
+// Per cell of every projection's grid, where its pieces start (and one more), then the piece lists.
+@group(1) @binding(15) var grid_texels: texture_2d<u32>;
+
+// Where element `i` of a table laid out in a texture, TABLE_ROW texels a row, is.
+fn table_at(i: u32) -> vec2<u32> {
+    return vec2<u32>(i % TABLE_ROW, i / TABLE_ROW);
 }
 
-const SETUP_ROW: u32 = 4096u;
-// Per piece, per projection.
-@group(1) @binding(14) var<storage, read> shafts: array<PieceShaft>;
-// Per cell of every projection's grid, where its pieces start (and one more), then the piece lists.
-@group(1) @binding(15) var<storage, read> grid_cells: array<u32>;
+const TABLE_ROW: u32 = 4096u;
+
+fn setup_at(i: u32) -> vec4<f32> {
+    return textureLoad(setup_texels, table_at(i), 0);
+}
+
+fn grid_at(i: u32) -> u32 {
+    return textureLoad(grid_texels, table_at(i), 0).x;
+}
+// Per piece.
+@group(1) @binding(14) var<storage, read> runs: array<PieceRun>;
 
 const GROUP: u32 = 64u;
 const SETUP: u32 = 5u;
@@ -240,7 +246,7 @@ fn add_triangles(first: u32, end: u32, p: vec3<f32>, receiver: vec4<f32>, tally:
 // far caps where their bounds on screen hold the pixel (a twig's caps are a few pixels across, its sides
 // reach its shadow).
 fn add_piece(k: u32, p: vec3<f32>, receiver: vec4<f32>, tally: ptr<function, Tally>) {
-    let s = shafts[k * casters.counts.y];
+    let s = runs[k];
     let near = s.first + s.sides;
     let far = near + s.caps;
     add_triangles(s.first, near, p, receiver, tally);
@@ -257,10 +263,11 @@ fn tolerance(r: f32, near: f32) -> f32 {
     return r * (1.0 / 4096.0) + r * r / near * (1.0 / 262144.0);
 }
 
-// Twin: shadow_core::shafts::Shaft::holds, for a point with outline `o`, distance `d` and tolerances.
-fn holds(s: PieceShaft, o: vec4<f32>, d: f32, side: f32, along: f32) -> bool {
+// Twin: shadow_core::shafts::Shaft::holds, for the shaft lo, hi, near and a point with outline `o`,
+// distance `d` and tolerances.
+fn holds(lo: vec4<f32>, hi: vec4<f32>, near: f32, o: vec4<f32>, d: f32, side: f32, along: f32) -> bool {
     let tol = vec4<f32>(side, side, 2.0 * side, 2.0 * side);
-    return d >= s.near - along && all(o >= s.lo - tol) && all(o <= s.hi + tol);
+    return d >= near - along && all(o >= lo - tol) && all(o <= hi + tol);
 }
 
 // Where a listed pixel's candidate pieces are: the pieces of its light-space cell (entries `first` to
@@ -310,7 +317,7 @@ fn candidates(pos: vec3<f32>) -> Candidates {
     let cell = clamp(vec2<i32>(floor((xy - g.xy) * g.zw)), vec2<i32>(0), vec2<i32>(n - 1));
     let c = casters.cells[j].y + u32(cell.y * n + cell.x);
     let o = vec4<f32>(xy, xy.x + xy.y, xy.x - xy.y);
-    return Candidates(grid_cells[c], grid_cells[c + 1u], false, j, o, d, side, tol);
+    return Candidates(grid_at(c), grid_at(c + 1u), false, j, o, d, side, tol);
 }
 
 // Entry `e` of a pixel's candidates: the piece, or NONE where its shaft does not hold the pixel.
@@ -318,9 +325,15 @@ fn candidate(c: Candidates, e: u32) -> u32 {
     if (c.all) {
         return e;
     }
-    let k = grid_cells[casters.lists.x + e];
-    let s = shafts[k * casters.counts.y + c.projection];
-    if (s.bounded == 0u || holds(s, c.o, c.d, c.side, c.along)) {
+    let k = grid_at(casters.lists.x + e);
+    let at = 3u * (k * casters.counts.y + c.projection);
+    let near = textureLoad(shaft_texels, table_at(at + 2u), 0).xy;
+    if (near.y == 0.0) {
+        return k;
+    }
+    let lo = textureLoad(shaft_texels, table_at(at), 0);
+    let hi = textureLoad(shaft_texels, table_at(at + 1u), 0);
+    if (holds(lo, hi, near.x, c.o, c.d, c.side, c.along)) {
         return k;
     }
     return NONE;

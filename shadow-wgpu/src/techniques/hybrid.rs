@@ -414,7 +414,7 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
             InstanceVolume::count(&volumes, &mut stats.counters);
             let shafts = CasterShafts::new(frame, light, &volumes);
             let split = Split::new(frame, &volumes, &shafts, LISTED_TRIANGLES, setup_room(cx));
-            casters.pieces = Some(CasterPasses::upload(cx, frame, light, &split, &shafts));
+            casters.pieces = Some(CasterPasses::upload(cx, frame, light, &split, &shafts)?);
             state.draws = Some(upload_volumes(cx, frame, &split.raster)?);
             casters.all_draws = self.unmasked_fill.is_on().then(|| upload_volumes(cx, frame, &volumes)).transpose()?;
         } else {

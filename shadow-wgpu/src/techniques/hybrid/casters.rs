@@ -12,7 +12,8 @@
 //!   have, meet each cell. Larger pieces (a single big mesh) stay rasterized through the stencil mask.
 //! - **Query**: the mask pass lists its silhouette pixels, and the compute passes (hybrid_casters.wgsl)
 //!   set each triangle up for the view (its rows of adj(M): homogeneous rasterization; copied into a
-//!   texture, which later passes fetch from faster than from a storage buffer on lavapipe) and gather each
+//!   texture, as the shafts and the grid are uploaded into textures: on lavapipe a texel fetch is several
+//!   times faster than a load from a storage buffer, which Mesa 22.3 makes lane by lane) and gather each
 //!   piece's caps' screen bounds; pair each listed pixel with the pieces of its light-space cell whose
 //!   shafts hold it (each pair staged and counted as it is found, then given runs by a prefix sum and
 //!   moved into them, so the shaft grid is searched once a pixel); count each piece at its pixels, a
@@ -57,13 +58,62 @@ const PROJECTIONS: usize = 6;
 /// vec4 per triangle set up for the view (hybrid_casters.wgsl's `SETUP`).
 const SETUP: u64 = 5;
 
-/// Texels per row of the setup texture (hybrid_casters.wgsl's `SETUP_ROW`).
-const SETUP_ROW: u32 = 4096;
+/// Texels per row of the tables the compute passes read from textures (hybrid_casters.wgsl's
+/// `TABLE_ROW`).
+const TABLE_ROW: u32 = 4096;
 
 /// The most triangles the compute passes can set up on `cx`'s device: as many as fill the tallest setup
 /// texture it allows.
 pub(super) fn setup_room(cx: &WgpuContext) -> usize {
-    cx.device.limits().max_texture_dimension_2d as usize * SETUP_ROW as usize / SETUP as usize
+    cx.device.limits().max_texture_dimension_2d as usize * TABLE_ROW as usize / SETUP as usize
+}
+
+/// Rows of a table of `n` elements (at least one).
+fn table_rows(n: u64) -> u32 {
+    n.div_ceil(u64::from(TABLE_ROW)).clamp(1, u64::from(u32::MAX)) as u32
+}
+
+/// A table of `rows` rows of [`TABLE_ROW`] texels as a texture, with `data` (padded to whole rows), or to
+/// be copied into.
+///
+/// # Errors
+/// [`WgpuError::BadSize`] for more rows than the device allows.
+fn table(
+    cx: &WgpuContext,
+    label: &'static str,
+    format: wgpu::TextureFormat,
+    rows: u32,
+    data: Option<&[u8]>,
+) -> Result<wgpu::Texture, WgpuError> {
+    let most = cx.device.limits().max_texture_dimension_2d;
+    if rows > most {
+        return Err(WgpuError::BadSize {
+            what: label,
+            width: u64::from(TABLE_ROW),
+            height: u64::from(rows),
+            why: format!("more rows than the device's {most}"),
+        });
+    }
+    let size = wgpu::Extent3d { width: TABLE_ROW, height: rows, depth_or_array_layers: 1 };
+    let desc = wgpu::TextureDescriptor {
+        label: Some(label),
+        size,
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    };
+    Ok(match data {
+        Some(bytes) => {
+            let mut padded = bytes.to_vec();
+            // Both formats used have 32-bit components.
+            padded.resize((u64::from(rows) * u64::from(TABLE_ROW) * 4 * format.components() as u64) as usize, 0);
+            cx.device.create_texture_with_data(&cx.queue, &desc, wgpu::util::TextureDataOrder::LayerMajor, &padded)
+        }
+        None => cx.device.create_texture(&desc),
+    })
 }
 
 /// Invocations per workgroup of the compute passes (hybrid_casters.wgsl's `GROUP`).
@@ -92,19 +142,14 @@ struct Params {
     lists: [u32; 4],
 }
 
-/// hybrid_casters.wgsl's `PieceShaft`.
+/// hybrid_casters.wgsl's `PieceRun`.
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
-struct PieceShaft {
-    lo: [f32; 4],
-    hi: [f32; 4],
-    near: f32,
-    bounded: u32,
+struct PieceRun {
     first: u32,
-    count: u32,
     sides: u32,
     caps: u32,
-    unused: [u32; 2],
+    unused: u32,
 }
 
 /// A piece counted by the compute passes.
@@ -318,8 +363,9 @@ pub(super) struct CasterPieces {
     triangles: wgpu::Buffer,
     setups: wgpu::Buffer,
     setup_texels: wgpu::Texture,
-    shafts: wgpu::Buffer,
-    grid: wgpu::Buffer,
+    runs: wgpu::Buffer,
+    shaft_texels: wgpu::Texture,
+    grid: wgpu::Texture,
     triangle_count: u32,
     /// Pieces counted by the compute passes.
     pub(super) pieces: usize,
@@ -415,31 +461,26 @@ fn storage(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
 
 impl CasterPasses {
     pub(super) fn new(cx: &WgpuContext) -> Self {
-        let position = wgpu::BindingType::Texture {
-            sample_type: wgpu::TextureSampleType::Float { filterable: false },
+        let texture = |sample_type| wgpu::BindingType::Texture {
+            sample_type,
             view_dimension: wgpu::TextureViewDimension::D2,
             multisampled: false,
         };
+        let floats = texture(wgpu::TextureSampleType::Float { filterable: false });
         let layout = cx.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("hybrid casters"),
             entries: &[
-                compute_entry(0, position),
+                compute_entry(0, floats),
                 storage(8, false),
                 storage(9, false),
                 buffer_entry(11, wgpu::BufferBindingType::Uniform, wgpu::ShaderStages::COMPUTE),
                 storage(12, true),
                 storage(13, false),
                 storage(14, true),
-                storage(15, true),
+                compute_entry(15, texture(wgpu::TextureSampleType::Uint)),
                 storage(16, false),
-                compute_entry(
-                    17,
-                    wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
-                    },
-                ),
+                compute_entry(17, floats),
+                compute_entry(18, floats),
             ],
         });
         let module = shaders::module(&cx.device, "hybrid casters", shaders::hybrid_casters());
@@ -476,7 +517,7 @@ impl CasterPasses {
         light: &LightView,
         split: &Split,
         shafts: &CasterShafts,
-    ) -> CasterPieces {
+    ) -> Result<CasterPieces, WgpuError> {
         let projections = light.projections.len().min(PROJECTIONS);
         let piece_shafts: Vec<&[Option<Shaft>]> =
             split.pieces.iter().map(|p| shafts.shafts[p.shaft].as_slice()).collect();
@@ -503,25 +544,22 @@ impl CasterPasses {
             [u32::from(point.is_some()), projections as u32, split.pieces.len() as u32, split.triangle_count()];
         params.light = point.unwrap_or_default().extend(frame.camera.near).to_array();
         params.lists = [first_cell + 1, 0, 0, 0];
-        let records: Vec<PieceShaft> = split
+        let runs: Vec<PieceRun> = split
+            .pieces
+            .iter()
+            .map(|piece| {
+                let (run, sides) = (&piece.triangles, piece.sides);
+                PieceRun { first: run.start, sides, caps: (run.end - run.start - sides) / 2, unused: 0 }
+            })
+            .collect();
+        // Per piece, per projection: lo, hi, (near, 1 where bounded).
+        let shaft_texels: Vec<[f32; 4]> = split
             .pieces
             .iter()
             .flat_map(|piece| {
-                let (run, sides) = (&piece.triangles, piece.sides);
-                shafts.shafts[piece.shaft][..projections].iter().map(move |s| {
-                    let bounded = s.is_some();
-                    let s = s.unwrap_or(Shaft { lo: Vec4::ZERO, hi: Vec4::ZERO, near: 0.0 });
-                    PieceShaft {
-                        lo: s.lo.to_array(),
-                        hi: s.hi.to_array(),
-                        near: s.near,
-                        bounded: u32::from(bounded),
-                        first: run.start,
-                        count: run.end - run.start,
-                        sides,
-                        caps: (run.end - run.start - sides) / 2,
-                        unused: [0; 2],
-                    }
+                shafts.shafts[piece.shaft][..projections].iter().flat_map(|s| match s {
+                    Some(s) => [s.lo.to_array(), s.hi.to_array(), [s.near, 1.0, 0.0, 0.0]],
+                    None => [[0.0; 4]; 3],
                 })
             })
             .collect();
@@ -532,34 +570,38 @@ impl CasterPasses {
         // A build with no small piece still binds its buffers: at least one element each.
         let nonempty = |bytes: &[u8]| {
             let mut v = bytes.to_vec();
-            v.resize(v.len().max(std::mem::size_of::<PieceShaft>()), 0);
+            v.resize(v.len().max(std::mem::size_of::<PieceRun>()), 0);
             v
         };
-        let setup_rows = (u64::from(split.triangle_count()) * SETUP).div_ceil(u64::from(SETUP_ROW)).max(1) as u32;
-        CasterPieces {
+        let setup_rows = table_rows(u64::from(split.triangle_count()) * SETUP);
+        Ok(CasterPieces {
             params: init("hybrid caster params", bytemuck::bytes_of(&params), U::UNIFORM),
             triangles: init("hybrid caster triangles", &nonempty(bytemuck::cast_slice(&split.triangles)), U::STORAGE),
             setups: cx.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("hybrid caster setups"),
-                size: u64::from(setup_rows) * u64::from(SETUP_ROW) * 16,
+                size: u64::from(setup_rows) * u64::from(TABLE_ROW) * 16,
                 usage: U::STORAGE | U::COPY_SRC,
                 mapped_at_creation: false,
             }),
-            setup_texels: cx.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some("hybrid caster setup texels"),
-                size: wgpu::Extent3d { width: SETUP_ROW, height: setup_rows, depth_or_array_layers: 1 },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: wgpu::TextureFormat::Rgba32Float,
-                usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-                view_formats: &[],
-            }),
-            shafts: init("hybrid caster shafts", &nonempty(bytemuck::cast_slice(&records)), U::STORAGE),
-            grid: init("hybrid caster grid", &nonempty(bytemuck::cast_slice(&grid)), U::STORAGE),
+            setup_texels: table(cx, "hybrid caster setup texels", wgpu::TextureFormat::Rgba32Float, setup_rows, None)?,
+            runs: init("hybrid caster runs", &nonempty(bytemuck::cast_slice(&runs)), U::STORAGE),
+            shaft_texels: table(
+                cx,
+                "hybrid caster shafts",
+                wgpu::TextureFormat::Rgba32Float,
+                table_rows(shaft_texels.len() as u64),
+                Some(bytemuck::cast_slice(&shaft_texels)),
+            )?,
+            grid: table(
+                cx,
+                "hybrid caster grid",
+                wgpu::TextureFormat::R32Uint,
+                table_rows(grid.len() as u64),
+                Some(bytemuck::cast_slice(&grid)),
+            )?,
             triangle_count: split.triangle_count(),
             pieces: split.pieces.len(),
-        }
+        })
     }
 
     /// Records the compute passes (hybrid_casters.wgsl): set up the triangles for `g`'s view, pair each
@@ -575,21 +617,27 @@ impl CasterPasses {
         fn buffer(binding: u32, b: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
             wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() }
         }
-        let texels = pieces.setup_texels.create_view(&Default::default());
+        let (setups, shafts, grid) = (
+            pieces.setup_texels.create_view(&Default::default()),
+            pieces.shaft_texels.create_view(&Default::default()),
+            pieces.grid.create_view(&Default::default()),
+        );
+        let view = |binding, v| wgpu::BindGroupEntry { binding, resource: wgpu::BindingResource::TextureView(v) };
         let group = cx.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("hybrid casters"),
             layout: &self.layout,
             entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&g.position) },
+                view(0, &g.position),
                 buffer(8, &listed.listed),
                 buffer(9, &listed.counts),
                 buffer(11, &pieces.params),
                 buffer(12, &pieces.triangles),
                 buffer(13, &pieces.setups),
-                buffer(14, &pieces.shafts),
-                buffer(15, &pieces.grid),
+                buffer(14, &pieces.runs),
+                view(15, &grid),
                 buffer(16, &listed.work),
-                wgpu::BindGroupEntry { binding: 17, resource: wgpu::BindingResource::TextureView(&texels) },
+                view(17, &setups),
+                view(18, &shafts),
             ],
         });
         // The pieces' words and the staged pairs' count.
@@ -617,7 +665,7 @@ impl CasterPasses {
                     buffer: &pieces.setups,
                     layout: wgpu::TexelCopyBufferLayout {
                         offset: 0,
-                        bytes_per_row: Some(SETUP_ROW * 16),
+                        bytes_per_row: Some(TABLE_ROW * 16),
                         rows_per_image: None,
                     },
                 },
