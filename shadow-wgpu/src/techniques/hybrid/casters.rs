@@ -68,13 +68,8 @@ pub(super) fn setup_room(cx: &WgpuContext) -> usize {
     cx.device.limits().max_texture_dimension_2d as usize * TABLE_ROW as usize / SETUP as usize
 }
 
-/// Rows of a table of `n` elements (at least one).
-fn table_rows(n: u64) -> u32 {
-    n.div_ceil(u64::from(TABLE_ROW)).clamp(1, u64::from(u32::MAX)) as u32
-}
-
-/// A table of `rows` rows of [`TABLE_ROW`] texels as a texture, with `data` (padded to whole rows), or to
-/// be copied into.
+/// A table of `n` texels as a texture of [`TABLE_ROW`] texels a row (at least one row), with `data`
+/// (padded to whole rows), or to be copied into.
 ///
 /// # Errors
 /// [`WgpuError::BadSize`] for more rows than the device allows.
@@ -82,9 +77,10 @@ fn table(
     cx: &WgpuContext,
     label: &'static str,
     format: wgpu::TextureFormat,
-    rows: u32,
+    n: u64,
     data: Option<&[u8]>,
 ) -> Result<wgpu::Texture, WgpuError> {
+    let rows = n.div_ceil(u64::from(TABLE_ROW)).clamp(1, u64::from(u32::MAX)) as u32;
     let most = cx.device.limits().max_texture_dimension_2d;
     if rows > most {
         return Err(WgpuError::BadSize {
@@ -567,38 +563,35 @@ impl CasterPasses {
             cx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
         };
         use wgpu::BufferUsages as U;
+        use wgpu::TextureFormat as F;
         // A build with no small piece still binds its buffers: at least one element each.
         let nonempty = |bytes: &[u8]| {
             let mut v = bytes.to_vec();
             v.resize(v.len().max(std::mem::size_of::<PieceRun>()), 0);
             v
         };
-        let setup_rows = table_rows(u64::from(split.triangle_count()) * SETUP);
+        let shaft_bytes: &[u8] = bytemuck::cast_slice(&shaft_texels);
+        let setup_texels =
+            table(cx, "hybrid caster setups", F::Rgba32Float, u64::from(split.triangle_count()) * SETUP, None)?;
         Ok(CasterPieces {
             params: init("hybrid caster params", bytemuck::bytes_of(&params), U::UNIFORM),
             triangles: init("hybrid caster triangles", &nonempty(bytemuck::cast_slice(&split.triangles)), U::STORAGE),
             setups: cx.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("hybrid caster setups"),
-                size: u64::from(setup_rows) * u64::from(TABLE_ROW) * 16,
+                size: u64::from(setup_texels.height()) * u64::from(TABLE_ROW) * 16,
                 usage: U::STORAGE | U::COPY_SRC,
                 mapped_at_creation: false,
             }),
-            setup_texels: table(cx, "hybrid caster setup texels", wgpu::TextureFormat::Rgba32Float, setup_rows, None)?,
+            setup_texels,
             runs: init("hybrid caster runs", &nonempty(bytemuck::cast_slice(&runs)), U::STORAGE),
             shaft_texels: table(
                 cx,
                 "hybrid caster shafts",
-                wgpu::TextureFormat::Rgba32Float,
-                table_rows(shaft_texels.len() as u64),
-                Some(bytemuck::cast_slice(&shaft_texels)),
+                F::Rgba32Float,
+                shaft_texels.len() as u64,
+                Some(shaft_bytes),
             )?,
-            grid: table(
-                cx,
-                "hybrid caster grid",
-                wgpu::TextureFormat::R32Uint,
-                table_rows(grid.len() as u64),
-                Some(bytemuck::cast_slice(&grid)),
-            )?,
+            grid: table(cx, "hybrid caster grid", F::R32Uint, grid.len() as u64, Some(bytemuck::cast_slice(&grid)))?,
             triangle_count: split.triangle_count(),
             pieces: split.pieces.len(),
         })
