@@ -5,7 +5,11 @@ struct GOut {
     @invariant @builtin(position) pos: vec4<f32>,
     @location(0) world: vec3<f32>,
     @location(1) normal: vec3<f32>,
-    @location(2) @interpolate(flat) instance: u32,
+    // The instance's colour (w: two-sided) and flags (x: receives shadow, y: mirrored), passed on flat
+    // rather than read from the instance buffer per fragment: lavapipe loads from a storage buffer lane by
+    // lane.
+    @location(2) @interpolate(flat) color: vec4<f32>,
+    @location(3) @interpolate(flat) flags: vec2<u32>,
 };
 
 @vertex
@@ -15,7 +19,8 @@ fn vs_gbuffer(@location(0) p: vec4<f32>, @location(1) n: vec4<f32>, @builtin(ins
     out.pos = clip_position(instance, p);
     out.world = (inst.world_from_local * p).xyz;
     out.normal = (inst.normal_from_local * vec4<f32>(n.xyz, 0.0)).xyz;
-    out.instance = instance;
+    out.color = inst.color;
+    out.flags = inst.flags.xy;
     return out;
 }
 
@@ -35,18 +40,17 @@ fn fs_gbuffer(in: GOut, @builtin(front_facing) front: bool) -> GTargets {
     if (dot(face, view.eye.xyz - in.world) < 0.0) {
         face = -face;
     }
-    let inst = instances[in.instance];
     var n = normalize(in.normal);
     // Twin: shadow-cpu's G-buffer resolve turns a two-sided surface's normal to the side that is seen. A
     // mirroring transform winds front faces clockwise, so its `front_facing` is reversed.
-    let seen_front = front != (inst.flags.y != 0u);
-    if (!seen_front && inst.color.w != 0.0) {
+    let seen_front = front != (in.flags.y != 0u);
+    if (!seen_front && in.color.w != 0.0) {
         n = -n;
     }
     var out: GTargets;
-    out.position = vec4<f32>(in.world, f32(inst.flags.x));
+    out.position = vec4<f32>(in.world, f32(in.flags.x));
     out.normal = vec4<f32>(n, 0.0);
-    out.albedo = vec4<f32>(inst.color.xyz, 1.0);
+    out.albedo = vec4<f32>(in.color.xyz, 1.0);
     out.geometric_normal = vec4<f32>(face, 0.0);
     return out;
 }
