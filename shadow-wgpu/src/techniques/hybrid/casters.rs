@@ -62,10 +62,15 @@ const SETUP: u64 = 5;
 /// `TABLE_ROW`).
 const TABLE_ROW: u32 = 4096;
 
-/// The most triangles the compute passes can set up on `cx`'s device: as many as fill the tallest setup
-/// texture it allows.
+/// The most triangles the compute passes can take on `cx`'s device: as many as the tallest setup texture
+/// it allows holds, whose rows the setup buffer also holds, and the triangle buffer (four vec4 each) too,
+/// within the largest storage binding.
 pub(super) fn setup_room(cx: &WgpuContext) -> usize {
-    cx.device.limits().max_texture_dimension_2d as usize * TABLE_ROW as usize / SETUP as usize
+    let limits = cx.device.limits();
+    let binding = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
+    let row = u64::from(TABLE_ROW);
+    let rows = u64::from(limits.max_texture_dimension_2d).min(binding / (16 * row));
+    (rows * row / SETUP).min(binding / 64) as usize
 }
 
 /// A table of `n` texels as a texture of [`TABLE_ROW`] texels a row (at least one row), with `data`
