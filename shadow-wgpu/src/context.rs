@@ -57,6 +57,14 @@ pub enum WgpuError {
         /// Why not.
         why: String,
     },
+    /// More lights than one frame can shade: one visibility layer and one uniform slot each.
+    #[error("the frame has {lights} lights; the wgpu backend shades at most {most}")]
+    TooManyLights {
+        /// Lights in the frame.
+        lights: usize,
+        /// The most it can shade on this device.
+        most: usize,
+    },
     /// A shared technique error.
     #[error(transparent)]
     Technique(#[from] TechniqueError),

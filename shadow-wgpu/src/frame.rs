@@ -40,6 +40,20 @@ pub struct WgpuFrame {
     pub stats: FrameStats,
 }
 
+/// The most lights a frame may have on this backend (fewer where the device has fewer texture array
+/// layers, one per light's visibility): the shading pass reads them from one uniform buffer.
+pub const MAX_LIGHTS: usize = 256;
+
+/// shade.wgsl's `Lights`: the count, then the lights. A uniform buffer rather than a storage one: lavapipe
+/// (Mesa 22.3) loads from a storage buffer lane by lane, and the shading pass reads every light at every
+/// pixel.
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct LightTable {
+    count: [u32; 4],
+    lights: [LightRaw; MAX_LIGHTS],
+}
+
 /// GPU twin of `Light` in common.wgsl.
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
@@ -123,6 +137,10 @@ pub fn render_frame(
     technique: &mut dyn DynShadowTechnique<WgpuBackend>,
 ) -> Result<WgpuFrame, WgpuError> {
     let start = Instant::now();
+    let most = MAX_LIGHTS.min(cx.device.limits().max_texture_array_layers as usize);
+    if frame.lights.len() > most {
+        return Err(WgpuError::TooManyLights { lights: frame.lights.len(), most });
+    }
     cx.clock = PhaseClock::new(cx);
     let result = frame_phases(cx, frame, width, height, technique, start);
     cx.clock = None;
@@ -250,12 +268,15 @@ fn shade(
 ) -> Result<(wgpu::Texture, wgpu::Buffer), WgpuError> {
     cx.scoped("the shading pass", |cx| {
         let color = layered(cx, "color", g.width, g.height, 1, COLOR);
-        let lights: Vec<LightRaw> = frame.lights.iter().map(LightRaw::of).collect();
-        let lights = if lights.is_empty() { vec![bytemuck::Zeroable::zeroed()] } else { lights };
+        let mut lights: LightTable = bytemuck::Zeroable::zeroed();
+        lights.count[0] = frame.lights.len() as u32;
+        for (slot, l) in lights.lights.iter_mut().zip(&frame.lights) {
+            *slot = LightRaw::of(l);
+        }
         let lbuf = cx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("lights"),
-            contents: bytemuck::cast_slice(&lights),
-            usage: wgpu::BufferUsages::STORAGE,
+            contents: bytemuck::bytes_of(&lights),
+            usage: wgpu::BufferUsages::UNIFORM,
         });
         let vis_view = vis.create_view(&wgpu::TextureViewDescriptor {
             dimension: Some(wgpu::TextureViewDimension::D2Array),

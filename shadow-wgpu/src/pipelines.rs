@@ -179,7 +179,7 @@ impl Shared {
                     wgpu::TextureSampleType::Float { filterable: false },
                     wgpu::TextureViewDimension::D2Array,
                 ),
-                buffer_entry(4, wgpu::BufferBindingType::Storage { read_only: true }, wgpu::ShaderStages::FRAGMENT),
+                buffer_entry(4, wgpu::BufferBindingType::Uniform, wgpu::ShaderStages::FRAGMENT),
             ],
         });
         let smod = shaders::module(device, "shade", shaders::shade());

@@ -5,18 +5,12 @@
 use shadow_core::FrameInputs;
 use shadow_core::scenes::{self, SceneParams};
 use shadow_core::technique::TechniqueSpec;
-use shadowlab::{BackendKind, Renderer, TechniqueRegistry};
+use shadowlab::{BackendKind, Renderer};
 
 /// A renderer with a wgpu adapter and the `cubes` frame, or `None` (and a note) without an adapter, which
 /// `SHADOWLAB_REQUIRE_GPU=1` turns into a failure.
 fn on_wgpu() -> Option<(Renderer, FrameInputs)> {
-    let mut renderer = Renderer::new(TechniqueRegistry::builtin());
-    let require = std::env::var("SHADOWLAB_REQUIRE_GPU").is_ok_and(|v| v == "1");
-    if let Err(e) = renderer.resolve(shadowlab::BackendChoice::Wgpu) {
-        assert!(!require, "SHADOWLAB_REQUIRE_GPU=1 but no wgpu adapter: {e}");
-        eprintln!("skipped: no wgpu adapter ({e})");
-        return None;
-    }
+    let renderer = crate::with_wgpu("the GPU clock test")?;
     let scene = scenes::build("cubes", &SceneParams::default()).expect("scene");
     let frame = FrameInputs::from_scene(&scene, scene.cameras().next().expect("camera").0).expect("frame");
     Some((renderer, frame))

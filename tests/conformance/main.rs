@@ -13,3 +13,16 @@ mod smoothies;
 mod planar;
 mod suite;
 mod volume_reconstruction;
+
+/// A renderer of the built-in techniques with a wgpu adapter resolved, or `None` (and a line saying that
+/// `what` is skipped) without one, which `SHADOWLAB_REQUIRE_GPU=1` turns into a failure.
+fn with_wgpu(what: &str) -> Option<shadowlab::Renderer> {
+    let mut renderer = shadowlab::Renderer::new(shadowlab::TechniqueRegistry::builtin());
+    if let Err(e) = renderer.resolve(shadowlab::BackendChoice::Wgpu) {
+        let require = std::env::var("SHADOWLAB_REQUIRE_GPU").is_ok_and(|v| v == "1");
+        assert!(!require, "SHADOWLAB_REQUIRE_GPU=1 but no wgpu adapter: {e}");
+        eprintln!("{what} skipped: no wgpu adapter ({e})");
+        return None;
+    }
+    Some(renderer)
+}

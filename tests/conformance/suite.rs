@@ -253,3 +253,40 @@ fn every_technique_agrees_across_backends_and_with_the_reference() {
     eprintln!("conformance on {}:\n{}", renderer.adapter().map_or("?".into(), |a| a.name.clone()), rows.join("\n"));
     assert!(failures.is_empty(), "conformance failures:\n{}", failures.join("\n"));
 }
+
+/// A frame of several lights shades alike on both backends (each light's term, times its own visibility,
+/// summed), differently from its first light alone; a frame of more lights than the wgpu backend can
+/// shade is refused with the count. Without a wgpu adapter this prints one line and passes, unless
+/// SHADOWLAB_REQUIRE_GPU=1.
+#[test]
+fn several_lights_shade_alike_on_both_backends() {
+    use shadow_core::Light;
+    use shadow_core::glam::Vec3;
+
+    let Some(mut renderer) = crate::with_wgpu("several lights") else { return };
+    let scene = scenes::build("primitives", &SceneParams::default()).expect("scene");
+    let camera = *scene.camera(scene.cameras().next().expect("camera").0).expect("camera");
+    let spot = *scene.lights().next().expect("a light").1;
+    let two = vec![spot, Light::point(Vec3::new(-1.5, 2.5, 1.0))];
+    let spec = TechniqueSpec::named("shadow-map");
+    let (reference, _) = renderer
+        .run_cpu_frame(&FrameInputs::new(&scene, camera, two.clone()).expect("frame"), SIZE, SIZE, &spec)
+        .expect("cpu frame");
+    let g = &reference.gbuffer;
+    let mask = measured_pixels(&g.receiver, &g.position, &g.geometric_normal, &reference.light_views[0]);
+    let mut run = |lights: Vec<Light>, backend| {
+        let frame = FrameInputs::new(&scene, camera, lights).expect("frame");
+        renderer.run(backend, &frame, SIZE, SIZE, &spec)
+    };
+    let cpu = run(two.clone(), BackendKind::Cpu).expect("cpu");
+    let gpu = run(two, BackendKind::Wgpu).expect("wgpu");
+    let one = run(vec![spot], BackendKind::Wgpu).expect("wgpu, one light");
+    assert_eq!((cpu.visibility.len(), gpu.visibility.len()), (2, 2), "a visibility per light");
+    let across = flip_mean(&gpu.color, &cpu.color, &mask).expect("sizes");
+    let second = flip_mean(&gpu.color, &one.color, &mask).expect("sizes");
+    assert!(across <= MAX_CROSS_FLIP, "two lights: cross-backend FLIP {across:.4} > {MAX_CROSS_FLIP}");
+    assert!(second > 10.0 * MAX_CROSS_FLIP, "the second light changes the picture by only {second:.4}");
+    let many = vec![spot; 1000];
+    let err = run(many, BackendKind::Wgpu).err().expect("a thousand lights refused");
+    assert!(err.to_string().contains("1000 lights"), "{err}");
+}

@@ -4,7 +4,13 @@
 @group(1) @binding(1) var g_normal: texture_2d<f32>;
 @group(1) @binding(2) var g_albedo: texture_2d<f32>;
 @group(1) @binding(3) var visibility: texture_2d_array<f32>;
-@group(1) @binding(4) var<storage, read> lights: array<Light>;
+// The frame's lights, `count.x` of them (MAX_LIGHTS in frame.rs).
+struct Lights {
+    count: vec4<u32>,
+    items: array<Light, 256>,
+};
+
+@group(1) @binding(4) var<uniform> lights: Lights;
 
 const AMBIENT: f32 = 0.15;
 const BACKGROUND: vec3<f32> = vec3<f32>(0.02, 0.025, 0.04);
@@ -18,9 +24,9 @@ fn fs_shade(in: FullScreen) -> @location(0) vec4<f32> {
         let p = textureLoad(g_position, px, 0).xyz;
         let n = textureLoad(g_normal, px, 0).xyz;
         var direct = vec3<f32>(0.0);
-        for (var i = 0u; i < arrayLength(&lights); i = i + 1u) {
+        for (var i = 0u; i < lights.count.x; i = i + 1u) {
             let v = textureLoad(visibility, px, i32(i), 0).x;
-            direct = direct + direct_light(lights[i], p, n) * v;
+            direct = direct + direct_light(lights.items[i], p, n) * v;
         }
         c = albedo.xyz * (vec3<f32>(AMBIENT) + direct);
     }
