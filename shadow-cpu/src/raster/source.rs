@@ -60,10 +60,11 @@ impl TriangleSource for Indexed<'_> {
 }
 
 /// Several indexed meshes drawn as one source, in order, under one numbering: primitive ids run on from one
-/// part to the next, so a visibility buffer of a whole frame ([`draw_flat`]) holds one id per pixel, which
-/// [`Batch::part_of`] turns back into the mesh and its triangle. Each part keeps its own `flip`; the
-/// fragments, and so the pictures, are those of the parts drawn in turn. (A draw's fixed cost per mesh is
-/// not what it saves: on cubes' thousand boxes, one draw and a thousand took the same time.)
+/// part to the next, so a visibility buffer of a whole frame ([`draw_flat`](super::draw_flat)) holds one
+/// id per pixel, which [`Batch::part_of`] turns back into the mesh and its triangle. Each part keeps its
+/// own `flip`; the fragments, and so the pictures, are those of the parts drawn in turn. (A draw's fixed
+/// cost per mesh is not what it saves: on cubes' thousand boxes, one draw and a thousand took the same
+/// time.)
 pub struct Batch<'a> {
     parts: Vec<Indexed<'a>>,
     /// The id of each part's first triangle, and the total at the end.

@@ -61,7 +61,7 @@ struct PieceRun {
 // row (z . adj(M)) with the cap flag in w, and the world plane through the triangle, turned so the eye
 // lies on its positive side.
 @group(1) @binding(13) var<storage, read_write> setups: array<vec4<f32>>;
-// The same, copied into a texture (SETUP_ROW texels a row) after cs_setup, for the passes that read them.
+// The same, copied into a texture (TABLE_ROW texels a row) after cs_setup, for the passes that read them.
 // On lavapipe (Mesa 22.3.6, which loads from a storage buffer lane by lane) two more texel fetches per
 // triangle test added 15 ms to tree's cs_pieces where two more storage loads added 65, and reading the
 // setups from the texture took that pass from 118-142 ms to 47.
@@ -88,6 +88,7 @@ fn setup_at(i: u32) -> vec4<f32> {
 fn grid_at(i: u32) -> u32 {
     return textureLoad(grid_texels, table_at(i), 0).x;
 }
+
 // Per piece.
 @group(1) @binding(14) var<storage, read> runs: array<PieceRun>;
 
