@@ -63,14 +63,14 @@ const SETUP: u64 = 5;
 const TABLE_ROW: u32 = 4096;
 
 /// The most triangles the compute passes can take on `cx`'s device: as many as the tallest setup texture
-/// it allows holds, whose rows the setup buffer also holds, and the triangle buffer (four vec4 each) too,
-/// within the largest storage binding.
+/// it allows holds (the triangle table, four texels a triangle, is shorter), within the largest storage
+/// binding for the setup buffer it is copied from.
 pub(super) fn setup_room(cx: &WgpuContext) -> usize {
     let limits = cx.device.limits();
     let binding = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
     let row = u64::from(TABLE_ROW);
     let rows = u64::from(limits.max_texture_dimension_2d).min(binding / (16 * row));
-    (rows * row / SETUP).min(binding / 64) as usize
+    (rows * row / SETUP) as usize
 }
 
 /// A table of `n` texels as a texture of [`TABLE_ROW`] texels a row (at least one row), with `data`
@@ -109,7 +109,7 @@ fn table(
     Ok(match data {
         Some(bytes) => {
             let mut padded = bytes.to_vec();
-            // Both formats used have 32-bit components.
+            // Every format used has 32-bit components.
             padded.resize((u64::from(rows) * u64::from(TABLE_ROW) * 4 * format.components() as u64) as usize, 0);
             cx.device.create_texture_with_data(&cx.queue, &desc, wgpu::util::TextureDataOrder::LayerMajor, &padded)
         }
@@ -361,7 +361,7 @@ pub(super) struct CasterPasses {
 /// One build's small pieces on the GPU.
 pub(super) struct CasterPieces {
     params: wgpu::Buffer,
-    triangles: wgpu::Buffer,
+    triangles: wgpu::Texture,
     setups: wgpu::Buffer,
     setup_texels: wgpu::Texture,
     runs: wgpu::Buffer,
@@ -475,7 +475,7 @@ impl CasterPasses {
                 storage(8, false),
                 storage(9, false),
                 buffer_entry(11, wgpu::BufferBindingType::Uniform, wgpu::ShaderStages::COMPUTE),
-                storage(12, true),
+                compute_entry(12, texture(wgpu::TextureSampleType::Uint)),
                 storage(13, false),
                 storage(14, true),
                 compute_entry(15, texture(wgpu::TextureSampleType::Uint)),
@@ -580,7 +580,13 @@ impl CasterPasses {
             table(cx, "hybrid caster setups", F::Rgba32Float, u64::from(split.triangle_count()) * SETUP, None)?;
         Ok(CasterPieces {
             params: init("hybrid caster params", bytemuck::bytes_of(&params), U::UNIFORM),
-            triangles: init("hybrid caster triangles", &nonempty(bytemuck::cast_slice(&split.triangles)), U::STORAGE),
+            triangles: table(
+                cx,
+                "hybrid caster triangles",
+                F::Rgba32Uint,
+                split.triangles.len() as u64,
+                Some(bytemuck::cast_slice(&split.triangles)),
+            )?,
             setups: cx.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("hybrid caster setups"),
                 size: u64::from(setup_texels.height()) * u64::from(TABLE_ROW) * 16,
@@ -615,7 +621,8 @@ impl CasterPasses {
         fn buffer(binding: u32, b: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
             wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() }
         }
-        let (setups, shafts, grid) = (
+        let (triangles, setups, shafts, grid) = (
+            pieces.triangles.create_view(&Default::default()),
             pieces.setup_texels.create_view(&Default::default()),
             pieces.shaft_texels.create_view(&Default::default()),
             pieces.grid.create_view(&Default::default()),
@@ -629,7 +636,7 @@ impl CasterPasses {
                 buffer(8, &listed.listed),
                 buffer(9, &listed.counts),
                 buffer(11, &pieces.params),
-                buffer(12, &pieces.triangles),
+                view(12, &triangles),
                 buffer(13, &pieces.setups),
                 buffer(14, &pieces.runs),
                 view(15, &grid),
