@@ -4,6 +4,9 @@
 // Follows shadow_map.wgsl (for g_position and cube_face) and the listed pixels' declarations
 // (CASTER_LISTS in shaders.rs), which the mask pass appends to.
 //
+// The tables these passes only read (the triangles, their setups, the shafts and the shaft grid) are
+// textures: lavapipe fetches a texel several times faster than it loads from a storage buffer.
+//
 // The passes: cs_setup sets each triangle up for the view; cs_tally finds each listed pixel's pieces
 // (those of its light-space grid cell whose shafts hold it) and counts the pixels of each piece;
 // cs_offsets gives each piece its run of pairs; cs_fill writes them; cs_pieces counts each piece at its
@@ -53,15 +56,16 @@ struct PieceRun {
 
 @group(1) @binding(9) var<storage, read_write> counts: array<atomic<i32>>;
 @group(1) @binding(11) var<uniform> casters: CasterParams;
-// Per triangle four vec4: its corners as homogeneous points in its mesh's space, wound so its front face
-// is counter-clockwise, then bitcasts of x: instance * 2 + 1 for a cap (near or far), + 0 for a side;
-// y: its piece; z: its group (0 side, 1 near cap, 2 far cap).
-// The bits in a table (TABLE_ROW texels a row), fetched faster than from a storage buffer on lavapipe.
+// Per triangle four texels: its corners as homogeneous points in its mesh's space, wound so its front
+// face is counter-clockwise (their bits), then x: instance * 2 + 1 for a cap (near or far), + 0 for a
+// side; y: its piece; z: its group (0 side, 1 near cap, 2 far cap). A table (TABLE_ROW texels a row),
+// fetched faster than a storage buffer is read on lavapipe.
 @group(1) @binding(12) var triangle_texels: texture_2d<u32>;
 
 fn triangle_at(i: u32) -> vec4<f32> {
     return bitcast<vec4<f32>>(textureLoad(triangle_texels, table_at(i), 0));
 }
+
 // Per triangle SETUP vec4, set up for the view: the rows of adj(M) with det(M) in the first's w, the depth
 // row (z . adj(M)) with the cap flag in w, and the world plane through the triangle, turned so the eye
 // lies on its positive side.
