@@ -185,25 +185,39 @@ impl Mesh {
     }
 
     /// Appends another mesh's vertices and triangles.
-    pub fn append(&mut self, other: &Mesh) {
-        let base = self.positions.len() as u32;
+    ///
+    /// # Errors
+    /// [`MeshError::TooManyVertices`] when the two together have more vertices than 32-bit indices can
+    /// address (the mesh is left as it was).
+    pub fn append(&mut self, other: &Mesh) -> Result<(), MeshError> {
+        let base = appended_base(self.positions.len(), other.positions.len())?;
         self.positions.extend_from_slice(&other.positions);
         self.normals.extend_from_slice(&other.normals);
         self.triangles.extend(other.triangles.iter().map(|t| t.map(|i| i + base)));
         self.bounds = self.bounds.union(other.bounds);
+        Ok(())
     }
 
     /// Several meshes as one.
     ///
     /// # Errors
-    /// [`MeshError::Empty`] when `parts` is empty.
+    /// [`MeshError::Empty`] when `parts` is empty, [`MeshError::TooManyVertices`] past 32-bit indices.
     pub fn merged<'a>(parts: impl IntoIterator<Item = &'a Mesh>) -> Result<Self, MeshError> {
         let mut parts = parts.into_iter();
         let mut out = parts.next().ok_or(MeshError::Empty)?.clone();
         for p in parts {
-            out.append(p);
+            out.append(p)?;
         }
         Ok(out)
+    }
+}
+
+/// The index of the first vertex appended to a mesh of `have` vertices, `more` of them: both together
+/// must be addressable by 32-bit indices, as [`Mesh::new`] requires of one mesh.
+fn appended_base(have: usize, more: usize) -> Result<u32, MeshError> {
+    match have.checked_add(more) {
+        Some(total) if total <= u32::MAX as usize => Ok(have as u32),
+        total => Err(MeshError::TooManyVertices(total.unwrap_or(usize::MAX))),
     }
 }
 
@@ -227,6 +241,20 @@ fn vertex_normals(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Vec3> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn appending_keeps_to_32_bit_indices() {
+        let a = Mesh::new(vec![Vec3::ZERO, Vec3::X, Vec3::Y], vec![[0, 1, 2]]).expect("a");
+        let b = a.transformed(glam::Mat4::from_translation(Vec3::Z));
+        let both = Mesh::merged([&a, &b]).expect("two triangles");
+        assert_eq!(both.triangles(), &[[0, 1, 2], [3, 4, 5]]);
+        assert_eq!(both.bounds(), a.bounds().union(b.bounds()));
+        // Past u32 indices (too large to build here): refused with the count, not wrapped.
+        let most = u32::MAX as usize;
+        assert_eq!(appended_base(most - 1, 1), Ok(most as u32 - 1));
+        assert_eq!(appended_base(most, 1), Err(MeshError::TooManyVertices(most + 1)));
+        assert_eq!(appended_base(usize::MAX, 1), Err(MeshError::TooManyVertices(usize::MAX)));
+    }
 
     #[test]
     fn refuses_bad_meshes() {
