@@ -140,12 +140,13 @@ impl FrameInputs {
         if instances.is_empty() {
             return Err(FrameError::Empty);
         }
-        let triangles: u64 = instances.iter().map(|i| i.mesh.triangle_count() as u64).sum();
+        let bounds = instances.iter().fold(Aabb::EMPTY, |b, i| b.union(i.bounds));
+        let frame = Self { instances, bounds, camera, lights };
+        let triangles = frame.triangle_count() as u64;
         if triangles > MAX_FRAME_TRIANGLES {
             return Err(FrameError::TooManyTriangles { triangles });
         }
-        let bounds = instances.iter().fold(Aabb::EMPTY, |b, i| b.union(i.bounds));
-        Ok(Self { instances, bounds, camera, lights })
+        Ok(frame)
     }
 
     /// The frame seen through one of the scene's cameras, with all of the scene's lights.

@@ -56,6 +56,7 @@
 
 mod casters;
 mod edges;
+mod tables;
 mod tiles;
 
 use casters::{CasterPasses, CasterPieces, LISTED_TRIANGLES, ListedPixels, Split, setup_room};

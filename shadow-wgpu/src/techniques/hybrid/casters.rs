@@ -40,6 +40,7 @@ use shadow_core::light::LightView;
 use shadow_core::shafts::{CasterShafts, Shaft, ShaftGrid, tolerance};
 use wgpu::util::DeviceExt;
 
+use super::tables::{TABLE_ROW, table};
 use crate::context::{WgpuContext, WgpuError};
 use crate::gbuffer::GpuGBuffer;
 use crate::pipelines::buffer_entry;
@@ -58,10 +59,6 @@ const PROJECTIONS: usize = 6;
 /// vec4 per triangle set up for the view (hybrid_casters.wgsl's `SETUP`).
 const SETUP: u64 = 5;
 
-/// Texels per row of the tables the compute passes read from textures (hybrid_casters.wgsl's
-/// `TABLE_ROW`).
-const TABLE_ROW: u32 = 4096;
-
 /// The most triangles the compute passes can take on `cx`'s device: as many as the tallest setup texture
 /// it allows holds (the triangle table, four texels a triangle, is shorter), within the largest storage
 /// binding for the setup buffer it is copied from.
@@ -71,50 +68,6 @@ pub(super) fn setup_room(cx: &WgpuContext) -> usize {
     let row = u64::from(TABLE_ROW);
     let rows = u64::from(limits.max_texture_dimension_2d).min(binding / (16 * row));
     (rows * row / SETUP) as usize
-}
-
-/// A table of `n` texels as a texture of [`TABLE_ROW`] texels a row (at least one row), with `data`
-/// (padded to whole rows), or to be copied into.
-///
-/// # Errors
-/// [`WgpuError::BadSize`] for more rows than the device allows.
-fn table(
-    cx: &WgpuContext,
-    label: &'static str,
-    format: wgpu::TextureFormat,
-    n: u64,
-    data: Option<&[u8]>,
-) -> Result<wgpu::Texture, WgpuError> {
-    let rows = n.div_ceil(u64::from(TABLE_ROW)).clamp(1, u64::from(u32::MAX)) as u32;
-    let most = cx.device.limits().max_texture_dimension_2d;
-    if rows > most {
-        return Err(WgpuError::BadSize {
-            what: label,
-            width: u64::from(TABLE_ROW),
-            height: u64::from(rows),
-            why: format!("more rows than the device's {most}"),
-        });
-    }
-    let size = wgpu::Extent3d { width: TABLE_ROW, height: rows, depth_or_array_layers: 1 };
-    let desc = wgpu::TextureDescriptor {
-        label: Some(label),
-        size,
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format,
-        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-        view_formats: &[],
-    };
-    Ok(match data {
-        Some(bytes) => {
-            let mut padded = bytes.to_vec();
-            // Every format used has 32-bit components.
-            padded.resize((u64::from(rows) * u64::from(TABLE_ROW) * 4 * format.components() as u64) as usize, 0);
-            cx.device.create_texture_with_data(&cx.queue, &desc, wgpu::util::TextureDataOrder::LayerMajor, &padded)
-        }
-        None => cx.device.create_texture(&desc),
-    })
 }
 
 /// Invocations per workgroup of the compute passes (hybrid_casters.wgsl's `GROUP`).
