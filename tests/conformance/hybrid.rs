@@ -177,9 +177,31 @@ fn caster_masks_keep_the_picture_on_both_backends() {
         s.add_light(Light::spot(Vec3::new(2.0, 4.0, 1.5), Vec3::ZERO, 60.0));
         s
     };
+    // Mirrored instances (negative determinants: front faces wind the other way, and the compute passes'
+    // side quads are laid out for that), tilted cubes on a ground.
+    let mirrored = {
+        let mut s = Scene::new();
+        let grey = s.add_material(Material::colored("grey", Vec3::splat(0.75)));
+        let cube = s.add_mesh(shadow_core::procedural::cuboid(Vec3::splat(0.15)));
+        for i in 0..9 {
+            let (x, z) = ((i % 3) as f32 * 0.5 - 0.5, (i / 3) as f32 * 0.5 - 0.5);
+            let tilt = Mat4::from_rotation_y(0.4 * i as f32) * Mat4::from_rotation_x(0.3 + 0.2 * i as f32);
+            let world = Mat4::from_translation(Vec3::new(x, 0.5 + 0.05 * i as f32, z))
+                * tilt
+                * Mat4::from_scale(Vec3::new(-1.0, 1.0, 1.0));
+            s.add_instance(&format!("mirrored cube {i}"), cube, grey, world).expect("cube");
+        }
+        let ground = s.add_mesh(scenes::ground_quad());
+        let ground = s.add_instance("ground", ground, grey, Mat4::IDENTITY).expect("ground");
+        s.set_shadow_flags(ground, false, true).expect("ground's flags");
+        s.add_camera(Camera::look_at(Vec3::new(0.8, 1.6, 2.2), Vec3::new(0.0, 0.3, 0.0), 45.0));
+        s.add_light(Light::spot(Vec3::new(1.0, 3.0, 0.8), Vec3::ZERO, 60.0));
+        s
+    };
     let built: Vec<(&str, Scene)> =
         scenes::names().iter().map(|&n| (n, scenes::build(n, &SceneParams::default()).expect("scene"))).collect();
-    for (name, s) in built.iter().map(|(n, s)| (*n, s)).chain([("lone sphere", &lone_sphere)]) {
+    let own = [("lone sphere", &lone_sphere), ("mirrored cubes", &mirrored)];
+    for (name, s) in built.iter().map(|(n, s)| (*n, s)).chain(own) {
         let cam_key = s.cameras().next().expect("camera").0;
         let cam = *s.camera(cam_key).expect("camera");
         let mut cases = vec![(name.to_string(), FrameInputs::from_scene(s, cam_key).expect("frame"))];

@@ -46,12 +46,13 @@ struct CasterParams {
     lists: vec4<u32>,
 };
 
-// A piece's run of triangles: from `first`, `sides` sides, then `caps` near caps and as many far caps.
+// A piece's run of triangles: from `first`, `sides` sides, then `caps` near caps and as many far caps;
+// `quads` 1 where the sides come in quads (two triangles each: every light but a directional one).
 struct PieceRun {
     first: u32,
     sides: u32,
     caps: u32,
-    unused: u32,
+    quads: u32,
 };
 
 @group(1) @binding(9) var<storage, read_write> counts: array<atomic<i32>>;
@@ -92,6 +93,19 @@ const TABLE_ROW: u32 = 4096u;
 
 fn setup_at(i: u32) -> vec4<f32> {
     return textureLoad(setup_texels, table_at(i), 0);
+}
+
+// Per instance of the frame, its world_from_local, a column a texel (the frame's `instances` hold the same,
+// but in a storage buffer: 16 lane-by-lane loads per triangle set up cost tree's cs_setup 4 ms on lavapipe).
+@group(1) @binding(19) var instance_texels: texture_2d<f32>;
+
+fn instance_at(i: u32) -> mat4x4<f32> {
+    return mat4x4<f32>(
+        textureLoad(instance_texels, table_at(4u * i), 0),
+        textureLoad(instance_texels, table_at(4u * i + 1u), 0),
+        textureLoad(instance_texels, table_at(4u * i + 2u), 0),
+        textureLoad(instance_texels, table_at(4u * i + 3u), 0),
+    );
 }
 
 fn grid_at(i: u32) -> u32 {
@@ -142,7 +156,7 @@ fn cs_setup(
     }
     let about = textureLoad(triangle_texels, table_at(4u * t + 3u), 0);
     let info = about.x;
-    let world_from_local = instances[info >> 1u].world_from_local;
+    let world_from_local = instance_at(info >> 1u);
     let wa = world_from_local * triangle_at(4u * t);
     let wb = world_from_local * triangle_at(4u * t + 1u);
     let wc = world_from_local * triangle_at(4u * t + 2u);
@@ -218,37 +232,60 @@ struct Tally {
     tests: u32,
 };
 
-// Triangles `first` to `end` at NDC point `p` over the receiver at world position `receiver`: z-fail's count,
-// each fragment behind the receiver (or at it: `Less` fails) adding 1 for a back face and -1 for a front
-// face. Caps always count where they are behind the near plane: a near cap is the caster's own surface,
-// never in front of the receiver but at it only up to rounding, and a far cap is at infinity.
+// Whether the edge row at `i` in the setups, oriented by `o`, covers NDC point `p`.
+fn covers(i: u32, o: f32, p: vec3<f32>) -> bool {
+    let e = setup_at(i).xyz * o;
+    return inside(dot(e, p), e);
+}
+
+// The fragment of triangle `t` (or of the side quad it begins), of orientation `o`, at a pixel it
+// covers at NDC point `p`, over the receiver at world position `receiver`: made unless the near plane
+// clips it there, and counted the z-fail way, adding 1 for a back face and -1 for a front face where it
+// lies behind the receiver (or at it: `Less` fails). Caps always count: a near cap is the caster's own
+// surface, never in front of the receiver but at it only up to rounding, and a far cap is at infinity.
+fn add_fragment(t: u32, o: f32, p: vec3<f32>, receiver: vec4<f32>, tally: ptr<function, Tally>) {
+    let zr = setup_at(SETUP * t + 3u);
+    if (dot(zr.xyz, p) * o < 0.0) {
+        return;
+    }
+    (*tally).fragments += 1u;
+    if (zr.w != 0.0 || dot(setup_at(SETUP * t + 4u), receiver) >= 0.0) {
+        (*tally).count += select(1, -1, o > 0.0);
+        (*tally).updates += 1u;
+    }
+}
+
+// Triangles `first` to `end` at NDC point `p` over the receiver at world position `receiver`, each edge
+// read and tested in turn (most triangles fail the first or second).
 fn add_triangles(first: u32, end: u32, p: vec3<f32>, receiver: vec4<f32>, tally: ptr<function, Tally>) {
     (*tally).tests += end - first;
     for (var t = first; t < end; t++) {
-        let r0 = setup_at(SETUP * t);
-        let det = r0.w;
-        // Each edge read and tested in turn: most triangles fail the first or second.
+        let i = SETUP * t;
+        let det = setup_at(i).w;
         let o = select(-1.0, 1.0, det > 0.0);
-        let e0 = r0.xyz * o;
-        if (det == 0.0 || !inside(dot(e0, p), e0)) {
-            continue;
+        if (det != 0.0 && covers(i, o, p) && covers(i + 1u, o, p) && covers(i + 2u, o, p)) {
+            add_fragment(t, o, p, receiver, tally);
         }
-        let e1 = setup_at(SETUP * t + 1u).xyz * o;
-        if (!inside(dot(e1, p), e1)) {
-            continue;
-        }
-        let e2 = setup_at(SETUP * t + 2u).xyz * o;
-        if (!inside(dot(e2, p), e2)) {
-            continue;
-        }
-        let zr = setup_at(SETUP * t + 3u);
-        if (dot(zr.xyz, p) * o < 0.0) {
-            continue;
-        }
-        (*tally).fragments += 1u;
-        if (zr.w != 0.0 || dot(setup_at(SETUP * t + 4u), receiver) >= 0.0) {
-            (*tally).count += select(1, -1, det > 0.0);
-            (*tally).updates += 1u;
+    }
+}
+
+// Side quads `first` to `end` (two triangles each, sharing a diagonal), as add_triangles. A side quad is
+// planar and convex (the part of a wedge from the light beyond a silhouette edge), so a pixel is covered
+// by one of its triangles exactly where the quad's four edges all cover it: as for a triangle, the
+// homogeneous test holds for any convex planar polygon, since a point cannot lie outside all of its
+// edges at once. Its two triangles share their plane, their facing, their depth row and their world
+// plane, so one test of four edges does the work of two of three: the upload turns each side triangle so
+// that the diagonal is its second row (Split::write_piece), and the quad's four edges are the first and
+// third rows of each. Each quad counts as its two triangles tested.
+fn add_quads(first: u32, end: u32, p: vec3<f32>, receiver: vec4<f32>, tally: ptr<function, Tally>) {
+    (*tally).tests += end - first;
+    for (var t = first; t < end; t += 2u) {
+        let i = SETUP * t;
+        let j = i + SETUP;
+        let det = setup_at(i).w;
+        let o = select(-1.0, 1.0, det > 0.0);
+        if (det != 0.0 && covers(i, o, p) && covers(i + 2u, o, p) && covers(j, o, p) && covers(j + 2u, o, p)) {
+            add_fragment(t, o, p, receiver, tally);
         }
     }
 }
@@ -260,7 +297,11 @@ fn add_piece(k: u32, p: vec3<f32>, receiver: vec4<f32>, tally: ptr<function, Tal
     let s = runs[k];
     let near = s.first + s.sides;
     let far = near + s.caps;
-    add_triangles(s.first, near, p, receiver, tally);
+    if (s.quads != 0u) {
+        add_quads(s.first, near, p, receiver, tally);
+    } else {
+        add_triangles(s.first, near, p, receiver, tally);
+    }
     if (within_bounds(PIECE * k + 3u, p)) {
         add_triangles(near, far, p, receiver, tally);
     }
@@ -511,6 +552,10 @@ fn cs_alone(
     @builtin(num_workgroups) groups: vec3<u32>,
     @builtin(local_invocation_index) local: u32,
 ) {
+    // Usually no pixel is flagged: then no flag is read.
+    if (atomicLoad(&listed.alone) == 0u) {
+        return;
+    }
     let n = atomicLoad(&listed.pixels);
     for (var i = invocation(wg, groups, local); i < n; i += groups.x * groups.y * GROUP) {
         if (atomicLoad(&work[flags_start() + i]) == 0u) {

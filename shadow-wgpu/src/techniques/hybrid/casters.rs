@@ -34,6 +34,7 @@ use bytemuck::{Pod, Zeroable};
 use shadow_core::FrameInputs;
 use shadow_core::LightKind;
 use shadow_core::frame::InstanceVolume;
+use shadow_core::geometry::LightSource;
 use shadow_core::geometry::volume::ShadowVolume;
 use shadow_core::glam::{Vec2, Vec4, Vec4Swizzles};
 use shadow_core::light::LightView;
@@ -84,6 +85,11 @@ const HEADER: u64 = 20;
 /// every so many.
 const PIXELS_PER_INVOCATION: u32 = 16;
 
+/// Workgroups of the pass over the pixels whose pairs did not fit (`cs_alone`): few, since there are
+/// usually none, and lavapipe pays for every workgroup it starts, work or none (256 took 2-3 ms on cubes
+/// and 6 on tree to find nothing; 64, 0.7 on cubes).
+const ALONE_GROUPS: u32 = 64;
+
 /// hybrid_casters.wgsl's `CasterParams`.
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
@@ -103,7 +109,7 @@ struct PieceRun {
     first: u32,
     sides: u32,
     caps: u32,
-    unused: u32,
+    quads: u32,
 }
 
 /// A piece counted by the compute passes.
@@ -114,6 +120,8 @@ struct SmallPiece {
     /// caps.
     triangles: Range<u32>,
     sides: u32,
+    /// Whether its sides come in quads, two triangles each ([`Split::write_piece`]).
+    quads: bool,
 }
 
 /// The volumes of a build split for the caster masks.
@@ -163,9 +171,9 @@ impl Split {
                     rest.caps_reversed.extend_from_slice(reversed);
                 } else {
                     let first = split.triangle_count();
-                    split.write_piece(iv, inst, sides, forward, reversed);
+                    let quads = split.write_piece(iv, inst, sides, forward, reversed);
                     let triangles = first..split.triangle_count();
-                    split.pieces.push(SmallPiece { shaft: k, triangles, sides: sides.len() as u32 });
+                    split.pieces.push(SmallPiece { shaft: k, triangles, sides: sides.len() as u32, quads });
                 }
                 k += 1;
             }
@@ -186,6 +194,11 @@ impl Split {
     /// that cast as wound; each wound so its front face is counter-clockwise. In that order, sides, near
     /// caps and far caps each in a run of their own, with the piece's index, so the caps can be passed
     /// over together where their bounds on screen are away from a pixel.
+    ///
+    /// Returns whether the sides come in quads: every light but a directional one extrudes a silhouette
+    /// edge (a, b) into the two triangles (b, a, a_inf) and (b, a_inf, b_inf) (`geometry::volume::extrude`).
+    /// Each is then turned, keeping its winding, so that the quad's diagonal from b to a_inf is its second
+    /// edge (from its third corner to its first), where hybrid_casters.wgsl's `add_quads` leaves it out.
     fn write_piece(
         &mut self,
         iv: &InstanceVolume,
@@ -193,7 +206,7 @@ impl Split {
         sides: &[[Vec4; 3]],
         forward: &[u32],
         reversed: &[u32],
-    ) {
+    ) -> bool {
         let m = inst.mirrored;
         let (tris, positions) = (inst.mesh.triangles(), inst.mesh.positions());
         let (instance, piece) = (iv.instance as u32, self.pieces.len() as u32);
@@ -207,8 +220,13 @@ impl Split {
             );
             self.triangles.extend([a, b, c, info]);
         };
-        for &s in sides {
-            push(s, m, Group::Side);
+        let quads = !matches!(iv.volume.light, LightSource::Directional(_)) && sides.len().is_multiple_of(2);
+        for (i, s) in sides.iter().enumerate() {
+            // The corner off the diagonal (a in the first triangle, b_inf in the second) goes where `push`
+            // leaves it in the middle (it swaps the last two corners when mirrored).
+            let (off, want) = (if i % 2 == 0 { 1 } else { 2 }, if m { 2 } else { 1 });
+            let turned = if quads { std::array::from_fn(|j| s[(j + off + 3 - want) % 3]) } else { *s };
+            push(turned, m, Group::Side);
         }
         let light = iv.volume.light;
         let faces = || forward.iter().map(|&f| (f, m, true)).chain(reversed.iter().map(|&f| (f, !m, false)));
@@ -220,6 +238,7 @@ impl Split {
             let far = corners(f).map(|p| light.extrude(p));
             push(if far_reverse { [far[0], far[2], far[1]] } else { far }, m, Group::Far);
         }
+        quads
     }
 }
 
@@ -320,6 +339,8 @@ pub(super) struct CasterPieces {
     runs: wgpu::Buffer,
     shaft_texels: wgpu::Texture,
     grid: wgpu::Texture,
+    /// Per instance of the frame, its `world_from_local`, a column a texel.
+    instance_texels: wgpu::Texture,
     triangle_count: u32,
     /// Pieces counted by the compute passes.
     pub(super) pieces: usize,
@@ -435,6 +456,7 @@ impl CasterPasses {
                 storage(16, false),
                 compute_entry(17, floats),
                 compute_entry(18, floats),
+                compute_entry(19, floats),
             ],
         });
         let module = shaders::module(&cx.device, "hybrid casters", shaders::hybrid_casters());
@@ -503,7 +525,8 @@ impl CasterPasses {
             .iter()
             .map(|piece| {
                 let (run, sides) = (&piece.triangles, piece.sides);
-                PieceRun { first: run.start, sides, caps: (run.end - run.start - sides) / 2, unused: 0 }
+                let caps = (run.end - run.start - sides) / 2;
+                PieceRun { first: run.start, sides, caps, quads: u32::from(piece.quads) }
             })
             .collect();
         // Per piece, per projection: lo, hi, (near, 1 where bounded).
@@ -529,6 +552,8 @@ impl CasterPasses {
             v
         };
         let shaft_bytes: &[u8] = bytemuck::cast_slice(&shaft_texels);
+        let instance_columns: Vec<[[f32; 4]; 4]> =
+            frame.instances.iter().map(|i| i.world_from_local.to_cols_array_2d()).collect();
         let setup_texels =
             table(cx, "hybrid caster setups", F::Rgba32Float, u64::from(split.triangle_count()) * SETUP, None)?;
         Ok(CasterPieces {
@@ -556,6 +581,13 @@ impl CasterPasses {
                 Some(shaft_bytes),
             )?,
             grid: table(cx, "hybrid caster grid", F::R32Uint, grid.len() as u64, Some(bytemuck::cast_slice(&grid)))?,
+            instance_texels: table(
+                cx,
+                "hybrid caster instances",
+                F::Rgba32Float,
+                4 * frame.instances.len() as u64,
+                Some(bytemuck::cast_slice(&instance_columns)),
+            )?,
             triangle_count: split.triangle_count(),
             pieces: split.pieces.len(),
         })
@@ -574,11 +606,12 @@ impl CasterPasses {
         fn buffer(binding: u32, b: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
             wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() }
         }
-        let (triangles, setups, shafts, grid) = (
+        let (triangles, setups, shafts, grid, instances) = (
             pieces.triangles.create_view(&Default::default()),
             pieces.setup_texels.create_view(&Default::default()),
             pieces.shaft_texels.create_view(&Default::default()),
             pieces.grid.create_view(&Default::default()),
+            pieces.instance_texels.create_view(&Default::default()),
         );
         let view = |binding, v| wgpu::BindGroupEntry { binding, resource: wgpu::BindingResource::TextureView(v) };
         let group = cx.device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -596,6 +629,7 @@ impl CasterPasses {
                 buffer(16, &listed.work),
                 view(17, &setups),
                 view(18, &shafts),
+                view(19, &instances),
             ],
         });
         // The pieces' words and the staged pairs' count.
@@ -639,7 +673,7 @@ impl CasterPasses {
         spread(&mut pass, &self.offsets, 1);
         spread(&mut pass, &self.fill, over_pixels);
         spread(&mut pass, &self.pieces, pieces.pieces as u32);
-        spread(&mut pass, &self.alone, over_pixels);
+        spread(&mut pass, &self.alone, ALONE_GROUPS);
     }
 }
 
@@ -711,6 +745,52 @@ mod tests {
             }
             let open = edges.values().filter(|&&n| n != 0).count();
             assert_eq!(open, 0, "piece {k}: {open} directed edges without their reverse");
+        }
+    }
+
+    #[test]
+    fn side_quads_keep_their_diagonal_in_the_rows_add_quads_leaves_out() {
+        use shadow_core::glam::{Mat4, Vec3};
+        use shadow_core::{Camera, Light, Material, Scene};
+
+        // A cube as it is and a mirrored one (front faces wound the other way), under a spot light, which
+        // sides come in quads for, and a directional light, which they do not.
+        let mut s = Scene::new();
+        let grey = s.add_material(Material::colored("grey", Vec3::splat(0.75)));
+        let cube = s.add_mesh(shadow_core::procedural::cuboid(Vec3::splat(0.3)));
+        let tilt = Mat4::from_rotation_x(0.4) * Mat4::from_rotation_y(0.7);
+        let at = |x: f32| Mat4::from_translation(Vec3::new(x, 0.5, 0.0)) * tilt;
+        s.add_instance("cube", cube, grey, at(-0.4)).expect("cube");
+        s.add_instance("mirrored", cube, grey, at(0.4) * Mat4::from_scale(Vec3::new(-1.0, 1.0, 1.0))).expect("cube");
+        let camera = Camera::look_at(Vec3::new(0.0, 1.5, 2.5), Vec3::ZERO, 45.0);
+        for (light, quads) in [
+            (Light::spot(Vec3::new(0.5, 3.0, 1.0), Vec3::ZERO, 60.0), true),
+            (Light::directional(Vec3::new(-0.3, -1.0, -0.2)), false),
+        ] {
+            let frame = shadow_core::FrameInputs::new(&s, camera, vec![light]).expect("frame");
+            let light = frame.light_view(&frame.lights[0]).expect("light view");
+            let volumes = frame.shadow_volumes(&light, Caps::Both);
+            let shafts = CasterShafts::new(&frame, &light, &volumes);
+            let split = Split::new(&frame, &volumes, &shafts, usize::MAX, usize::MAX);
+            let mirrored: Vec<bool> = frame.instances.iter().map(|i| i.mirrored).collect();
+            assert_eq!(mirrored, [false, true]);
+            assert_eq!(split.pieces.len(), 2, "a piece per cube");
+            for piece in &split.pieces {
+                assert_eq!(piece.quads, quads);
+                if !quads {
+                    continue;
+                }
+                let corners = |t: u32| &split.triangles[4 * t as usize..4 * t as usize + 3];
+                let sides = piece.triangles.start..piece.triangles.start + piece.sides;
+                for t in sides.step_by(2) {
+                    let (first, second) = (corners(t), corners(t + 1));
+                    // The diagonal, from b to a_inf, is each triangle's edge from its third corner to its
+                    // first, once each way; the corner off it is a (finite) in the first, b_inf in the second.
+                    assert_eq!((first[0], first[2]), (second[2], second[0]), "side quad at {t}");
+                    assert_eq!([first[0].w, first[2].w].iter().sum::<f32>(), 1.0, "one end at infinity");
+                    assert_eq!((first[1].w, second[1].w), (1.0, 0.0), "side quad at {t}");
+                }
+            }
         }
     }
 
