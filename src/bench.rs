@@ -232,16 +232,19 @@ pub fn bench_table(r: &BenchReport) -> String {
 
 /// The scene of a triangle-count sweep: a sphere of about `tris` triangles on the ground, staged like a
 /// model file (DESIGN 11).
-#[must_use]
-pub fn sweep_scene(tris: u32) -> shadow_core::Scene {
+///
+/// # Errors
+/// [`ShapeError::TooManyVertices`](shadow_core::procedural::ShapeError) for a sphere past
+/// [`MAX_SHAPE_VERTICES`](shadow_core::procedural::MAX_SHAPE_VERTICES).
+pub fn sweep_scene(tris: u32) -> Result<shadow_core::Scene, shadow_core::procedural::ShapeError> {
     let segments = (tris as f32).sqrt().round().max(3.0) as u32;
     let rings = (tris / segments).div_ceil(2).max(2) + 1;
     let mut s = shadow_core::Scene::new();
-    let m = s.add_mesh(shadow_core::procedural::sphere(0.5, segments, rings));
+    let m = s.add_mesh(shadow_core::procedural::sphere(0.5, segments, rings)?);
     let mat = s.add_material(shadow_core::Material::colored("sphere", Vec3::new(0.85, 0.45, 0.25)));
     let _ = s.add_instance("sphere", m, mat, glam::Mat4::IDENTITY);
     shadow_core::scenes::stage_model(&mut s, true);
-    s
+    Ok(s)
 }
 
 #[cfg(test)]

@@ -536,7 +536,7 @@ fn bench(args: &SceneArgs, b: BenchArgs) -> Result<(), Error> {
             args.frame()?
         } else {
             let (w, h) = parse_size(&args.size).map_err(|e| Error::Usage(e.to_string()))?;
-            let scene = sweep_scene(v);
+            let scene = sweep_scene(v).map_err(|e| Error::Usage(format!("--sweep tris={v}: {e}")))?;
             let cam = scene.cameras().next().map(|(k, _)| k).ok_or_else(|| Error::Usage("no camera".into()))?;
             (FrameInputs::from_scene(&scene, cam)?, w, h)
         };

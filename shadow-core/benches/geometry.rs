@@ -20,7 +20,7 @@ const SIZES: [u32; 3] = [10_000, 100_000, 1_000_000];
 fn sphere(tris: u32) -> Mesh {
     let segments = (tris as f32).sqrt().round() as u32;
     let rings = (tris / segments).div_ceil(2) + 1;
-    procedural::sphere(1.0, segments, rings)
+    procedural::sphere(1.0, segments, rings).expect("a sphere of the bench sizes")
 }
 
 const LIGHT: LightSource = LightSource::Point(Vec3::new(2.0, 4.0, 1.5));

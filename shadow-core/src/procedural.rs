@@ -9,27 +9,83 @@ use std::f32::consts::{PI, TAU};
 
 use glam::{Vec2, Vec3};
 
-use crate::mesh::Mesh;
+use crate::mesh::{Mesh, MeshError};
 
-/// Builders only produce valid meshes; a failure here is a bug in this module.
-fn build(positions: Vec<Vec3>, triangles: Vec<[u32; 3]>) -> Mesh {
-    match Mesh::new(positions, triangles) {
-        Ok(m) => m,
-        Err(e) => panic!("procedural mesh is invalid: {e}"),
+/// The most vertices a procedural mesh may have: 2^26 (some 2.3 GB with its triangles), so that a
+/// mistaken parameter is refused before it is allocated.
+pub const MAX_SHAPE_VERTICES: u64 = 1 << 26;
+
+/// Why a procedural mesh could not be built.
+#[derive(Debug, thiserror::Error)]
+pub enum ShapeError {
+    /// A parameter out of its range.
+    #[error("{shape}: {what} = {value}: {why}")]
+    Parameter {
+        /// The shape asked for.
+        shape: &'static str,
+        /// The parameter.
+        what: &'static str,
+        /// Its value, printed.
+        value: String,
+        /// What it must be.
+        why: &'static str,
+    },
+    /// The parameters ask for more than [`MAX_SHAPE_VERTICES`].
+    #[error("{shape}: {vertices} vertices, over the limit of {}", MAX_SHAPE_VERTICES)]
+    TooManyVertices {
+        /// The shape asked for.
+        shape: &'static str,
+        /// The vertices it would have.
+        vertices: u64,
+    },
+    /// The mesh made is refused (an implicit surface with no triangles, say).
+    #[error("{shape}: {source}")]
+    Mesh {
+        /// The shape asked for.
+        shape: &'static str,
+        /// Why.
+        source: MeshError,
+    },
+}
+
+/// `value` for `what` of `shape`, refused unless finite and above zero.
+fn positive(shape: &'static str, what: &'static str, value: f32) -> Result<f32, ShapeError> {
+    if value.is_finite() && value > 0.0 {
+        return Ok(value);
     }
+    Err(ShapeError::Parameter { shape, what, value: value.to_string(), why: "must be finite and above 0" })
+}
+
+/// Refuses `vertices` over [`MAX_SHAPE_VERTICES`].
+fn within_limit(shape: &'static str, vertices: u64) -> Result<(), ShapeError> {
+    if vertices > MAX_SHAPE_VERTICES {
+        return Err(ShapeError::TooManyVertices { shape, vertices });
+    }
+    Ok(())
+}
+
+fn build(shape: &'static str, positions: Vec<Vec3>, triangles: Vec<[u32; 3]>) -> Result<Mesh, ShapeError> {
+    Mesh::new(positions, triangles).map_err(|source| ShapeError::Mesh { shape, source })
 }
 
 /// A `width x depth` rectangle in the XZ plane, centred at the origin, facing +Y. Open: two triangles.
-#[must_use]
-pub fn plane(width: f32, depth: f32) -> Mesh {
-    let (w, d) = (width * 0.5, depth * 0.5);
+///
+/// # Errors
+/// [`ShapeError::Parameter`] for a side not finite and above 0.
+pub fn plane(width: f32, depth: f32) -> Result<Mesh, ShapeError> {
+    let (w, d) = (positive("plane", "width", width)? * 0.5, positive("plane", "depth", depth)? * 0.5);
     let p = vec![Vec3::new(-w, 0.0, -d), Vec3::new(-w, 0.0, d), Vec3::new(w, 0.0, d), Vec3::new(w, 0.0, -d)];
-    build(p, vec![[0, 1, 2], [0, 2, 3]])
+    build("plane", p, vec![[0, 1, 2], [0, 2, 3]])
 }
 
 /// An axis-aligned box of the given size centred at the origin, flat-shaded (24 vertices, 12 triangles).
-#[must_use]
-pub fn cuboid(size: Vec3) -> Mesh {
+///
+/// # Errors
+/// [`ShapeError::Parameter`] for a side not finite and above 0.
+pub fn cuboid(size: Vec3) -> Result<Mesh, ShapeError> {
+    for (what, v) in [("size.x", size.x), ("size.y", size.y), ("size.z", size.z)] {
+        positive("cuboid", what, v)?;
+    }
     let h = size * 0.5;
     let mut positions = Vec::with_capacity(24);
     let mut triangles = Vec::with_capacity(12);
@@ -49,16 +105,33 @@ pub fn cuboid(size: Vec3) -> Mesh {
         triangles.push([base, base + 1, base + 2]);
         triangles.push([base, base + 2, base + 3]);
     }
-    build(positions, triangles)
+    build("cuboid", positions, triangles)
 }
 
 /// A solid of revolution about +Y. `profile` lists (radius, height) points; the solid lies to the left of
 /// the profile's direction in the (radius, height) plane (so run it bottom to top on the outside). A point
 /// with radius 0 becomes a pole; a point repeated makes a crease (duplicated vertices, separate normals).
-/// With `closed_profile` the last point connects back to the first (a torus).
-#[must_use]
-pub fn lathe(profile: &[Vec2], segments: u32, closed_profile: bool) -> Mesh {
+/// With `closed_profile` the last point connects back to the first (a torus). At least 3 segments.
+///
+/// # Errors
+/// [`ShapeError::Parameter`] for fewer than two profile points, or one not finite or of a negative
+/// radius; [`ShapeError::TooManyVertices`] past [`MAX_SHAPE_VERTICES`]; [`ShapeError::Mesh`] for a
+/// profile that sweeps no area.
+pub fn lathe(profile: &[Vec2], segments: u32, closed_profile: bool) -> Result<Mesh, ShapeError> {
+    lathed("lathe", profile, segments, closed_profile)
+}
+
+/// [`lathe`], its errors naming `shape`.
+fn lathed(shape: &'static str, profile: &[Vec2], segments: u32, closed_profile: bool) -> Result<Mesh, ShapeError> {
     let segments = segments.max(3);
+    let point = |what, value: String, why| Err(ShapeError::Parameter { shape, what, value, why });
+    if profile.len() < 2 {
+        return point("profile", format!("{} points", profile.len()), "needs at least 2");
+    }
+    if let Some(p) = profile.iter().find(|p| !p.is_finite() || p.x < 0.0) {
+        return point("profile point", format!("{p}"), "must be finite with a radius of 0 or more");
+    }
+    within_limit(shape, profile.iter().map(|p| if p.x == 0.0 { 1 } else { u64::from(segments) }).sum())?;
     let mut positions = Vec::new();
     // Ring i: its first vertex, and whether it is a single pole vertex.
     let mut rings: Vec<(u32, bool)> = Vec::with_capacity(profile.len());
@@ -95,13 +168,18 @@ pub fn lathe(profile: &[Vec2], segments: u32, closed_profile: bool) -> Mesh {
             }
         }
     }
-    build(positions, triangles)
+    build(shape, positions, triangles)
 }
 
-/// A UV sphere centred at the origin.
-#[must_use]
-pub fn sphere(radius: f32, segments: u32, rings: u32) -> Mesh {
+/// A UV sphere centred at the origin; at least 3 segments and 2 rings.
+///
+/// # Errors
+/// [`ShapeError::Parameter`] for a radius not finite and above 0, [`ShapeError::TooManyVertices`] past
+/// [`MAX_SHAPE_VERTICES`].
+pub fn sphere(radius: f32, segments: u32, rings: u32) -> Result<Mesh, ShapeError> {
+    let radius = positive("sphere", "radius", radius)?;
     let rings = rings.max(2);
+    within_limit("sphere", u64::from(rings) * u64::from(segments.max(3)))?;
     let profile: Vec<Vec2> = (0..=rings)
         .map(|i| {
             let phi = PI * i as f32 / rings as f32;
@@ -109,41 +187,63 @@ pub fn sphere(radius: f32, segments: u32, rings: u32) -> Mesh {
             Vec2::new(r, -radius * phi.cos())
         })
         .collect();
-    lathe(&profile, segments, false)
+    lathed("sphere", &profile, segments, false)
 }
 
-/// A capped cylinder standing on y = 0, flat caps.
-#[must_use]
-pub fn cylinder(radius: f32, height: f32, segments: u32) -> Mesh {
-    let (r, h) = (radius, height);
+/// A capped cylinder standing on y = 0, flat caps; at least 3 segments.
+///
+/// # Errors
+/// [`ShapeError::Parameter`] for a radius or height not finite and above 0,
+/// [`ShapeError::TooManyVertices`] past [`MAX_SHAPE_VERTICES`].
+pub fn cylinder(radius: f32, height: f32, segments: u32) -> Result<Mesh, ShapeError> {
+    let (r, h) = (positive("cylinder", "radius", radius)?, positive("cylinder", "height", height)?);
     let profile = [(0.0, 0.0), (r, 0.0), (r, 0.0), (r, h), (r, h), (0.0, h)].map(Vec2::from);
-    lathe(&profile, segments, false)
+    lathed("cylinder", &profile, segments, false)
 }
 
-/// A cone standing on y = 0 with its apex at y = height.
-#[must_use]
-pub fn cone(radius: f32, height: f32, segments: u32) -> Mesh {
-    let profile = [(0.0, 0.0), (radius, 0.0), (radius, 0.0), (0.0, height)].map(Vec2::from);
-    lathe(&profile, segments, false)
+/// A cone standing on y = 0 with its apex at y = height; at least 3 segments.
+///
+/// # Errors
+/// As [`cylinder`].
+pub fn cone(radius: f32, height: f32, segments: u32) -> Result<Mesh, ShapeError> {
+    let (r, h) = (positive("cone", "radius", radius)?, positive("cone", "height", height)?);
+    let profile = [(0.0, 0.0), (r, 0.0), (r, 0.0), (0.0, h)].map(Vec2::from);
+    lathed("cone", &profile, segments, false)
 }
 
-/// A torus about +Y centred at the origin: ring radius `major`, tube radius `minor`.
-#[must_use]
-pub fn torus(major: f32, minor: f32, segments: u32, sides: u32) -> Mesh {
+/// A torus about +Y centred at the origin: ring radius `major`, tube radius `minor`; at least 3 segments
+/// and 3 sides.
+///
+/// # Errors
+/// [`ShapeError::Parameter`] for radii not finite and above 0, or a tube as wide as the ring or wider
+/// (it would cross the axis); [`ShapeError::TooManyVertices`] past [`MAX_SHAPE_VERTICES`].
+pub fn torus(major: f32, minor: f32, segments: u32, sides: u32) -> Result<Mesh, ShapeError> {
+    let (major, minor) = (positive("torus", "major", major)?, positive("torus", "minor", minor)?);
+    if minor >= major {
+        let why = "must be below the ring radius (major)";
+        return Err(ShapeError::Parameter { shape: "torus", what: "minor", value: minor.to_string(), why });
+    }
     let sides = sides.max(3);
+    within_limit("torus", u64::from(sides) * u64::from(segments.max(3)))?;
     let profile: Vec<Vec2> = (0..sides)
         .map(|i| {
             let t = TAU * i as f32 / sides as f32;
             Vec2::new(major + minor * t.cos(), minor * t.sin())
         })
         .collect();
-    lathe(&profile, segments, true)
+    lathed("torus", &profile, segments, true)
 }
 
-/// A capsule along +Y from y = 0 to y = `height` (caps included).
-#[must_use]
-pub fn capsule(radius: f32, height: f32, segments: u32, cap_rings: u32) -> Mesh {
+/// A capsule along +Y from y = 0 to y = `height` (caps included; the body is `height - 2 radius`, none
+/// when that is not above 0); at least 3 segments and 2 rings a cap.
+///
+/// # Errors
+/// [`ShapeError::Parameter`] for a radius or height not finite and above 0,
+/// [`ShapeError::TooManyVertices`] past [`MAX_SHAPE_VERTICES`].
+pub fn capsule(radius: f32, height: f32, segments: u32, cap_rings: u32) -> Result<Mesh, ShapeError> {
+    let (radius, height) = (positive("capsule", "radius", radius)?, positive("capsule", "height", height)?);
     let cap_rings = cap_rings.max(2);
+    within_limit("capsule", 2 * (u64::from(cap_rings) + 1) * u64::from(segments.max(3)))?;
     let body = (height - 2.0 * radius).max(0.0);
     let mut profile = Vec::new();
     for i in 0..=cap_rings {
@@ -156,15 +256,31 @@ pub fn capsule(radius: f32, height: f32, segments: u32, cap_rings: u32) -> Mesh 
         let r = if i == cap_rings { 0.0 } else { radius * phi.cos() };
         profile.push(Vec2::new(r, radius + body + radius * phi.sin()));
     }
-    lathe(&profile, segments, false)
+    lathed("capsule", &profile, segments, false)
 }
 
 /// A prism: a polygon in the XZ plane (counter-clockwise seen from +Y) extruded from y = 0 to `height`.
 /// The caps are fanned from vertex `fan_from`, which must see the whole polygon (any vertex of a convex
 /// polygon; the reflex vertex of an L).
-#[must_use]
-pub fn prism(outline: &[Vec2], fan_from: usize, height: f32) -> Mesh {
+///
+/// # Errors
+/// [`ShapeError::Parameter`] for fewer than 3 outline points or one not finite, `fan_from` not one of
+/// them, or a height not finite and above 0; [`ShapeError::TooManyVertices`] past
+/// [`MAX_SHAPE_VERTICES`].
+pub fn prism(outline: &[Vec2], fan_from: usize, height: f32) -> Result<Mesh, ShapeError> {
     let n = outline.len();
+    let bad = |what, value: String, why| Err(ShapeError::Parameter { shape: "prism", what, value, why });
+    if n < 3 {
+        return bad("outline", format!("{n} points"), "needs at least 3");
+    }
+    if let Some(p) = outline.iter().find(|p| !p.is_finite()) {
+        return bad("outline point", format!("{p}"), "must be finite");
+    }
+    if fan_from >= n {
+        return bad("fan_from", fan_from.to_string(), "must be the index of an outline point");
+    }
+    let height = positive("prism", "height", height)?;
+    within_limit("prism", 6 * n as u64)?;
     let mut positions = Vec::new();
     let mut triangles = Vec::new();
     // Caps: bottom faces -Y (reverse order), top faces +Y.
@@ -191,17 +307,29 @@ pub fn prism(outline: &[Vec2], fan_from: usize, height: f32) -> Mesh {
         triangles.push([base, base + 1, base + 2]);
         triangles.push([base, base + 2, base + 3]);
     }
-    build(positions, triangles)
+    build("prism", positions, triangles)
 }
 
 /// The isosurface f = 0 of an implicit solid (f < 0 inside) over a box, by marching tetrahedra on a grid
 /// of `cells` cubes along the longest side, each cut into six tetrahedra around its main diagonal (the cut
-/// agrees across shared faces, so the surface is watertight). Returns `None` if the surface is empty.
-/// Normals are the normalized gradient of f.
-pub fn implicit(f: impl Fn(Vec3) -> f32, lo: Vec3, hi: Vec3, cells: u32) -> Option<Mesh> {
+/// agrees across shared faces, so the surface is watertight). Normals are the normalized gradient of f.
+///
+/// # Errors
+/// [`ShapeError::Parameter`] for a box not finite or empty along an axis, or no cells;
+/// [`ShapeError::TooManyVertices`] for a grid of more nodes than [`MAX_SHAPE_VERTICES`];
+/// [`ShapeError::Mesh`] ([`MeshError::Empty`]) where the surface does not cross the box.
+pub fn implicit(f: impl Fn(Vec3) -> f32, lo: Vec3, hi: Vec3, cells: u32) -> Result<Mesh, ShapeError> {
+    let bad = |what, value: String, why| Err(ShapeError::Parameter { shape: "implicit", what, value, why });
+    if !lo.is_finite() || !hi.is_finite() || lo.cmpge(hi).any() {
+        return bad("box", format!("{lo} to {hi}"), "must be finite, its high corner above its low one on every axis");
+    }
+    if cells == 0 {
+        return bad("cells", "0".into(), "must be at least 1");
+    }
     let size = hi - lo;
-    let h = size.max_element() / cells.max(1) as f32;
+    let h = size.max_element() / cells as f32;
     let dims = (size / h).ceil().as_uvec3().max(glam::UVec3::ONE);
+    within_limit("implicit", (dims.as_u64vec3() + 1).element_product())?;
     let (nx, ny) = (dims.x + 1, dims.y + 1);
     let node = |x: u32, y: u32, z: u32| -> u32 { x + nx * (y + ny * z) };
     let node_pos = |i: u32| {
@@ -259,7 +387,7 @@ pub fn implicit(f: impl Fn(Vec3) -> f32, lo: Vec3, hi: Vec3, cells: u32) -> Opti
         }
     }
     if triangles.is_empty() {
-        return None;
+        return Err(ShapeError::Mesh { shape: "implicit", source: MeshError::Empty });
     }
     let e = h * 0.25;
     let normals = positions
@@ -273,7 +401,7 @@ pub fn implicit(f: impl Fn(Vec3) -> f32, lo: Vec3, hi: Vec3, cells: u32) -> Opti
             g.normalize_or_zero()
         })
         .collect();
-    Mesh::with_normals(positions, normals, triangles).ok()
+    Mesh::with_normals(positions, normals, triangles).map_err(|source| ShapeError::Mesh { shape: "implicit", source })
 }
 
 #[cfg(test)]
@@ -294,12 +422,12 @@ mod tests {
     #[test]
     fn solids_are_closed_with_the_right_volume() {
         let cases: [(Mesh, f32, f32); 6] = [
-            (cuboid(Vec3::new(1.0, 2.0, 3.0)), 6.0, 1e-5),
-            (sphere(1.0, 64, 32), 4.0 / 3.0 * PI, 0.01),
-            (cylinder(0.5, 2.0, 64), PI * 0.25 * 2.0, 0.01),
-            (cone(1.0, 3.0, 64), PI / 3.0 * 3.0, 0.01),
-            (torus(1.0, 0.25, 64, 32), 2.0 * PI * PI * 0.0625, 0.01),
-            (capsule(0.5, 3.0, 48, 12), PI * 0.25 * 2.0 + 4.0 / 3.0 * PI * 0.125, 0.01),
+            (cuboid(Vec3::new(1.0, 2.0, 3.0)).expect("shape"), 6.0, 1e-5),
+            (sphere(1.0, 64, 32).expect("shape"), 4.0 / 3.0 * PI, 0.01),
+            (cylinder(0.5, 2.0, 64).expect("shape"), PI * 0.25 * 2.0, 0.01),
+            (cone(1.0, 3.0, 64).expect("shape"), PI / 3.0 * 3.0, 0.01),
+            (torus(1.0, 0.25, 64, 32).expect("shape"), 2.0 * PI * PI * 0.0625, 0.01),
+            (capsule(0.5, 3.0, 48, 12).expect("shape"), PI * 0.25 * 2.0 + 4.0 / 3.0 * PI * 0.125, 0.01),
         ];
         for (i, (mesh, expected, tol)) in cases.iter().enumerate() {
             let adj = Adjacency::build(mesh);
@@ -310,16 +438,65 @@ mod tests {
     }
 
     #[test]
+    fn bad_parameters_are_refused_naming_the_shape_and_the_value() {
+        let l = [Vec2::ZERO, Vec2::X, Vec2::ONE];
+        let tilted = |f: &dyn Fn(Vec3) -> f32| implicit(f, Vec3::splat(-1.0), Vec3::splat(1.0), 8);
+        let cases: [(Result<Mesh, ShapeError>, &str); 14] = [
+            (plane(0.0, 1.0), "plane: width = 0: must be finite and above 0"),
+            (plane(1.0, f32::NAN), "plane: depth = NaN"),
+            (cuboid(Vec3::new(1.0, -1.0, 1.0)), "cuboid: size.y = -1"),
+            (sphere(f32::INFINITY, 8, 4), "sphere: radius = inf"),
+            (cylinder(0.5, 0.0, 8), "cylinder: height = 0"),
+            (cone(-1.0, 1.0, 8), "cone: radius = -1"),
+            (torus(0.2, 0.3, 8, 8), "torus: minor = 0.3: must be below the ring radius"),
+            (capsule(0.0, 1.0, 8, 2), "capsule: radius = 0"),
+            (lathe(&[Vec2::Y], 8, false), "lathe: profile = 1 points: needs at least 2"),
+            (lathe(&[Vec2::ZERO, Vec2::new(-1.0, 1.0)], 8, false), "lathe: profile point = [-1, 1]"),
+            (prism(&l[..2], 0, 1.0), "prism: outline = 2 points: needs at least 3"),
+            (prism(&l, 3, 1.0), "prism: fan_from = 3: must be the index of an outline point"),
+            (tilted(&|p| p.length() + 1.0), "implicit: mesh has no triangles"),
+            (implicit(|p| p.length() - 0.5, Vec3::ONE, Vec3::ONE, 8), "implicit: box = [1, 1, 1] to [1, 1, 1]"),
+        ];
+        for (shape, words) in cases {
+            let e = shape.expect_err(words).to_string();
+            assert!(e.starts_with(words), "'{e}' does not start with '{words}'");
+        }
+    }
+
+    #[test]
+    fn shapes_past_the_vertex_limit_are_refused_before_they_are_made() {
+        // Each would take gigabytes: the test runs out of memory if the limit is not checked first.
+        let huge = 1 << 20;
+        for (shape, name) in [
+            (sphere(1.0, huge, huge), "sphere"),
+            (torus(1.0, 0.5, huge, huge), "torus"),
+            (capsule(1.0, 4.0, huge, huge), "capsule"),
+            (implicit(|p| p.length() - 1.0, Vec3::splat(-1.0), Vec3::splat(1.0), 1 << 12), "implicit"),
+        ] {
+            match shape {
+                Err(ShapeError::TooManyVertices { shape, vertices }) => {
+                    assert_eq!(shape, name);
+                    assert!(vertices > MAX_SHAPE_VERTICES, "{name}: {vertices}");
+                }
+                other => panic!("{name}: {other:?}"),
+            }
+        }
+        // The limit itself is allowed, one vertex more is not.
+        assert!(within_limit("sphere", MAX_SHAPE_VERTICES).is_ok());
+        assert!(within_limit("sphere", MAX_SHAPE_VERTICES + 1).is_err());
+    }
+
+    #[test]
     fn l_prism_is_closed() {
         let l = [(0.0, 0.0), (2.0, 0.0), (2.0, -1.0), (1.0, -1.0), (1.0, -2.0), (0.0, -2.0)].map(Vec2::from);
-        let m = prism(&l, 3, 1.0);
+        let m = prism(&l, 3, 1.0).expect("shape");
         assert!(Adjacency::build(&m).closed());
         assert!((volume(&m) - 3.0).abs() < 1e-5);
     }
 
     #[test]
     fn implicit_sphere_is_closed() {
-        let m = implicit(|p| p.length() - 1.0, Vec3::splat(-1.3), Vec3::splat(1.3), 20).unwrap();
+        let m = implicit(|p| p.length() - 1.0, Vec3::splat(-1.3), Vec3::splat(1.3), 20).expect("shape");
         let adj = Adjacency::build(&m);
         assert!(adj.closed(), "boundary {} complex {}", adj.boundary_edge_count(), adj.complex_edges().len());
         assert!((volume(&m) - 4.0 / 3.0 * PI).abs() < 0.1);

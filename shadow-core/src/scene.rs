@@ -710,8 +710,8 @@ mod tests {
     fn mesh_versions_differ_across_scenes() {
         // Two scenes give out the same first key; a GPU cache keyed by (key, version) must not mix them.
         let (mut a, mut b) = (Scene::new(), Scene::new());
-        let ka = a.add_mesh(procedural::cuboid(Vec3::ONE));
-        let kb = b.add_mesh(procedural::plane(1.0, 1.0));
+        let ka = a.add_mesh(procedural::cuboid(Vec3::ONE).expect("shape"));
+        let kb = b.add_mesh(procedural::plane(1.0, 1.0).expect("shape"));
         assert_eq!(ka, kb);
         assert_ne!(a.mesh_version(ka), b.mesh_version(kb));
     }
@@ -719,11 +719,11 @@ mod tests {
     #[test]
     fn replacing_a_mesh_drops_its_adjacency() {
         let mut s = Scene::new();
-        let m = s.add_mesh(procedural::cuboid(Vec3::ONE));
+        let m = s.add_mesh(procedural::cuboid(Vec3::ONE).expect("shape"));
         let v0 = s.mesh_version(m).unwrap();
         assert!(s.adjacency(m).unwrap().closed());
         assert!(s.has_cached_adjacency(m));
-        s.replace_mesh(m, procedural::plane(1.0, 1.0)).unwrap();
+        s.replace_mesh(m, procedural::plane(1.0, 1.0).expect("shape")).unwrap();
         assert!(!s.has_cached_adjacency(m));
         assert_ne!(s.mesh_version(m).unwrap(), v0);
         assert!(!s.adjacency(m).unwrap().closed());

@@ -176,7 +176,7 @@ mod tests {
     /// x in x0..x0 + 4, z in -2..2).
     fn occluder_from(x0: f32) -> SceneBvh {
         let mut scene = Scene::new();
-        let mesh = scene.add_mesh(procedural::plane(4.0, 4.0));
+        let mesh = scene.add_mesh(procedural::plane(4.0, 4.0).expect("shape"));
         let material = scene.add_material(Material::colored("grey", Vec3::splat(0.5)));
         scene.add_instance("occluder", mesh, material, Mat4::from_translation(Vec3::new(x0 + 2.0, 1.0, 0.0))).unwrap();
         let camera = scene.add_camera(Camera::look_at(Vec3::new(0.0, 5.0, 5.0), Vec3::ZERO, 45.0));

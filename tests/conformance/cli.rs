@@ -85,6 +85,12 @@ fn bad_inputs_give_one_line_and_the_right_status() {
         (&["bench", "--frames", "0", "--backend", "cpu"], 2, "--frames must be at least 1"),
         (&["bench", "--sweep", "speed=1,2", "--backend", "cpu"], 2, "must be res or tris"),
         (&["bench", "--sweep", "res=256,-3", "--backend", "cpu"], 2, "positive whole numbers"),
+        // A sphere of 2 billion vertices, refused before it is allocated.
+        (
+            &["bench", "--sweep", "tris=4000000000", "--backend", "cpu"],
+            2,
+            "sphere: 2000091504 vertices, over the limit",
+        ),
         (
             &["render", "--technique", "ray-traced", "--backend", "wgpu", "-o", out],
             2,

@@ -168,7 +168,7 @@ fn caster_masks_keep_the_picture_on_both_backends() {
     let lone_sphere = {
         let mut s = Scene::new();
         let grey = s.add_material(Material::colored("grey", Vec3::splat(0.75)));
-        let sphere = s.add_mesh(shadow_core::procedural::sphere(0.4, 128, 32));
+        let sphere = s.add_mesh(shadow_core::procedural::sphere(0.4, 128, 32).expect("shape"));
         s.add_instance("sphere", sphere, grey, Mat4::from_translation(Vec3::new(0.0, 0.5, 0.0))).expect("sphere");
         let ground = s.add_mesh(scenes::ground_quad());
         let ground = s.add_instance("ground", ground, grey, Mat4::IDENTITY).expect("ground");
@@ -182,7 +182,7 @@ fn caster_masks_keep_the_picture_on_both_backends() {
     let mirrored = {
         let mut s = Scene::new();
         let grey = s.add_material(Material::colored("grey", Vec3::splat(0.75)));
-        let cube = s.add_mesh(shadow_core::procedural::cuboid(Vec3::splat(0.15)));
+        let cube = s.add_mesh(shadow_core::procedural::cuboid(Vec3::splat(0.15)).expect("shape"));
         for i in 0..9 {
             let (x, z) = ((i % 3) as f32 * 0.5 - 0.5, (i / 3) as f32 * 0.5 - 0.5);
             let tilt = Mat4::from_rotation_y(0.4 * i as f32) * Mat4::from_rotation_x(0.3 + 0.2 * i as f32);

@@ -359,7 +359,7 @@ mod tests {
     #[test]
     fn cube_is_closed_after_welding() {
         // The procedural cuboid has 24 vertices (flat normals); welding leaves 8.
-        let adj = Adjacency::build(&procedural::cuboid(Vec3::ONE));
+        let adj = Adjacency::build(&procedural::cuboid(Vec3::ONE).expect("shape"));
         assert_eq!(adj.vertex_count(), 8);
         assert_eq!(adj.edge_count(), 18);
         assert!(adj.closed());
@@ -369,8 +369,8 @@ mod tests {
     fn components_are_joined_by_edges_not_by_vertices() {
         // Two cubes touching at one corner, and a pair of triangles sharing only a vertex (a bowtie): four
         // components, numbered in order of first appearance, each bounding its own faces.
-        let a = procedural::cuboid(Vec3::ONE);
-        let b = procedural::cuboid(Vec3::ONE).transformed(glam::Mat4::from_translation(Vec3::ONE));
+        let a = procedural::cuboid(Vec3::ONE).expect("shape");
+        let b = procedural::cuboid(Vec3::ONE).expect("shape").transformed(glam::Mat4::from_translation(Vec3::ONE));
         let bowtie = Mesh::new(
             vec![
                 Vec3::new(5.0, 0.0, 0.0),
@@ -393,7 +393,7 @@ mod tests {
 
     #[test]
     fn plane_has_boundary() {
-        let adj = Adjacency::build(&procedural::plane(2.0, 2.0));
+        let adj = Adjacency::build(&procedural::plane(2.0, 2.0).expect("shape"));
         assert_eq!(adj.boundary_edge_count(), 4);
         assert_eq!(adj.edge_count(), 5);
         assert!(!adj.closed());
@@ -411,7 +411,7 @@ mod tests {
 
     #[test]
     fn flipped_triangle_is_inconsistent() {
-        let mesh = procedural::cuboid(Vec3::ONE);
+        let mesh = procedural::cuboid(Vec3::ONE).expect("shape");
         let mut tris = mesh.triangles().to_vec();
         tris[0] = [tris[0][0], tris[0][2], tris[0][1]];
         let flipped = Mesh::new(mesh.positions().to_vec(), tris).unwrap();

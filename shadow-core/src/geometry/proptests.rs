@@ -23,7 +23,7 @@ fn closed_mesh() -> impl Strategy<Value = Mesh> {
                 Vec2::new(r, -phi.cos() * jitter[(i + 5) % jitter.len()])
             })
             .collect();
-        procedural::lathe(&profile, segments, false)
+        procedural::lathe(&profile, segments, false).expect("a lathe of finite points")
     })
 }
 

@@ -145,7 +145,7 @@ mod tests {
     use crate::procedural;
 
     fn cube() -> Adjacency {
-        Adjacency::build(&procedural::cuboid(Vec3::splat(2.0)))
+        Adjacency::build(&procedural::cuboid(Vec3::splat(2.0)).expect("shape"))
     }
 
     /// Net weighted out-degree of every vertex: zero everywhere for a closed loop set.
@@ -195,7 +195,7 @@ mod tests {
 
     #[test]
     fn open_plane_casts_with_boundary_weight_one() {
-        let adj = Adjacency::build(&procedural::plane(2.0, 2.0));
+        let adj = Adjacency::build(&procedural::plane(2.0, 2.0).expect("shape"));
         assert_eq!(CastMode::for_mesh(&adj), CastMode::Bergeron);
         let above = silhouette(&adj, LightSource::Point(Vec3::new(0.0, 3.0, 0.0)), CastMode::Bergeron);
         assert_eq!(above.edges.len(), 4);

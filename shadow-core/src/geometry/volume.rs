@@ -229,8 +229,11 @@ pub(crate) mod tests {
 
     #[test]
     fn closed_volumes_are_closed_and_outward() {
-        for mesh in [procedural::cuboid(Vec3::ONE), procedural::sphere(0.7, 12, 8), procedural::torus(1.0, 0.3, 16, 8)]
-        {
+        for mesh in [
+            procedural::cuboid(Vec3::ONE).expect("shape"),
+            procedural::sphere(0.7, 12, 8).expect("shape"),
+            procedural::torus(1.0, 0.3, 16, 8).expect("shape"),
+        ] {
             let adj = Adjacency::build(&mesh);
             for light in
                 [LightSource::Point(Vec3::new(2.0, 3.0, 1.5)), LightSource::Directional(Vec3::new(-0.3, -1.0, 0.2))]
@@ -255,10 +258,16 @@ pub(crate) mod tests {
     fn each_component_casts_a_closed_piece() {
         // Two boxes, a torus and an open plane in one mesh; a point and a directional light.
         let parts = [
-            procedural::cuboid(Vec3::ONE),
-            procedural::cuboid(Vec3::splat(0.5)).transformed(glam::Mat4::from_translation(Vec3::new(3.0, 0.5, 0.0))),
-            procedural::torus(1.0, 0.3, 16, 8).transformed(glam::Mat4::from_translation(Vec3::new(-3.0, 0.0, 1.0))),
-            procedural::plane(2.0, 2.0).transformed(glam::Mat4::from_translation(Vec3::new(0.0, -2.0, 0.0))),
+            procedural::cuboid(Vec3::ONE).expect("shape"),
+            procedural::cuboid(Vec3::splat(0.5))
+                .expect("shape")
+                .transformed(glam::Mat4::from_translation(Vec3::new(3.0, 0.5, 0.0))),
+            procedural::torus(1.0, 0.3, 16, 8)
+                .expect("shape")
+                .transformed(glam::Mat4::from_translation(Vec3::new(-3.0, 0.0, 1.0))),
+            procedural::plane(2.0, 2.0)
+                .expect("shape")
+                .transformed(glam::Mat4::from_translation(Vec3::new(0.0, -2.0, 0.0))),
         ];
         let adj = Adjacency::build(&crate::mesh::Mesh::merged(&parts).expect("four parts"));
         assert_eq!(adj.component_bounds().len(), 4);
@@ -297,7 +306,7 @@ pub(crate) mod tests {
     fn side_quads_face_out_of_the_shadow() {
         // Cube lit from straight above by a point light: a point just outside a side quad, away from the
         // cube's shadow, lies on the side the quad's normal points to.
-        let adj = Adjacency::build(&procedural::cuboid(Vec3::splat(2.0)));
+        let adj = Adjacency::build(&procedural::cuboid(Vec3::splat(2.0)).expect("shape"));
         let light = LightSource::Point(Vec3::new(0.0, 5.0, 0.0));
         let vol = extrude(&adj, &silhouette(&adj, light, CastMode::Closed), light, Caps::None);
         assert_eq!(vol.sides.len(), 8);

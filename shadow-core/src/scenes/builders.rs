@@ -5,7 +5,7 @@
 
 use glam::{Mat4, Quat, Vec2, Vec3};
 
-use super::{Rng, SceneParams};
+use super::{Rng, SceneParams, built};
 use crate::mesh::Mesh;
 use crate::procedural;
 use crate::scene::{Camera, Light, Material, Scene};
@@ -30,7 +30,7 @@ impl Stage {
     }
 
     fn ground(mut self, size: f32) -> Self {
-        self.add("ground", procedural::plane(size, size), Vec3::splat(0.75), Mat4::IDENTITY);
+        self.add("ground", built(procedural::plane(size, size)), Vec3::splat(0.75), Mat4::IDENTITY);
         self
     }
 
@@ -52,7 +52,7 @@ fn at(x: f32, y: f32, z: f32) -> Mat4 {
 
 pub(super) fn cylinder(_: &SceneParams) -> Scene {
     let mut s = Stage::new().ground(10.0);
-    s.add("cylinder", procedural::cylinder(0.3, 1.0, 64), WARM, Mat4::IDENTITY);
+    s.add("cylinder", built(procedural::cylinder(0.3, 1.0, 64)), WARM, Mat4::IDENTITY);
     s.finish(
         Camera::look_at(Vec3::new(1.2, 1.9, 3.2), Vec3::new(-0.4, 0.3, -0.5), 45.0),
         Light::spot(Vec3::new(2.0, 4.0, 1.5), Vec3::new(0.0, 0.3, 0.0), 60.0),
@@ -61,10 +61,10 @@ pub(super) fn cylinder(_: &SceneParams) -> Scene {
 
 pub(super) fn primitives(_: &SceneParams) -> Scene {
     let mut s = Stage::new().ground(10.0);
-    s.add("box", procedural::cuboid(Vec3::splat(0.6)), WARM, at(-0.9, 0.3, 0.3) * Mat4::from_rotation_y(0.5));
-    s.add("cylinder", procedural::cylinder(0.25, 0.8, 128), BLUE, at(0.8, 0.0, 0.5));
-    s.add("sphere", procedural::sphere(0.35, 64, 40), GREEN, at(0.0, 0.35, -0.6));
-    s.add("torus", procedural::torus(0.35, 0.12, 80, 24), GOLD, at(0.9, 0.12, -0.7));
+    s.add("box", built(procedural::cuboid(Vec3::splat(0.6))), WARM, at(-0.9, 0.3, 0.3) * Mat4::from_rotation_y(0.5));
+    s.add("cylinder", built(procedural::cylinder(0.25, 0.8, 128)), BLUE, at(0.8, 0.0, 0.5));
+    s.add("sphere", built(procedural::sphere(0.35, 64, 40)), GREEN, at(0.0, 0.35, -0.6));
+    s.add("torus", built(procedural::torus(0.35, 0.12, 80, 24)), GOLD, at(0.9, 0.12, -0.7));
     s.finish(
         Camera::look_at(Vec3::new(0.3, 2.2, 3.4), Vec3::new(-0.2, 0.1, -0.4), 45.0),
         Light::spot(Vec3::new(2.0, 4.0, 1.5), Vec3::new(-0.1, 0.0, -0.1), 60.0),
@@ -73,10 +73,10 @@ pub(super) fn primitives(_: &SceneParams) -> Scene {
 
 pub(super) fn stacked_boxes(_: &SceneParams) -> Scene {
     let mut s = Stage::new().ground(10.0);
-    s.add("lower box", procedural::cuboid(Vec3::new(1.2, 0.5, 1.2)), BLUE, at(0.0, 0.25, 0.0));
+    s.add("lower box", built(procedural::cuboid(Vec3::new(1.2, 0.5, 1.2))), BLUE, at(0.0, 0.25, 0.0));
     s.add(
         "upper box",
-        procedural::cuboid(Vec3::new(0.6, 0.08, 0.6)),
+        built(procedural::cuboid(Vec3::new(0.6, 0.08, 0.6))),
         WARM,
         at(0.55, 1.4, 0.35) * Mat4::from_rotation_y(0.3),
     );
@@ -89,7 +89,7 @@ pub(super) fn stacked_boxes(_: &SceneParams) -> Scene {
 pub(super) fn l_shape(_: &SceneParams) -> Scene {
     let mut s = Stage::new().ground(6.0);
     let outline = [(0.0, 0.0), (1.2, 0.0), (1.2, -0.4), (0.4, -0.4), (0.4, -1.2), (0.0, -1.2)].map(Vec2::from);
-    s.add("l-shape", procedural::prism(&outline, 3, 0.3), WARM, at(-0.6, 0.5, 0.6));
+    s.add("l-shape", built(procedural::prism(&outline, 3, 0.3)), WARM, at(-0.6, 0.5, 0.6));
     s.finish(
         Camera::look_at(Vec3::new(1.3, 2.3, 2.4), Vec3::new(-0.1, 0.2, -0.1), 45.0),
         Light::directional(Vec3::new(0.25, -1.0, 0.15)),
@@ -107,8 +107,8 @@ fn double_torus_sdf(p: Vec3) -> f32 {
 
 pub(super) fn double_torus(_: &SceneParams) -> Scene {
     let mut s = Stage::new().ground(8.0);
-    let mesh = procedural::implicit(double_torus_sdf, Vec3::new(-1.2, -0.3, -0.75), Vec3::new(1.2, 0.3, 0.75), 48);
-    let mesh = mesh.unwrap_or_else(|| panic!("the double torus surface is empty"));
+    let mesh =
+        built(procedural::implicit(double_torus_sdf, Vec3::new(-1.2, -0.3, -0.75), Vec3::new(1.2, 0.3, 0.75), 48));
     s.add("double torus", mesh, GOLD, at(0.0, 0.6, 0.0) * Mat4::from_rotation_x(0.25));
     s.finish(
         Camera::look_at(Vec3::new(0.6, 2.2, 2.8), Vec3::new(0.0, 0.3, 0.0), 45.0),
@@ -138,12 +138,12 @@ fn pin() -> Mesh {
     ]
     .map(Vec2::from)
     .to_vec();
-    procedural::lathe(&profile, 16, false)
+    built(procedural::lathe(&profile, 16, false))
 }
 
 pub(super) fn strike(_: &SceneParams) -> Scene {
     let mut s = Stage::new();
-    s.add("lane", procedural::plane(2.2, 8.0), Vec3::new(0.8, 0.65, 0.45), Mat4::IDENTITY);
+    s.add("lane", built(procedural::plane(2.2, 8.0)), Vec3::new(0.8, 0.65, 0.45), Mat4::IDENTITY);
     let pin_mesh = pin();
     let spacing = 0.305;
     for row in 0..4 {
@@ -153,7 +153,7 @@ pub(super) fn strike(_: &SceneParams) -> Scene {
             s.add(&format!("pin {row}.{k}"), pin_mesh.clone(), Vec3::splat(0.92), at(x, 0.0, z));
         }
     }
-    s.add("ball", procedural::sphere(0.11, 32, 20), Vec3::new(0.2, 0.25, 0.7), at(0.12, 0.11, -0.8));
+    s.add("ball", built(procedural::sphere(0.11, 32, 20)), Vec3::new(0.2, 0.25, 0.7), at(0.12, 0.11, -0.8));
     s.finish(
         Camera::look_at(Vec3::new(0.5, 0.9, 0.6), Vec3::new(-0.1, 0.1, -1.9), 45.0),
         Light::spot(Vec3::new(-0.9, 2.6, 0.2), Vec3::new(0.0, 0.0, -1.7), 60.0),
@@ -164,7 +164,7 @@ pub(super) fn strike(_: &SceneParams) -> Scene {
 fn figure(rng: &mut Rng) -> Mesh {
     let limb = |r: f32, len: f32, from: Vec3, dir: Vec3| {
         let rot = Quat::from_rotation_arc(Vec3::Y, dir.normalize());
-        procedural::capsule(r, len, 8, 3).transformed(Mat4::from_rotation_translation(rot, from))
+        built(procedural::capsule(r, len, 8, 3)).transformed(Mat4::from_rotation_translation(rot, from))
     };
     let sway = rng.range(-0.15, 0.15);
     let parts = [
@@ -173,7 +173,7 @@ fn figure(rng: &mut Rng) -> Mesh {
         limb(0.16, 0.7, Vec3::new(0.0, 0.78, 0.0), Vec3::Y),
         limb(0.05, 0.65, Vec3::new(-0.2, 1.38, 0.0), Vec3::new(-0.3 + sway, -1.0, 0.1)),
         limb(0.05, 0.65, Vec3::new(0.2, 1.38, 0.0), Vec3::new(0.3 + sway, -1.0, -0.1)),
-        procedural::sphere(0.11, 10, 8).transformed(at(0.0, 1.58, 0.0)),
+        built(procedural::sphere(0.11, 10, 8)).transformed(at(0.0, 1.58, 0.0)),
     ];
     Mesh::merged(&parts).unwrap_or_else(|e| panic!("figure: {e}"))
 }
@@ -183,7 +183,7 @@ pub(super) fn crowd(p: &SceneParams) -> Scene {
     let mut s = Stage::new().ground(16.0);
     s.add(
         "wall",
-        procedural::plane(16.0, 6.0),
+        built(procedural::plane(16.0, 6.0)),
         Vec3::splat(0.8),
         at(0.0, 3.0, -6.0) * Mat4::from_rotation_x(std::f32::consts::FRAC_PI_2),
     );
@@ -207,7 +207,7 @@ pub(super) fn crowd(p: &SceneParams) -> Scene {
 pub(super) fn cubes(p: &SceneParams) -> Scene {
     let mut rng = Rng::new(p.seed);
     let mut s = Stage::new().ground(10.0);
-    let unit = procedural::cuboid(Vec3::splat(0.13));
+    let unit = built(procedural::cuboid(Vec3::splat(0.13)));
     let parts: Vec<Mesh> = (0..1000)
         .map(|_| {
             let pos = Vec3::new(rng.range(-1.3, 1.3), rng.range(0.2, 1.6), rng.range(-1.3, 1.3));
@@ -231,7 +231,7 @@ fn blob(rng: &mut Rng) -> Mesh {
         })
         .collect();
     let f = move |q: Vec3| q.length() - 0.42 - waves.iter().map(|(k, ph)| 0.025 * (k.dot(q) + ph).sin()).sum::<f32>();
-    procedural::implicit(f, Vec3::splat(-0.6), Vec3::splat(0.6), 24).unwrap_or_else(|| panic!("blob surface is empty"))
+    built(procedural::implicit(f, Vec3::splat(-0.6), Vec3::splat(0.6), 24))
 }
 
 pub(super) fn cage(p: &SceneParams) -> Scene {
@@ -242,10 +242,10 @@ pub(super) fn cage(p: &SceneParams) -> Scene {
     let mut parts = Vec::new();
     for i in 0..bars {
         let a = std::f32::consts::TAU * i as f32 / bars as f32;
-        parts.push(procedural::cylinder(0.025, 1.6, 10).transformed(at(0.85 * a.cos(), 0.0, 0.85 * a.sin())));
+        parts.push(built(procedural::cylinder(0.025, 1.6, 10)).transformed(at(0.85 * a.cos(), 0.0, 0.85 * a.sin())));
     }
     for y in [0.05, 1.55] {
-        parts.push(procedural::torus(0.85, 0.035, 64, 10).transformed(at(0.0, y, 0.0)));
+        parts.push(built(procedural::torus(0.85, 0.035, 64, 10)).transformed(at(0.0, y, 0.0)));
     }
     s.add("cage", Mesh::merged(&parts).unwrap_or_else(|e| panic!("cage: {e}")), Vec3::splat(0.55), Mat4::IDENTITY);
     s.finish(
@@ -256,7 +256,7 @@ pub(super) fn cage(p: &SceneParams) -> Scene {
 
 fn branch(rng: &mut Rng, base: Vec3, dir: Vec3, length: f32, radius: f32, depth: u32, out: &mut Vec<Mesh>) {
     let rot = Quat::from_rotation_arc(Vec3::Y, dir);
-    out.push(procedural::cylinder(radius, length, 9).transformed(Mat4::from_rotation_translation(rot, base)));
+    out.push(built(procedural::cylinder(radius, length, 9)).transformed(Mat4::from_rotation_translation(rot, base)));
     if depth == 0 {
         return;
     }
@@ -297,17 +297,22 @@ pub(super) fn room(_: &SceneParams) -> Scene {
     use std::f32::consts::FRAC_PI_2;
     let mut s = Stage::new();
     let wall = Vec3::splat(0.8);
-    s.add("floor", procedural::plane(6.0, 7.0), Vec3::splat(0.7), at(0.0, 0.0, 0.5));
-    s.add("back wall", procedural::plane(6.0, 3.6), wall, at(0.0, 1.8, -3.0) * Mat4::from_rotation_x(FRAC_PI_2));
-    s.add("left wall", procedural::plane(3.6, 7.0), wall, at(-3.0, 1.8, 0.5) * Mat4::from_rotation_z(-FRAC_PI_2));
-    s.add("right wall", procedural::plane(3.6, 7.0), wall, at(3.0, 1.8, 0.5) * Mat4::from_rotation_z(FRAC_PI_2));
-    s.add("beam", procedural::cuboid(Vec3::new(1.4, 0.25, 0.9)), WARM, at(0.0, 2.5, 1.25));
-    s.add("table", procedural::cuboid(Vec3::new(1.2, 0.8, 0.8)), BLUE, at(1.0, 0.4, -0.3));
-    s.add("ball", procedural::sphere(0.3, 32, 16), GREEN, at(-1.1, 0.3, -1.0));
+    s.add("floor", built(procedural::plane(6.0, 7.0)), Vec3::splat(0.7), at(0.0, 0.0, 0.5));
+    s.add("back wall", built(procedural::plane(6.0, 3.6)), wall, at(0.0, 1.8, -3.0) * Mat4::from_rotation_x(FRAC_PI_2));
+    s.add(
+        "left wall",
+        built(procedural::plane(3.6, 7.0)),
+        wall,
+        at(-3.0, 1.8, 0.5) * Mat4::from_rotation_z(-FRAC_PI_2),
+    );
+    s.add("right wall", built(procedural::plane(3.6, 7.0)), wall, at(3.0, 1.8, 0.5) * Mat4::from_rotation_z(FRAC_PI_2));
+    s.add("beam", built(procedural::cuboid(Vec3::new(1.4, 0.25, 0.9))), WARM, at(0.0, 2.5, 1.25));
+    s.add("table", built(procedural::cuboid(Vec3::new(1.2, 0.8, 0.8))), BLUE, at(1.0, 0.4, -0.3));
+    s.add("ball", built(procedural::sphere(0.3, 32, 16)), GREEN, at(-1.1, 0.3, -1.0));
     // The eye is at (0, 1.2, 3) with a near plane 0.05 ahead (z = 2.95), whose half-width is 0.026 at
     // 55 degrees: the post reaches 0.025 to the eye's left and spans z 2.935..2.96, so the near plane cuts
     // it. The segment from the eye to the light runs through the beam, so the eye is in its shadow.
-    s.add("post", procedural::cuboid(Vec3::new(0.18, 3.0, 0.025)), GOLD, at(-0.115, 1.5, 2.9475));
+    s.add("post", built(procedural::cuboid(Vec3::new(0.18, 3.0, 0.025))), GOLD, at(-0.115, 1.5, 2.9475));
     s.finish(
         Camera::look_at(Vec3::new(0.0, 1.2, 3.0), Vec3::new(0.0, 0.7, -2.0), 55.0),
         Light::spot(Vec3::new(0.0, 3.4, 0.0), Vec3::new(0.0, 0.0, -1.0), 130.0),

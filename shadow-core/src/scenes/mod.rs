@@ -177,10 +177,16 @@ pub fn retype_lights(scene: &mut Scene, t: LightType) {
     }
 }
 
+/// A shape of the built-in scenes, whose parameters are this module's own constants: a failure is a bug
+/// here, not bad input.
+pub(crate) fn built(shape: Result<Mesh, procedural::ShapeError>) -> Mesh {
+    shape.unwrap_or_else(|e| panic!("built-in scene: {e}"))
+}
+
 /// The ground receiver of staged models: a 10 x 10 quad on y = 0.
 #[must_use]
 pub fn ground_quad() -> Mesh {
-    procedural::plane(10.0, 10.0)
+    built(procedural::plane(10.0, 10.0))
 }
 
 /// Puts a loaded model on stage (DESIGN 11): scaled so the largest side of its bounds is 1, centred over
@@ -289,7 +295,7 @@ mod tests {
     #[test]
     fn staged_models_stand_on_the_ground() {
         let mut s = Scene::new();
-        let m = s.add_mesh(procedural::sphere(3.0, 16, 8));
+        let m = s.add_mesh(procedural::sphere(3.0, 16, 8).expect("shape"));
         let mat = s.add_material(Material::default());
         s.add_instance("ball", m, mat, Mat4::from_translation(Vec3::new(10.0, -5.0, 2.0))).unwrap();
         stage_model(&mut s, true);

@@ -146,7 +146,7 @@ mod tests {
     /// One unit cube on the origin under a spot light of radius 0.2 at height 4.
     fn frame() -> FrameInputs {
         let mut scene = Scene::new();
-        let mesh = scene.add_mesh(procedural::cuboid(Vec3::splat(1.0)));
+        let mesh = scene.add_mesh(procedural::cuboid(Vec3::splat(1.0)).expect("shape"));
         let material = scene.add_material(Material::colored("grey", Vec3::splat(0.5)));
         scene.add_instance("caster", mesh, material, Mat4::IDENTITY).unwrap();
         let camera = scene.add_camera(Camera::look_at(Vec3::new(0.0, 3.0, 4.0), Vec3::ZERO, 45.0));

@@ -244,7 +244,7 @@ mod tests {
         // extended away from the cube's centre, and four convex corners.
         for (name, transform) in [("plain", Mat4::IDENTITY), ("mirrored", Mat4::from_scale(Vec3::new(-1.0, 1.0, 1.0)))]
         {
-            let frame = frame_of(procedural::cuboid(Vec3::splat(1.0)), transform);
+            let frame = frame_of(procedural::cuboid(Vec3::splat(1.0)).expect("shape"), transform);
             let (s, centre) = smoothies_of(&frame, 0.02);
             assert_eq!(s.edges, 4, "{name}");
             for tri in &s.triangles {
@@ -286,8 +286,12 @@ mod tests {
     fn vertices_with_more_than_two_silhouette_edges_join_their_edges_to_the_averaged_normal() {
         // Two cubes sharing one corner vertex diagonally make a vertex with four silhouette edges: the
         // thesis's special case, one triangle per adjacent edge to the apex t out along the normal.
-        let a = procedural::cuboid(Vec3::splat(1.0)).transformed(Mat4::from_translation(Vec3::new(0.5, 0.0, 0.5)));
-        let b = procedural::cuboid(Vec3::splat(1.0)).transformed(Mat4::from_translation(Vec3::new(-0.5, 0.0, -0.5)));
+        let a = procedural::cuboid(Vec3::splat(1.0))
+            .expect("shape")
+            .transformed(Mat4::from_translation(Vec3::new(0.5, 0.0, 0.5)));
+        let b = procedural::cuboid(Vec3::splat(1.0))
+            .expect("shape")
+            .transformed(Mat4::from_translation(Vec3::new(-0.5, 0.0, -0.5)));
         let mesh = shadow_core::Mesh::merged([&a, &b]).unwrap();
         let frame = frame_of(mesh, Mat4::IDENTITY);
         let (s, _) = smoothies_of(&frame, 0.02);

@@ -757,7 +757,7 @@ mod tests {
         // sides come in quads for, and a directional light, which they do not.
         let mut s = Scene::new();
         let grey = s.add_material(Material::colored("grey", Vec3::splat(0.75)));
-        let cube = s.add_mesh(shadow_core::procedural::cuboid(Vec3::splat(0.3)));
+        let cube = s.add_mesh(shadow_core::procedural::cuboid(Vec3::splat(0.3)).expect("shape"));
         let tilt = Mat4::from_rotation_x(0.4) * Mat4::from_rotation_y(0.7);
         let at = |x: f32| Mat4::from_translation(Vec3::new(x, 0.5, 0.0)) * tilt;
         s.add_instance("cube", cube, grey, at(-0.4)).expect("cube");
