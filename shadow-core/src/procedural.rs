@@ -179,6 +179,7 @@ fn lathed(shape: &'static str, profile: &[Vec2], segments: u32, closed_profile: 
 pub fn sphere(radius: f32, segments: u32, rings: u32) -> Result<Mesh, ShapeError> {
     let radius = positive("sphere", "radius", radius)?;
     let rings = rings.max(2);
+    // Checked before the profile is made: its rings alone could exhaust memory (lathe checks again, exactly).
     within_limit("sphere", u64::from(rings) * u64::from(segments.max(3)))?;
     let profile: Vec<Vec2> = (0..=rings)
         .map(|i| {
@@ -224,6 +225,7 @@ pub fn torus(major: f32, minor: f32, segments: u32, sides: u32) -> Result<Mesh, 
         return Err(ShapeError::Parameter { shape: "torus", what: "minor", value: minor.to_string(), why });
     }
     let sides = sides.max(3);
+    // As sphere's: before the profile is made.
     within_limit("torus", u64::from(sides) * u64::from(segments.max(3)))?;
     let profile: Vec<Vec2> = (0..sides)
         .map(|i| {
@@ -243,6 +245,7 @@ pub fn torus(major: f32, minor: f32, segments: u32, sides: u32) -> Result<Mesh, 
 pub fn capsule(radius: f32, height: f32, segments: u32, cap_rings: u32) -> Result<Mesh, ShapeError> {
     let (radius, height) = (positive("capsule", "radius", radius)?, positive("capsule", "height", height)?);
     let cap_rings = cap_rings.max(2);
+    // As sphere's: before the profile is made.
     within_limit("capsule", 2 * (u64::from(cap_rings) + 1) * u64::from(segments.max(3)))?;
     let body = (height - 2.0 * radius).max(0.0);
     let mut profile = Vec::new();
