@@ -565,6 +565,28 @@ impl Scene {
         Ok(())
     }
 
+    /// Puts every root node under one new root `name` with transform `local`, and returns it: one pass
+    /// over the roots, where moving each with [`Scene::set_parent`] would search the root list each time.
+    ///
+    /// # Errors
+    /// A non-finite transform.
+    pub fn group_roots(&mut self, name: &str, local: Mat4) -> Result<NodeKey, SceneError> {
+        let roots = std::mem::take(&mut self.roots);
+        let group = match self.add_node(name, None, local) {
+            Ok(k) => k,
+            Err(e) => {
+                self.roots = roots;
+                return Err(e);
+            }
+        };
+        for &r in &roots {
+            self.nodes[r].parent = Some(group);
+        }
+        self.nodes[group].children = roots;
+        self.update_subtree(group);
+        Ok(group)
+    }
+
     /// Removes a node and its whole subtree.
     ///
     /// # Errors
@@ -704,6 +726,22 @@ mod tests {
         assert!(s.set_local_transform(a, Mat4::from_scale(Vec3::splat(f32::NAN))).is_err());
         s.remove_node(a).unwrap();
         assert_eq!(s.node_count(), 0);
+    }
+
+    #[test]
+    fn grouping_the_roots_moves_every_subtree() {
+        let mut s = Scene::new();
+        let a = s.add_node("a", None, Mat4::from_translation(Vec3::X)).unwrap();
+        let b = s.add_node("b", Some(a), Mat4::from_translation(Vec3::Y)).unwrap();
+        let c = s.add_node("c", None, Mat4::from_translation(Vec3::Z)).unwrap();
+        let g = s.group_roots("g", Mat4::from_scale(Vec3::splat(2.0))).unwrap();
+        assert_eq!(s.roots(), &[g]);
+        assert_eq!(s.node(g).unwrap().children(), &[a, c]);
+        assert_eq!(s.node(a).unwrap().parent(), Some(g));
+        assert_eq!(s.node(b).unwrap().world_transform().w_axis.truncate(), Vec3::new(2.0, 2.0, 0.0));
+        assert_eq!(s.node(c).unwrap().world_transform().w_axis.truncate(), Vec3::new(0.0, 0.0, 2.0));
+        assert!(s.group_roots("bad", Mat4::from_scale(Vec3::splat(f32::NAN))).is_err());
+        assert_eq!(s.roots(), &[g]);
     }
 
     #[test]

@@ -13,14 +13,14 @@ use glam::{Mat4, Vec3};
 use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::{Mode, Semantic};
 
-use super::{AssetError, AssetFault, read_file};
-use crate::mesh::Mesh;
+use super::{AssetError, AssetFault, LoadOptions, read_model, read_referenced};
+use crate::mesh::{MAX_COORDINATE, Mesh};
 use crate::scene::{Camera, Light, LightKind, Material, MaterialKey, MeshKey, NodeKey, Scene};
 
 type Fault = AssetFault;
 
-pub(super) fn load(path: &Path) -> Result<Scene, AssetError> {
-    parse(path).map_err(|f| AssetError::new(path, f))
+pub(super) fn load(path: &Path, options: &LoadOptions) -> Result<Scene, AssetError> {
+    parse(path, options).map_err(|f| AssetError::new(path, f))
 }
 
 /// The JSON and BIN chunks of a GLB container.
@@ -98,35 +98,33 @@ fn percent_decode(s: &str) -> String {
     String::from_utf8_lossy(&out).into_owned()
 }
 
-fn load_buffers(doc: &gltf::Document, dir: &Path, bin: Option<&[u8]>) -> Result<Vec<Vec<u8>>, Fault> {
+fn load_buffers(
+    doc: &gltf::Document,
+    dir: &Path,
+    bin: Option<&[u8]>,
+    options: &LoadOptions,
+) -> Result<Vec<Vec<u8>>, Fault> {
     doc.buffers()
         .map(|b| {
+            let what = format!("buffer {}", b.index());
             let data = match b.source() {
                 gltf::buffer::Source::Bin => bin
-                    .ok_or_else(|| {
-                        Fault::Malformed(format!("buffer {} refers to a GLB BIN chunk that is missing", b.index()))
-                    })?
+                    .ok_or_else(|| Fault::Malformed(format!("{what} refers to a GLB BIN chunk that is missing")))?
                     .to_vec(),
                 gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => {
                     let (_, payload) = uri
                         .split_once(";base64,")
-                        .ok_or_else(|| Fault::Unsupported("a data URI that is not base64".into()))?;
+                        .ok_or_else(|| Fault::Unsupported(format!("{what}: a data URI that is not base64")))?;
                     base64_decode(payload)?
                 }
+                // Never more than the buffer declares: a file may be longer (or endless) behind it.
                 gltf::buffer::Source::Uri(uri) => {
-                    let file = dir.join(percent_decode(uri));
-                    read_file(&file).map_err(|f| match f {
-                        Fault::NotFound(_) => {
-                            Fault::NotFound(format!("{} (buffer {} of the model)", file.display(), b.index()))
-                        }
-                        other => other,
-                    })?
+                    read_referenced(dir, &percent_decode(uri), &what, Some(b.length() as u64), options)?
                 }
             };
             if data.len() < b.length() {
                 return Err(Fault::Truncated(format!(
-                    "buffer {} holds {} bytes, the file declares {}",
-                    b.index(),
+                    "{what} holds {} bytes, the file declares {}",
                     data.len(),
                     b.length()
                 )));
@@ -161,7 +159,9 @@ fn read_accessor(acc: &gltf::Accessor, buffers: &[Vec<u8>], what: &str) -> Resul
     }
     let count = acc.count();
     if count > 0 {
-        let need = (count - 1).checked_mul(stride).and_then(|n| n.checked_add(acc.offset() + elem));
+        // Every later offset is below `need`, so once it fits nothing below can overflow.
+        let need =
+            (count - 1).checked_mul(stride).and_then(|n| n.checked_add(acc.offset())).and_then(|n| n.checked_add(elem));
         if need.is_none_or(|n| n > view_bytes.len()) {
             return Err(Fault::Truncated(format!(
                 "accessor {} ({what}) reads past the end of buffer view {}",
@@ -321,31 +321,68 @@ impl Loader<'_> {
         Ok(out)
     }
 
-    /// Adds a node and its subtree; `path` holds the nodes above, to find cycles.
+    /// Adds the scene's nodes depth-first from `roots`, without recursion (a chain of nodes may be as deep
+    /// as the file is long). A node met again is a cycle when it is on the path from its root, and a node
+    /// with two parents otherwise.
+    fn walk(&mut self, roots: &[usize]) -> Result<(), Fault> {
+        enum Step {
+            Enter(usize, Option<NodeKey>, Mat4),
+            Leave(usize),
+        }
+        let nodes: Vec<gltf::Node> = self.doc.nodes().collect();
+        let count = nodes.len();
+        let (mut seen, mut on_path) = (vec![false; count], vec![false; count]);
+        let mut stack: Vec<Step> = roots.iter().rev().map(|&r| Step::Enter(r, None, Mat4::IDENTITY)).collect();
+        while let Some(step) = stack.pop() {
+            let (index, parent, parent_world) = match step {
+                Step::Enter(i, p, w) => (i, p, w),
+                Step::Leave(i) => {
+                    on_path[i] = false;
+                    continue;
+                }
+            };
+            if on_path[index] {
+                return Err(Fault::Cycle(format!("node {index} is its own ancestor")));
+            }
+            if std::mem::replace(&mut seen[index], true) {
+                return Err(Fault::Cycle(format!("node {index} has more than one parent")));
+            }
+            let node = nodes.get(index).ok_or_else(|| Fault::Malformed(format!("node {index} does not exist")))?;
+            let (key, world) = self.node(node, parent, parent_world)?;
+            on_path[index] = true;
+            stack.push(Step::Leave(index));
+            let children: Vec<usize> = node.children().map(|c| c.index()).collect();
+            stack.extend(children.into_iter().rev().map(|c| Step::Enter(c, Some(key), world)));
+        }
+        Ok(())
+    }
+
+    /// Adds one node under `parent`: its mesh's primitives, camera and light. Returns its key and world
+    /// transform.
     fn node(
         &mut self,
-        node: gltf::Node,
+        node: &gltf::Node,
         parent: Option<NodeKey>,
         parent_world: Mat4,
-        path: &mut Vec<usize>,
-        seen: &mut [bool],
-    ) -> Result<(), Fault> {
-        if path.contains(&node.index()) {
-            return Err(Fault::Cycle(format!("node {} is its own ancestor", node.index())));
-        }
-        if std::mem::replace(&mut seen[node.index()], true) {
-            return Err(Fault::Cycle(format!("node {} has more than one parent", node.index())));
-        }
+    ) -> Result<(NodeKey, Mat4), Fault> {
+        let index = node.index();
         let local = Mat4::from_cols_array_2d(&node.transform().matrix());
         if !local.is_finite() {
-            return Err(Fault::Malformed(format!("node {} has a non-finite transform", node.index())));
+            return Err(Fault::Malformed(format!("node {index} has a non-finite transform")));
         }
-        let name = node.name().map_or_else(|| format!("node {}", node.index()), str::to_string);
+        // glTF node matrices are decomposable into translation, rotation and scale, so affine.
+        if local.row(3) != glam::Vec4::W {
+            return Err(Fault::Malformed(format!("node {index} has a matrix whose last row is not 0 0 0 1")));
+        }
+        let name = node.name().map_or_else(|| format!("node {index}"), str::to_string);
         let key = self.scene.add_node(&name, parent, local).map_err(|e| Fault::Malformed(e.to_string()))?;
         let world = parent_world * local;
         if let Some(mesh) = node.mesh() {
             let prims = self.primitives(&mesh)?;
             for (i, p) in prims.into_iter().enumerate() {
+                let what = format!("mesh {} primitive {i}", mesh.index());
+                check_world(&self.scene, p.0, world)
+                    .map_err(|why| Fault::Malformed(format!("node {index}: {what} {why}")))?;
                 // A node holds one mesh; extra primitives hang below it as children at the same place.
                 let target = if i == 0 {
                     key
@@ -357,6 +394,12 @@ impl Loader<'_> {
                 self.scene.set_mesh(target, Some(p)).map_err(|e| Fault::Malformed(e.to_string()))?;
             }
         }
+        self.camera_and_light(node, world);
+        Ok((key, world))
+    }
+
+    /// The node's perspective camera and KHR punctual light, placed by its world transform.
+    fn camera_and_light(&mut self, node: &gltf::Node, world: Mat4) {
         let (_, rot, trans) = world.to_scale_rotation_translation();
         let forward = (rot * Vec3::NEG_Z).normalize_or(Vec3::NEG_Z);
         if let Some(cam) = node.camera()
@@ -384,21 +427,65 @@ impl Loader<'_> {
                 self.scene.add_light(light);
             }
         }
-        path.push(node.index());
-        for child in node.children() {
-            self.node(child, Some(key), world, path, seen)?;
-        }
-        path.pop();
-        Ok(())
     }
 }
 
-fn parse(path: &Path) -> Result<Scene, Fault> {
-    let bytes = read_file(path)?;
+/// Checks that a mesh placed by `world` stays inside f32 geometry and keeps some area: the mesh's own
+/// checks ran on its local positions, and a transform can overflow them (a huge translation, nested
+/// huge scales) or flatten every triangle (a zero scale). The corners of the local bounds bound the
+/// placed positions, since the transform is affine.
+fn check_world(scene: &Scene, mesh: MeshKey, world: Mat4) -> Result<(), String> {
+    let Some(mesh) = scene.mesh(mesh) else { return Ok(()) };
+    if !world.is_finite() {
+        return Err("has a world transform that overflows f32".into());
+    }
+    let b = mesh.bounds();
+    let reach = (0..8)
+        .map(|i| {
+            let corner = Vec3::new(
+                if i & 1 == 0 { b.min.x } else { b.max.x },
+                if i & 2 == 0 { b.min.y } else { b.max.y },
+                if i & 4 == 0 { b.min.z } else { b.max.z },
+            );
+            world.transform_point3(corner).abs().max_element()
+        })
+        .fold(0.0f32, |m, r| if r.is_nan() { f32::INFINITY } else { m.max(r) });
+    if reach > MAX_COORDINATE {
+        return Err(format!("reaches {reach:e} in world space, beyond +-{MAX_COORDINATE:e}"));
+    }
+    let p = |i: u32| world.transform_point3(mesh.positions()[i as usize]);
+    let has_area = mesh.triangles().iter().any(|&[a, b, c]| (p(b) - p(a)).cross(p(c) - p(a)).length_squared() > 0.0);
+    if !has_area {
+        return Err(format!("has zero area in world space (all {} triangles degenerate)", mesh.triangle_count()));
+    }
+    Ok(())
+}
+
+/// Refuses attributes and indices that name accessors the file does not have, before the gltf crate
+/// validates (it indexes the POSITION accessor unchecked to look at its bounds).
+fn check_accessor_indices(root: &gltf::json::Root) -> Result<(), Fault> {
+    let n = root.accessors.len();
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, prim) in mesh.primitives.iter().enumerate() {
+            let named = prim.attributes.iter().map(|(semantic, a)| (format!("{semantic:?}"), a.value()));
+            let indices = prim.indices.iter().map(|a| ("indices".to_string(), a.value()));
+            if let Some((what, a)) = named.chain(indices).find(|&(_, a)| a >= n) {
+                return Err(Fault::Malformed(format!(
+                    "mesh {m} primitive {p}: {what} names accessor {a}, but the file has {n}"
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
+fn parse(path: &Path, options: &LoadOptions) -> Result<Scene, Fault> {
+    let bytes = read_model(path)?;
     let (json, bin) = if bytes.starts_with(b"glTF") { split_glb(&bytes)? } else { (bytes.as_slice(), None) };
     let root: gltf::json::Root =
         gltf::json::deserialize::from_slice(json).map_err(|e| Fault::Malformed(format!("JSON: {e}")))?;
     check_required_extensions(&root)?;
+    check_accessor_indices(&root)?;
     let doc = match gltf::Document::from_json(root.clone()) {
         Ok(doc) => doc,
         Err(gltf::Error::Validation(errs)) => {
@@ -418,7 +505,7 @@ fn parse(path: &Path) -> Result<Scene, Fault> {
         Err(other) => return Err(Fault::Malformed(other.to_string())),
     };
     let dir = path.parent().unwrap_or(Path::new("."));
-    let buffers = load_buffers(&doc, dir, bin)?;
+    let buffers = load_buffers(&doc, dir, bin, options)?;
     let mut loader = Loader {
         buffers,
         scene: Scene::new(),
@@ -427,22 +514,21 @@ fn parse(path: &Path) -> Result<Scene, Fault> {
         doc: &doc,
         triangles: 0,
     };
-    let roots: Vec<gltf::Node> = match doc.default_scene().or_else(|| doc.scenes().next()) {
-        Some(s) => s.nodes().collect(),
+    let roots: Vec<usize> = match doc.default_scene().or_else(|| doc.scenes().next()) {
+        Some(s) => s.nodes().map(|n| n.index()).collect(),
         None => {
             // No scene: every node that is nobody's child is a root.
-            let children: Vec<usize> =
-                doc.nodes().flat_map(|n| n.children().map(|c| c.index()).collect::<Vec<_>>()).collect();
-            doc.nodes().filter(|n| !children.contains(&n.index())).collect()
+            let mut is_child = vec![false; doc.nodes().len()];
+            for c in doc.nodes().flat_map(|n| n.children()) {
+                is_child[c.index()] = true;
+            }
+            (0..is_child.len()).filter(|&i| !is_child[i]).collect()
         }
     };
     if roots.is_empty() && doc.nodes().len() > 0 {
         return Err(Fault::Cycle("every node is some node's child, so there is no root".into()));
     }
-    let mut seen = vec![false; loader.doc.nodes().len()];
-    for r in roots {
-        loader.node(r, None, Mat4::IDENTITY, &mut Vec::new(), &mut seen)?;
-    }
+    loader.walk(&roots)?;
     if loader.triangles == 0 {
         let any_prims = doc.meshes().any(|m| m.primitives().len() > 0);
         return Err(if any_prims {

@@ -12,6 +12,7 @@ mod obj;
 mod ply;
 
 use std::fmt;
+use std::io::Read;
 use std::path::Path;
 
 use crate::mesh::MeshError;
@@ -38,6 +39,9 @@ pub enum AssetFault {
     Cycle(String),
     /// A mesh that would render wrong: index out of range, non-finite position, no triangles.
     Mesh(String, MeshError),
+    /// A file the model names that the loader may not read (outside the model's folder, not a regular
+    /// file, a URI scheme other than a relative path or `data:`).
+    Access(String),
 }
 
 impl fmt::Display for AssetFault {
@@ -54,6 +58,7 @@ impl fmt::Display for AssetFault {
             Self::WrongAccessor(what) => write!(f, "wrong accessor type: {what}"),
             Self::Cycle(what) => write!(f, "bad node graph: {what}"),
             Self::Mesh(which, e) => write!(f, "{which}: {e}"),
+            Self::Access(what) => write!(f, "{what}"),
         }
     }
 }
@@ -83,12 +88,37 @@ pub fn is_model_path(path: &Path) -> bool {
     path.extension().and_then(|e| e.to_str()).is_some_and(|e| EXTENSIONS.contains(&e.to_ascii_lowercase().as_str()))
 }
 
+/// Which files a model may name besides itself (glTF buffers, OBJ material libraries).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum FileAccess {
+    /// Relative paths that stay inside the model's folder, links included (the default).
+    #[default]
+    ModelFolder,
+    /// Any regular file, absolute paths and `..` included.
+    Anywhere,
+}
+
+/// How a model is loaded.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct LoadOptions {
+    /// Which files the model may name.
+    pub file_access: FileAccess,
+}
+
 /// Loads a model file into a new scene (meshes, materials and nodes; cameras and lights where the format
-/// has them).
+/// has them), with the default [`LoadOptions`].
 ///
 /// # Errors
 /// An [`AssetError`] naming the file and the fault.
 pub fn load(path: impl AsRef<Path>) -> Result<Scene, AssetError> {
+    load_with(path, &LoadOptions::default())
+}
+
+/// Loads a model file with the given options.
+///
+/// # Errors
+/// An [`AssetError`] naming the file and the fault.
+pub fn load_with(path: impl AsRef<Path>, options: &LoadOptions) -> Result<Scene, AssetError> {
     let path = path.as_ref();
     let err = |fault| AssetError::new(path, fault);
     if !path.exists() {
@@ -98,8 +128,8 @@ pub fn load(path: impl AsRef<Path>) -> Result<Scene, AssetError> {
     let ext = name.rsplit('.').next().unwrap_or("");
     // The parsers are hardened, but a bug in a dependency must not take the process down with it.
     let result = std::panic::catch_unwind(|| match ext {
-        "obj" => obj::load(path),
-        "gltf" | "glb" => gltf::load(path),
+        "obj" => obj::load(path, options),
+        "gltf" | "glb" => gltf::load(path, options),
         "ply" => ply::load(path),
         "gz" if name.ends_with(".ply.gz") => ply::load(path),
         _ => Err(err(AssetFault::UnknownFormat(ext.to_string()))),
@@ -107,10 +137,88 @@ pub fn load(path: impl AsRef<Path>) -> Result<Scene, AssetError> {
     result.unwrap_or_else(|_| Err(err(AssetFault::Malformed("the parser failed on this input".into()))))
 }
 
-/// Reads a whole file, mapping failures to faults.
-fn read_file(path: &Path) -> Result<Vec<u8>, AssetFault> {
-    std::fs::read(path).map_err(|e| match e.kind() {
+/// Reads the model file itself. The user named it, so it is read whole, but only if it is a regular file:
+/// a FIFO or a device could block or never end.
+fn read_model(path: &Path) -> Result<Vec<u8>, AssetFault> {
+    regular_file(path, &path.display().to_string())?;
+    std::fs::read(path).map_err(|e| io_fault(path, &e))
+}
+
+fn io_fault(path: &Path, e: &std::io::Error) -> AssetFault {
+    match e.kind() {
         std::io::ErrorKind::NotFound => AssetFault::NotFound(path.display().to_string()),
-        _ => AssetFault::Io(e.to_string()),
-    })
+        _ => AssetFault::Io(format!("{}: {e}", path.display())),
+    }
+}
+
+/// Fails unless `path` is (or links to) a regular file.
+fn regular_file(path: &Path, what: &str) -> Result<(), AssetFault> {
+    let meta = std::fs::metadata(path).map_err(|e| io_fault(path, &e))?;
+    if meta.is_file() { Ok(()) } else { Err(AssetFault::Access(format!("{what} is not a regular file"))) }
+}
+
+/// Reads a file that a model names (`reference`, as the model writes it; `what` says where, e.g.
+/// "buffer 0"), resolved against the model's `folder` under `options.file_access`, and at most `limit`
+/// bytes of it when given.
+///
+/// Under [`FileAccess::ModelFolder`] the reference must be a relative path whose `..` never climbs out of
+/// the folder, and whose real location (links followed) is inside it. Under either rule it must be a
+/// regular file, and URI schemes (`http:`, `file:`, ...) are not read.
+fn read_referenced(
+    folder: &Path,
+    reference: &str,
+    what: &str,
+    limit: Option<u64>,
+    options: &LoadOptions,
+) -> Result<Vec<u8>, AssetFault> {
+    let refuse = |why: String| AssetFault::Access(format!("{what} names '{reference}', {why}"));
+    // A scheme is two or more characters before a colon (one is a Windows drive letter).
+    if let Some((scheme, _)) = reference.split_once(':')
+        && scheme.len() > 1
+        && scheme.chars().all(|c| c.is_ascii_alphanumeric() || "+-.".contains(c))
+    {
+        return Err(refuse(format!("a '{scheme}:' URI; only relative paths and data: URIs are read")));
+    }
+    let relative = Path::new(reference);
+    let confined = options.file_access == FileAccess::ModelFolder;
+    if confined {
+        use std::path::Component;
+        let absolute = relative.is_absolute()
+            || reference.starts_with(['/', '\\'])
+            || relative.components().any(|c| matches!(c, Component::Prefix(_) | Component::RootDir));
+        if absolute {
+            return Err(refuse("an absolute path; a model may name only files inside its own folder".into()));
+        }
+        let mut depth = 0i64;
+        for c in relative.components() {
+            depth += match c {
+                Component::Normal(_) => 1,
+                Component::ParentDir => -1,
+                _ => 0,
+            };
+            if depth < 0 {
+                return Err(refuse("a path outside the model's folder".into()));
+            }
+        }
+    }
+    let file = folder.join(relative);
+    regular_file(&file, &format!("{what} ('{}')", file.display()))?;
+    if confined {
+        let real = |p: &Path| p.canonicalize().map_err(|e| io_fault(p, &e));
+        if !real(&file)?.starts_with(real(folder)?) {
+            return Err(refuse("a link to a file outside the model's folder".into()));
+        }
+    }
+    let mut reader = std::fs::File::open(&file).map_err(|e| io_fault(&file, &e))?;
+    read_at_most(&mut reader, limit.unwrap_or(u64::MAX)).map_err(|e| io_fault(&file, &e))
+}
+
+/// Reads at most `limit` bytes.
+///
+/// # Errors
+/// The reader's error.
+pub fn read_at_most(reader: &mut impl std::io::Read, limit: u64) -> std::io::Result<Vec<u8>> {
+    let mut out = Vec::new();
+    reader.take(limit).read_to_end(&mut out)?;
+    Ok(out)
 }

@@ -1,14 +1,15 @@
 //! PLY (Stanford polygon format): ASCII, binary little endian and binary big endian, optionally gzipped
 //! (recognized by its magic bytes). Vertex `x y z` and optional `nx ny nz`; faces from the list property
-//! `vertex_indices` (or `vertex_index`), polygons fanned into triangles. Other elements and properties
-//! are read past.
+//! `vertex_indices` (or `vertex_index`) of a `face` element, polygons fanned into triangles, or of a
+//! `tristrips` element, strips split at each -1 (as classic range scans ship them). Other elements and
+//! properties are read past. Errors in an ASCII body name the line, in a binary body the byte.
 
 use std::io::Read;
 use std::path::Path;
 
 use glam::{Mat4, Vec3};
 
-use super::{AssetError, AssetFault, read_file};
+use super::{AssetError, AssetFault, read_model};
 use crate::mesh::Mesh;
 use crate::scene::{Material, Scene};
 
@@ -76,12 +77,25 @@ struct Body<'a> {
     bytes: &'a [u8],
     pos: usize,
     encoding: Encoding,
+    /// The file line `pos` is on (ASCII bodies).
+    line: usize,
+    /// The file byte `bytes` starts at (binary bodies).
+    offset: usize,
 }
 
-impl Body<'_> {
-    fn token(&mut self) -> Result<&str, AssetFault> {
-        let b = self.bytes;
+impl<'a> Body<'a> {
+    /// Where the cursor is, for messages: the line of an ASCII body, the byte of a binary one.
+    fn place(&self) -> String {
+        match self.encoding {
+            Encoding::Ascii => format!("line {}", self.line),
+            _ => format!("byte {}", self.offset + self.pos),
+        }
+    }
+
+    fn token(&mut self) -> Result<&'a str, AssetFault> {
+        let b: &'a [u8] = self.bytes;
         while self.pos < b.len() && b[self.pos].is_ascii_whitespace() {
+            self.line += usize::from(b[self.pos] == b'\n');
             self.pos += 1;
         }
         let start = self.pos;
@@ -89,22 +103,28 @@ impl Body<'_> {
             self.pos += 1;
         }
         if start == self.pos {
-            return Err(AssetFault::Truncated("the data ends before every element was read".into()));
+            return Err(AssetFault::Truncated(format!(
+                "the data ends at {} before every element was read",
+                self.place()
+            )));
         }
         std::str::from_utf8(&b[start..self.pos])
-            .map_err(|_| AssetFault::Malformed("non-text bytes in an ASCII body".into()))
+            .map_err(|_| AssetFault::Malformed(format!("line {}: non-text bytes in an ASCII body", self.line)))
     }
 
     fn value(&mut self, t: Scalar) -> Result<f64, AssetFault> {
         if self.encoding == Encoding::Ascii {
             let tok = self.token()?;
-            return tok.parse::<f64>().map_err(|_| AssetFault::Malformed(format!("'{tok}' is not a number")));
+            return tok
+                .parse::<f64>()
+                .map_err(|_| AssetFault::Malformed(format!("line {}: '{tok}' is not a number", self.line)));
         }
         let n = t.size();
+        let place = self.place();
         let raw = self
             .bytes
             .get(self.pos..self.pos + n)
-            .ok_or_else(|| AssetFault::Truncated("the data ends before every element was read".into()))?;
+            .ok_or_else(|| AssetFault::Truncated(format!("the data ends at {place} before every element was read")))?;
         self.pos += n;
         let mut buf = [0u8; 8];
         buf[..n].copy_from_slice(raw);
@@ -136,7 +156,8 @@ fn parse_header(text: &str) -> Result<(Encoding, Vec<Element>), AssetFault> {
     }
     let mut encoding = None;
     let mut elements: Vec<Element> = Vec::new();
-    for line in lines {
+    for (n, line) in lines.enumerate() {
+        let bad = |m: String| AssetFault::Malformed(format!("header line {}: {m}", n + 2));
         let words: Vec<&str> = line.split_whitespace().collect();
         match words.as_slice() {
             [] | ["comment", ..] | ["obj_info", ..] => {}
@@ -191,7 +212,7 @@ pub(super) fn load(path: &Path) -> Result<Scene, AssetError> {
 }
 
 fn parse(path: &Path) -> Result<Scene, AssetFault> {
-    let bytes = decompress(read_file(path)?)?;
+    let bytes = decompress(read_model(path)?)?;
     if !bytes.starts_with(b"ply") {
         return Err(AssetFault::Malformed("the file does not start with 'ply'".into()));
     }
@@ -208,7 +229,9 @@ fn parse(path: &Path) -> Result<Scene, AssetFault> {
     while start < bytes.len() && bytes[start] != b'\n' {
         start += 1;
     }
-    let mut body = Body { bytes: &bytes[(start + 1).min(bytes.len())..], pos: 0, encoding };
+    let body_start = (start + 1).min(bytes.len());
+    let first_line = 1 + bytes[..body_start].iter().filter(|&&b| b == b'\n').count();
+    let mut body = Body { bytes: &bytes[body_start..], pos: 0, encoding, line: first_line, offset: body_start };
 
     let mut positions: Vec<Vec3> = Vec::new();
     let mut normals: Vec<Vec3> = Vec::new();
@@ -237,6 +260,7 @@ fn parse(path: &Path) -> Result<Scene, AssetFault> {
         }
         let is_vertex = e.name == "vertex";
         let is_face = e.name == "face";
+        let is_strips = e.name == "tristrips";
         let find = |n: &str| e.properties.iter().position(|p| matches!(p, Property::Scalar(name, _) if name == n));
         let xyz = [find("x"), find("y"), find("z")];
         let nxyz = [find("nx"), find("ny"), find("nz")];
@@ -261,9 +285,15 @@ fn parse(path: &Path) -> Result<Scene, AssetFault> {
                         for _ in 0..n as usize {
                             list.push(body.value(*it)?);
                         }
-                        if is_face && (name == "vertex_indices" || name == "vertex_index") {
+                        if (is_face || is_strips) && (name == "vertex_indices" || name == "vertex_index") {
                             faces_seen += 1;
-                            fan(&list, faces_seen - 1, &mut triangles)?;
+                            let place = body.place();
+                            if is_face {
+                                fan(&list, faces_seen - 1, &mut triangles)
+                            } else {
+                                strips(&list, faces_seen - 1, &mut triangles)
+                            }
+                            .map_err(|why| AssetFault::Malformed(format!("{place}: {why}")))?;
                         }
                     }
                 }
@@ -296,17 +326,38 @@ fn parse(path: &Path) -> Result<Scene, AssetFault> {
     Ok(scene)
 }
 
+/// A list entry as a vertex index: a whole number in u32's range.
+fn vertex_index(i: f64) -> Option<u32> {
+    (i >= 0.0 && i.fract() == 0.0 && i <= f64::from(u32::MAX)).then_some(i as u32)
+}
+
 /// Fans a polygon into triangles, checking that every index is a non-negative integer.
-fn fan(indices: &[f64], face: usize, out: &mut Vec<[u32; 3]>) -> Result<(), AssetFault> {
-    let mut idx = Vec::with_capacity(indices.len());
-    for &i in indices {
-        if i < 0.0 || i.fract() != 0.0 || i > f64::from(u32::MAX) {
-            return Err(AssetFault::Malformed(format!("face {face} has vertex index {i}")));
-        }
-        idx.push(i as u32);
-    }
+fn fan(indices: &[f64], face: usize, out: &mut Vec<[u32; 3]>) -> Result<(), String> {
+    let idx: Vec<u32> = indices
+        .iter()
+        .map(|&i| vertex_index(i).ok_or_else(|| format!("face {face} has vertex index {i}")))
+        .collect::<Result<_, _>>()?;
     for k in 1..idx.len().saturating_sub(1) {
         out.push([idx[0], idx[k], idx[k + 1]]);
+    }
+    Ok(())
+}
+
+/// Triangles of a `tristrips` entry: strips separated by -1. Every other triangle of a strip swaps its
+/// first two corners so all keep the first one's winding; triangles with a repeated corner (the joins
+/// strippers insert) are left out.
+fn strips(indices: &[f64], entry: usize, out: &mut Vec<[u32; 3]>) -> Result<(), String> {
+    for strip in indices.split(|&i| i == -1.0) {
+        let idx: Vec<u32> = strip
+            .iter()
+            .map(|&i| vertex_index(i).ok_or_else(|| format!("strip entry {entry} has vertex index {i}")))
+            .collect::<Result<_, _>>()?;
+        for k in 2..idx.len() {
+            let t = if k % 2 == 0 { [idx[k - 2], idx[k - 1], idx[k]] } else { [idx[k - 1], idx[k - 2], idx[k]] };
+            if t[0] != t[1] && t[1] != t[2] && t[0] != t[2] {
+                out.push(t);
+            }
+        }
     }
     Ok(())
 }

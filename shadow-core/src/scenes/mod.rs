@@ -199,13 +199,8 @@ pub fn stage_model(model: &mut Scene, ground: bool) {
     let scale = 1.0 / b.size().max_element().max(1e-12);
     let offset = Vec3::new(-b.center().x, -b.min.y, -b.center().z);
     let place = Mat4::from_scale(Vec3::splat(scale)) * Mat4::from_translation(offset);
-    let roots: Vec<_> = model.roots().to_vec();
-    if let Ok(stage) = model.add_node("stage", None, place) {
-        for r in roots {
-            // Both keys exist and `stage` is a fresh root, so no cycle is possible.
-            let _ = model.set_parent(r, Some(stage));
-        }
-    }
+    // `place` is finite: the bounds are finite and the scale's divisor is at least 1e-12.
+    let _ = model.group_roots("stage", place);
     if ground {
         let mesh = model.add_mesh(ground_quad());
         let mat = model.add_material(Material::colored("ground", Vec3::splat(0.75)));
