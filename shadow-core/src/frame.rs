@@ -126,7 +126,7 @@ impl FrameInputs {
                     mesh_version: scene.mesh_version(mesh_key)?,
                     adjacency: scene.adjacency(mesh_key)?,
                     world_from_local: world,
-                    local_from_world: world.inverse(),
+                    local_from_world: crate::affine::inverse(world),
                     mirrored: world.determinant() < 0.0,
                     base_color: material.base_color,
                     two_sided: material.two_sided,

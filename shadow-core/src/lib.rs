@@ -8,6 +8,7 @@
 //! Nothing here needs a GPU. The conventions both backends follow (DESIGN section 4) are written down
 //! where they are implemented: light-space lookups in [`light`], the metrics in [`metrics`].
 
+pub mod affine;
 pub mod assets;
 pub mod bounds;
 pub mod frame;

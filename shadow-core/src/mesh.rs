@@ -169,7 +169,7 @@ impl Mesh {
     /// A mirroring transform reverses the triangles so they stay counter-clockwise outside.
     #[must_use]
     pub fn transformed(&self, m: glam::Mat4) -> Self {
-        let normal_m = glam::Mat3::from_mat4(m).inverse().transpose();
+        let normal_m = crate::affine::normal_matrix(m);
         let mirror = glam::Mat3::from_mat4(m).determinant() < 0.0;
         let positions: Vec<Vec3> = self.positions.iter().map(|&p| m.transform_point3(p)).collect();
         Self {

@@ -207,7 +207,7 @@ pub fn render_reusing(
     // pass (the background's too: the buffers are not cleared first). The triangle's world corners and face
     // normal are those of the pixel before on most pixels of a row.
     let normal_from_local: Vec<Mat3> =
-        frame.instances.iter().map(|i| Mat3::from_mat4(i.world_from_local).inverse().transpose()).collect();
+        frame.instances.iter().map(|i| shadow_core::affine::normal_matrix(i.world_from_local)).collect();
     let (mut position, mut normal, mut geometric_normal, mut albedo) = (position, normal, geometric_normal, albedo);
     let w = width as usize;
     let world_from_clip = clip_from_world.inverse();

@@ -121,3 +121,30 @@ fn bad_requests_are_refused_before_allocating() {
     let n = s.add_node("n", None, glam::Mat4::IDENTITY).expect("node");
     assert!(s.set_local_transform(n, glam::Mat4::from_scale(glam::Vec3::splat(f32::NAN))).is_err());
 }
+
+/// A tetrahedron of side `size` standing on a staged ground, as a model file of that size would load.
+fn tetrahedron_staged(size: f32) -> Scene {
+    use shadow_core::glam::{Mat4, Vec3};
+    let p = [Vec3::ZERO, Vec3::X, Vec3::Z, Vec3::new(0.2, 1.0, 0.2)].map(|v| v * size);
+    let mesh =
+        shadow_core::Mesh::new(p.to_vec(), vec![[0, 1, 2], [0, 3, 1], [1, 3, 2], [0, 2, 3]]).expect("tetrahedron");
+    let mut s = Scene::new();
+    let m = s.add_mesh(mesh);
+    let mat = s.add_material(shadow_core::Material::default());
+    s.add_instance("tetrahedron", m, mat, Mat4::IDENTITY).expect("instance");
+    scenes::stage_model(&mut s, true);
+    s
+}
+
+#[test]
+fn volumes_are_exact_at_every_scale_the_loaders_accept() {
+    // Staged to one unit, a model of side 1e13 and up has face planes whose offsets pass f32's range and a
+    // staging scale whose determinant is below f32's normal numbers.
+    for size in [1.0, 1e13, shadow_core::mesh::MAX_COORDINATE] {
+        let scene = tetrahedron_staged(size);
+        let m = measure(&scene, vec![volume(ShadowVolume::ZFAIL), volume(ShadowVolume::ZPASS)]);
+        for (name, m) in ["z-fail", "z-pass"].iter().zip(&m) {
+            assert!(m.mismatch <= 0.0005, "side {size:e}: {name} mismatch {:.4}%", m.mismatch * 100.0);
+        }
+    }
+}

@@ -4,7 +4,7 @@
 use std::collections::HashMap;
 
 use bytemuck::{Pod, Zeroable};
-use glam::{Mat3, Mat4};
+use glam::Mat4;
 use shadow_core::{FrameInputs, MeshKey};
 use wgpu::util::DeviceExt;
 
@@ -33,7 +33,7 @@ pub struct InstanceRaw {
 
 impl InstanceRaw {
     fn of(inst: &shadow_core::Instance) -> Self {
-        let n = Mat4::from_mat3(Mat3::from_mat4(inst.world_from_local).inverse().transpose());
+        let n = Mat4::from_mat3(shadow_core::affine::normal_matrix(inst.world_from_local));
         Self {
             world_from_local: inst.world_from_local.to_cols_array_2d(),
             normal_from_local: n.to_cols_array_2d(),

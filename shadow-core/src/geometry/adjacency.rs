@@ -122,6 +122,26 @@ fn weld_key(p: Vec3) -> [u32; 3] {
     [p.x, p.y, p.z].map(|c| if c == 0.0 { 0 } else { c.to_bits() })
 }
 
+/// `n` scaled by the power of two that brings its largest component into [1, 2).
+///
+/// The raw normal's length is the square of the mesh's size, and the plane offset `n . p` its cube: at
+/// coordinates of 1e13 that offset passes f32's range (3.4e38) and every facing test of the face reads
+/// infinity. Scaling by a power of two is exact, and every product and sum of the facing test scales by
+/// the same power, so each test keeps the sign the raw normal gives wherever that did not overflow.
+/// Normals too small to scale into range unharmed (subnormal components) are left as they are.
+fn power_of_two_unit(n: Vec3) -> Vec3 {
+    let largest = n.abs().max_element();
+    if !(largest.is_normal() && largest.is_finite()) {
+        return n;
+    }
+    // largest = 2^e * m with m in [1, 2); 2^-e is a normal f32 for every e of a normal f32 but the top one.
+    let e = ((largest.to_bits() >> 23) & 0xff) as i32 - 127;
+    if e >= 127 {
+        return n;
+    }
+    n * f32::from_bits(((127 - e) as u32) << 23)
+}
+
 impl Adjacency {
     /// Builds the adjacency of a mesh.
     #[must_use]
@@ -133,7 +153,7 @@ impl Adjacency {
             .par_iter()
             .map(|t| {
                 let p = t.map(|i| positions[i as usize]);
-                let n = face_normal(p);
+                let n = power_of_two_unit(face_normal(p));
                 // Exactly zero for two equal corners; -0.0 folded so the facing test gives exactly 0.
                 if n == Vec3::ZERO { Vec4::ZERO } else { n.extend(-n.dot(p[0])) }
             })
@@ -210,7 +230,8 @@ impl Adjacency {
     pub fn triangles(&self) -> &[[u32; 3]] {
         &self.triangles
     }
-    /// Face planes `(n, -n.p0)` with unnormalized normals `n = (b - a) x (c - a)`; all zero for a
+    /// Face planes `(n, -n.p0)` with `n = (b - a) x (c - a)` scaled by a power of two so its largest
+    /// component lies in [1, 2) (exactly, so facing signs are the raw normal's); all zero for a
     /// degenerate face, which therefore faces no light.
     #[must_use]
     pub fn planes(&self) -> &[Vec4] {

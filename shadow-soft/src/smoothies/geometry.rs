@@ -209,7 +209,7 @@ fn vertex_normal(adj: &Adjacency, v: u32, world_from_local: Mat4) -> Vec3 {
         .filter(|(tri, _)| tri.contains(&v))
         .map(|(_, plane)| plane.truncate().normalize_or_zero())
         .sum();
-    world_from_local.inverse().transpose().transform_vector3(sum).normalize_or_zero()
+    (shadow_core::affine::normal_matrix(world_from_local) * sum).normalize_or_zero()
 }
 
 #[cfg(test)]
