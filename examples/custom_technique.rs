@@ -14,7 +14,15 @@ use shadowlab::compare::{CompareJob, run_compare};
 use shadowlab::setup::SceneSetup;
 use shadowlab::{BackendChoice, Renderer, TechniqueRegistry};
 
+const USAGE: &str = "usage: custom_technique [SCENE] [OUT_DIR]
+  SCENE    a built-in scene or a model file (default: cylinder)
+  OUT_DIR  where compare's pictures and reports go (default: out/custom-technique)";
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
+    if let Some(flag) = std::env::args().skip(1).find(|a| a.starts_with('-')) {
+        println!("{USAGE}");
+        return if flag == "-h" || flag == "--help" { Ok(()) } else { Err(format!("unknown flag {flag}").into()) };
+    }
     let mut args = std::env::args().skip(1);
     let scene_name = args.next().unwrap_or_else(|| "cylinder".into());
     let out = args.next().unwrap_or_else(|| "out/custom-technique".into());
@@ -43,6 +51,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         height: 512,
         techniques: vec![TechniqueSpec::named("planar-shadow"), TechniqueSpec::named("shadow-map")],
         reference: TechniqueSpec::named("ray-traced"),
+        soft_reference: None,
         backends,
         out_dir: Some(out.clone().into()),
     };

@@ -10,7 +10,17 @@ use shadow_core::technique::TechniqueSpec;
 use shadowlab::setup::SceneSetup;
 use shadowlab::{BackendChoice, Renderer, TechniqueRegistry};
 
+const USAGE: &str = "usage: render_model [MODEL] [BACKEND] [TECHNIQUE]
+  MODEL      a .gltf, .glb, .obj, .ply or .ply.gz file (default: the built-in strike scene, exported to .glb)
+  BACKEND    auto, cpu, wgpu or both (default: auto)
+  TECHNIQUE  NAME[:key=value,...] (default: shadow-volume-zfail)
+writes out/render_model-BACKEND.png";
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
+    if let Some(flag) = std::env::args().skip(1).find(|a| a.starts_with('-')) {
+        println!("{USAGE}");
+        return if flag == "-h" || flag == "--help" { Ok(()) } else { Err(format!("unknown flag {flag}").into()) };
+    }
     let mut args = std::env::args().skip(1);
     let model = match args.next() {
         Some(m) => m,

@@ -30,6 +30,9 @@ pub struct CompareJob<'a> {
     /// What they are measured against, on the CPU: `ray-traced` for hard shadows, `area-light-reference`
     /// for soft ones (see [`reference_for`]).
     pub reference: TechniqueSpec,
+    /// When set, soft techniques are measured against this reference instead (a run that mixes hard and
+    /// soft techniques scores each against its own kind's reference; see [`references_for`]).
+    pub soft_reference: Option<TechniqueSpec>,
     /// Backends to run them on.
     pub backends: Vec<BackendKind>,
     /// Where the files go (`None`: compute only).
@@ -49,7 +52,9 @@ pub struct ResultEntry {
     pub timings_ms: BTreeMap<String, f64>,
     /// Measured counters only.
     pub counters: BTreeMap<String, f64>,
-    /// Errors against the reference.
+    /// The reference this entry is measured against, as its spec reads.
+    pub reference: String,
+    /// Errors against the reference (fractions in [0, 1], RMSE and FLIP as they are).
     pub vs_reference: BTreeMap<String, f64>,
     /// File stem of its pictures.
     #[serde(skip)]
@@ -95,14 +100,26 @@ pub struct CompareReport {
 }
 
 /// The reference for `techniques`: `area-light-reference` when they are all soft, `ray-traced` otherwise
-/// (a soft technique's penumbra measured against a hard edge is an error only in name; a mix of both
-/// kinds is measured against the hard reference).
+/// (a soft technique's penumbra measured against a hard edge is an error only in name).
 #[must_use]
 pub fn reference_for(registry: &crate::TechniqueRegistry, techniques: &[TechniqueSpec]) -> TechniqueSpec {
     let soft = |t: &TechniqueSpec| registry.get(&t.name).is_ok_and(|e| e.soft);
     let name =
         if !techniques.is_empty() && techniques.iter().all(soft) { "area-light-reference" } else { "ray-traced" };
     TechniqueSpec::named(name)
+}
+
+/// The references of a run: [`reference_for`], and for a mix of hard and soft techniques
+/// `area-light-reference` as the soft techniques' own.
+#[must_use]
+pub fn references_for(
+    registry: &crate::TechniqueRegistry,
+    techniques: &[TechniqueSpec],
+) -> (TechniqueSpec, Option<TechniqueSpec>) {
+    let soft = |t: &TechniqueSpec| registry.get(&t.name).is_ok_and(|e| e.soft);
+    let primary = reference_for(registry, techniques);
+    let mixed = techniques.iter().any(soft) && !techniques.iter().all(soft);
+    (primary, mixed.then(|| TechniqueSpec::named("area-light-reference")))
 }
 
 /// Report keys of a frame's timings.
@@ -171,16 +188,42 @@ pub fn run_compare(
         save(&ref_frame.color, dir, "reference.png")?;
         save(&visibility_to_rgb(ref_vis, &mask), dir, "reference.vis.png")?;
     }
+    // The soft techniques' own reference, when the run mixes kinds: same view, same G-buffer and mask.
+    let soft: Vec<bool> =
+        job.techniques.iter().map(|s| renderer.registry().get(&s.name).is_ok_and(|e| e.soft)).collect();
+    let soft_reference = match &job.soft_reference {
+        Some(spec) if soft.contains(&true) => {
+            progress(&format!("reference: {spec} on cpu"));
+            let (frame, _) = renderer.run_cpu_frame(job.frame, job.width, job.height, spec)?;
+            sheet.push((format!("{}\nreference", spec.name), frame.color.clone()));
+            if let Some(dir) = &job.out_dir {
+                save(&frame.color, dir, &format!("reference-{}.png", spec.name))?;
+                save(
+                    &visibility_to_rgb(&frame.visibility[0], &mask),
+                    dir,
+                    &format!("reference-{}.vis.png", spec.name),
+                )?;
+            }
+            Some((spec, frame.color, frame.visibility.into_iter().next()))
+        }
+        _ => None,
+    };
 
     let mut results = Vec::new();
     let mut runs: Vec<RunOutput> = Vec::new();
     for (i, spec) in job.techniques.iter().enumerate() {
         let same_name = job.techniques.iter().filter(|s| s.name == spec.name).count() > 1;
+        // Each technique against its own kind's reference.
+        let soft = soft[i];
+        let (reference, ref_color, ref_vis) = match &soft_reference {
+            Some((spec_ref, color, Some(vis))) if soft => (*spec_ref, color, vis),
+            _ => (reference, &ref_frame.color, ref_vis),
+        };
         for &backend in &job.backends {
             progress(&format!("{spec} on {}", backend.name()));
             let run = renderer.run(backend, job.frame, job.width, job.height, spec)?;
             let metrics = compare_visibility(&run.visibility[0], ref_vis, &mask)?;
-            let flip = flip_mean(&run.color, &ref_frame.color, &mask)?;
+            let flip = flip_mean(&run.color, ref_color, &mask)?;
             let file = if same_name {
                 format!("{}-{}-{}", spec.name, i + 1, backend.name())
             } else {
@@ -197,7 +240,7 @@ pub fn run_compare(
             // Map-based techniques (a `res` setting) also get acne told apart from undersampling.
             let res =
                 run.settings.split(',').find_map(|kv| kv.strip_prefix("res=")).and_then(|v| v.parse::<u32>().ok());
-            let acne = res.map(|r| probe.texel_acne(&run.visibility[0], r));
+            let acne = res.filter(|_| !soft).map(|r| probe.texel_acne(&run.visibility[0], r));
             let back = back_false_light(&run.visibility[0], ref_vis, &mask, &reach)?;
             // A technique asked for more than once is told apart by the settings it was given.
             let given = if same_name {
@@ -205,12 +248,19 @@ pub fn run_compare(
             } else {
                 String::new()
             };
-            let label = format!("{}\n{given}{} {:.3}%", spec.name, backend.name(), metrics.mismatch * 100.0);
+            // Soft techniques are scored by RMSE: a penumbra has no lit/shadowed state to mismatch.
+            let score = if soft {
+                format!("RMSE {:.4}", metrics.rmse)
+            } else {
+                format!("mismatch {:.3}%", metrics.mismatch * 100.0)
+            };
+            let label = format!("{}\n{given}{} {score}", spec.name, backend.name());
             sheet.push((label, run.color.clone()));
             results.push(ResultEntry {
                 technique: run.technique.clone(),
                 settings: run.settings.clone(),
                 backend: backend.name().into(),
+                reference: reference.to_string(),
                 timings_ms: timings_map(&run.stats),
                 counters: run.stats.counters.entries().into_iter().collect(),
                 vs_reference: {
@@ -270,17 +320,20 @@ pub fn run_compare(
 #[must_use]
 pub fn report_markdown(r: &CompareReport) -> String {
     let mut s = format!(
-        "# {} at {}x{}\n\nErrors against `{}` over receiver pixels that face the light and lie in its reach.\n\n",
-        r.scene, r.width, r.height, r.reference
+        "# {} at {}x{}\n\nErrors against each row's reference over receiver pixels that face the light and lie in \
+         its reach. Mismatch, edge band, interior, false shadow and false light are percentages of those pixels; \
+         RMSE and FLIP are on visibility and colour in [0, 1]. Soft techniques are judged by RMSE.\n\n",
+        r.scene, r.width, r.height
     );
-    s.push_str("| technique | backend | mismatch | edge band | interior | false shadow | false light | RMSE | FLIP | total ms | picture |\n");
-    s.push_str("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---|\n");
+    s.push_str("| technique | backend | reference | mismatch | edge band | interior | false shadow | false light | RMSE | FLIP | total ms | picture |\n");
+    s.push_str("|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---|\n");
     for e in &r.results {
         let m = &e.metrics;
         s.push_str(&format!(
-            "| `{}` | {} | {:.3}% | {:.3}% | {:.3}% | {:.3}% | {:.3}% | {:.4} | {:.4} | {:.1} | [png]({}.png) [errors]({}.err.png) |\n",
+            "| `{}` | {} | `{}` | {:.3}% | {:.3}% | {:.3}% | {:.3}% | {:.3}% | {:.4} | {:.4} | {:.1} | [png]({}.png) [errors]({}.err.png) |\n",
             e.technique,
             e.backend,
+            e.reference,
             m.mismatch * 100.0,
             m.edge_band_mismatch * 100.0,
             m.interior_mismatch * 100.0,

@@ -41,9 +41,22 @@ pub enum SceneSourceError {
 /// # Errors
 /// An unknown scene name, or a model file that does not load.
 pub fn load_scene(source: &str, params: &SceneParams, ground: bool) -> Result<Scene, SceneSourceError> {
+    load_scene_with(source, params, ground, &assets::LoadOptions::default())
+}
+
+/// [`load_scene`] with the given model loading options.
+///
+/// # Errors
+/// An unknown scene name, or a model file that does not load.
+pub fn load_scene_with(
+    source: &str,
+    params: &SceneParams,
+    ground: bool,
+    options: &assets::LoadOptions,
+) -> Result<Scene, SceneSourceError> {
     let path = Path::new(source);
     if assets::is_model_path(path) || (path.exists() && scenes::info(source).is_none()) {
-        let mut scene = assets::load(path)?;
+        let mut scene = assets::load_with(path, options)?;
         scenes::stage_model(&mut scene, ground);
         if let Some(t) = params.light {
             scenes::retype_lights(&mut scene, t);

@@ -1,5 +1,6 @@
 //! The `shadowlab` command line (DESIGN 11). Exit status: 0 on success, 2 for a usage error, 1 for any
-//! other error, with one line naming the cause.
+//! other error, with one line naming the cause. Every input is checked before anything is printed or
+//! written, so a refusal is that one line.
 
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -8,6 +9,7 @@ use std::process::ExitCode;
 use clap::{Args, Parser, Subcommand};
 use serde_json::json;
 use shadow_core::FrameInputs;
+use shadow_core::assets::FileAccess;
 use shadow_core::inspect::Inspection;
 use shadow_core::scenes::{self, SceneParams};
 use shadow_core::technique::TechniqueSpec;
@@ -15,8 +17,42 @@ use shadowlab::compare::{CompareJob, run_compare};
 use shadowlab::setup::{SceneSetup, parse_size};
 use shadowlab::{BackendChoice, Error, Renderer, TechniqueRegistry};
 
+/// Writes a line to standard output. A closed pipe (`shadowlab techniques | head -1`) ends the program
+/// quietly: whoever read the output has what they wanted.
+macro_rules! out {
+    () => { out!("") };
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        if let Err(e) = writeln!(std::io::stdout().lock(), $($arg)*) {
+            return Err(stdout_error(&e));
+        }
+    }};
+}
+
+/// [`out!`] without the line break.
+macro_rules! out_raw {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        if let Err(e) = write!(std::io::stdout().lock(), $($arg)*) {
+            return Err(stdout_error(&e));
+        }
+    }};
+}
+
+fn stdout_error(e: &std::io::Error) -> Error {
+    if e.kind() == std::io::ErrorKind::BrokenPipe {
+        std::process::exit(0);
+    }
+    Error::Write { path: "standard output".into(), why: e.to_string() }
+}
+
+const EXIT_CODES: &str = "Exit status: 0 on success; 1 when the work fails (a model file that does not \
+load, a technique that refuses the light, a file that cannot be written); 2 for a usage error (an unknown \
+flag, scene or technique, a bad value). Every failure is one line on standard error.";
+
 #[derive(Parser)]
 #[command(
+    after_help = EXIT_CODES,
     name = "shadowlab",
     version,
     about = "Real-time shadow techniques on the GPU and on a CPU reference, measured against ray-traced ground truth"
@@ -44,6 +80,15 @@ struct SceneArgs {
     /// Seed for scenes with random placement.
     #[arg(long, default_value_t = 1)]
     seed: u64,
+    /// Let a model file name files outside its own folder (absolute paths, '..'); off by default, so a
+    /// model cannot read other files on the machine.
+    #[arg(long)]
+    allow_outside_files: bool,
+}
+
+/// How big the view is and where it is rendered.
+#[derive(Args, Clone)]
+struct ViewArgs {
     /// View size, WxH.
     #[arg(long, default_value = "512x512")]
     size: String,
@@ -51,6 +96,45 @@ struct SceneArgs {
     /// when named or with --backend wgpu.
     #[arg(long)]
     adapter: Option<String>,
+}
+
+impl ViewArgs {
+    /// The view size, within the memory budget.
+    fn size(&self) -> Result<(u32, u32), Error> {
+        let (w, h) = parse_size(&self.size).map_err(|e| Error::Usage(e.to_string()))?;
+        check_view_size(w, h)?;
+        Ok((w, h))
+    }
+
+    /// Refuses an adapter for a backend that uses none.
+    fn check_adapter(&self, backend: &str) -> Result<(), Error> {
+        match &self.adapter {
+            Some(a) if backend == "cpu" => Err(Error::Usage(format!(
+                "--adapter {a} names a wgpu adapter, but --backend cpu uses none (use --backend wgpu or both)"
+            ))),
+            _ => Ok(()),
+        }
+    }
+}
+
+/// Bytes a view pixel takes in the largest job (`compare`: the G-buffer, the reference, one technique's
+/// images and maps in flight, the error maps), rounded up from a measured 2048x2048 CPU run.
+const BYTES_PER_VIEW_PIXEL: u64 = 400;
+/// The memory a view may take.
+const VIEW_MEMORY_BUDGET: u64 = 8 << 30;
+
+fn check_view_size(w: u32, h: u32) -> Result<(), Error> {
+    let need = u64::from(w) * u64::from(h) * BYTES_PER_VIEW_PIXEL;
+    if need > VIEW_MEMORY_BUDGET {
+        return Err(Error::Usage(format!(
+            "--size {w}x{h} would take about {:.1} GB ({BYTES_PER_VIEW_PIXEL} bytes a pixel); the budget is {} GB, \
+             about {} megapixels",
+            need as f64 / 1e9,
+            VIEW_MEMORY_BUDGET >> 30,
+            VIEW_MEMORY_BUDGET / BYTES_PER_VIEW_PIXEL / 1_000_000
+        )));
+    }
+    Ok(())
 }
 
 impl SceneArgs {
@@ -61,11 +145,12 @@ impl SceneArgs {
             params: SceneParams { light: None, seed: self.seed },
             camera: self.camera.clone(),
             light: self.light.clone(),
+            file_access: if self.allow_outside_files { FileAccess::Anywhere } else { FileAccess::ModelFolder },
         }
     }
 
-    fn frame(&self) -> Result<(FrameInputs, u32, u32), Error> {
-        let (w, h) = parse_size(&self.size).map_err(|e| Error::Usage(e.to_string()))?;
+    fn frame(&self, view: &ViewArgs) -> Result<(FrameInputs, u32, u32), Error> {
+        let (w, h) = view.size()?;
         let scene = self.setup().build()?;
         let cam =
             scene.cameras().next().map(|(k, _)| k).ok_or_else(|| Error::Usage("the scene has no camera".into()))?;
@@ -95,6 +180,9 @@ enum Command {
     Inspect {
         /// A built-in scene name or a model file.
         target: String,
+        /// Let a model file name files outside its own folder.
+        #[arg(long)]
+        allow_outside_files: bool,
         /// Print JSON.
         #[arg(long)]
         json: bool,
@@ -103,6 +191,8 @@ enum Command {
     Render {
         #[command(flatten)]
         scene: SceneArgs,
+        #[command(flatten)]
+        view: ViewArgs,
         /// NAME[:key=value,...].
         #[arg(long, default_value = "shadow-volume-zfail")]
         technique: String,
@@ -117,7 +207,10 @@ enum Command {
     Bench {
         #[command(flatten)]
         scene: SceneArgs,
-        /// NAME[:key=value,...], repeatable.
+        #[command(flatten)]
+        view: ViewArgs,
+        /// NAME[:key=value,...], repeatable (default: every technique but the references, with default
+        /// settings).
         #[arg(long)]
         technique: Vec<String>,
         /// all, or NAME,NAME with default settings.
@@ -151,13 +244,16 @@ enum Command {
         #[arg(long, short)]
         out: PathBuf,
     },
-    /// Every asked-for technique against the reference (ray-traced; area-light-reference when every
-    /// technique asked for is a soft one): pictures, error maps, a contact sheet,
-    /// report.md and report.json.
+    /// Every asked-for technique against its reference (ray-traced for hard shadows,
+    /// area-light-reference for soft ones): pictures, error maps, a contact sheet, report.md and
+    /// report.json.
     Compare {
         #[command(flatten)]
         scene: SceneArgs,
-        /// NAME[:key=value,...], repeatable.
+        #[command(flatten)]
+        view: ViewArgs,
+        /// NAME[:key=value,...], repeatable (default: every technique but the references, with default
+        /// settings).
         #[arg(long)]
         technique: Vec<String>,
         /// all, or NAME,NAME with default settings.
@@ -166,8 +262,8 @@ enum Command {
         /// Backend: auto, cpu, wgpu or both.
         #[arg(long, default_value = "auto")]
         backend: String,
-        /// The reference, NAME[:key=value,...]: ray-traced or area-light-reference (default: the latter
-        /// when every technique asked for is a soft one).
+        /// The reference for every technique, NAME[:key=value,...]: ray-traced or area-light-reference
+        /// (default: each technique's own kind's).
         #[arg(long)]
         reference: Option<String>,
         /// Output folder (default out/compare-SCENE).
@@ -177,6 +273,13 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    private_runtime_dir();
+    // A panic is a bug; it is said in one line, like every other failure, not as a backtrace.
+    std::panic::set_hook(Box::new(|info| {
+        let place = info.location().map_or_else(String::new, |l| format!(" at {}:{}", l.file(), l.line()));
+        let what = info.payload_as_str().unwrap_or("a panic").replace('\n', " ");
+        eprintln!("error: internal error{place}: {what} (a bug in shadowlab: please report the command)");
+    }));
     let cli = Cli::parse();
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
@@ -187,24 +290,48 @@ fn main() -> ExitCode {
     }
 }
 
+/// Gives the process a private `XDG_RUNTIME_DIR` when it has none: without one the Vulkan loader prints
+/// "error: XDG_RUNTIME_DIR is invalid or not set" twice on a run that then succeeds, and a line that
+/// says `error:` must only ever be an error. The folder is the user's own (mode 0700) under the system's
+/// temp folder; where it cannot be made, the loader's lines are left as they are.
+#[allow(unsafe_code)]
+fn private_runtime_dir() {
+    if std::env::var_os("XDG_RUNTIME_DIR").is_some_and(|d| Path::new(&d).is_dir()) {
+        return;
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::{DirBuilderExt, PermissionsExt};
+        let user = std::env::var("USER").unwrap_or_else(|_| "user".into());
+        let dir = std::env::temp_dir().join(format!("shadowlab-runtime-{user}"));
+        let _ = std::fs::DirBuilder::new().mode(0o700).create(&dir);
+        let private = std::fs::symlink_metadata(&dir).is_ok_and(|m| m.is_dir() && m.permissions().mode() & 0o077 == 0);
+        if private {
+            // SAFETY: called first thing in `main`, before any other thread exists, so nothing can be
+            // reading the environment while it changes.
+            unsafe { std::env::set_var("XDG_RUNTIME_DIR", &dir) };
+        }
+    }
+}
+
 fn run(cli: Cli) -> Result<(), Error> {
     match cli.command {
         Command::Scenes { json } => list_scenes(json),
         Command::Techniques { json } => list_techniques(json),
-        Command::Inspect { target, json } => inspect(&target, json),
-        Command::Render { scene, technique, backend, out } => render(&scene, &technique, &backend, &out),
-        Command::Compare { scene, technique, techniques, backend, reference, out_dir } => {
-            compare(&scene, technique, techniques, &backend, reference.as_deref(), out_dir)
+        Command::Inspect { target, json, allow_outside_files } => inspect(&target, json, allow_outside_files),
+        Command::Render { scene, view, technique, backend, out } => render(&scene, &view, &technique, &backend, &out),
+        Command::Compare { scene, view, technique, techniques, backend, reference, out_dir } => {
+            compare(&scene, &view, technique, techniques, &backend, reference.as_deref(), out_dir)
         }
-        Command::Bench { scene, technique, techniques, backend, frames, warmup, json, sweep, out_dir } => {
-            bench(&scene, BenchArgs { technique, techniques, backend, frames, warmup, json, sweep, out_dir })
+        Command::Bench { scene, view, technique, techniques, backend, frames, warmup, json, sweep, out_dir } => {
+            bench(&scene, &view, BenchArgs { technique, techniques, backend, frames, warmup, json, sweep, out_dir })
         }
         Command::Export { scene, out } => export(&scene, &out),
     }
 }
 
 fn print_json(v: &serde_json::Value) -> Result<(), Error> {
-    println!("{}", serde_json::to_string_pretty(v).map_err(|e| Error::Usage(e.to_string()))?);
+    out!("{}", serde_json::to_string_pretty(v).map_err(|e| Error::Usage(e.to_string()))?);
     Ok(())
 }
 
@@ -223,9 +350,9 @@ fn list_scenes(json: bool) -> Result<(), Error> {
                 .collect::<Vec<_>>()
         ));
     }
-    println!("{:<14} {:>9}  description", "scene", "triangles");
+    out!("{:<14} {:>9}  description", "scene", "triangles");
     for (n, t, d, a) in rows {
-        println!("{n:<14} {t:>9}  {d} ({a})");
+        out!("{n:<14} {t:>9}  {d} ({a})");
     }
     Ok(())
 }
@@ -254,22 +381,24 @@ fn list_techniques(json: bool) -> Result<(), Error> {
         return print_json(&json!(v));
     }
     for e in reg.entries() {
-        println!("{}  [{}]\n  {}\n  paper: {}", e.name, backends(e).join(", "), e.description, e.paper);
+        out!("{}  [{}]\n  {}\n  paper: {}", e.name, backends(e).join(", "), e.description, e.paper);
         for k in (e.keys)() {
-            println!("    {}={:<10} {}", k.key, k.default, k.help);
+            out!("    {}={:<10} {}", k.key, k.default, k.help);
         }
     }
     Ok(())
 }
 
-fn inspect(target: &str, json: bool) -> Result<(), Error> {
+fn inspect(target: &str, json: bool, allow_outside_files: bool) -> Result<(), Error> {
     let path = Path::new(target);
     let is_file = shadow_core::assets::is_model_path(path) || path.exists();
+    let file_access = if allow_outside_files { FileAccess::Anywhere } else { FileAccess::ModelFolder };
     let i = if is_file {
         // The file's own numbers; the silhouette from the default staged light.
-        let raw =
-            shadowlab::load_model(path).map_err(|e| Error::Setup(shadowlab::SceneSourceError::Asset(e).into()))?;
-        let staged = SceneSetup { ground: false, ..SceneSetup::new(target) }.build()?;
+        let options = shadow_core::assets::LoadOptions { file_access };
+        let raw = shadow_core::assets::load_with(path, &options)
+            .map_err(|e| Error::Setup(shadowlab::SceneSourceError::Asset(e).into()))?;
+        let staged = SceneSetup { ground: false, file_access, ..SceneSetup::new(target) }.build()?;
         Inspection { silhouette_edges: Inspection::of(&staged).silhouette_edges, ..Inspection::of(&raw) }
     } else {
         Inspection::of(&SceneSetup::new(target).build()?)
@@ -287,18 +416,18 @@ fn inspect(target: &str, json: bool) -> Result<(), Error> {
             "silhouette_edges": i.silhouette_edges,
         }));
     }
-    println!("{target}");
-    println!("  triangles           {}", i.triangles);
-    println!("  vertices (welded)   {}", i.vertices);
-    println!("  closed              {}", i.closed);
-    println!("  components          {}", i.components);
-    println!("  boundary edges      {}", i.boundary_edges);
-    println!("  non-manifold edges  {}", i.non_manifold_edges);
-    println!("  inconsistent edges  {}", i.inconsistent_edges);
-    println!("  bounds              {} .. {}", i.bounds.min, i.bounds.max);
+    out!("{target}");
+    out!("  triangles           {}", i.triangles);
+    out!("  vertices (welded)   {}", i.vertices);
+    out!("  closed              {}", i.closed);
+    out!("  components          {}", i.components);
+    out!("  boundary edges      {}", i.boundary_edges);
+    out!("  non-manifold edges  {}", i.non_manifold_edges);
+    out!("  inconsistent edges  {}", i.inconsistent_edges);
+    out!("  bounds              {} .. {}", i.bounds.min, i.bounds.max);
     match i.silhouette_edges {
-        Some(n) => println!("  silhouette edges    {n} (default light)"),
-        None => println!("  silhouette edges    - (no light)"),
+        Some(n) => out!("  silhouette edges    {n} (default light)"),
+        None => out!("  silhouette edges    - (no light)"),
     }
     Ok(())
 }
@@ -331,10 +460,11 @@ fn backends(renderer: &mut Renderer, choice: &str) -> Result<Vec<shadowlab::Back
     Ok(kinds)
 }
 
-fn render(args: &SceneArgs, technique: &str, backend: &str, out: &Path) -> Result<(), Error> {
-    let (frame, w, h) = args.frame()?;
+fn render(args: &SceneArgs, view: &ViewArgs, technique: &str, backend: &str, out: &Path) -> Result<(), Error> {
+    view.check_adapter(backend)?;
+    let (frame, w, h) = args.frame(view)?;
     let spec = TechniqueSpec::parse(technique)?;
-    let mut renderer = Renderer::new(TechniqueRegistry::builtin()).with_adapter(args.adapter.clone());
+    let mut renderer = Renderer::new(TechniqueRegistry::builtin()).with_adapter(view.adapter.clone());
     renderer.registry().canonical(&spec)?;
     check_availability(&renderer, std::slice::from_ref(&spec), backend)?;
     for kind in backends(&mut renderer, backend)? {
@@ -351,27 +481,30 @@ fn render(args: &SceneArgs, technique: &str, backend: &str, out: &Path) -> Resul
 
 fn compare(
     args: &SceneArgs,
+    view: &ViewArgs,
     technique: Vec<String>,
     techniques: Option<String>,
     backend: &str,
     reference: Option<&str>,
     out_dir: Option<PathBuf>,
 ) -> Result<(), Error> {
-    let mut renderer = Renderer::new(TechniqueRegistry::builtin()).with_adapter(args.adapter.clone());
+    view.check_adapter(backend)?;
+    let mut renderer = Renderer::new(TechniqueRegistry::builtin()).with_adapter(view.adapter.clone());
     let specs = technique_specs(&renderer, &technique, techniques.as_deref())?;
-    let reference = match reference {
+    let (reference, soft_reference) = match reference {
         Some(text) => {
             let spec = TechniqueSpec::parse(text)?;
             if !renderer.registry().get(&spec.name)?.reference {
                 return Err(Error::Usage(format!("--reference {text}: '{}' is not a reference technique", spec.name)));
             }
-            spec
+            renderer.registry().canonical(&spec)?;
+            (spec, None)
         }
-        None => shadowlab::compare::reference_for(renderer.registry(), &specs),
+        None => shadowlab::compare::references_for(renderer.registry(), &specs),
     };
     check_availability(&renderer, &specs, backend)?;
+    let (frame, w, h) = args.frame(view)?;
     let kinds = backends(&mut renderer, backend)?;
-    let (frame, w, h) = args.frame()?;
     let out = out_dir.unwrap_or_else(|| PathBuf::from(format!("out/compare-{}", args.name())));
     let job = CompareJob {
         scene: args.name(),
@@ -379,6 +512,7 @@ fn compare(
         width: w,
         height: h,
         reference,
+        soft_reference,
         techniques: specs,
         backends: kinds,
         out_dir: Some(out.clone()),
@@ -388,24 +522,40 @@ fn compare(
     if let Some(b) = bar {
         b.finish_and_clear();
     }
-    println!(
-        "{:<24} {:<5} {:>9} {:>9} {:>9} {:>8} {:>9}",
-        "technique", "", "mismatch", "edge", "interior", "FLIP", "total ms"
+    out!(
+        "{:<24} {:<5} {:<21} {:>9} {:>9} {:>9} {:>7} {:>7} {:>9}",
+        "technique",
+        "",
+        "reference",
+        "mismatch",
+        "edge",
+        "interior",
+        "RMSE",
+        "FLIP",
+        "total ms"
     );
     for r in &report.results {
         let m = &r.metrics;
-        println!(
-            "{:<24} {:<5} {:>8.3}% {:>8.3}% {:>8.3}% {:>8.4} {:>9.1}",
+        out!(
+            "{:<24} {:<5} {:<21} {:>8.3}% {:>8.3}% {:>8.3}% {:>7.4} {:>7.4} {:>9.1}",
             r.technique,
             r.backend,
+            r.reference,
             m.mismatch * 100.0,
             m.edge_band_mismatch * 100.0,
             m.interior_mismatch * 100.0,
+            m.rmse,
             r.flip,
             r.timings_ms.get("total").copied().unwrap_or(0.0)
         );
     }
-    println!("wrote {}/contact.png, report.md, report.json", out.display());
+    if !report.cross_backend.is_empty() {
+        out!("\n{:<24} {:>20} {:>7} {:>7}", "cpu vs wgpu", "mismatch", "RMSE", "FLIP");
+        for c in &report.cross_backend {
+            out!("{:<24} {:>19.3}% {:>7.4} {:>7.4}", c.technique, c.mismatch * 100.0, c.rmse, c.flip_mean);
+        }
+    }
+    out!("wrote {}/contact.png, report.md, report.json", out.display());
     Ok(())
 }
 
@@ -485,18 +635,28 @@ fn parse_sweep(sweep: &str) -> Result<(&str, Vec<u32>), Error> {
     Ok((key, values))
 }
 
-fn bench(args: &SceneArgs, b: BenchArgs) -> Result<(), Error> {
+fn bench(args: &SceneArgs, view: &ViewArgs, b: BenchArgs) -> Result<(), Error> {
     use shadowlab::bench::{BenchJob, bench_table, run_bench, sweep_scene};
     if b.frames == 0 {
         return Err(Error::Usage("--frames must be at least 1".into()));
     }
     let sweep = b.sweep.as_deref().map(parse_sweep).transpose()?;
-    let mut renderer = Renderer::new(TechniqueRegistry::builtin()).with_adapter(args.adapter.clone());
+    view.check_adapter(&b.backend)?;
+    let mut renderer = Renderer::new(TechniqueRegistry::builtin()).with_adapter(view.adapter.clone());
     let specs = technique_specs(&renderer, &b.technique, b.techniques.as_deref())?;
     check_availability(&renderer, &specs, &b.backend)?;
+    // The scene and its view are checked before the backend says which it is.
+    let first = args.frame(view)?;
+    // A triangle sweep's scenes are built up front too: a count too large is refused before anything runs.
+    let mut sweep_scenes = Vec::new();
+    if let Some(("tris", values)) = &sweep {
+        for &v in values {
+            sweep_scenes.push(sweep_scene(v).map_err(|e| Error::Usage(format!("--sweep tris={v}: {e}")))?);
+        }
+    }
     let kinds = backends(&mut renderer, &b.backend)?;
     let Some((key, values)) = sweep else {
-        let (frame, w, h) = args.frame()?;
+        let (frame, w, h) = first;
         let job = BenchJob {
             scene: args.name(),
             frame: &frame,
@@ -515,7 +675,7 @@ fn bench(args: &SceneArgs, b: BenchArgs) -> Result<(), Error> {
         if b.json {
             return print_json(&serde_json::to_value(&r).map_err(|e| Error::Usage(e.to_string()))?);
         }
-        print!("{}", bench_table(&r));
+        out_raw!("{}", bench_table(&r));
         return Ok(());
     };
     let has_res =
@@ -531,12 +691,12 @@ fn bench(args: &SceneArgs, b: BenchArgs) -> Result<(), Error> {
     // Per value, as `BenchJob::steps` counts them: per backend, each technique prepared, then the frames.
     let steps = kinds.len() as u64 * (specs.len() as u64 + u64::from(b.warmup + b.frames));
     let bar = progress_bar(values.len() as u64 * steps);
-    for &v in &values {
+    for (i, &v) in values.iter().enumerate() {
         let (frame, w, h) = if key == "res" {
-            args.frame()?
+            args.frame(view)?
         } else {
-            let (w, h) = parse_size(&args.size).map_err(|e| Error::Usage(e.to_string()))?;
-            let scene = sweep_scene(v).map_err(|e| Error::Usage(format!("--sweep tris={v}: {e}")))?;
+            let (w, h) = view.size()?;
+            let scene = &sweep_scenes[i];
             let cam = scene.cameras().next().map(|(k, _)| k).ok_or_else(|| Error::Usage("no camera".into()))?;
             (FrameInputs::from_scene(&scene, cam)?, w, h)
         };
@@ -578,8 +738,8 @@ fn bench(args: &SceneArgs, b: BenchArgs) -> Result<(), Error> {
     let series: Vec<(String, Vec<(f64, f64)>)> = series.into_iter().collect();
     shadowlab::plot::line_plot(&format!("{} frame time", args.name()), x_label, "median ms per frame", &series)
         .save_png(out.join("sweep.png"))?;
-    print!("{csv}");
-    println!("wrote {}/sweep.csv and sweep.png", out.display());
+    out_raw!("{csv}");
+    out!("wrote {}/sweep.csv and sweep.png", out.display());
     Ok(())
 }
 
@@ -587,6 +747,6 @@ fn export(args: &SceneArgs, out: &Path) -> Result<(), Error> {
     let scene = args.setup().build()?;
     shadow_core::assets::export::export_glb(&scene, out)
         .map_err(|e| Error::Write { path: out.to_path_buf(), why: e.source.to_string() })?;
-    println!("wrote {} ({} triangles)", out.display(), scene.triangle_count());
+    out!("wrote {} ({} triangles)", out.display(), scene.triangle_count());
     Ok(())
 }

@@ -116,16 +116,21 @@ impl Renderer {
         let describe = |g: &WgpuContext| format!("{} ({}, {})", g.adapter.name, g.adapter.backend, g.adapter.kind);
         match choice {
             BackendChoice::Cpu => Ok((vec![BackendKind::Cpu], "backend: cpu".into())),
-            BackendChoice::Auto => match self.gpu(false) {
-                Ok(g) => {
-                    let note = format!("backend: wgpu on {} (auto: a GPU adapter was found)", describe(g));
-                    Ok((vec![BackendKind::Wgpu], note))
+            BackendChoice::Auto => {
+                let named = self.adapter.asked_by_name();
+                match self.gpu(false) {
+                    Ok(g) => {
+                        let note = format!("backend: wgpu on {} (auto: a GPU adapter was found)", describe(g));
+                        Ok((vec![BackendKind::Wgpu], note))
+                    }
+                    // An adapter asked for by name that is not there is an error, not a reason to fall back.
+                    Err(e) if named => Err(e),
+                    Err(e) => {
+                        self.gpu = None;
+                        Ok((vec![BackendKind::Cpu], format!("backend: cpu (auto: {e})")))
+                    }
                 }
-                Err(e) => {
-                    self.gpu = None;
-                    Ok((vec![BackendKind::Cpu], format!("backend: cpu (auto: {e})")))
-                }
-            },
+            }
             BackendChoice::Wgpu => {
                 let g = self.gpu(true)?;
                 Ok((vec![BackendKind::Wgpu], format!("backend: wgpu on {}", describe(g))))

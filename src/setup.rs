@@ -6,7 +6,9 @@ use shadow_core::Scene;
 use shadow_core::scene::{Camera, Light, LightKind};
 use shadow_core::scenes::{LightType, SceneParams};
 
-use crate::{SceneSourceError, load_scene};
+use shadow_core::assets::{FileAccess, LoadOptions};
+
+use crate::{SceneSourceError, load_scene_with};
 
 /// A malformed `--camera`, `--light` or `--size` value.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -20,25 +22,9 @@ pub struct OptionError {
     pub why: String,
 }
 
-/// Splits `key=a,b,c,key2=d` into (key, value) pairs, where a piece without `=` continues the value
-/// before it (so vectors keep their commas).
+/// The `key=value` pairs of a flag, by the one parser technique settings use too.
 fn pairs(flag: &'static str, text: &str) -> Result<Vec<(String, String)>, OptionError> {
-    let mut out: Vec<(String, String)> = Vec::new();
-    for piece in text.split(',') {
-        match piece.split_once('=') {
-            Some((k, v)) => out.push((k.trim().to_string(), v.trim().to_string())),
-            None => match out.last_mut() {
-                Some((_, v)) => {
-                    v.push(',');
-                    v.push_str(piece.trim());
-                }
-                None => {
-                    return Err(OptionError { flag, value: text.into(), why: format!("'{piece}' is not key=value") });
-                }
-            },
-        }
-    }
-    Ok(out)
+    shadow_core::technique::key_values(text).map_err(|why| OptionError { flag, value: text.into(), why })
 }
 
 fn vec3(flag: &'static str, whole: &str, key: &str, v: &str) -> Result<Vec3, OptionError> {
@@ -112,10 +98,17 @@ pub fn parse_light(text: &str, default: &Light, scene_center: Vec3) -> Result<Li
     };
     let mut radius = default.radius;
     let mut target = None;
-    for (k, v) in if rest.is_empty() { Vec::new() } else { pairs(F, rest)? } {
+    let refuse = |why: String| OptionError { flag: F, value: text.into(), why };
+    for (k, v) in pairs(F, rest)? {
         match k.as_str() {
             "pos" => pos = vec3(F, text, "pos", &v)?,
+            "target" if t == LightType::Point => {
+                return Err(refuse("a point light shines every way: it takes no target".into()));
+            }
             "target" => target = Some(vec3(F, text, "target", &v)?),
+            "fov" if t != LightType::Spot => {
+                return Err(refuse(format!("fov is a spot light's cone; a {kind} light has none", kind = kind.trim())));
+            }
             "fov" => fov = number(F, text, "fov", &v)?,
             "radius" => radius = number(F, text, "radius", &v)?,
             other => {
@@ -173,13 +166,22 @@ pub struct SceneSetup {
     pub camera: Option<String>,
     /// Replaces the scene's light.
     pub light: Option<String>,
+    /// Which files a model file may name besides itself.
+    pub file_access: FileAccess,
 }
 
 impl SceneSetup {
     /// A built-in scene or model file with its own camera and light.
     #[must_use]
     pub fn new(source: &str) -> Self {
-        Self { source: source.into(), ground: true, params: SceneParams::default(), camera: None, light: None }
+        Self {
+            source: source.into(),
+            ground: true,
+            params: SceneParams::default(),
+            camera: None,
+            light: None,
+            file_access: FileAccess::default(),
+        }
     }
 
     /// Loads the scene and applies the overrides.
@@ -187,7 +189,8 @@ impl SceneSetup {
     /// # Errors
     /// Unknown scene, bad model file, or bad overrides.
     pub fn build(&self) -> Result<Scene, SetupError> {
-        let mut scene = load_scene(&self.source, &self.params, self.ground)?;
+        let options = LoadOptions { file_access: self.file_access };
+        let mut scene = load_scene_with(&self.source, &self.params, self.ground, &options)?;
         if let Some(c) = &self.camera {
             let cam = parse_camera(c)?;
             scene.clear_cameras();

@@ -97,6 +97,20 @@ pub struct AdapterChoice {
     pub allow_software: bool,
 }
 
+impl AdapterChoice {
+    /// The adapter name asked for: [`Self::name`], else a non-empty `SHADOWLAB_ADAPTER`.
+    #[must_use]
+    pub fn wanted(&self) -> Option<String> {
+        self.name.clone().or_else(|| std::env::var("SHADOWLAB_ADAPTER").ok()).filter(|s| !s.is_empty())
+    }
+
+    /// True when an adapter is asked for by name (then a missing one is an error, never a fallback).
+    #[must_use]
+    pub fn asked_by_name(&self) -> bool {
+        self.wanted().is_some()
+    }
+}
+
 /// What an adapter is.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct AdapterSummary {
@@ -187,8 +201,11 @@ impl WgpuContext {
     pub fn new(choice: &AdapterChoice) -> Result<Self, WgpuError> {
         let inst = instance();
         let adapters = pollster::block_on(inst.enumerate_adapters(wgpu::Backends::all()));
-        let wanted = choice.name.clone().or_else(|| std::env::var("SHADOWLAB_ADAPTER").ok()).filter(|s| !s.is_empty());
-        let all: Vec<String> = adapters.iter().map(|a| a.get_info().name).collect();
+        let wanted = choice.wanted();
+        // Each adapter once, with its API: llvmpipe is both a Vulkan and an OpenGL adapter of one name.
+        let mut all: Vec<String> =
+            adapters.iter().map(|a| format!("{} ({:?})", a.get_info().name, a.get_info().backend)).collect();
+        all.dedup();
         let adapter = match &wanted {
             Some(name) => {
                 let n = name.to_lowercase();
@@ -228,7 +245,11 @@ impl WgpuContext {
                             unfit.join(", ")
                         )
                     } else {
-                        format!("no hardware adapter (software ones: {}; ask for one by name)", all.join(", "))
+                        format!(
+                            "no hardware adapter (software ones: {}); use one with --backend wgpu, or name it with \
+                             --adapter NAME",
+                            all.join(", ")
+                        )
                     })
                 })?
             }

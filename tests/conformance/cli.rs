@@ -75,12 +75,19 @@ fn bad_inputs_give_one_line_and_the_right_status() {
         (&["render", "--technique", "shadow-map:res", "-o", out], 2, "is not key=value"),
         (&["render", "--size", "512", "-o", out], 2, "expected WxH"),
         (&["render", "--size", "0x512", "-o", out], 2, "at least 1"),
-        (&["render", "--size", "20000x20000", "--backend", "cpu", "-o", out], 1, "over the limit"),
+        (&["render", "--size", "20000x20000", "--backend", "cpu", "-o", out], 2, "would take about 160.0 GB"),
+        (&["render", "--size", "16384x16384", "-o", out], 2, "the budget is 8 GB"),
         (&["render", "--scene", "no/such/model.obj", "-o", out], 1, "file not found"),
         (&["render", "--scene", cycle, "-o", out], 1, "own ancestor"),
         (&["render", "--camera", "eye=1,2,target=0,0,0", "-o", out], 2, "eye must be three"),
         (&["render", "--light", "laser", "-o", out], 2, "type must be one of spot, directional, point"),
         (&["render", "--light", "spot,fov=250", "-o", out], 2, "cone angle"),
+        (&["render", "--light", "directional,fov=0", "-o", out], 2, "a directional light has none"),
+        (&["render", "--light", "point,target=0,0,0", "-o", out], 2, "takes no target"),
+        (&["render", "--light", "spot,pos=1,2,3,pos=4,5,6", "-o", out], 2, "'pos' is given twice"),
+        (&["render", "--camera", "eye=1,2,3,target=0,0,0,eye=0,1,2", "-o", out], 2, "'eye' is given twice"),
+        (&["render", "--backend", "cpu", "--adapter", "llvmpipe", "-o", out], 2, "--backend cpu uses none"),
+        (&["render", "--adapter", "no-such-adapter", "-o", out], 1, "none named like 'no-such-adapter'"),
         (&["compare", "--backend", "quantum", "--out-dir", out], 2, "bad --backend 'quantum'"),
         (&["bench", "--frames", "0", "--backend", "cpu"], 2, "--frames must be at least 1"),
         (&["bench", "--sweep", "speed=1,2", "--backend", "cpu"], 2, "must be res or tris"),
@@ -100,8 +107,8 @@ fn bad_inputs_give_one_line_and_the_right_status() {
     ];
     for (args, status, words) in cases {
         let (code, _, err) = shadowlab(args);
-        let lines: Vec<&str> =
-            err.lines().filter(|l| !l.starts_with("backend") && !l.contains("XDG_RUNTIME_DIR")).collect();
+        // Input is checked before anything is said: a refusal is its one line.
+        let lines: Vec<&str> = err.lines().collect();
         assert_eq!(code, *status, "{args:?}: status {code}, stderr: {err}");
         assert_eq!(lines.len(), 1, "{args:?}: not one line: {err}");
         assert!(
@@ -111,4 +118,101 @@ fn bad_inputs_give_one_line_and_the_right_status() {
         );
     }
     let _ = std::fs::remove_file(out);
+}
+
+#[test]
+fn a_refused_run_leaves_no_output_folder() {
+    let out = std::env::temp_dir().join(format!("shadowlab-refused-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&out);
+    for bad in [&["--light", "laser"][..], &["--scene", "no/such/model.obj"][..], &["--size", "0x9"][..]] {
+        let mut args = vec!["compare", "--backend", "cpu", "--out-dir", out.to_str().unwrap()];
+        args.extend_from_slice(bad);
+        let (code, _, err) = shadowlab(&args);
+        assert_ne!(code, 0, "{bad:?} ran");
+        assert_eq!(err.lines().count(), 1, "{bad:?}: {err}");
+        assert!(!out.exists(), "{bad:?} left {} behind", out.display());
+    }
+}
+
+#[test]
+fn a_closed_pipe_ends_the_program_quietly() {
+    use std::process::Stdio;
+    for command in ["techniques", "scenes"] {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_shadowlab"))
+            .arg(command)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("the binary runs");
+        // Closing the read end before the program writes makes its first write fail with a broken pipe.
+        drop(child.stdout.take());
+        let out = child.wait_with_output().expect("it ends");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(0), "{command}: {err}");
+        assert!(err.is_empty(), "{command}: {err}");
+    }
+}
+
+#[test]
+fn no_error_line_on_a_run_that_succeeds_without_a_runtime_folder() {
+    let out = std::env::temp_dir().join(format!("shadowlab-xdg-{}.png", std::process::id()));
+    let out = out.to_str().unwrap();
+    let status = Command::new(env!("CARGO_BIN_EXE_shadowlab"))
+        .args(["render", "--size", "32x32", "-o", out])
+        .env_remove("XDG_RUNTIME_DIR")
+        .output()
+        .expect("the binary runs");
+    let err = String::from_utf8_lossy(&status.stderr);
+    assert!(status.status.success(), "{err}");
+    assert!(!err.lines().any(|l| l.starts_with("error")), "{err}");
+    let _ = std::fs::remove_file(out);
+    let _ = std::fs::remove_file(out.replace(".png", ".vis.png"));
+}
+
+#[test]
+fn help_says_what_runs_and_what_the_exit_codes_mean() {
+    let (_, top, _) = shadowlab(&["--help"]);
+    assert!(top.contains("Exit status: 0 on success"), "{top}");
+    let (_, export, _) = shadowlab(&["export", "--help"]);
+    for meaningless in ["--size", "--adapter"] {
+        assert!(!export.contains(meaningless), "export --help lists {meaningless}");
+    }
+    for command in ["compare", "bench"] {
+        let (_, help, _) = shadowlab(&[command, "--help"]);
+        let help = help.split_whitespace().collect::<Vec<_>>().join(" ");
+        assert!(help.contains("default: every technique but the references"), "{command}: {help}");
+    }
+}
+
+#[test]
+fn a_mixed_compare_scores_each_technique_against_its_own_reference() {
+    let out = std::env::temp_dir().join(format!("shadowlab-mixed-{}", std::process::id()));
+    let args = [
+        "compare",
+        "--scene",
+        "cylinder",
+        "--size",
+        "64x64",
+        "--backend",
+        "cpu",
+        "--technique",
+        "shadow-map",
+        "--technique",
+        "pcss",
+        "--out-dir",
+        out.to_str().unwrap(),
+    ];
+    let (code, stdout, err) = shadowlab(&args);
+    assert_eq!(code, 0, "{err}");
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).expect("report.json")).unwrap();
+    let reference_of = |name: &str| {
+        report["results"].as_array().unwrap().iter().find(|r| r["technique"] == name).unwrap()["reference"].clone()
+    };
+    assert_eq!(reference_of("shadow-map"), "ray-traced");
+    assert_eq!(reference_of("pcss"), "area-light-reference");
+    let pcss_line = stdout.lines().find(|l| l.starts_with("pcss")).expect("a pcss row");
+    assert!(pcss_line.contains("area-light-reference"), "{pcss_line}");
+    assert!(out.join("reference-area-light-reference.png").exists());
+    let _ = std::fs::remove_dir_all(&out);
 }

@@ -26,6 +26,7 @@ fn run(scene: &str, specs: Vec<String>) -> Vec<ResultEntry> {
         height: 384,
         techniques,
         reference: TechniqueSpec::named("ray-traced"),
+        soft_reference: None,
         backends: vec![BackendKind::Cpu],
         out_dir: None,
     };

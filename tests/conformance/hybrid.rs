@@ -31,6 +31,7 @@ fn run(scene: &str, specs: &[&str]) -> Vec<ResultEntry> {
         height: 512,
         techniques: specs.iter().map(|t| TechniqueSpec::parse(t).expect("spec")).collect(),
         reference: TechniqueSpec::named("ray-traced"),
+        soft_reference: None,
         backends: vec![BackendKind::Cpu],
         out_dir: None,
     };

@@ -34,6 +34,7 @@ fn silhouette_maps_cut_edge_errors_to_a_third_of_a_shadow_maps() {
                 height: 512,
                 techniques: specs.iter().map(|t| TechniqueSpec::parse(t).expect("spec")).collect(),
                 reference: TechniqueSpec::named("ray-traced"),
+                soft_reference: None,
                 backends: vec![BackendKind::Cpu],
                 out_dir: None,
             };

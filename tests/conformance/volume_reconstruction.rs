@@ -36,6 +36,7 @@ fn run(frame: &FrameInputs, specs: &[String]) -> Vec<ResultEntry> {
         height: 512,
         techniques: specs.iter().map(|t| TechniqueSpec::parse(t).expect("spec")).collect(),
         reference: TechniqueSpec::named("ray-traced"),
+        soft_reference: None,
         backends: vec![BackendKind::Cpu],
         out_dir: None,
     };

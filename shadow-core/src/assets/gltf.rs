@@ -422,7 +422,8 @@ impl Loader<'_> {
                     cone_angle: (2.0 * outer_cone_angle).clamp(1e-3, 3.1),
                 },
             };
-            let light = Light { kind, color: Vec3::from(l.color()), intensity: 1.0, radius: 0.05 };
+            // The light's radius is for soft shadows, which glTF does not describe: the default.
+            let light = Light { kind, color: Vec3::from(l.color()), intensity: l.intensity(), ..Light::point(trans) };
             if light.validate().is_ok() {
                 self.scene.add_light(light);
             }

@@ -190,10 +190,14 @@ pub fn ground_quad() -> Mesh {
 }
 
 /// Puts a loaded model on stage (DESIGN 11): scaled so the largest side of its bounds is 1, centred over
-/// the origin and set on y = 0, over a 10 x 10 ground quad (unless `ground` is false), with the default
-/// spotlight at (2, 4, 1.5) aiming at the origin with a 60 degree cone and the camera at (0, 1.1, 2.2)
-/// looking at (0, 0.35, 0) with a 45 degree vertical field of view. The model's own cameras and lights are
-/// replaced.
+/// the origin and set on y = 0.
+///
+/// A bare model (one without cameras and lights of its own) gets a 10 x 10 ground quad (unless `ground`
+/// is false), the default spotlight at (2, 4, 1.5) aiming at the origin with a 60 degree cone and the
+/// camera at (0, 1.1, 2.2) looking at (0, 0.35, 0) with a 45 degree vertical field of view. A file that
+/// brings its own cameras or lights is a scene already: they are moved with it, it gets no second ground
+/// (which would lie in its own floor and z-fight), and only what it lacks, a camera or a light, is
+/// given the default.
 pub fn stage_model(model: &mut Scene, ground: bool) {
     let b = model.bounds();
     let scale = 1.0 / b.size().max_element().max(1e-12);
@@ -201,15 +205,36 @@ pub fn stage_model(model: &mut Scene, ground: bool) {
     let place = Mat4::from_scale(Vec3::splat(scale)) * Mat4::from_translation(offset);
     // `place` is finite: the bounds are finite and the scale's divisor is at least 1e-12.
     let _ = model.group_roots("stage", place);
-    if ground {
+    let cameras: Vec<Camera> = model.cameras().map(|(_, c)| *c).collect();
+    let lights: Vec<Light> = model.lights().map(|(_, l)| *l).collect();
+    let bare = cameras.is_empty() && lights.is_empty();
+    model.clear_cameras();
+    model.clear_lights();
+    for c in cameras {
+        let (eye, target) = (place.transform_point3(c.eye), place.transform_point3(c.target));
+        model.add_camera(Camera { eye, target, near: c.near * scale, ..c });
+    }
+    for l in lights {
+        let kind = match l.kind {
+            LightKind::Spot { position, direction, cone_angle } => {
+                LightKind::Spot { position: place.transform_point3(position), direction, cone_angle }
+            }
+            LightKind::Point { position } => LightKind::Point { position: place.transform_point3(position) },
+            directional @ LightKind::Directional { .. } => directional,
+        };
+        model.add_light(Light { kind, radius: l.radius * scale, ..l });
+    }
+    if ground && bare {
         let mesh = model.add_mesh(ground_quad());
         let mat = model.add_material(Material::colored("ground", Vec3::splat(0.75)));
         let _ = model.add_instance("ground", mesh, mat, Mat4::IDENTITY);
     }
-    model.clear_cameras();
-    model.clear_lights();
-    model.add_camera(Camera::look_at(Vec3::new(0.0, 1.1, 2.2), Vec3::new(0.0, 0.35, 0.0), 45.0));
-    model.add_light(Light::spot(Vec3::new(2.0, 4.0, 1.5), Vec3::ZERO, 60.0));
+    if model.cameras().next().is_none() {
+        model.add_camera(Camera::look_at(Vec3::new(0.0, 1.1, 2.2), Vec3::new(0.0, 0.35, 0.0), 45.0));
+    }
+    if model.lights().next().is_none() {
+        model.add_light(Light::spot(Vec3::new(2.0, 4.0, 1.5), Vec3::ZERO, 60.0));
+    }
 }
 
 /// A small deterministic generator (SplitMix64) for scene placement.

@@ -22,7 +22,7 @@ use crate::light::LightView;
 use crate::scene::Light;
 use crate::stats::{Counters, Timings};
 
-pub use settings::{SettingKey, SettingsError, TechniqueSettings, TechniqueSpec};
+pub use settings::{SettingKey, SettingsError, TechniqueSettings, TechniqueSpec, key_values};
 
 /// A backend: a bundle of associated types (after wgpu-hal's `Api`).
 pub trait Backend: Sized + 'static {

@@ -75,20 +75,48 @@ impl TechniqueSpec {
         if name.is_empty() || !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_') {
             return Err(bad("the name must be non-empty letters, digits and '-'"));
         }
-        let mut values: Vec<(String, String)> = Vec::new();
-        for pair in rest.into_iter().flat_map(|r| r.split(',')).filter(|p| !p.trim().is_empty()) {
-            let (k, v) = pair.split_once('=').ok_or_else(|| bad(&format!("'{pair}' is not key=value")))?;
-            let (k, v) = (k.trim(), v.trim());
-            if k.is_empty() {
-                return Err(bad(&format!("'{pair}' has an empty key")));
-            }
-            if values.iter().any(|(seen, _)| seen == k) {
-                return Err(bad(&format!("'{k}' is given twice")));
-            }
-            values.push((k.into(), v.into()));
-        }
+        let values = key_values(rest.unwrap_or("")).map_err(|why| bad(&why))?;
         Ok(Self { name: name.into(), values })
     }
+}
+
+/// Parses `key=value,key=value,...`: the one syntax of technique settings and of the CLI's `--camera` and
+/// `--light`. A piece without `=` continues the value before it, so vectors keep their commas
+/// (`pos=1,2,3`); empty pieces are skipped. The error says what is wrong, without the text.
+///
+/// # Errors
+/// A first piece without `=`, an empty key, or a key given twice.
+///
+/// # Examples
+/// ```
+/// use shadow_core::technique::key_values;
+/// let kv = key_values("eye=0,1,2,fov=30").unwrap();
+/// assert_eq!(kv, vec![("eye".into(), "0,1,2".into()), ("fov".into(), "30".into())]);
+/// assert!(key_values("fov=30,fov=40").unwrap_err().contains("twice"));
+/// ```
+pub fn key_values(text: &str) -> Result<Vec<(String, String)>, String> {
+    let mut values: Vec<(String, String)> = Vec::new();
+    for piece in text.split(',').map(str::trim).filter(|p| !p.is_empty()) {
+        let Some((k, v)) = piece.split_once('=') else {
+            match values.last_mut() {
+                Some((_, v)) => {
+                    v.push(',');
+                    v.push_str(piece);
+                    continue;
+                }
+                None => return Err(format!("'{piece}' is not key=value")),
+            }
+        };
+        let (k, v) = (k.trim(), v.trim());
+        if k.is_empty() {
+            return Err(format!("'{piece}' has an empty key"));
+        }
+        if values.iter().any(|(seen, _)| seen == k) {
+            return Err(format!("'{k}' is given twice"));
+        }
+        values.push((k.into(), v.into()));
+    }
+    Ok(values)
 }
 
 impl fmt::Display for TechniqueSpec {
