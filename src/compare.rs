@@ -5,7 +5,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use serde::Serialize;
-use shadow_core::image::{Rgb8, error_map, visibility_to_rgb};
+use shadow_core::image::{Rgb8, error_map_over, visibility_to_rgb};
 use shadow_core::metrics::{VisibilityMetrics, back_false_light, compare_visibility, flip_mean, measured_pixels};
 use shadow_core::stats::Phase;
 use shadow_core::technique::{FrameStats, TechniqueSpec};
@@ -13,7 +13,7 @@ use shadow_core::{FrameInputs, Image};
 
 use crate::Error;
 use crate::renderer::{BackendKind, Renderer, RunOutput};
-use crate::sheet::contact_sheet;
+use crate::sheet::{SheetItem, contact_sheet, disagreement_inset};
 
 /// What to compare.
 pub struct CompareJob<'a> {
@@ -182,8 +182,12 @@ pub fn run_compare(
         reference: ref_vis,
         mask: &mask,
     };
-    let mut sheet: Vec<(String, Image<Rgb8>)> =
-        vec![(format!("{}\nreference", reference.name), ref_frame.color.clone())];
+    // A reference's tile shows its visibility where the others show their errors.
+    let mut sheet = vec![SheetItem {
+        label: format!("{}\nreference", reference.name),
+        picture: ref_frame.color.clone(),
+        errors: Some(visibility_to_rgb(ref_vis, &mask)),
+    }];
     if let Some(dir) = &job.out_dir {
         save(&ref_frame.color, dir, "reference.png")?;
         save(&visibility_to_rgb(ref_vis, &mask), dir, "reference.vis.png")?;
@@ -195,7 +199,11 @@ pub fn run_compare(
         Some(spec) if soft.contains(&true) => {
             progress(&format!("reference: {spec} on cpu"));
             let (frame, _) = renderer.run_cpu_frame(job.frame, job.width, job.height, spec)?;
-            sheet.push((format!("{}\nreference", spec.name), frame.color.clone()));
+            sheet.push(SheetItem {
+                label: format!("{}\nreference", spec.name),
+                picture: frame.color.clone(),
+                errors: Some(visibility_to_rgb(&frame.visibility[0], &mask)),
+            });
             if let Some(dir) = &job.out_dir {
                 save(&frame.color, dir, &format!("reference-{}.png", spec.name))?;
                 save(
@@ -211,6 +219,8 @@ pub fn run_compare(
 
     let mut results = Vec::new();
     let mut runs: Vec<RunOutput> = Vec::new();
+    // Which reference each run was measured against: false for the first, true for the soft one.
+    let mut against_soft: Vec<bool> = Vec::new();
     for (i, spec) in job.techniques.iter().enumerate() {
         let same_name = job.techniques.iter().filter(|s| s.name == spec.name).count() > 1;
         // Each technique against its own kind's reference.
@@ -224,6 +234,7 @@ pub fn run_compare(
             let run = renderer.run(backend, job.frame, job.width, job.height, spec)?;
             let metrics = compare_visibility(&run.visibility[0], ref_vis, &mask)?;
             let flip = flip_mean(&run.color, ref_color, &mask)?;
+            let errors = error_map_over(&run.visibility[0], ref_vis, &mask, &reach, &run.color);
             let file = if same_name {
                 format!("{}-{}-{}", spec.name, i + 1, backend.name())
             } else {
@@ -232,7 +243,7 @@ pub fn run_compare(
             if let Some(dir) = &job.out_dir {
                 save(&run.color, dir, &format!("{file}.png"))?;
                 save(&visibility_to_rgb(&run.visibility[0], &mask), dir, &format!("{file}.vis.png"))?;
-                save(&error_map(&run.visibility[0], ref_vis, &mask, &reach), dir, &format!("{file}.err.png"))?;
+                save(&errors, dir, &format!("{file}.err.png"))?;
                 for v in &run.debug_views {
                     save(&v.image, dir, &format!("{file}.{}.png", v.name))?;
                 }
@@ -255,7 +266,7 @@ pub fn run_compare(
                 format!("mismatch {:.3}%", metrics.mismatch * 100.0)
             };
             let label = format!("{}\n{given}{} {score}", spec.name, backend.name());
-            sheet.push((label, run.color.clone()));
+            sheet.push(SheetItem { label, picture: run.color.clone(), errors: Some(errors) });
             results.push(ResultEntry {
                 technique: run.technique.clone(),
                 settings: run.settings.clone(),
@@ -276,6 +287,7 @@ pub fn run_compare(
                 flip,
             });
             runs.push(run);
+            against_soft.push(soft && soft_reference.is_some());
         }
     }
 
@@ -305,7 +317,14 @@ pub fn run_compare(
         reference: job.reference.to_string(),
     };
     if let Some(dir) = &job.out_dir {
-        save(&contact_sheet(&sheet, 320), dir, "contact.png")?;
+        let soft_vis = soft_reference.as_ref().and_then(|(_, _, v)| v.as_ref());
+        let pairs: Vec<(&Image<f32>, &Image<f32>)> = runs
+            .iter()
+            .zip(&against_soft)
+            .map(|(run, &soft)| (&run.visibility[0], if soft { soft_vis.unwrap_or(ref_vis) } else { ref_vis }))
+            .collect();
+        let inset = disagreement_inset(&pairs, ref_vis, &mask, (job.width.min(job.height) / 8).max(8));
+        save(&contact_sheet(&sheet, 320, Some(inset)), dir, "contact.png")?;
         let json = serde_json::to_string_pretty(&report).map_err(|e| Error::Usage(e.to_string()))?;
         let write = |name: &str, text: &str| {
             std::fs::write(dir.join(name), text).map_err(|e| Error::Write { path: dir.join(name), why: e.to_string() })

@@ -698,7 +698,7 @@ fn bench(args: &SceneArgs, view: &ViewArgs, b: BenchArgs) -> Result<(), Error> {
             let (w, h) = view.size()?;
             let scene = &sweep_scenes[i];
             let cam = scene.cameras().next().map(|(k, _)| k).ok_or_else(|| Error::Usage("no camera".into()))?;
-            (FrameInputs::from_scene(&scene, cam)?, w, h)
+            (FrameInputs::from_scene(scene, cam)?, w, h)
         };
         let with_value: Vec<TechniqueSpec> = specs
             .iter()

@@ -20,7 +20,10 @@ use std::time::{Duration, Instant};
 use shadow_core::FrameInputs;
 use shadow_core::assets;
 
-const TARGETS: &[(&str, fn(&mut rng::Rng) -> generate::Case)] = &[
+/// A generator of one format's cases.
+type Generator = fn(&mut rng::Rng) -> generate::Case;
+
+const TARGETS: &[(&str, Generator)] = &[
     ("obj", generate::obj),
     ("ply", generate::ply),
     ("ply-gz", generate::ply_gz),
@@ -102,13 +105,7 @@ struct Tally {
     findings: u64,
 }
 
-fn run_target(
-    name: &str,
-    generate: fn(&mut rng::Rng) -> generate::Case,
-    o: &Options,
-    root: &Path,
-    findings_dir: &Path,
-) -> u64 {
+fn run_target(name: &str, generate: Generator, o: &Options, root: &Path, findings_dir: &Path) -> u64 {
     let case_dir = root.join(name).join("case");
     std::fs::create_dir_all(case_dir.join("sub")).expect("the fuzz folder");
     // What a model must not reach: files beside its folder.

@@ -268,6 +268,49 @@ pub fn error_map(
     })
 }
 
+/// The error map over the shaded picture, as the contact sheet and `compare` show it: agreement is the
+/// picture in grey (so the model stays visible against the ground), false shadow red, false light blue,
+/// unmeasured receivers dimmed; a legend in the top-left corner says which colour is which.
+#[must_use]
+pub fn error_map_over(
+    test: &Image<f32>,
+    reference: &Image<f32>,
+    measured: &Image<bool>,
+    shown: &Image<bool>,
+    picture: &Image<Rgb8>,
+) -> Image<Rgb8> {
+    const FALSE_SHADOW: Rgb8 = [230, 40, 40];
+    const FALSE_LIGHT: Rgb8 = [40, 90, 240];
+    let mut out = Image::from_fn(test.width(), test.height(), |x, y| {
+        let p = picture.get(x, y);
+        let grey = ((u16::from(p[0]) * 3 + u16::from(p[1]) * 6 + u16::from(p[2])) / 10) as u8;
+        let (m, s) = (*measured.get(x, y), *shown.get(x, y));
+        let (t, r) = (*test.get(x, y) >= 0.5, *reference.get(x, y) >= 0.5);
+        match (m || s, t, r) {
+            (true, false, true) if m => FALSE_SHADOW,
+            (true, true, false) if m => FALSE_LIGHT,
+            (true, false, true) => FALSE_SHADOW.map(|v| v / 2 + grey / 2),
+            (true, true, false) => FALSE_LIGHT.map(|v| v / 2 + grey / 2),
+            // Agreement, and everything not measured: the picture at lower contrast, so colours stand out.
+            _ => [(u16::from(grey) * 3 / 5 + 40) as u8; 3],
+        }
+    });
+    // The legend: two swatches with their meaning, on a dark band.
+    let scale = (out.width() / 256).max(1);
+    let (line, cell) = (crate::text::LINE_HEIGHT * scale, crate::text::CELL_WIDTH * scale);
+    let band_w = cell * 30;
+    let y0 = 0;
+    crate::text::fill_rect(&mut out, 0, y0, band_w, line + 4, [30, 30, 36]);
+    let mut x = 4i32;
+    for (colour, words) in [(FALSE_SHADOW, "false shadow"), (FALSE_LIGHT, "false light")] {
+        crate::text::fill_rect(&mut out, x, y0 + 2 + (line / 4) as i32, cell, line / 2, colour);
+        x += (cell + cell / 2) as i32;
+        crate::text::draw_text(&mut out, x, y0 + 2, words, [235, 235, 235], scale);
+        x += (crate::text::text_width(words, scale) + cell * 2) as i32;
+    }
+    out
+}
+
 /// A scalar field as a blue-to-yellow ramp between `lo` and `hi` (debug views of depth maps); NaN is black.
 #[must_use]
 pub fn false_colour(values: &Image<f32>, lo: f32, hi: f32) -> Image<Rgb8> {

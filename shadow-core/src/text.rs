@@ -1,92 +1,62 @@
-//! A 5x7 bitmap font (drawn for this project) for labels on contact sheets and plots.
+//! Labels on contact sheets and plots, in Hack (a monospaced typeface under the MIT and Bitstream Vera
+//! licences, embedded by `epaint_default_fonts`) rasterized with anti-aliasing by `ab_glyph`.
+//!
+//! Sizes are given as a `scale`: at scale 1 a character cell is [`CELL_WIDTH`] pixels wide and a line
+//! [`LINE_HEIGHT`] pixels tall, so layouts can be computed without the font.
+
+use std::sync::OnceLock;
+
+use ab_glyph::{Font, FontRef, PxScale, ScaleFont};
 
 use crate::image::{Image, Rgb8};
 
-/// Glyphs: 7 rows of 5 bits, most significant bit on the left. Upper case is drawn as lower case.
-const GLYPHS: &[(char, [u8; 7])] = &[
-    ('%', [0b11000, 0b11001, 0b00010, 0b00100, 0b01000, 0b10011, 0b00011]),
-    ('(', [0b00010, 0b00100, 0b01000, 0b01000, 0b01000, 0b00100, 0b00010]),
-    (')', [0b01000, 0b00100, 0b00010, 0b00010, 0b00010, 0b00100, 0b01000]),
-    ('+', [0b00000, 0b00100, 0b00100, 0b11111, 0b00100, 0b00100, 0b00000]),
-    (',', [0b00000, 0b00000, 0b00000, 0b00000, 0b01100, 0b00100, 0b01000]),
-    ('-', [0b00000, 0b00000, 0b00000, 0b11111, 0b00000, 0b00000, 0b00000]),
-    ('.', [0b00000, 0b00000, 0b00000, 0b00000, 0b00000, 0b01100, 0b01100]),
-    ('/', [0b00000, 0b00001, 0b00010, 0b00100, 0b01000, 0b10000, 0b00000]),
-    ('0', [0b01110, 0b10001, 0b10011, 0b10101, 0b11001, 0b10001, 0b01110]),
-    ('1', [0b00100, 0b01100, 0b00100, 0b00100, 0b00100, 0b00100, 0b01110]),
-    ('2', [0b01110, 0b10001, 0b00001, 0b00110, 0b01000, 0b10000, 0b11111]),
-    ('3', [0b11110, 0b00001, 0b00001, 0b01110, 0b00001, 0b00001, 0b11110]),
-    ('4', [0b00010, 0b00110, 0b01010, 0b10010, 0b11111, 0b00010, 0b00010]),
-    ('5', [0b11111, 0b10000, 0b11110, 0b00001, 0b00001, 0b10001, 0b01110]),
-    ('6', [0b00110, 0b01000, 0b10000, 0b11110, 0b10001, 0b10001, 0b01110]),
-    ('7', [0b11111, 0b00001, 0b00010, 0b00100, 0b01000, 0b01000, 0b01000]),
-    ('8', [0b01110, 0b10001, 0b10001, 0b01110, 0b10001, 0b10001, 0b01110]),
-    ('9', [0b01110, 0b10001, 0b10001, 0b01111, 0b00001, 0b00010, 0b01100]),
-    (':', [0b00000, 0b01100, 0b01100, 0b00000, 0b01100, 0b01100, 0b00000]),
-    ('=', [0b00000, 0b00000, 0b11111, 0b00000, 0b11111, 0b00000, 0b00000]),
-    ('^', [0b00100, 0b01010, 0b10001, 0b00000, 0b00000, 0b00000, 0b00000]),
-    ('_', [0b00000, 0b00000, 0b00000, 0b00000, 0b00000, 0b00000, 0b11111]),
-    ('a', [0b00000, 0b00000, 0b01110, 0b00001, 0b01111, 0b10001, 0b01111]),
-    ('b', [0b10000, 0b10000, 0b10110, 0b11001, 0b10001, 0b10001, 0b11110]),
-    ('c', [0b00000, 0b00000, 0b01110, 0b10000, 0b10000, 0b10001, 0b01110]),
-    ('d', [0b00001, 0b00001, 0b01101, 0b10011, 0b10001, 0b10001, 0b01111]),
-    ('e', [0b00000, 0b00000, 0b01110, 0b10001, 0b11111, 0b10000, 0b01110]),
-    ('f', [0b00110, 0b01001, 0b01000, 0b11100, 0b01000, 0b01000, 0b01000]),
-    ('g', [0b00000, 0b01111, 0b10001, 0b10001, 0b01111, 0b00001, 0b01110]),
-    ('h', [0b10000, 0b10000, 0b10110, 0b11001, 0b10001, 0b10001, 0b10001]),
-    ('i', [0b00100, 0b00000, 0b01100, 0b00100, 0b00100, 0b00100, 0b01110]),
-    ('j', [0b00010, 0b00000, 0b00110, 0b00010, 0b00010, 0b10010, 0b01100]),
-    ('k', [0b10000, 0b10000, 0b10010, 0b10100, 0b11000, 0b10100, 0b10010]),
-    ('l', [0b01100, 0b00100, 0b00100, 0b00100, 0b00100, 0b00100, 0b01110]),
-    ('m', [0b00000, 0b00000, 0b11010, 0b10101, 0b10101, 0b10001, 0b10001]),
-    ('n', [0b00000, 0b00000, 0b10110, 0b11001, 0b10001, 0b10001, 0b10001]),
-    ('o', [0b00000, 0b00000, 0b01110, 0b10001, 0b10001, 0b10001, 0b01110]),
-    ('p', [0b00000, 0b00000, 0b11110, 0b10001, 0b11110, 0b10000, 0b10000]),
-    ('q', [0b00000, 0b00000, 0b01101, 0b10011, 0b01111, 0b00001, 0b00001]),
-    ('r', [0b00000, 0b00000, 0b10110, 0b11001, 0b10000, 0b10000, 0b10000]),
-    ('s', [0b00000, 0b00000, 0b01110, 0b10000, 0b01110, 0b00001, 0b11110]),
-    ('t', [0b01000, 0b01000, 0b11100, 0b01000, 0b01000, 0b01001, 0b00110]),
-    ('u', [0b00000, 0b00000, 0b10001, 0b10001, 0b10001, 0b10011, 0b01101]),
-    ('v', [0b00000, 0b00000, 0b10001, 0b10001, 0b10001, 0b01010, 0b00100]),
-    ('w', [0b00000, 0b00000, 0b10001, 0b10001, 0b10101, 0b10101, 0b01010]),
-    ('x', [0b00000, 0b00000, 0b10001, 0b01010, 0b00100, 0b01010, 0b10001]),
-    ('y', [0b00000, 0b00000, 0b10001, 0b10001, 0b01111, 0b00001, 0b01110]),
-    ('z', [0b00000, 0b00000, 0b11111, 0b00010, 0b00100, 0b01000, 0b11111]),
-];
-
-/// Width of one character cell at scale 1 (5 pixels and a 1-pixel gap).
+/// Width of one character cell at scale 1.
 pub const CELL_WIDTH: u32 = 6;
 /// Height of one line at scale 1.
-pub const LINE_HEIGHT: u32 = 9;
+pub const LINE_HEIGHT: u32 = 13;
+
+fn font() -> &'static FontRef<'static> {
+    static FONT: OnceLock<FontRef<'static>> = OnceLock::new();
+    // The font is a constant of the build, and `the_embedded_font_parses` parses it.
+    FONT.get_or_init(|| FontRef::try_from_slice(epaint_default_fonts::HACK_REGULAR).expect("Hack parses"))
+}
+
+/// The glyph size whose advance (the same for every glyph of a monospaced face) fills `scale` cells.
+fn cell_scale(scale: f32) -> PxScale {
+    let unit = font().as_scaled(PxScale::from(1.0)).h_advance(font().glyph_id('m'));
+    PxScale::from(CELL_WIDTH as f32 * scale / unit)
+}
 
 /// Width in pixels of `text` at `scale`.
 #[must_use]
 pub fn text_width(text: &str, scale: u32) -> u32 {
-    text.chars().count() as u32 * CELL_WIDTH * scale
+    text.chars().count() as u32 * CELL_WIDTH * scale.max(1)
 }
 
-/// Draws `text` with its top-left corner at (x, y); pixels outside the image are skipped.
+/// Draws `text` with its top-left corner at (x, y), blending each glyph's coverage over the image;
+/// pixels outside the image are skipped.
 pub fn draw_text(img: &mut Image<Rgb8>, x: i32, y: i32, text: &str, color: Rgb8, scale: u32) {
-    let s = scale.max(1) as i32;
+    let s = scale.max(1) as f32;
+    let scaled = font().as_scaled(cell_scale(s));
+    // The line's ascent sits in the middle of the line's extra height, so text is centred in it.
+    let baseline = y as f32 + (LINE_HEIGHT as f32 * s - (scaled.ascent() - scaled.descent())) / 2.0 + scaled.ascent();
     for (k, ch) in text.chars().enumerate() {
-        let c = ch.to_ascii_lowercase();
-        let Some((_, rows)) = GLYPHS.iter().find(|(g, _)| *g == c) else { continue };
-        let x0 = x + k as i32 * CELL_WIDTH as i32 * s;
-        for (r, bits) in rows.iter().enumerate() {
-            for col in 0..5 {
-                if bits & (0b10000 >> col) == 0 {
-                    continue;
-                }
-                for dy in 0..s {
-                    for dx in 0..s {
-                        let (px, py) = (x0 + col * s + dx, y + r as i32 * s + dy);
-                        if px >= 0 && py >= 0 && (px as u32) < img.width() && (py as u32) < img.height() {
-                            *img.get_mut(px as u32, py as u32) = color;
-                        }
-                    }
-                }
+        let pen = ab_glyph::point(x as f32 + k as f32 * CELL_WIDTH as f32 * s, baseline);
+        let mut glyph = scaled.scaled_glyph(ch);
+        glyph.position = pen;
+        let Some(outline) = font().outline_glyph(glyph) else { continue };
+        let bounds = outline.px_bounds();
+        outline.draw(|gx, gy, coverage| {
+            let (px, py) = (bounds.min.x as i32 + gx as i32, bounds.min.y as i32 + gy as i32);
+            if px < 0 || py < 0 || px as u32 >= img.width() || py as u32 >= img.height() {
+                return;
             }
-        }
+            let under = img.get_mut(px as u32, py as u32);
+            let a = coverage.clamp(0.0, 1.0);
+            for c in 0..3 {
+                under[c] = (f32::from(under[c]) * (1.0 - a) + f32::from(color[c]) * a).round() as u8;
+            }
+        });
     }
 }
 
@@ -104,12 +74,27 @@ mod tests {
     use super::*;
 
     #[test]
-    fn text_draws_inside_its_box() {
-        let mut img = Image::new(40, 12, [0u8; 3]);
-        draw_text(&mut img, 1, 1, "ab-1%", [255; 3], 1);
+    fn the_embedded_font_parses_and_advances_one_cell_a_character() {
+        let scaled = font().as_scaled(cell_scale(1.0));
+        let advance = scaled.h_advance(font().glyph_id('m'));
+        assert!((advance - CELL_WIDTH as f32).abs() < 0.1, "advance {advance}");
+    }
+
+    #[test]
+    fn text_draws_inside_its_box_with_descenders() {
+        let (w, h) = (60, 2 * LINE_HEIGHT);
+        let mut img = Image::new(w, h, [0u8; 3]);
+        draw_text(&mut img, 1, 1, "gyp-1%", [255; 3], 1);
         let lit: Vec<(u32, u32)> =
-            (0..12).flat_map(|y| (0..40).map(move |x| (x, y))).filter(|&(x, y)| img.get(x, y)[0] == 255).collect();
-        assert!(!lit.is_empty());
-        assert!(lit.iter().all(|&(x, y)| x >= 1 && x < 1 + text_width("ab-1%", 1) && (1..8).contains(&y)));
+            (0..h).flat_map(|y| (0..w).map(move |x| (x, y))).filter(|&(x, y)| img.get(x, y)[0] > 64).collect();
+        assert!(lit.len() > 20, "{} pixels drawn", lit.len());
+        assert!(
+            lit.iter()
+                .all(|&(x, y)| (1..1 + text_width("gyp-1%", 1)).contains(&x) && (1..1 + LINE_HEIGHT).contains(&y))
+        );
+        // 'g', 'y' and 'p' reach below the baseline that '1' stands on.
+        let bottom = |x0: u32, x1: u32| lit.iter().filter(|p| p.0 >= x0 && p.0 < x1).map(|p| p.1).max();
+        let (descender, digit) = (bottom(1, 1 + CELL_WIDTH), bottom(1 + 4 * CELL_WIDTH, 1 + 5 * CELL_WIDTH));
+        assert!(descender > digit, "'g' ends at {descender:?}, '1' at {digit:?}");
     }
 }
