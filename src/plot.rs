@@ -2,7 +2,7 @@
 
 use shadow_core::Image;
 use shadow_core::image::Rgb8;
-use shadow_core::text::{CELL_WIDTH, draw_text, fill_rect, text_width};
+use shadow_core::text::{CELL_WIDTH, LINE_HEIGHT, draw_text, fill_rect, text_width};
 
 const PALETTE: [Rgb8; 8] = [
     [31, 119, 180],
@@ -28,7 +28,7 @@ fn line(img: &mut Image<Rgb8>, (x0, y0): (f32, f32), (x1, y1): (f32, f32), c: Rg
 #[must_use]
 pub fn line_plot(title: &str, x_label: &str, y_label: &str, series: &[(String, Vec<(f64, f64)>)]) -> Image<Rgb8> {
     let (w, h) = (900u32, 560u32);
-    let (left, right, top, bottom) = (80.0f32, 250.0f32, 40.0f32, 60.0f32);
+    let (left, right, top, bottom) = (80.0f32, 250.0f32, 70.0f32, 60.0f32);
     let mut img = Image::new(w, h, [255u8, 255, 255]);
     let pts: Vec<(f64, f64)> = series.iter().flat_map(|(_, p)| p.iter().copied()).collect();
     let log_x = pts.iter().all(|p| p.0 > 0.0);
@@ -48,7 +48,8 @@ pub fn line_plot(title: &str, x_label: &str, y_label: &str, series: &[(String, V
     for k in 0..=4 {
         let y = y1 * f64::from(k) / 4.0;
         let label = format!("{y:.0}");
-        draw_text(&mut img, (left - 8.0) as i32 - text_width(&label, 1) as i32, py(y) as i32 - 3, &label, ink, 1);
+        let y_text = py(y) as i32 - LINE_HEIGHT as i32 / 2;
+        draw_text(&mut img, (left - 8.0) as i32 - text_width(&label, 1) as i32, y_text, &label, ink, 1);
     }
     let mut xs: Vec<f64> = pts.iter().map(|p| p.0).collect();
     xs.sort_by(f64::total_cmp);
@@ -66,7 +67,7 @@ pub fn line_plot(title: &str, x_label: &str, y_label: &str, series: &[(String, V
     }
     draw_text(&mut img, 10, 10, title, ink, 2);
     draw_text(&mut img, (w as f32 / 2.0 - right / 2.0) as i32, h as i32 - 24, x_label, ink, 1);
-    draw_text(&mut img, 8, (top - 14.0) as i32, y_label, ink, 1);
+    draw_text(&mut img, 8, top as i32 - LINE_HEIGHT as i32 - 8, y_label, ink, 1);
     for (i, (name, p)) in series.iter().enumerate() {
         let c = PALETTE[i % PALETTE.len()];
         for w2 in p.windows(2) {
@@ -77,7 +78,8 @@ pub fn line_plot(title: &str, x_label: &str, y_label: &str, series: &[(String, V
         }
         let ly = top as i32 + 18 * i as i32;
         fill_rect(&mut img, w as i32 - right as i32 + 12, ly, 14, 8, c);
-        draw_text(&mut img, w as i32 - right as i32 + 12 + 3 * CELL_WIDTH as i32, ly, name, ink, 1);
+        let text_y = ly + 4 - LINE_HEIGHT as i32 / 2;
+        draw_text(&mut img, w as i32 - right as i32 + 12 + 3 * CELL_WIDTH as i32, text_y, name, ink, 1);
     }
     img
 }
