@@ -98,6 +98,7 @@ pub fn parse_light(text: &str, default: &Light, scene_center: Vec3) -> Result<Li
     };
     let mut radius = default.radius;
     let mut target = None;
+    let mut fov_given = false;
     let refuse = |why: String| OptionError { flag: F, value: text.into(), why };
     for (k, v) in pairs(F, rest)? {
         match k.as_str() {
@@ -109,7 +110,10 @@ pub fn parse_light(text: &str, default: &Light, scene_center: Vec3) -> Result<Li
             "fov" if t != LightType::Spot => {
                 return Err(refuse(format!("fov is a spot light's cone; a {kind} light has none", kind = kind.trim())));
             }
-            "fov" => fov = number(F, text, "fov", &v)?,
+            "fov" => {
+                fov = number(F, text, "fov", &v)?;
+                fov_given = true;
+            }
             "radius" => radius = number(F, text, "radius", &v)?,
             other => {
                 return Err(OptionError {
@@ -131,7 +135,9 @@ pub fn parse_light(text: &str, default: &Light, scene_center: Vec3) -> Result<Li
         LightType::Directional => LightKind::Directional { direction: dir },
         LightType::Point => LightKind::Point { position: pos },
     };
-    let light = Light { kind, radius, ..*default };
+    // A new cone, or no cone, leaves the old inner cone behind.
+    let inner_cone_angle = if t == LightType::Spot && !fov_given { default.inner_cone_angle } else { None };
+    let light = Light { kind, radius, inner_cone_angle, ..*default };
     light.validate().map_err(|e| OptionError { flag: F, value: text.into(), why: e.to_string() })?;
     Ok(light)
 }

@@ -123,6 +123,9 @@ pub struct Light {
     pub intensity: f32,
     /// Radius of the emitting sphere, for soft shadows (hard-shadow techniques treat the light as a point).
     pub radius: f32,
+    /// A spot light's inner cone, its full apex angle in radians: full light inside it, fading to none at
+    /// the cone's rim (glTF's `innerConeAngle`, doubled). `None`: the last fifth of the half-angle fades.
+    pub inner_cone_angle: Option<f32>,
 }
 
 impl Light {
@@ -146,7 +149,7 @@ impl Light {
     }
 
     fn white(kind: LightKind) -> Self {
-        Self { kind, color: Vec3::ONE, intensity: 1.0, radius: 0.05 }
+        Self { kind, color: Vec3::ONE, intensity: 1.0, radius: 0.05, inner_cone_angle: None }
     }
 
     /// Position for spot and point lights, `None` for directional ones.
@@ -194,6 +197,9 @@ impl Light {
                 }
                 if !(cone_angle > 0.0 && cone_angle < std::f32::consts::PI) {
                     return bad("cone angle must be between 0 and 180 degrees");
+                }
+                if self.inner_cone_angle.is_some_and(|inner| !(inner >= 0.0 && inner < cone_angle)) {
+                    return bad("inner cone angle must be at least 0 and below the cone angle");
                 }
             }
             LightKind::Directional { direction } => {

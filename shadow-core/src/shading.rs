@@ -17,6 +17,20 @@ pub fn cone_falloff(light: &Light, p: Vec3) -> f32 {
     LightTerms::new(light).falloff(p)
 }
 
+/// A spot light's cosines of its rim's and its inner cone's half-angles (the falloff runs between them):
+/// the inner cone as the light gives it, else the last [`SPOT_SOFT_EDGE`] of the half-angle fades.
+/// `None` for other lights. Both backends' shading read the cone from here.
+#[must_use]
+pub fn cone_cosines(light: &Light) -> Option<(f32, f32)> {
+    let LightKind::Spot { cone_angle, .. } = light.kind else { return None };
+    let half = cone_angle * 0.5;
+    let inner = match light.inner_cone_angle {
+        Some(inner) => inner * 0.5,
+        None => half * (1.0 - SPOT_SOFT_EDGE),
+    };
+    Some((half.cos(), inner.cos()))
+}
+
 /// Hermite smoothstep of `x` between `e0` and `e1`.
 #[must_use]
 #[inline]
@@ -55,11 +69,11 @@ impl LightTerms {
     #[must_use]
     pub fn new(light: &Light) -> Self {
         let cone = match light.kind {
-            LightKind::Spot { position, direction, cone_angle } => Some(Cone {
+            LightKind::Spot { position, direction, .. } => cone_cosines(light).map(|(outer, inner)| Cone {
                 apex: position,
                 axis: direction.normalize_or_zero(),
-                outer: (cone_angle * 0.5).cos(),
-                inner: (cone_angle * 0.5 * (1.0 - SPOT_SOFT_EDGE)).cos(),
+                outer,
+                inner,
             }),
             _ => None,
         };

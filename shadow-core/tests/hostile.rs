@@ -337,3 +337,38 @@ fn malformed_numbers_name_their_line() {
     let (msg, _) = load_err(&path);
     assert_one_line_naming(&msg, &path, &["line 12", "1.2.3"]);
 }
+
+// ---- lights a file brings ----
+
+#[test]
+fn gltf_spot_lights_keep_their_cones_and_intensity() {
+    let dir = scratch("spot");
+    write(&dir.join("tri.bin"), triangle_bytes());
+    let text = gltf_with(
+        "tri.bin",
+        36,
+        r#"{"mesh": 0}, {"translation": [0, 4, 0], "extensions": {"KHR_lights_punctual": {"light": 0}}}"#,
+        Some("0, 1"),
+    )
+    .replacen(
+        r#""asset": {"version": "2.0"},"#,
+        r#""asset": {"version": "2.0"}, "extensionsUsed": ["KHR_lights_punctual"],
+               "extensions": {"KHR_lights_punctual": {"lights": [{"type": "spot", "intensity": 3.5,
+                   "spot": {"innerConeAngle": 0.3, "outerConeAngle": 0.5}}]}},"#,
+        1,
+    );
+    let path = write(&dir.join("spot.gltf"), text);
+    let s = assets::load(&path).expect("loads");
+    let light = *s.lights().next().expect("the file's light").1;
+    assert_eq!(light.intensity, 3.5);
+    assert_eq!(light.inner_cone_angle, Some(0.6));
+    let (outer, inner) = shadow_core::shading::cone_cosines(&light).expect("a spot");
+    assert!((outer - 0.5f32.cos()).abs() < 1e-6 && (inner - 0.3f32.cos()).abs() < 1e-6, "{outer} {inner}");
+    // Exported and loaded again, the cone is the same.
+    let glb = dir.join("again.glb");
+    shadow_core::assets::export::export_glb(&s, &glb).expect("exports");
+    let back = *assets::load(&glb).expect("loads again").lights().next().expect("a light").1;
+    let (o2, i2) = shadow_core::shading::cone_cosines(&back).expect("a spot");
+    assert!((o2 - outer).abs() < 1e-5 && (i2 - inner).abs() < 1e-5, "{o2} {i2}");
+    assert_eq!(back.intensity, 3.5);
+}

@@ -68,14 +68,9 @@ struct LightRaw {
 impl LightRaw {
     fn of(l: &shadow_core::scene::Light) -> Self {
         let (kind, position, direction, cone) = match l.kind {
-            LightKind::Spot { position, direction, cone_angle } => {
-                let half = cone_angle * 0.5;
-                (
-                    0,
-                    position,
-                    direction.normalize(),
-                    [half.cos(), (half * (1.0 - shadow_core::shading::SPOT_SOFT_EDGE)).cos()],
-                )
+            LightKind::Spot { position, direction, .. } => {
+                let (outer, inner) = shadow_core::shading::cone_cosines(l).unwrap_or((0.0, 0.0));
+                (0, position, direction.normalize(), [outer, inner])
             }
             LightKind::Directional { direction } => (1, glam::Vec3::ZERO, direction.normalize(), [0.0, 0.0]),
             LightKind::Point { position } => (2, position, glam::Vec3::NEG_Y, [0.0, 0.0]),

@@ -10,6 +10,7 @@ use glam::{Mat4, Quat, Vec3};
 use serde_json::{Value, json};
 
 use crate::scene::{LightKind, MeshKey, Scene};
+use crate::shading;
 
 /// Why a scene could not be written.
 #[derive(Debug, thiserror::Error)]
@@ -100,7 +101,7 @@ pub fn glb_bytes(scene: &Scene) -> Vec<u8> {
         let color = l.color.to_array();
         let (light, pos, dir) = match l.kind {
             LightKind::Spot { position, direction, cone_angle } => (
-                json!({"type": "spot", "color": color, "intensity": l.intensity, "spot": {"innerConeAngle": cone_angle * 0.4, "outerConeAngle": cone_angle * 0.5}}),
+                json!({"type": "spot", "color": color, "intensity": l.intensity, "spot": {"innerConeAngle": shading::cone_cosines(l).map_or(0.0, |(_, inner)| inner.acos()), "outerConeAngle": cone_angle * 0.5}}),
                 position,
                 direction,
             ),

@@ -413,17 +413,25 @@ impl Loader<'_> {
         }
         if let Some(l) = node.light() {
             use gltf::khr_lights_punctual::Kind;
-            let kind = match l.kind() {
-                Kind::Directional => LightKind::Directional { direction: forward },
-                Kind::Point => LightKind::Point { position: trans },
-                Kind::Spot { outer_cone_angle, .. } => LightKind::Spot {
-                    position: trans,
-                    direction: forward,
-                    cone_angle: (2.0 * outer_cone_angle).clamp(1e-3, 3.1),
-                },
+            // glTF cone angles are half-angles; ours are full apex angles.
+            let (kind, inner_cone_angle) = match l.kind() {
+                Kind::Directional => (LightKind::Directional { direction: forward }, None),
+                Kind::Point => (LightKind::Point { position: trans }, None),
+                Kind::Spot { inner_cone_angle, outer_cone_angle } => {
+                    let cone_angle = (2.0 * outer_cone_angle).clamp(1e-3, 3.1);
+                    let inner = (2.0 * inner_cone_angle).clamp(0.0, cone_angle * 0.999);
+                    (LightKind::Spot { position: trans, direction: forward, cone_angle }, Some(inner))
+                }
             };
-            // The light's radius is for soft shadows, which glTF does not describe: the default.
-            let light = Light { kind, color: Vec3::from(l.color()), intensity: l.intensity(), ..Light::point(trans) };
+            // The light's radius is for soft shadows, which glTF does not describe: the default. Its
+            // `range` is not kept: shading here has no distance falloff for it to end.
+            let light = Light {
+                kind,
+                color: Vec3::from(l.color()),
+                intensity: l.intensity(),
+                inner_cone_angle,
+                ..Light::point(trans)
+            };
             if light.validate().is_ok() {
                 self.scene.add_light(light);
             }
