@@ -284,9 +284,24 @@ fn main() -> ExitCode {
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e}");
+            eprintln!("error: {e}{}", hint(&e));
             ExitCode::from(if e.is_usage() { 2 } else { 1 })
         }
+    }
+}
+
+/// What the user can do about an error, where the CLI has a flag for it.
+fn hint(e: &Error) -> &'static str {
+    use shadow_core::assets::AssetFault;
+    use shadowlab::SceneSourceError;
+    use shadowlab::setup::SetupError;
+    match e {
+        Error::Setup(SetupError::Source(SceneSourceError::Asset(a)))
+            if matches!(a.fault, AssetFault::OutsideFolder(_)) =>
+        {
+            " (--allow-outside-files reads it, for a model you trust)"
+        }
+        _ => "",
     }
 }
 

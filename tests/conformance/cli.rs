@@ -66,6 +66,11 @@ fn bad_inputs_give_one_line_and_the_right_status() {
     let cycle = cycle.to_str().unwrap();
     let out = std::env::temp_dir().join(format!("shadowlab-cli-{}", std::process::id()));
     let out = out.to_str().unwrap();
+    // A model whose buffer is an absolute path.
+    let outside = std::env::temp_dir().join(format!("shadowlab-cli-outside-{}.gltf", std::process::id()));
+    let gltf = r#"{"asset": {"version": "2.0"}, "buffers": [{"uri": "/etc/hostname", "byteLength": 4}]}"#;
+    std::fs::write(&outside, gltf).unwrap();
+    let outside = outside.display().to_string();
     let cases: &[(&[&str], i32, &str)] = &[
         (&["render", "--scene", "atlantis", "-o", out], 2, "unknown scene 'atlantis'"),
         (&["render", "--technique", "shadow-mop", "-o", out], 2, "unknown technique 'shadow-mop'"),
@@ -79,6 +84,7 @@ fn bad_inputs_give_one_line_and_the_right_status() {
         (&["render", "--size", "16384x16384", "-o", out], 2, "the budget is 8 GB"),
         (&["render", "--scene", "no/such/model.obj", "-o", out], 1, "file not found"),
         (&["render", "--scene", cycle, "-o", out], 1, "own ancestor"),
+        (&["render", "--scene", outside.as_str(), "-o", out], 1, "--allow-outside-files reads it"),
         (&["render", "--camera", "eye=1,2,target=0,0,0", "-o", out], 2, "eye must be three"),
         (&["render", "--light", "laser", "-o", out], 2, "type must be one of spot, directional, point"),
         (&["render", "--light", "spot,fov=250", "-o", out], 2, "cone angle"),
@@ -118,6 +124,7 @@ fn bad_inputs_give_one_line_and_the_right_status() {
         );
     }
     let _ = std::fs::remove_file(out);
+    let _ = std::fs::remove_file(&outside);
 }
 
 #[test]

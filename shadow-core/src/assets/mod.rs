@@ -39,8 +39,11 @@ pub enum AssetFault {
     Cycle(String),
     /// A mesh that would render wrong: index out of range, non-finite position, no triangles.
     Mesh(String, MeshError),
-    /// A file the model names that the loader may not read (outside the model's folder, not a regular
-    /// file, a URI scheme other than a relative path or `data:`).
+    /// A file the model names outside its own folder (an absolute path, `..` out of it, a link out of
+    /// it): refused under [`FileAccess::ModelFolder`], read under [`FileAccess::Anywhere`].
+    OutsideFolder(String),
+    /// A file the loader never reads: not a regular file (a device, a FIFO, a folder), or named by a URI
+    /// scheme other than `data:`.
     Access(String),
 }
 
@@ -58,7 +61,7 @@ impl fmt::Display for AssetFault {
             Self::WrongAccessor(what) => write!(f, "wrong accessor type: {what}"),
             Self::Cycle(what) => write!(f, "bad node graph: {what}"),
             Self::Mesh(which, e) => write!(f, "{which}: {e}"),
-            Self::Access(what) => write!(f, "{what}"),
+            Self::OutsideFolder(what) | Self::Access(what) => write!(f, "{what}"),
         }
     }
 }
@@ -171,13 +174,15 @@ fn read_referenced(
     limit: Option<u64>,
     options: &LoadOptions,
 ) -> Result<Vec<u8>, AssetFault> {
-    let refuse = |why: String| AssetFault::Access(format!("{what} names '{reference}', {why}"));
+    let named = |why: String| format!("{what} names '{reference}', {why}");
     // A scheme is two or more characters before a colon (one is a Windows drive letter).
     if let Some((scheme, _)) = reference.split_once(':')
         && scheme.len() > 1
         && scheme.chars().all(|c| c.is_ascii_alphanumeric() || "+-.".contains(c))
     {
-        return Err(refuse(format!("a '{scheme}:' URI; only relative paths and data: URIs are read")));
+        return Err(AssetFault::Access(named(format!(
+            "a '{scheme}:' URI; only relative paths and data: URIs are read"
+        ))));
     }
     let relative = Path::new(reference);
     let confined = options.file_access == FileAccess::ModelFolder;
@@ -187,7 +192,8 @@ fn read_referenced(
             || reference.starts_with(['/', '\\'])
             || relative.components().any(|c| matches!(c, Component::Prefix(_) | Component::RootDir));
         if absolute {
-            return Err(refuse("an absolute path; a model may name only files inside its own folder".into()));
+            let why = "an absolute path; a model may name only files inside its own folder";
+            return Err(AssetFault::OutsideFolder(named(why.into())));
         }
         let mut depth = 0i64;
         for c in relative.components() {
@@ -197,7 +203,7 @@ fn read_referenced(
                 _ => 0,
             };
             if depth < 0 {
-                return Err(refuse("a path outside the model's folder".into()));
+                return Err(AssetFault::OutsideFolder(named("a path outside the model's folder".into())));
             }
         }
     }
@@ -206,7 +212,7 @@ fn read_referenced(
     if confined {
         let real = |p: &Path| p.canonicalize().map_err(|e| io_fault(p, &e));
         if !real(&file)?.starts_with(real(folder)?) {
-            return Err(refuse("a link to a file outside the model's folder".into()));
+            return Err(AssetFault::OutsideFolder(named("a link to a file outside the model's folder".into())));
         }
     }
     let mut reader = std::fs::File::open(&file).map_err(|e| io_fault(&file, &e))?;
