@@ -11,6 +11,7 @@ mod smoothies;
 #[path = "../../examples/planar/mod.rs"]
 #[allow(dead_code)]
 mod planar;
+mod scale;
 mod suite;
 mod volume_reconstruction;
 
