@@ -115,8 +115,10 @@ pub fn contact_sheet(items: &[SheetItem], tile: u32, inset: Option<Inset>) -> Im
 }
 
 /// The square of `side` view pixels where the techniques disagree most with their references (each test
-/// paired with its own, summed over tests), else where `reference`'s shadow edges are densest, else the
-/// centre.
+/// paired with its own, summed over tests) and `reference`'s shadow edges are densest: an edge weighs
+/// about as much as one technique's error there, so a view that one technique gets wrong everywhere still
+/// shows an edge, and a view that every technique gets right shows the densest edges. The centre when
+/// there is neither.
 #[must_use]
 pub fn disagreement_inset(
     tests: &[(&Image<f32>, &Image<f32>)],
@@ -133,10 +135,9 @@ pub fn disagreement_inset(
         }
         let r = shadowed(reference, x, y);
         let wrong = tests.iter().filter(|(t, own)| shadowed(t, x, y) != shadowed(own, x, y)).count() as u64;
-        // Disagreement counts far above an edge, so an edge decides only where nothing disagrees.
         let edge =
             (x + 1 < w && shadowed(reference, x + 1, y) != r) || (y + 1 < h && shadowed(reference, x, y + 1) != r);
-        wrong * 1024 + u64::from(edge)
+        wrong * 4 + u64::from(edge) * 3
     };
     // Summed-area table of the weights, then every window's sum in constant time.
     let mut sum = vec![0u64; ((w + 1) * (h + 1)) as usize];
