@@ -248,7 +248,7 @@ fn transforms_that_leave_f32_world_space_are_refused() {
     assert_eq!(assets::load(&path).expect("a flattened card loads").triangle_count(), 1);
 }
 
-// ---- what used to panic inside the crates ----
+// ---- input the crates underneath would panic on ----
 
 #[test]
 fn offsets_near_the_top_of_usize_are_refused() {
