@@ -137,7 +137,8 @@ pub fn parse_light(text: &str, default: &Light, scene_center: Vec3) -> Result<Li
     };
     // A new cone, or no cone, leaves the old inner cone behind.
     let inner_cone_angle = if t == LightType::Spot && !fov_given { default.inner_cone_angle } else { None };
-    let light = Light { kind, radius, inner_cone_angle, ..*default };
+    let range = if t == LightType::Directional { None } else { default.range };
+    let light = Light { kind, radius, inner_cone_angle, range, ..*default };
     light.validate().map_err(|e| OptionError { flag: F, value: text.into(), why: e.to_string() })?;
     Ok(light)
 }

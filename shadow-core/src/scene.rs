@@ -126,6 +126,9 @@ pub struct Light {
     /// A spot light's inner cone, its full apex angle in radians: full light inside it, fading to none at
     /// the cone's rim (glTF's `innerConeAngle`, doubled). `None`: the last fifth of the half-angle fades.
     pub inner_cone_angle: Option<f32>,
+    /// Where a point or spot light ends (glTF's `range`): its direct term is scaled by
+    /// clamp(1 - (d / range)^4, 0, 1) at distance d, reaching zero at the range. `None`: it never ends.
+    pub range: Option<f32>,
 }
 
 impl Light {
@@ -149,7 +152,7 @@ impl Light {
     }
 
     fn white(kind: LightKind) -> Self {
-        Self { kind, color: Vec3::ONE, intensity: 1.0, radius: 0.05, inner_cone_angle: None }
+        Self { kind, color: Vec3::ONE, intensity: 1.0, radius: 0.05, inner_cone_angle: None, range: None }
     }
 
     /// Position for spot and point lights, `None` for directional ones.
@@ -212,6 +215,9 @@ impl Light {
                     return bad("position is not finite");
                 }
             }
+        }
+        if self.range.is_some_and(|r| !(r > 0.0 && r.is_finite())) {
+            return bad("range must be positive");
         }
         if !(self.radius.is_finite() && self.radius >= 0.0 && self.color.is_finite() && self.intensity.is_finite()) {
             return bad("colour, intensity or radius is not finite and non-negative");

@@ -31,6 +31,21 @@ pub fn cone_cosines(light: &Light) -> Option<(f32, f32)> {
     Some((half.cos(), inner.cos()))
 }
 
+/// How much of a point or spot light with a range reaches `p`: clamp(1 - (d / range)^4, 0, 1), glTF's
+/// window, which is 1 near the light and falls to 0 at the range. 1 for lights without one and for
+/// directional lights.
+#[must_use]
+#[inline]
+pub fn range_window(light: &Light, p: Vec3) -> f32 {
+    match (light.range, light.position()) {
+        (Some(range), Some(position)) => {
+            let x = (p - position).length() / range;
+            (1.0 - x * x * x * x).clamp(0.0, 1.0)
+        }
+        _ => 1.0,
+    }
+}
+
 /// Hermite smoothstep of `x` between `e0` and `e1`.
 #[must_use]
 #[inline]
@@ -91,7 +106,8 @@ impl LightTerms {
     #[must_use]
     #[inline]
     pub fn direct(&self, p: Vec3, n: Vec3) -> Vec3 {
-        self.radiance * n.dot(self.light.to_light(p)).max(0.0) * self.falloff(p)
+        let term = self.radiance * n.dot(self.light.to_light(p)).max(0.0) * self.falloff(p);
+        if self.light.range.is_some() { term * range_window(&self.light, p) } else { term }
     }
 }
 
@@ -106,3 +122,29 @@ pub fn shade<'a>(albedo: Vec3, p: Vec3, n: Vec3, lit: impl IntoIterator<Item = (
 
 /// Background colour (linear) for pixels that show no surface.
 pub const BACKGROUND: Vec3 = Vec3::new(0.02, 0.025, 0.04);
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+
+    use super::*;
+
+    #[test]
+    fn a_range_ends_a_light_by_gltf_s_window() {
+        let at = Vec3::new(0.0, 4.0, 0.0);
+        let ranged = Light { range: Some(2.0), ..Light::point(at) };
+        let below = |d: f32| at - Vec3::Y * d;
+        assert_eq!(range_window(&ranged, below(0.0)), 1.0);
+        assert!((range_window(&ranged, below(1.0)) - (1.0 - 1.0 / 16.0)).abs() < 1e-6);
+        assert_eq!(range_window(&ranged, below(2.0)), 0.0);
+        assert_eq!(range_window(&ranged, below(3.0)), 0.0);
+        assert_eq!(range_window(&Light::point(at), below(100.0)), 1.0);
+        let sun = Light { range: Some(2.0), ..Light::directional(Vec3::NEG_Y) };
+        assert_eq!(range_window(&sun, below(100.0)), 1.0);
+        // The direct term follows the window: full near the light, none beyond its range.
+        let n = Vec3::Y;
+        assert_eq!(direct(&ranged, below(3.0), n), Vec3::ZERO);
+        let near = direct(&ranged, below(1.0), n);
+        assert!((near - direct(&Light::point(at), below(1.0), n) * (15.0 / 16.0)).length() < 1e-6, "{near}");
+    }
+}

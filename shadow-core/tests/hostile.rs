@@ -346,7 +346,7 @@ fn malformed_numbers_name_their_line() {
 // ---- lights a file brings ----
 
 #[test]
-fn gltf_spot_lights_keep_their_cones_and_intensity() {
+fn gltf_spot_lights_keep_their_cones_intensity_and_range() {
     let dir = scratch("spot");
     write(&dir.join("tri.bin"), triangle_bytes());
     let text = gltf_with(
@@ -358,7 +358,7 @@ fn gltf_spot_lights_keep_their_cones_and_intensity() {
     .replacen(
         r#""asset": {"version": "2.0"},"#,
         r#""asset": {"version": "2.0"}, "extensionsUsed": ["KHR_lights_punctual"],
-               "extensions": {"KHR_lights_punctual": {"lights": [{"type": "spot", "intensity": 3.5,
+               "extensions": {"KHR_lights_punctual": {"lights": [{"type": "spot", "intensity": 3.5, "range": 7.0,
                    "spot": {"innerConeAngle": 0.3, "outerConeAngle": 0.5}}]}},"#,
         1,
     );
@@ -366,6 +366,7 @@ fn gltf_spot_lights_keep_their_cones_and_intensity() {
     let s = assets::load(&path).expect("loads");
     let light = *s.lights().next().expect("the file's light").1;
     assert_eq!(light.intensity, 3.5);
+    assert_eq!(light.range, Some(7.0));
     assert_eq!(light.inner_cone_angle, Some(0.6));
     let (outer, inner) = shadow_core::shading::cone_cosines(&light).expect("a spot");
     assert!((outer - 0.5f32.cos()).abs() < 1e-6 && (inner - 0.3f32.cos()).abs() < 1e-6, "{outer} {inner}");
@@ -376,4 +377,5 @@ fn gltf_spot_lights_keep_their_cones_and_intensity() {
     let (o2, i2) = shadow_core::shading::cone_cosines(&back).expect("a spot");
     assert!((o2 - outer).abs() < 1e-5 && (i2 - inner).abs() < 1e-5, "{o2} {i2}");
     assert_eq!(back.intensity, 3.5);
+    assert_eq!(back.range, Some(7.0));
 }

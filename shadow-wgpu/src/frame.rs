@@ -79,7 +79,8 @@ impl LightRaw {
             kind: [kind, 0, 0, 0],
             position: position.extend(1.0).to_array(),
             direction: direction.extend(0.0).to_array(),
-            cone: [cone[0], cone[1], 0.0, 0.0],
+            // z: the range, 0 for none.
+            cone: [cone[0], cone[1], l.range.unwrap_or(0.0), 0.0],
             color: (l.color * l.intensity).extend(1.0).to_array(),
         }
     }

@@ -280,12 +280,21 @@ fn several_lights_shade_alike_on_both_backends() {
     };
     let cpu = run(two.clone(), BackendKind::Cpu).expect("cpu");
     let gpu = run(two, BackendKind::Wgpu).expect("wgpu");
+    let two_lights = gpu.color.clone();
     let one = run(vec![spot], BackendKind::Wgpu).expect("wgpu, one light");
     assert_eq!((cpu.visibility.len(), gpu.visibility.len()), (2, 2), "a visibility per light");
     let across = flip_mean(&gpu.color, &cpu.color, &mask).expect("sizes");
     let second = flip_mean(&gpu.color, &one.color, &mask).expect("sizes");
     assert!(across <= MAX_CROSS_FLIP, "two lights: cross-backend FLIP {across:.4} > {MAX_CROSS_FLIP}");
     assert!(second > 10.0 * MAX_CROSS_FLIP, "the second light changes the picture by only {second:.4}");
+    // A point light with a range, on both backends: alike, and unlike the same light without it.
+    let ranged = Light { range: Some(2.5), ..Light::point(Vec3::new(-1.5, 2.5, 1.0)) };
+    let cpu = run(vec![spot, ranged], BackendKind::Cpu).expect("cpu, ranged");
+    let gpu = run(vec![spot, ranged], BackendKind::Wgpu).expect("wgpu, ranged");
+    let across = flip_mean(&gpu.color, &cpu.color, &mask).expect("sizes");
+    let unranged = flip_mean(&gpu.color, &two_lights, &mask).expect("sizes");
+    assert!(across <= MAX_CROSS_FLIP, "a ranged light: cross-backend FLIP {across:.4} > {MAX_CROSS_FLIP}");
+    assert!(unranged > 10.0 * MAX_CROSS_FLIP, "the range changes the picture by only {unranged:.4}");
     let many = vec![spot; 1000];
     let err = run(many, BackendKind::Wgpu).err().expect("a thousand lights refused");
     assert!(err.to_string().contains("1000 lights"), "{err}");

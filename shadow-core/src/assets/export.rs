@@ -112,6 +112,10 @@ pub fn glb_bytes(scene: &Scene) -> Vec<u8> {
                 (json!({"type": "point", "color": color, "intensity": l.intensity}), position, Vec3::NEG_Z)
             }
         };
+        let mut light = light;
+        if let (Some(range), Some(o)) = (l.range, light.as_object_mut()) {
+            o.insert("range".into(), json!(range));
+        }
         lights.push(light);
         let mut n = node_trs(pos, look_rotation(dir));
         if let Some(o) = n.as_object_mut() {

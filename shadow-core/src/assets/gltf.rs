@@ -423,13 +423,14 @@ impl Loader<'_> {
                     (LightKind::Spot { position: trans, direction: forward, cone_angle }, Some(inner))
                 }
             };
-            // The light's radius is for soft shadows, which glTF does not describe: the default. Its
-            // `range` is not kept: shading here has no distance falloff for it to end.
+            // The light's radius is for soft shadows, which glTF does not describe: the default.
+            let range = l.range().filter(|_| !matches!(kind, LightKind::Directional { .. }));
             let light = Light {
                 kind,
                 color: Vec3::from(l.color()),
                 intensity: l.intensity(),
                 inner_cone_angle,
+                range,
                 ..Light::point(trans)
             };
             if light.validate().is_ok() {

@@ -222,7 +222,7 @@ pub fn stage_model(model: &mut Scene, ground: bool) {
             LightKind::Point { position } => LightKind::Point { position: place.transform_point3(position) },
             directional @ LightKind::Directional { .. } => directional,
         };
-        model.add_light(Light { kind, radius: l.radius * scale, ..l });
+        model.add_light(Light { kind, radius: l.radius * scale, range: l.range.map(|r| r * scale), ..l });
     }
     if ground && bare {
         let mesh = model.add_mesh(ground_quad());

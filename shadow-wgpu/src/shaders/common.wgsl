@@ -24,7 +24,7 @@ struct Light {
     position: vec4<f32>,
     // unit direction the light travels (spot axis)
     direction: vec4<f32>,
-    // x: cos outer half-angle, y: cos inner half-angle
+    // x: cos outer half-angle, y: cos inner half-angle, z: range (0: none)
     cone: vec4<f32>,
     // colour times intensity
     color: vec4<f32>,
@@ -62,9 +62,19 @@ fn to_light(light: Light, p: vec3<f32>) -> vec3<f32> {
     return d / len;
 }
 
+// Twin: shadow_core::shading::range_window.
+fn range_window(light: Light, p: vec3<f32>) -> f32 {
+    let x = length(p - light.position.xyz) / light.cone.z;
+    return clamp(1.0 - x * x * x * x, 0.0, 1.0);
+}
+
 // Twin: shadow_core::shading::direct.
 fn direct_light(light: Light, p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
-    return light.color.xyz * max(dot(n, to_light(light, p)), 0.0) * cone_falloff(light, p);
+    let term = light.color.xyz * max(dot(n, to_light(light, p)), 0.0) * cone_falloff(light, p);
+    if (light.cone.z > 0.0 && light.kind.x != 1u) {
+        return term * range_window(light, p);
+    }
+    return term;
 }
 
 // Twin: shadow_core::image::linear_to_srgb8 (before the unorm write rounds to nearest).
