@@ -223,3 +223,26 @@ fn a_mixed_compare_scores_each_technique_against_its_own_reference() {
     assert!(out.join("reference-area-light-reference.png").exists());
     let _ = std::fs::remove_dir_all(&out);
 }
+
+#[test]
+fn a_model_named_by_a_bare_file_name_finds_its_buffers() {
+    let dir = std::env::temp_dir().join(format!("shadowlab-bare-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let triangle: Vec<u8> =
+        [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0].iter().flat_map(|f| f.to_le_bytes()).collect();
+    std::fs::write(dir.join("tri.bin"), triangle).unwrap();
+    let gltf = r#"{"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+        "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]}],
+        "bufferViews": [{"buffer": 0, "byteLength": 36}], "buffers": [{"uri": "tri.bin", "byteLength": 36}]}"#;
+    std::fs::write(dir.join("m.gltf"), gltf).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_shadowlab"))
+        .args(["inspect", "m.gltf", "--json"])
+        .current_dir(&dir)
+        .output()
+        .expect("the binary runs");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["triangles"], 1);
+    let _ = std::fs::remove_dir_all(&dir);
+}

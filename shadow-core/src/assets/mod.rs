@@ -175,6 +175,8 @@ fn read_referenced(
     options: &LoadOptions,
 ) -> Result<Vec<u8>, AssetFault> {
     let named = |why: String| format!("{what} names '{reference}', {why}");
+    // A model named without a folder ("m.gltf") has the empty path as its parent: the current folder.
+    let folder = if folder.as_os_str().is_empty() { Path::new(".") } else { folder };
     // A scheme is two or more characters before a colon (one is a Windows drive letter).
     if let Some((scheme, _)) = reference.split_once(':')
         && scheme.len() > 1
