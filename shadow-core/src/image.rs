@@ -242,6 +242,21 @@ pub fn visibility_to_rgb(vis: &Image<f32>, mask: &Image<bool>) -> Image<Rgb8> {
     })
 }
 
+/// The colour of false shadow (shadowed here, lit in the reference) in error maps.
+const FALSE_SHADOW: Rgb8 = [230, 40, 40];
+/// The colour of false light (lit here, shadowed in the reference) in error maps.
+const FALSE_LIGHT: Rgb8 = [40, 90, 240];
+
+/// The error colour of a pixel whose visibility is `test` where the reference has `reference`, or `None`
+/// where the two agree on lit or shadowed.
+fn disagreement(test: f32, reference: f32) -> Option<Rgb8> {
+    match (test >= 0.5, reference >= 0.5) {
+        (false, true) => Some(FALSE_SHADOW),
+        (true, false) => Some(FALSE_LIGHT),
+        _ => None,
+    }
+}
+
 /// The error heat map of DESIGN 11: false shadow red, false light blue, agreement grey (lit light, shadowed
 /// dark) over the measured pixels; over `shown` pixels that are not measured (receivers turned away from
 /// the light) the same colours, dimmed; everything else black.
@@ -257,13 +272,9 @@ pub fn error_map(
         if !m && !s {
             return [0, 0, 0];
         }
-        let (t, r) = (*test.get(x, y) >= 0.5, *reference.get(x, y) >= 0.5);
-        let c: Rgb8 = match (t, r) {
-            (false, true) => [230, 40, 40],
-            (true, false) => [40, 90, 240],
-            (true, true) => [150, 150, 150],
-            (false, false) => [70, 70, 70],
-        };
+        let (t, r) = (*test.get(x, y), *reference.get(x, y));
+        let agreement = if r >= 0.5 { [150, 150, 150] } else { [70, 70, 70] };
+        let c = disagreement(t, r).unwrap_or(agreement);
         if m { c } else { c.map(|v| v / 3 + 20) }
     })
 }
@@ -279,18 +290,13 @@ pub fn error_map_over(
     shown: &Image<bool>,
     picture: &Image<Rgb8>,
 ) -> Image<Rgb8> {
-    const FALSE_SHADOW: Rgb8 = [230, 40, 40];
-    const FALSE_LIGHT: Rgb8 = [40, 90, 240];
     let mut out = Image::from_fn(test.width(), test.height(), |x, y| {
         let p = picture.get(x, y);
         let grey = ((u16::from(p[0]) * 3 + u16::from(p[1]) * 6 + u16::from(p[2])) / 10) as u8;
         let (m, s) = (*measured.get(x, y), *shown.get(x, y));
-        let (t, r) = (*test.get(x, y) >= 0.5, *reference.get(x, y) >= 0.5);
-        match (m || s, t, r) {
-            (true, false, true) if m => FALSE_SHADOW,
-            (true, true, false) if m => FALSE_LIGHT,
-            (true, false, true) => FALSE_SHADOW.map(|v| v / 2 + grey / 2),
-            (true, true, false) => FALSE_LIGHT.map(|v| v / 2 + grey / 2),
+        match disagreement(*test.get(x, y), *reference.get(x, y)) {
+            Some(c) if m => c,
+            Some(c) if s => c.map(|v| v / 2 + grey / 2),
             // Agreement, and everything not measured: the picture at lower contrast, so colours stand out.
             _ => [(u16::from(grey) * 3 / 5 + 40) as u8; 3],
         }
