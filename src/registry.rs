@@ -2,13 +2,13 @@
 //! backend. Built-in, shadow-soft and user techniques register the same way; the CLI, the reports and the
 //! conformance tests enumerate it, so a new technique gets all of them for free.
 
-use shadow_core::technique::hard::{
-    DepthLayers, DualShadowMap, Hybrid, MidpointShadowMap, RayTraced, SecondDepthShadowMap, ShadowMap, ShadowVolume,
-    SilhouetteMap, VolumeReconstruction,
-};
 use shadow_core::technique::settings::{SettingKey, SettingsError, TechniqueSettings, TechniqueSpec};
 use shadow_core::technique::{DynShadowTechnique, ShadowTechnique, Stateful};
 use shadow_cpu::CpuBackend;
+use shadow_hard::{
+    DepthLayers, DualShadowMap, Hybrid, MidpointShadowMap, RayTraced, SecondDepthShadowMap, ShadowMap, ShadowVolume,
+    SilhouetteMap, VolumeReconstruction,
+};
 use shadow_soft::{AreaLightReference, Pcss, PenumbraMap, Smoothies};
 use shadow_wgpu::WgpuBackend;
 
@@ -141,7 +141,7 @@ where
     ShadowVolume: shadow_core::technique::ShadowTechnique<B>,
 {
     ShadowVolume::parse(&spec.name, &spec.values)?;
-    let v = if spec.name == "shadow-volume-zpass" { ShadowVolume::ZPASS } else { ShadowVolume::ZFAIL };
+    let v = ShadowVolume::named(&spec.name).unwrap_or(ShadowVolume::ZFAIL);
     Ok(Stateful::boxed(v, String::new()))
 }
 

@@ -204,7 +204,7 @@ pub fn classify(map: &Image<f32>, uv: Vec2, depth: f32, faces_light: bool) -> Ma
 
 /// Whether a silhouette edge nearer the light than `depth` (by [`EDGE_MARGIN`]) crosses one of the four texels nearest `uv` in
 /// `edges`, a map of the nearest edge's NDC depth per texel (1 where none; `hybrid`'s `edge_texels`; WGSL
-/// twin: `near_edge` in shadow-wgpu's hybrid_edges.wgsl). Outside the map, no.
+/// twin: `near_edge` in shadow-wgpu's edges_all.wgsl). Outside the map, no.
 #[must_use]
 #[inline]
 pub fn near_edge(edges: &Image<f32>, uv: Vec2, depth: f32) -> bool {
@@ -216,7 +216,7 @@ pub fn near_edge(edges: &Image<f32>, uv: Vec2, depth: f32) -> bool {
     texels_2x2(edges, x, y).iter().any(|&edge| edge < depth - EDGE_MARGIN)
 }
 
-/// The cell of an [`edge_cells`](crate::geometry::edge_map::edge_cells) map of a map of side `res` that
+/// The cell of an `edge_cells` (shadow-hard's `hybrid::edge_map`) map of a map of side `res` that
 /// holds `uv`: the square between the four texels a lookup at `uv` reads, `(0, 0)` to `(res, res)` for
 /// `uv` on the map.
 #[inline]
@@ -230,8 +230,8 @@ pub fn cell_of(res: u32, uv: Vec2) -> (u32, u32) {
 /// Whether two silhouette edges or more nearer the light than `depth` (by [`EDGE_MARGIN`]) enter the
 /// square between the four texels of `map` nearest `uv`, where Chan's rule may miss a sliver, a gap or a
 /// corner between them (`hybrid`'s `edge_texels=paired`; `cells` from
-/// [`edge_cells`](crate::geometry::edge_map::edge_cells), side one more than `map`'s; WGSL twin:
-/// `near_edge` in hybrid_edges.wgsl). Outside the map, no.
+/// `edge_cells` (shadow-hard's `hybrid::edge_map`), side one more than `map`'s; WGSL twin:
+/// `near_edge` in edges_all.wgsl). Outside the map, no.
 ///
 /// Not where the edges are hidden ([`hidden`]): when all four texels hold a surface nearer the light than
 /// the nearest of the edges (by [`EDGE_MARGIN`]), those surfaces cover the whole square in front of the

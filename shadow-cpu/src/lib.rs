@@ -2,16 +2,16 @@
 //!
 //! A software rasterizer that follows DESIGN 4 exactly ([`raster`]), BVH ray casting for the exact
 //! reference ([`bvh`]), the G-buffer ([`gbuffer`]), shading ([`shade`]) and frame assembly ([`frame`]),
-//! and the CPU versions of the techniques ([`techniques`]).
+//! and the passes techniques are built from ([`passes`]).
 
 pub mod acne;
 pub mod bvh;
 pub mod context;
 pub mod frame;
 pub mod gbuffer;
+pub mod passes;
 pub mod raster;
 pub mod shade;
-pub mod techniques;
 
 pub use context::{CpuBackend, CpuContext, CpuError};
 pub use frame::{CpuFrame, render_frame};

@@ -15,8 +15,8 @@ use shadow_core::technique::settings::{SettingKey, SettingsError, TechniqueSetti
 use shadow_core::technique::{FrameStats, ShadowTechnique, TechniqueError};
 use shadow_core::{FrameInputs, Image};
 use shadow_cpu::bvh::SceneBvh;
-use shadow_cpu::techniques::per_receiver;
-use shadow_cpu::techniques::ray_traced::{RayOrigins, State as RayState};
+use shadow_cpu::passes::per_receiver;
+use shadow_cpu::passes::rays::{RayOrigins, State as RayState};
 use shadow_cpu::{CpuBackend, CpuContext, CpuError, GBuffer};
 
 /// The largest sample count, per pixel.

@@ -35,15 +35,15 @@ pub fn spot_projection<'a>(light: &'a LightView, technique: &str) -> Result<&'a 
     }
 }
 
-/// Parses and validates WGSL with naga, so a shader error fails `cargo test`, not a user.
-///
-/// # Panics
-/// On a parse or validation error, with naga's report.
-#[cfg(test)]
-pub(crate) fn validate_wgsl(name: &str, src: &str) {
-    let module = naga::front::wgsl::parse_str(src).unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(src)));
-    let mut v = naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all());
-    if let Err(e) = v.validate(&module) {
-        panic!("{name}: {}", e.emit_to_string(src));
-    }
+/// Every technique's WGSL as it is compiled (each file after the shadow-map shader it extends), by name:
+/// for validation.
+#[must_use]
+pub fn shaders() -> Vec<(&'static str, String)> {
+    vec![
+        ("pcss query", pcss::gpu::query_shader()),
+        ("smoothie buffer", smoothies::gpu::buffer_shader()),
+        ("smoothie query", smoothies::gpu::query_shader()),
+        ("penumbra map", penumbra_map::gpu::build_shader()),
+        ("penumbra query", penumbra_map::gpu::query_shader()),
+    ]
 }

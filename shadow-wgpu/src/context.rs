@@ -148,8 +148,10 @@ pub struct WgpuContext {
     /// The frame's phase clock while [`crate::frame::render_frame`] runs (timestamp adapters only).
     pub(crate) clock: Option<crate::clock::PhaseClock>,
     lost: Arc<Mutex<Option<String>>>,
-    pub(crate) cache: crate::upload::SceneCache,
-    pub(crate) shared: crate::pipelines::Shared,
+    /// The scene's meshes and instances on the device, uploaded once per mesh.
+    pub cache: crate::upload::SceneCache,
+    /// The pipelines and layouts every pass shares (the frame bind group's layout among them).
+    pub shared: crate::pipelines::Shared,
 }
 
 /// The instance. Set `XDG_RUNTIME_DIR` (CI does) to keep the Vulkan loader quiet on headless machines.

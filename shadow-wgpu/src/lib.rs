@@ -1,17 +1,17 @@
 //! shadow-wgpu: the GPU backend, through wgpu.
 //!
 //! A headless context ([`context`]), scene upload cached per mesh ([`upload`]), the G-buffer
-//! ([`gbuffer`]), the frame driver with shading and readback ([`frame`]), and the GPU versions of the
-//! techniques ([`techniques`]), each a folder-like module with its WGSL next to it in `shaders/`.
+//! ([`gbuffer`]), the frame driver with shading and readback ([`frame`]), pipelines and WGSL every
+//! technique uses ([`pipelines`], [`shaders`]), and the passes techniques are built from ([`passes`]).
 
 pub mod clock;
 pub mod context;
 pub mod frame;
 pub mod gbuffer;
+pub mod passes;
 pub mod pipelines;
 pub mod readback;
 pub mod shaders;
-pub mod techniques;
 pub mod upload;
 
 pub use context::{AdapterChoice, AdapterSummary, WgpuBackend, WgpuContext, WgpuError, list_adapters};

@@ -14,6 +14,7 @@ mod planar;
 mod scale;
 mod suite;
 mod volume_reconstruction;
+mod wgsl;
 
 /// A renderer of the built-in techniques with a wgpu adapter resolved, or `None` (and a line saying that
 /// `what` is skipped) without one, which `SHADOWLAB_REQUIRE_GPU=1` turns into a failure.

@@ -4,7 +4,7 @@
 //!
 //! The paper's own rules (`corner_depth=fragment,keep=last`) are measured alongside and must at least
 //! beat the shadow map near edges; they miss the third on `strike` and `crowd` (see
-//! shadow_core::silhouette_map for why the defaults differ).
+//! silhouette_map::points for why the defaults differ).
 
 use shadow_core::FrameInputs;
 use shadow_core::scenes::{self, SceneParams};

@@ -3,12 +3,9 @@
 //! - [`adjacency`]: weld coincident positions, map edges to faces, classify manifold, boundary and
 //!   non-manifold edges, and decide whether a mesh is closed.
 //! - [`silhouette`]: the silhouette edges of a mesh for one light, with Bergeron weights for open meshes.
-//! - [`edge_map`]: silhouette edges as light-space maps of texels and texel cells (`hybrid`'s
-//!   `edge_texels`).
 //! - [`volume`]: extrusion of silhouettes to infinity (w = 0) and the front and back caps.
 
 pub mod adjacency;
-pub mod edge_map;
 pub mod silhouette;
 pub mod volume;
 

@@ -30,6 +30,17 @@ use super::adjacency::Adjacency;
 use super::silhouette::Silhouette;
 use crate::bounds::Aabb;
 
+/// How stencil shadow volumes count (DESIGN 4).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum VolumeCounting {
+    /// Crow / Heidmann: count volume faces in front of the surface; sides only. Wrong where the eye is in
+    /// shadow or a volume crosses the near plane.
+    ZPass,
+    /// Everitt-Kilgard / Carmack: count faces behind the surface; needs both caps; right everywhere with an
+    /// infinite far plane.
+    ZFail,
+}
+
 /// Whether a volume needs caps: z-pass counts only the sides, z-fail needs both caps.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Caps {

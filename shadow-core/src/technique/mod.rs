@@ -1,5 +1,6 @@
-//! The backend-neutral technique traits (DESIGN 3), settings parsing and the settings of the hard-shadow
-//! techniques.
+//! The backend-neutral technique traits (DESIGN 3), settings parsing, and the settings every technique
+//! built on a light depth map shares ([`maps`]). The techniques themselves live in shadow-hard and
+//! shadow-soft, one folder each.
 //!
 //! A technique is a plain settings struct (in [`settings`]). Each backend implements
 //! [`ShadowTechnique`] for it, which the orphan rule allows because the backend type is local to the
@@ -13,7 +14,7 @@
 //! - `Backend::Error: From<TechniqueError>`, so the shared checks (unsupported light, bad settings) give
 //!   the same error on every backend.
 
-pub mod hard;
+pub mod maps;
 pub mod settings;
 
 use crate::frame::FrameInputs;

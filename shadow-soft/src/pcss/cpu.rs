@@ -6,7 +6,8 @@ use shadow_core::light::LightView;
 use shadow_core::lookup::{POISSON16, compare_bilinear, hash_unit, on_map, pixel_hash};
 use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
 use shadow_core::{FrameInputs, Image};
-use shadow_cpu::techniques::{map_position, per_receiver, render_depth_maps};
+use shadow_cpu::passes::maps::{map_position, render_depth_maps};
+use shadow_cpu::passes::per_receiver;
 use shadow_cpu::{CpuBackend, CpuContext, CpuError, GBuffer};
 
 use super::{Pcss, PcssLens};

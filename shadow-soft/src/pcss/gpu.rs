@@ -3,17 +3,16 @@
 
 use shadow_core::FrameInputs;
 use shadow_core::light::LightView;
-use shadow_core::technique::hard::ShadowMap;
 use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
+use shadow_wgpu::passes::maps::{DepthMaps, LookupParams, MapQuery, QueryExtras};
 use shadow_wgpu::pipelines::{FragmentEntry, attribute_entry};
-use shadow_wgpu::techniques::shadow_map::{LookupParams, MapQuery, QueryExtras};
 use shadow_wgpu::{GpuGBuffer, GpuVisibility, WgpuBackend, WgpuContext, WgpuError, shaders};
 
 use super::{Pcss, PcssLens};
 
 /// Pipelines, the blockers' map and the lens of the last build.
 pub struct State {
-    map: shadow_wgpu::techniques::shadow_map::State,
+    map: DepthMaps,
     query: MapQuery,
     lens: Option<PcssLens>,
 }
@@ -26,7 +25,7 @@ impl ShadowTechnique<WgpuBackend> for Pcss {
     }
 
     fn create_state(&self, cx: &mut WgpuContext) -> Result<State, WgpuError> {
-        let map = <ShadowMap as ShadowTechnique<WgpuBackend>>::create_state(&self.depth, cx)?;
+        let map = DepthMaps::new(cx, &self.depth);
         cx.scoped("creating the pcss pipelines", |cx| {
             let module = shaders::module(&cx.device, "pcss query", query_shader());
             let query = MapQuery::with_entry(cx, &module, FragmentEntry::from("fs_pcss_query"), &[attribute_entry(4)]);
@@ -40,10 +39,10 @@ impl ShadowTechnique<WgpuBackend> for Pcss {
         state: &mut State,
         frame: &FrameInputs,
         light: &LightView,
-        stats: &mut FrameStats,
+        _: &mut FrameStats,
     ) -> Result<(), WgpuError> {
         state.lens = Some(Self::lens(light)?);
-        <ShadowMap as ShadowTechnique<WgpuBackend>>::build(&self.depth, cx, &mut state.map, frame, light, stats)
+        state.map.render(cx, frame, light, self.depth.resolution)
     }
 
     fn query(
@@ -75,12 +74,4 @@ impl ShadowTechnique<WgpuBackend> for Pcss {
 #[must_use]
 pub fn query_shader() -> String {
     shaders::with_shadow_map(include_str!("query.wgsl"))
-}
-
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn the_shader_validates() {
-        crate::validate_wgsl("query", &super::query_shader());
-    }
 }

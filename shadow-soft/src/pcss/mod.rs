@@ -26,23 +26,18 @@ pub mod gpu;
 
 use shadow_core::light::{LightProjection, LightView};
 use shadow_core::technique::TechniqueError;
-use shadow_core::technique::hard::{MAP_KEYS, ShadowMap};
+use shadow_core::technique::maps::{BIAS, BIAS_CONSTANT, BIAS_SLOPE, BIAS_WORLD, DepthMap, resolution_key};
 use shadow_core::technique::settings::{SettingKey, SettingsError, TechniqueSettings, Values};
 
 /// `pcss` settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Pcss {
     /// The depth map: resolution and bias, as `shadow-map` has them. The light's size is its radius.
-    pub depth: ShadowMap,
+    pub depth: DepthMap,
 }
 
-const KEYS: [SettingKey; 5] = [
-    SettingKey { key: "res", default: "1024", help: "depth map side in texels (16 to 16384)" },
-    MAP_KEYS[1],
-    MAP_KEYS[2],
-    MAP_KEYS[3],
-    MAP_KEYS[6],
-];
+const KEYS: [SettingKey; 5] =
+    [resolution_key("1024", "depth map side in texels (16 to 16384)"), BIAS, BIAS_CONSTANT, BIAS_SLOPE, BIAS_WORLD];
 
 impl TechniqueSettings for Pcss {
     fn keys() -> &'static [SettingKey] {
@@ -50,11 +45,11 @@ impl TechniqueSettings for Pcss {
     }
 
     fn from_values(v: &Values<'_>) -> Result<Self, SettingsError> {
-        Ok(Self { depth: ShadowMap::read_depth(v)? })
+        Ok(Self { depth: DepthMap::read(v)? })
     }
 
     fn to_values(&self) -> Vec<String> {
-        self.depth.depth_values()
+        self.depth.values()
     }
 }
 

@@ -7,8 +7,9 @@ use shadow_core::lookup::{bilinear, on_map};
 use shadow_core::stats::ms;
 use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
 use shadow_core::{FrameInputs, Image};
+use shadow_cpu::passes::maps::{map_position, render_depth_maps};
+use shadow_cpu::passes::per_receiver;
 use shadow_cpu::raster::{CullMode, DepthStencil, RasterState, Soup, draw};
-use shadow_cpu::techniques::{map_position, per_receiver, render_depth_maps};
 use shadow_cpu::{CpuBackend, CpuContext, CpuError, GBuffer};
 use std::time::Instant;
 

@@ -6,11 +6,10 @@
 use bytemuck::{Pod, Zeroable};
 use shadow_core::FrameInputs;
 use shadow_core::light::{LightProjection, LightView};
-use shadow_core::technique::hard::ShadowMap;
 use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
 use shadow_wgpu::frame::{layer_view, layered};
+use shadow_wgpu::passes::maps::{DepthMaps, LookupParams, MapQuery, QueryExtras};
 use shadow_wgpu::pipelines::{FragmentEntry, MAP_DEPTH, depth_entry};
-use shadow_wgpu::techniques::shadow_map::{LookupParams, MapQuery, QueryExtras};
 use shadow_wgpu::{GpuGBuffer, GpuVisibility, WgpuBackend, WgpuContext, WgpuError, readback, shaders};
 
 use super::PenumbraMap;
@@ -41,7 +40,7 @@ const VERTEX_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayou
 
 /// Pipelines, the surfaces' map and the penumbra map of the last build.
 pub struct State {
-    map: shadow_wgpu::techniques::shadow_map::State,
+    map: DepthMaps,
     build_layout: wgpu::BindGroupLayout,
     build: wgpu::RenderPipeline,
     query: MapQuery,
@@ -93,7 +92,7 @@ impl ShadowTechnique<WgpuBackend> for PenumbraMap {
     }
 
     fn create_state(&self, cx: &mut WgpuContext) -> Result<State, WgpuError> {
-        let map = <ShadowMap as ShadowTechnique<WgpuBackend>>::create_state(&self.depth, cx)?;
+        let map = DepthMaps::new(cx, &self.depth);
         cx.scoped("creating the penumbra-map pipelines", |cx| {
             let build_module = shaders::module(&cx.device, "penumbra map", build_shader());
             let build_layout = min_target::layout(cx, "penumbra map");
@@ -117,7 +116,7 @@ impl ShadowTechnique<WgpuBackend> for PenumbraMap {
         let t0 = std::time::Instant::now();
         let (proj, built) = Self::construct(frame, light, stats)?;
         let construct = t0.elapsed();
-        <ShadowMap as ShadowTechnique<WgpuBackend>>::build(&self.depth, cx, &mut state.map, frame, light, stats)?;
+        state.map.render(cx, frame, light, self.depth.resolution)?;
         let t0 = std::time::Instant::now();
         let maps = state.map.maps().ok_or_else(|| TechniqueError::NotBuilt(Self::NAME.into()))?.clone();
         cx.scoped("the penumbra map", |cx| state.render_penumbra(cx, &maps, proj, &built.triangles))?;
@@ -161,13 +160,4 @@ pub fn build_shader() -> String {
 #[must_use]
 pub fn query_shader() -> String {
     shaders::with_shadow_map(include_str!("query.wgsl"))
-}
-
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn the_shaders_validate() {
-        crate::validate_wgsl("build", &super::build_shader());
-        crate::validate_wgsl("query", &super::query_shader());
-    }
 }

@@ -28,7 +28,7 @@ pub mod gpu;
 use shadow_core::FrameInputs;
 use shadow_core::image::Image;
 use shadow_core::light::{LightProjection, LightView};
-use shadow_core::technique::hard::{MAP_KEYS, ShadowMap};
+use shadow_core::technique::maps::{BIAS, BIAS_CONSTANT, BIAS_SLOPE, BIAS_WORLD, DepthMap, resolution_key};
 use shadow_core::technique::settings::{SettingKey, SettingsError, TechniqueSettings, Values};
 use shadow_core::technique::{DebugView, FrameStats, TechniqueError};
 
@@ -37,15 +37,15 @@ use shadow_core::technique::{DebugView, FrameStats, TechniqueError};
 pub struct PenumbraMap {
     /// The depth map: resolution (the penumbra map's too) and bias, as `shadow-map` has them. The cones'
     /// opening is the light's radius.
-    pub depth: ShadowMap,
+    pub depth: DepthMap,
 }
 
 const KEYS: [SettingKey; 5] = [
-    SettingKey { key: "res", default: "1024", help: "depth map and penumbra map side in texels (16 to 16384)" },
-    MAP_KEYS[1],
-    MAP_KEYS[2],
-    MAP_KEYS[3],
-    MAP_KEYS[6],
+    resolution_key("1024", "depth map and penumbra map side in texels (16 to 16384)"),
+    BIAS,
+    BIAS_CONSTANT,
+    BIAS_SLOPE,
+    BIAS_WORLD,
 ];
 
 impl TechniqueSettings for PenumbraMap {
@@ -54,11 +54,11 @@ impl TechniqueSettings for PenumbraMap {
     }
 
     fn from_values(v: &Values<'_>) -> Result<Self, SettingsError> {
-        Ok(Self { depth: ShadowMap::read_depth(v)? })
+        Ok(Self { depth: DepthMap::read(v)? })
     }
 
     fn to_values(&self) -> Vec<String> {
-        self.depth.depth_values()
+        self.depth.values()
     }
 }
 

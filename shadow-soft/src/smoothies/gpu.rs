@@ -6,11 +6,10 @@
 use bytemuck::{Pod, Zeroable};
 use shadow_core::FrameInputs;
 use shadow_core::light::{LightProjection, LightView};
-use shadow_core::technique::hard::ShadowMap;
 use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
 use shadow_wgpu::frame::{layer_view, layered};
+use shadow_wgpu::passes::maps::{DepthMaps, LookupParams, MapQuery, QueryExtras};
 use shadow_wgpu::pipelines::{FragmentEntry, MAP_DEPTH, buffer_entry, depth_entry};
-use shadow_wgpu::techniques::shadow_map::{LookupParams, MapQuery, QueryExtras};
 use shadow_wgpu::{GpuGBuffer, GpuVisibility, WgpuBackend, WgpuContext, WgpuError, readback, shaders};
 use wgpu::util::DeviceExt;
 
@@ -43,7 +42,7 @@ const VERTEX_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayou
 
 /// Pipelines, the blockers' map, the smoothie buffer of the last build.
 pub struct State {
-    map: shadow_wgpu::techniques::shadow_map::State,
+    map: DepthMaps,
     buffer_layout: wgpu::BindGroupLayout,
     depth_pass: wgpu::RenderPipeline,
     alpha_pass: wgpu::RenderPipeline,
@@ -104,7 +103,7 @@ impl ShadowTechnique<WgpuBackend> for Smoothies {
     }
 
     fn create_state(&self, cx: &mut WgpuContext) -> Result<State, WgpuError> {
-        let map = <ShadowMap as ShadowTechnique<WgpuBackend>>::create_state(&self.depth, cx)?;
+        let map = DepthMaps::new(cx, &self.depth);
         let falloff = FalloffTable::new(self.falloff);
         cx.scoped("creating the smoothie pipelines", |cx| {
             let buffer_module = shaders::module(&cx.device, "smoothie buffer", buffer_shader());
@@ -136,7 +135,7 @@ impl ShadowTechnique<WgpuBackend> for Smoothies {
         stats: &mut FrameStats,
     ) -> Result<(), WgpuError> {
         let proj = Self::projection(light)?;
-        <ShadowMap as ShadowTechnique<WgpuBackend>>::build(&self.depth, cx, &mut state.map, frame, light, stats)?;
+        state.map.render(cx, frame, light, self.depth.resolution)?;
         let t0 = std::time::Instant::now();
         let (t, smoothies) = self.construct(frame, light, proj, stats);
         let maps = state.map.maps().ok_or_else(|| TechniqueError::NotBuilt(Self::NAME.into()))?.clone();
@@ -188,13 +187,4 @@ pub fn buffer_shader() -> String {
 #[must_use]
 pub fn query_shader() -> String {
     shaders::with_shadow_map(include_str!("query.wgsl"))
-}
-
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn the_shaders_validate() {
-        crate::validate_wgsl("buffer", &super::buffer_shader());
-        crate::validate_wgsl("query", &super::query_shader());
-    }
 }

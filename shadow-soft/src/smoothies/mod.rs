@@ -24,7 +24,7 @@ use shadow_core::scene::LightKind;
 use shadow_core::technique::DebugView;
 use shadow_core::technique::FrameStats;
 use shadow_core::technique::TechniqueError;
-use shadow_core::technique::hard::{MAP_KEYS, ShadowMap};
+use shadow_core::technique::maps::{BIAS, BIAS_CONSTANT, BIAS_SLOPE, BIAS_WORLD, DepthMap, resolution_key};
 use shadow_core::technique::settings::{OnOff, SettingKey, SettingsError, TechniqueSettings, Values};
 use shadow_core::{FrameInputs, Image};
 
@@ -32,7 +32,7 @@ use shadow_core::{FrameInputs, Image};
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Smoothies {
     /// The depth map: resolution (the smoothie buffer's too) and bias, as `shadow-map` has them.
-    pub depth: ShadowMap,
+    pub depth: DepthMap,
     /// The smoothie size `t`.
     pub size: SmoothieSize,
     /// Whether alpha is remapped by the distances (Eq. 4.1); off shows the fixed-width ramp of Fig. 4-4b.
@@ -109,11 +109,11 @@ impl FalloffTable {
 }
 
 const KEYS: [SettingKey; 8] = [
-    SettingKey { key: "res", default: "1024", help: "depth map and smoothie buffer side in texels (16 to 16384)" },
-    MAP_KEYS[1],
-    MAP_KEYS[2],
-    MAP_KEYS[3],
-    MAP_KEYS[6],
+    resolution_key("1024", "depth map and smoothie buffer side in texels (16 to 16384)"),
+    BIAS,
+    BIAS_CONSTANT,
+    BIAS_SLOPE,
+    BIAS_WORLD,
     SettingKey {
         key: "size",
         default: "auto",
@@ -137,11 +137,11 @@ impl TechniqueSettings for Smoothies {
             "auto" => SmoothieSize::Auto,
             _ => SmoothieSize::Fixed(v.ranged("size", 0.001, 1.0).map_err(|_| v.bad("size", "auto or 0.001 to 1"))?),
         };
-        Ok(Self { depth: ShadowMap::read_depth(v)?, size, remap: v.get("remap")?, falloff: v.get("falloff")? })
+        Ok(Self { depth: DepthMap::read(v)?, size, remap: v.get("remap")?, falloff: v.get("falloff")? })
     }
 
     fn to_values(&self) -> Vec<String> {
-        let mut v = self.depth.depth_values();
+        let mut v = self.depth.values();
         v.extend([
             match self.size {
                 SmoothieSize::Auto => "auto".into(),

@@ -1,5 +1,5 @@
 // Stencil shadow volumes: the volume pass (stencil only) and the resolve (twin: shadow-cpu's
-// techniques/shadow_volume.rs).
+// passes::volumes).
 
 @group(1) @binding(0) var g_position: texture_2d<f32>;
 

@@ -1,0 +1,190 @@
+//! Light depth maps on the CPU (twin: shadow-wgpu's `passes::maps`): rendered with Vulkan's depth bias,
+//! one per light projection (a point light's six cube faces), optionally with McCool's object-ID channel;
+//! looked up per receiver through `shadow_core::lookup::shadow_lookup` with each filter.
+
+use shadow_core::frame::FrameError;
+use shadow_core::glam::{Vec2, Vec3, Vec4};
+use shadow_core::light::{LightProjection, LightView};
+use shadow_core::lookup::shadow_lookup;
+use shadow_core::technique::DebugView;
+use shadow_core::technique::settings::{DepthBias, Filter};
+use shadow_core::{FrameInputs, Image};
+
+use super::per_receiver;
+use crate::context::{CpuError, MAX_MAP_TEXELS, check_size};
+use crate::gbuffer::{GBuffer, clip_vertices};
+use crate::raster::{
+    Batch, CullMode, DepthState, DepthStencil, Indexed, RasterCounters, RasterState, draw_depth, draw_flat,
+};
+
+/// Refuses a set of `count` square maps of side `res` before anything is allocated.
+///
+/// # Errors
+/// [`CpuError::BadSize`] over the limits.
+pub fn check_maps(res: u32, count: usize) -> Result<(), CpuError> {
+    check_size("shadow map", u64::from(res), u64::from(res), u64::MAX)?;
+    let total = u64::from(res) * u64::from(res) * count as u64;
+    if total > MAX_MAP_TEXELS {
+        return Err(CpuError::BadSize {
+            what: "shadow maps",
+            width: u64::from(res),
+            height: u64::from(res),
+            why: format!("{count} maps of this size are {total} texels, over the limit of {MAX_MAP_TEXELS}"),
+        });
+    }
+    Ok(())
+}
+
+/// Renders the depth of every casting instance from one light projection into a `res x res` map, in the
+/// storage of `reuse` when given (last frame's map: its pages are already mapped).
+///
+/// # Errors
+/// [`FrameError::TooManyTriangles`] for casters of more triangles than a draw can number.
+pub fn render_depth_map(
+    frame: &FrameInputs,
+    proj: &LightProjection,
+    res: u32,
+    bias: DepthBias,
+    cull: CullMode,
+    reuse: Option<Image<f32>>,
+) -> Result<(Image<f32>, RasterCounters), FrameError> {
+    let n = res as usize * res as usize;
+    let mut depth = reuse.map(Image::into_vec).unwrap_or_default();
+    depth.clear();
+    depth.resize(n, 1.0);
+    let mut ds = DepthStencil::from_parts(res, res, depth, vec![0; n]);
+    let state =
+        RasterState { cull, depth: Some(DepthState { bias, ..DepthState::LESS_WRITE }), ..RasterState::default() };
+    let (casters, clip) = casters_clipped(frame, proj);
+    let counters = draw_depth(&mut ds, &casters_batch(frame, &casters, &clip)?, &state);
+    Ok((ds.into_depth_image(), counters))
+}
+
+/// The shadow casters of `frame` (indices into its instances) and their vertices in the clip space of
+/// `proj`.
+fn casters_clipped(frame: &FrameInputs, proj: &LightProjection) -> (Vec<usize>, Vec<Vec<Vec4>>) {
+    let casters: Vec<usize> = (0..frame.instances.len()).filter(|&k| frame.instances[k].casts_shadow).collect();
+    let clip = casters
+        .iter()
+        .map(|&k| {
+            let inst = &frame.instances[k];
+            clip_vertices(inst.mesh.positions(), proj.clip_from_world * inst.world_from_local)
+        })
+        .collect();
+    (casters, clip)
+}
+
+/// The casters of [`casters_clipped`] as one draw; its parts are in the order of `casters`.
+fn casters_batch<'a>(
+    frame: &'a FrameInputs,
+    casters: &[usize],
+    clip: &'a [Vec<Vec4>],
+) -> Result<Batch<'a>, FrameError> {
+    Batch::new(casters.iter().zip(clip).map(|(&k, clip)| Indexed::instance(&frame.instances[k], clip)).collect())
+}
+
+/// Renders one depth map per projection of `light` (after checking their size), each in the storage of the
+/// map it replaces in `maps`.
+///
+/// # Errors
+/// [`CpuError::BadSize`] over the limits, [`FrameError::TooManyTriangles`] for casters a draw cannot number.
+pub fn render_depth_maps(
+    frame: &FrameInputs,
+    light: &LightView,
+    res: u32,
+    bias: DepthBias,
+    maps: &mut Vec<Image<f32>>,
+) -> Result<(), CpuError> {
+    check_maps(res, light.projections.len())?;
+    let mut old = std::mem::take(maps).into_iter();
+    *maps = light
+        .projections
+        .iter()
+        .map(|p| Ok(render_depth_map(frame, p, res, bias, CullMode::None, old.next())?.0))
+        .collect::<Result<_, CpuError>>()?;
+    Ok(())
+}
+
+/// Renders one depth map per projection of `light` as [`render_depth_maps`] does, and with each an ID map:
+/// 1 + the index in `frame.instances` of the caster a texel shows, 0 where it shows none (McCool's object-ID
+/// channel, section 3.2; the GPU backend's light pass writes the same values).
+///
+/// # Errors
+/// As [`render_depth_maps`].
+pub fn render_depth_and_id_maps(
+    frame: &FrameInputs,
+    light: &LightView,
+    res: u32,
+    bias: DepthBias,
+    maps: &mut Vec<Image<f32>>,
+    ids: &mut Vec<Image<u32>>,
+) -> Result<(), CpuError> {
+    check_maps(res, light.projections.len())?;
+    let state = RasterState { depth: Some(DepthState { bias, ..DepthState::LESS_WRITE }), ..RasterState::default() };
+    maps.clear();
+    ids.clear();
+    for p in &light.projections {
+        let mut ds = DepthStencil::new(res, res, 1.0, 0);
+        let mut id = Image::new(res, res, 0u32);
+        let (casters, clip) = casters_clipped(frame, p);
+        let all = casters_batch(frame, &casters, &clip)?;
+        draw_flat(&mut ds, &mut id, &all, &state, |prim| casters[all.part_of(prim).0] as u32 + 1);
+        maps.push(ds.into_depth_image());
+        ids.push(id);
+    }
+    Ok(())
+}
+
+/// Where a receiver looks into a light's maps.
+#[derive(Clone, Copy, Debug)]
+pub struct MapPosition {
+    /// The projection (cube face) it falls in.
+    pub projection: usize,
+    /// Map coordinates.
+    pub uv: Vec2,
+    /// NDC depth.
+    pub depth: f32,
+    /// The world point looked up (moved towards the light under `bias=world`).
+    pub world: Vec3,
+}
+
+/// Where a receiver at `p` looks into the light's maps, after moving it `receiver_offset` towards the
+/// light (`bias=world`).
+#[must_use]
+pub fn map_position(light: &LightView, mut p: Vec3, receiver_offset: f32) -> MapPosition {
+    if receiver_offset != 0.0 {
+        p += light.light.to_light(p) * receiver_offset;
+    }
+    let k = light.projection_index(p);
+    let (uv, depth) = light.projections[k].uv_depth(p);
+    MapPosition { projection: k, uv, depth, world: p }
+}
+
+/// The lookup every map-based technique shares: each receiver (moved `receiver_offset` towards the light)
+/// projected into its map and compared through `filter`.
+pub fn query_maps(
+    maps: &[Image<f32>],
+    light: &LightView,
+    g: &GBuffer,
+    out: &mut Image<f32>,
+    filter: Filter,
+    radius: f32,
+    receiver_offset: f32,
+) {
+    per_receiver(g, out, |x, y, i| {
+        let m = map_position(light, g.position.data()[i], receiver_offset);
+        shadow_lookup(&maps[m.projection], m.uv, m.depth, filter, radius, (x, y))
+    });
+}
+
+/// False-colour pictures of depth maps, named `{prefix}{k}`.
+#[must_use]
+pub fn depth_views(prefix: &str, maps: &[Image<f32>]) -> Vec<DebugView> {
+    maps.iter()
+        .enumerate()
+        .map(|(k, m)| {
+            let lo = m.data().iter().copied().fold(1.0f32, f32::min);
+            DebugView { name: format!("{prefix}{k}"), image: shadow_core::image::false_colour(m, lo, 1.0) }
+        })
+        .collect()
+}

@@ -1,0 +1,55 @@
+//! Shadow rays for the ray-traced references (`ray-traced` in shadow-hard, `area-light-reference` in
+//! shadow-soft): the scene BVH, built once per frame, and each receiver's ray origin, offset off the
+//! surface by a fraction of the scene's diagonal along the face normal turned towards the viewer.
+
+use shadow_core::FrameInputs;
+use shadow_core::glam::Vec3;
+use shadow_core::technique::TechniqueError;
+
+use crate::bvh::SceneBvh;
+use crate::context::CpuContext;
+use crate::gbuffer::GBuffer;
+
+/// What a ray-traced technique keeps: the BVH of the last build (shared with `area-light-reference`).
+#[derive(Default)]
+pub struct State {
+    bvh: Option<std::sync::Arc<SceneBvh>>,
+}
+
+impl State {
+    /// Builds (or takes the context's cached) BVH of the frame's casters.
+    pub fn build(&mut self, cx: &mut CpuContext, frame: &FrameInputs) {
+        self.bvh = Some(cx.bvh(frame));
+    }
+
+    /// The BVH of the last build.
+    ///
+    /// # Errors
+    /// [`TechniqueError::NotBuilt`] naming `technique` before any build.
+    pub fn bvh(&self, technique: &str) -> Result<&SceneBvh, TechniqueError> {
+        self.bvh.as_deref().ok_or_else(|| TechniqueError::NotBuilt(technique.into()))
+    }
+}
+
+/// Where shadow rays leave the receivers of a G-buffer: each position moved `epsilon` times the scene's
+/// bounding-box diagonal along its geometric normal (turned towards the viewer, the side that is seen), so
+/// the offset is as many f32 ulps at any scene size.
+pub struct RayOrigins<'a> {
+    g: &'a GBuffer,
+    offset: f32,
+}
+
+impl<'a> RayOrigins<'a> {
+    /// The origins over `g` for a frame, `epsilon` a fraction of its diagonal.
+    #[must_use]
+    pub fn new(g: &'a GBuffer, frame: &FrameInputs, epsilon: f32) -> Self {
+        Self { g, offset: epsilon * frame.bounds.size().length() }
+    }
+
+    /// Pixel `i`'s ray origin and its geometric normal.
+    #[must_use]
+    pub fn at(&self, i: usize) -> (Vec3, Vec3) {
+        let n = self.g.geometric_normal.data()[i];
+        (self.g.position.data()[i] + n * self.offset, n)
+    }
+}

@@ -1,0 +1,136 @@
+//! `midpoint-shadow-map` (Woo), `second-depth-shadow-map` (Wang-Molnar) and `dual-shadow-map`
+//! (Weiskopf-Ertl 2003): the two layers nearest the light, found by depth peeling, combined into one map
+//! that the ordinary shadow-map lookup then reads (Weiskopf-Ertl section 5: "the rendering of the scene
+//! from the eye point in phase two is not modified").
+//!
+//! Pass 1 renders the nearest depth z1. Pass 2 renders the scene again, discarding every fragment within
+//! `peel_epsilon` of z1 at its texel, which leaves the second-nearest depth z2. Where a layer is missing
+//! the far plane stands in, as in the paper. Back faces of closed meshes are culled in both passes under
+//! `culling=auto`, open meshes are never culled: the paper's mix of solid and thin objects in one scene.
+//! The combination is taken on linear depths (see `DepthLayers::combine`).
+
+use super::{DepthLayers, LayerCulling};
+use shadow_core::light::{LightProjection, LightView};
+use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
+use shadow_core::{FrameInputs, Image};
+
+use shadow_cpu::gbuffer::{GBuffer, clip_vertices};
+use shadow_cpu::passes::maps::check_maps;
+use shadow_cpu::passes::maps::{depth_views, query_maps};
+use shadow_cpu::raster::{CullMode, DepthState, DepthStencil, Indexed, RasterState, draw, draw_depth};
+use shadow_cpu::{CpuBackend, CpuContext, CpuError};
+
+/// The layers and the combined map of the last build, one of each per light projection.
+#[derive(Default)]
+pub struct State {
+    z1: Vec<Image<f32>>,
+    z2: Vec<Image<f32>>,
+    maps: Vec<Image<f32>>,
+}
+
+/// One light pass: the nearest depth, or with `first` the nearest depth behind it (depth peeling).
+fn layer_pass(
+    frame: &FrameInputs,
+    proj: &LightProjection,
+    res: u32,
+    culling: LayerCulling,
+    first: Option<(&Image<f32>, f32)>,
+) -> Image<f32> {
+    let mut ds = DepthStencil::new(res, res, 1.0, 0);
+    for inst in frame.instances.iter().filter(|i| i.casts_shadow) {
+        let cull =
+            if culling == LayerCulling::Auto && inst.adjacency.closed() { CullMode::Back } else { CullMode::None };
+        let clip = clip_vertices(inst.mesh.positions(), proj.clip_from_world * inst.world_from_local);
+        let src = Indexed { positions: &clip, triangles: inst.mesh.triangles(), prim_base: 0, flip: inst.mirrored };
+        match first {
+            None => {
+                let state = RasterState { cull, depth: Some(DepthState::LESS_WRITE), ..RasterState::default() };
+                draw_depth(&mut ds, &src, &state);
+            }
+            Some((z1, eps)) => {
+                // The fragment test must run before the depth test, so a peeled fragment leaves no depth.
+                let state = RasterState {
+                    cull,
+                    depth: Some(DepthState::LESS_WRITE),
+                    early_tests: false,
+                    ..RasterState::default()
+                };
+                let mut none = Image::new(res, res, ());
+                draw(
+                    &mut ds,
+                    &mut none,
+                    &src,
+                    &state,
+                    |f| (f.depth > *z1.get(f.x, f.y) + eps).then_some(()),
+                    |_, _| {},
+                );
+            }
+        }
+    }
+    ds.into_depth_image()
+}
+
+impl ShadowTechnique<CpuBackend> for DepthLayers {
+    type State = State;
+
+    fn name(&self) -> &'static str {
+        self.kind.name()
+    }
+
+    fn create_state(&self, _: &mut CpuContext) -> Result<State, CpuError> {
+        Ok(State::default())
+    }
+
+    fn build(
+        &self,
+        _: &mut CpuContext,
+        state: &mut State,
+        frame: &FrameInputs,
+        light: &LightView,
+        _: &mut FrameStats,
+    ) -> Result<(), CpuError> {
+        check_maps(self.resolution, 3 * light.projections.len())?;
+        state.z1.clear();
+        state.z2.clear();
+        state.maps.clear();
+        for proj in &light.projections {
+            let z1 = layer_pass(frame, proj, self.resolution, self.culling, None);
+            let z2 = layer_pass(frame, proj, self.resolution, self.culling, Some((&z1, self.peel_epsilon)));
+            let combined = Image::from_fn(self.resolution, self.resolution, |x, y| {
+                let (a, b) = (*z1.get(x, y), *z2.get(x, y));
+                if a >= 1.0 {
+                    return 1.0;
+                }
+                proj.ndc_depth(self.combine(proj.linear_depth(a), proj.linear_depth(b)))
+            });
+            state.z1.push(z1);
+            state.z2.push(z2);
+            state.maps.push(combined);
+        }
+        Ok(())
+    }
+
+    fn query(
+        &self,
+        _: &mut CpuContext,
+        state: &mut State,
+        _: &FrameInputs,
+        light: &LightView,
+        g: &GBuffer,
+        out: &mut Image<f32>,
+        _: &mut FrameStats,
+    ) -> Result<(), CpuError> {
+        if state.maps.len() != light.projections.len() {
+            return Err(TechniqueError::NotBuilt(self.kind.name().into()).into());
+        }
+        query_maps(&state.maps, light, g, out, self.filter, self.filter_radius, 0.0);
+        Ok(())
+    }
+
+    fn debug_views(&self, _: &mut CpuContext, state: &State) -> Result<Vec<DebugView>, CpuError> {
+        let mut v = depth_views("z1-", &state.z1);
+        v.extend(depth_views("z2-", &state.z2));
+        v.extend(depth_views("map", &state.maps));
+        Ok(v)
+    }
+}

@@ -1,0 +1,258 @@
+//! `midpoint-shadow-map`, `second-depth-shadow-map` and `dual-shadow-map` on the GPU (twin: depth_layers/cpu.rs). Per light projection: pass 1 renders z1; pass 2 renders again with
+//! fragments at z1 discarded (depth peeling), giving z2; a full-screen pass combines them and writes the
+//! result as depth into that layer of the map array, which the ordinary shadow-map query then reads.
+//! Culling is chosen per instance (closed meshes cull back faces under `culling=auto`), with clockwise
+//! pipeline variants for mirrored instances.
+
+use super::{DepthLayers, LayerCulling, LayerKind};
+use bytemuck::{Pod, Zeroable};
+use shadow_core::FrameInputs;
+use shadow_core::light::{LightProjection, LightView};
+use shadow_core::technique::settings::Filter;
+use shadow_core::technique::{FrameStats, ShadowTechnique, TechniqueError};
+use wgpu::util::DeviceExt;
+
+use shadow_wgpu::frame::{GpuVisibility, layer_view};
+use shadow_wgpu::gbuffer::{GpuGBuffer, check_size};
+use shadow_wgpu::passes::maps::{LookupParams, MapQuery, QueryExtras, map_texture};
+use shadow_wgpu::pipelines::{MAP_DEPTH, POSITION_LAYOUT, ViewRaw, buffer_entry, depth_entry, depth_pass};
+use shadow_wgpu::shaders;
+use shadow_wgpu::{WgpuBackend, WgpuContext, WgpuError};
+
+/// GPU twin of `LayerParams` in layers.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct LayerParams {
+    view: [f32; 4],
+    settings: [f32; 4],
+}
+
+/// Pipelines (index: peel pass, back-face culling, clockwise fronts) and the maps of the last build.
+pub struct State {
+    passes: Vec<wgpu::RenderPipeline>,
+    combine: wgpu::RenderPipeline,
+    layout: wgpu::BindGroupLayout,
+    query: MapQuery,
+    maps: Option<wgpu::Texture>,
+    scratch: Option<(wgpu::Texture, wgpu::Texture)>,
+}
+
+fn pass_index(peel: bool, cull: bool, cw: bool) -> usize {
+    usize::from(peel) * 4 + usize::from(cull) * 2 + usize::from(cw)
+}
+
+fn kind_code(k: LayerKind) -> f32 {
+    match k {
+        LayerKind::Midpoint => 0.0,
+        LayerKind::SecondDepth => 1.0,
+        LayerKind::Dual => 2.0,
+    }
+}
+
+impl State {
+    fn new(cx: &WgpuContext, filter: Filter) -> Self {
+        let module = shaders::module(&cx.device, "depth_layers", shader());
+        let map_module = shaders::module(&cx.device, "shadow_map", shaders::shadow_map());
+        let layout = cx.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("depth layers"),
+            entries: &[
+                depth_entry(0),
+                depth_entry(1),
+                buffer_entry(2, wgpu::BufferBindingType::Uniform, wgpu::ShaderStages::FRAGMENT),
+            ],
+        });
+        let groups = [Some(&cx.shared.frame_layout), Some(&layout)];
+        let pl = cx.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("depth layers"),
+            bind_group_layouts: &groups,
+            immediate_size: 0,
+        });
+        let depth_state = |compare, write| wgpu::DepthStencilState {
+            format: MAP_DEPTH,
+            depth_write_enabled: Some(write),
+            depth_compare: Some(compare),
+            stencil: Default::default(),
+            bias: Default::default(),
+        };
+        let mut passes = Vec::new();
+        for peel in [false, true] {
+            for cull in [false, true] {
+                for cw in [false, true] {
+                    debug_assert_eq!(passes.len(), pass_index(peel, cull, cw));
+                    passes.push(cx.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                        label: Some("depth layer"),
+                        layout: Some(&pl),
+                        vertex: wgpu::VertexState {
+                            module: &module,
+                            entry_point: Some("vs_layer"),
+                            compilation_options: Default::default(),
+                            buffers: &[Some(POSITION_LAYOUT)],
+                        },
+                        primitive: wgpu::PrimitiveState {
+                            front_face: if cw { wgpu::FrontFace::Cw } else { wgpu::FrontFace::Ccw },
+                            cull_mode: cull.then_some(wgpu::Face::Back),
+                            ..Default::default()
+                        },
+                        depth_stencil: Some(depth_state(wgpu::CompareFunction::Less, true)),
+                        multisample: Default::default(),
+                        fragment: peel.then(|| wgpu::FragmentState {
+                            module: &module,
+                            entry_point: Some("fs_peel"),
+                            compilation_options: Default::default(),
+                            targets: &[],
+                        }),
+                        multiview_mask: None,
+                        cache: None,
+                    }));
+                }
+            }
+        }
+        let combine = cx.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("combine layers"),
+            layout: Some(&pl),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_full_screen"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: Default::default(),
+            depth_stencil: Some(depth_state(wgpu::CompareFunction::Always, true)),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_combine"),
+                compilation_options: Default::default(),
+                targets: &[],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        Self { passes, combine, layout, query: MapQuery::new(cx, &map_module, filter), maps: None, scratch: None }
+    }
+}
+
+/// Both layers and their combination for one projection, into layer `k` of `maps`.
+#[allow(clippy::too_many_arguments)]
+fn render_projection(
+    s: &DepthLayers,
+    cx: &WgpuContext,
+    state: &State,
+    frame: &FrameInputs,
+    proj: &LightProjection,
+    k: u32,
+    maps: &wgpu::Texture,
+    instances: &wgpu::Buffer,
+) {
+    let Some((z1, z2)) = &state.scratch else { return };
+    let res = maps.width();
+    let group0 =
+        cx.shared.frame_group(&cx.device, &ViewRaw::new(proj.clip_from_world, glam::Vec3::ZERO, res, res), instances);
+    let params = LayerParams {
+        view: [proj.near, proj.far, if proj.orthographic { 1.0 } else { 0.0 }, kind_code(s.kind)],
+        settings: [s.z_offset, s.peel_epsilon, 0.0, 0.0],
+    };
+    let ubuf = cx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("layer params"),
+        contents: bytemuck::bytes_of(&params),
+        usage: wgpu::BufferUsages::UNIFORM,
+    });
+    let (v1, v2) = (z1.create_view(&Default::default()), z2.create_view(&Default::default()));
+    let group1 = |a: &wgpu::TextureView, b: &wgpu::TextureView| {
+        cx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("depth layers"),
+            layout: &state.layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(a) },
+                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(b) },
+                wgpu::BindGroupEntry { binding: 2, resource: ubuf.as_entire_binding() },
+            ],
+        })
+    };
+    // Pass 1 cannot bind z1 while writing it: it gets z2's texture as a stand-in it never reads.
+    let (first, peel) = (group1(&v2, &v2), group1(&v1, &v1));
+    let mut enc = cx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("depth layers") });
+    for (peeling, target, group) in [(false, &v1, &first), (true, &v2, &peel)] {
+        let mut pass = depth_pass(&mut enc, target, if peeling { "second layer" } else { "first layer" });
+        pass.set_bind_group(0, &group0, &[]);
+        pass.set_bind_group(1, group, &[]);
+        for (i, inst) in frame.instances.iter().enumerate().filter(|(_, i)| i.casts_shadow) {
+            let Some(m) = cx.cache.mesh(inst.mesh_key) else { continue };
+            let cull = s.culling == LayerCulling::Auto && inst.adjacency.closed();
+            pass.set_pipeline(&state.passes[pass_index(peeling, cull, inst.mirrored)]);
+            pass.set_vertex_buffer(0, m.positions.slice(..));
+            pass.set_index_buffer(m.indices.slice(..), wgpu::IndexFormat::Uint32);
+            pass.draw_indexed(0..m.index_count, 0, i as u32..i as u32 + 1);
+        }
+    }
+    {
+        let out = layer_view(maps, k);
+        let both = group1(&v1, &v2);
+        let mut pass = depth_pass(&mut enc, &out, "combine layers");
+        pass.set_pipeline(&state.combine);
+        pass.set_bind_group(0, &group0, &[]);
+        pass.set_bind_group(1, &both, &[]);
+        pass.draw(0..3, 0..1);
+    }
+    cx.queue.submit([enc.finish()]);
+}
+
+impl ShadowTechnique<WgpuBackend> for DepthLayers {
+    type State = State;
+
+    fn name(&self) -> &'static str {
+        self.kind.name()
+    }
+
+    fn create_state(&self, cx: &mut WgpuContext) -> Result<State, WgpuError> {
+        cx.scoped("creating the depth-layer pipelines", |cx| State::new(cx, self.filter))
+    }
+
+    fn build(
+        &self,
+        cx: &mut WgpuContext,
+        state: &mut State,
+        frame: &FrameInputs,
+        light: &LightView,
+        _: &mut FrameStats,
+    ) -> Result<(), WgpuError> {
+        let (res, layers) = (self.resolution, light.projections.len() as u32);
+        check_size(cx, "shadow map", res, res)?;
+        if !state.maps.as_ref().is_some_and(|m| m.width() == res && m.depth_or_array_layers() == layers) {
+            state.maps = Some(cx.scoped("allocating shadow maps", |cx| map_texture(cx, res, layers))?);
+        }
+        if state.scratch.as_ref().is_none_or(|(a, _)| a.width() != res) {
+            state.scratch =
+                Some(cx.scoped("allocating depth layers", |cx| (map_texture(cx, res, 1), map_texture(cx, res, 1)))?);
+        }
+        cx.cache.upload_meshes(&cx.device, frame);
+        let instances = cx.cache.instances(&cx.device, frame).clone();
+        let maps = state.maps.clone().ok_or_else(|| TechniqueError::NotBuilt(self.kind.name().into()))?;
+        cx.scoped("the depth-layer passes", |cx| {
+            for (k, proj) in light.projections.iter().enumerate() {
+                render_projection(self, cx, state, frame, proj, k as u32, &maps, &instances);
+            }
+        })
+    }
+
+    fn query(
+        &self,
+        cx: &mut WgpuContext,
+        state: &mut State,
+        _: &FrameInputs,
+        light: &LightView,
+        g: &GpuGBuffer,
+        out: &mut GpuVisibility,
+        _: &mut FrameStats,
+    ) -> Result<(), WgpuError> {
+        let maps = state.maps.as_ref().ok_or_else(|| TechniqueError::NotBuilt(self.kind.name().into()))?;
+        let lookup = LookupParams { radius: self.filter_radius, receiver_offset: 0.0 };
+        state.query.run(cx, maps, light, g, out, lookup, &QueryExtras::NONE)
+    }
+}
+
+/// The peeling and combination passes.
+#[must_use]
+pub fn shader() -> String {
+    shaders::with_common(include_str!("layers.wgsl"))
+}

@@ -1,0 +1,676 @@
+//! `hybrid` (Chan, thesis chapter 3) on the GPU (twin: hybrid's cpu.rs).
+//!
+//! Build: the classifying maps, rendered as `shadow-map` renders them, and the z-fail volumes, built and
+//! uploaded as `shadow-volume-zfail` does. Query, the thesis's section 3.2 in three passes over the
+//! G-buffer's depth-stencil:
+//!
+//! 1. **Mask.** A full-screen pass classifies each receiver against the four nearest texels and discards
+//!    every pixel but the silhouette pixels, on which the stencil's bit 7 is set ([`MASK`]).
+//! 2. **Volumes.** The z-fail volumes, with the stencil test "bit 7 set": outside the mask the hardware's
+//!    early stencil test can reject the fragments before any other work (on the H100 measured, it does
+//!    not pay: the masked pass costs about what the unmasked one does). The count wraps in the other seven
+//!    bits ([`COUNT`]), so it is exact up to 127 overlapping volumes.
+//! 3. **Answer.** One colour pass, two draws: outside the mask the map's answer; inside it, 0 where the
+//!    count is not 0 (the stencil is above 0x80). Silhouette pixels the volumes leave lit keep the cleared 1.
+//!
+//! With `gpu_mask=depth` the mask lives in a scratch depth-stencil instead, as Chan keeps it (section 3.2,
+//! with the depth bounds test, which wgpu does not expose): the G-buffer's depth-stencil is copied into the
+//! scratch, the mask pass sets bit 7 as before (for the answer) and then rasterizes a full-screen triangle
+//! at depth 1 where the bit is clear (no depth written by a shader, so hierarchical depth can follow it),
+//! and the volumes count z-fail's way with the depth test turned around: a fragment behind the receiver
+//! fails `Less` exactly where it passes `GreaterEqual`, so the counting ops move from depth-fail to pass,
+//! and outside the mask (depth 1) every fragment fails the test, which hierarchical depth can do a tile at
+//! a time before rasterizing it. A first version wrote the silhouette pixels' depth from the mask shader
+//! instead; on an H100 both were slower than the stencil mask (see `GpuMask::Depth`).
+//!
+//! With `scissor_tile=N` the mask pass also marks, in a storage buffer, each N x N pixel tile that holds a
+//! silhouette pixel; the CPU reads the marks back and the volume pass repeats its draws inside scissor
+//! rectangles around the marked tiles (runs along each row, merged down while the run below spans the same
+//! columns), so fragments elsewhere are never made; it trades the read-back and the repeated geometry for
+//! them (measured in the README: on an H100 from 0.63 to 1.56 times z-fail's query, against 0.67 to 1.30
+//! without).
+//!
+//! With `edge_texels=all` (both backends) the build also draws the casters' silhouette edges into edge
+//! maps, and the classification masks every receiver facing the light whose texels an edge nearer than it
+//! crosses (edges_all.wgsl), so casters thinner than a texel still get volumes; with `paired`, only
+//! where two edges enter the square between its four texels and may hide something there (the edge
+//! cells, made by shared code on the CPU and uploaded; edges_paired.wgsl).
+//!
+//! With `caster_masks=on` (the default, as on the CPU; ours) each small piece of the volumes (one connected
+//! component's) is counted only at the silhouette pixels its shaft holds, by compute passes over the
+//! pixels the mask pass lists (`casters`); the pieces too large for that are rasterized as above, and
+//! the answer's third draw shadows the silhouette pixels whose listed count is not 0.
+//!
+//! Without caster masks the map's classification runs twice, in the mask pass on every pixel and in the
+//! answer outside the mask: a full-screen pass can write a colour or set the stencil for the pixels it
+//! keeps, but not both for different pixels, and one more 4-texel lookup costs less than a class target
+//! written and read. With them the mask pass also leaves each pixel's class in the per-pixel buffer the
+//! compute passes write the listed pixels' counts to, and the answer reads it there (lavapipe, six runs
+//! in turn: tree's query 47-56 ms against 51-63 classifying twice, cubes' 24-35 against 26-43).
+//!
+//! Counters come from occlusion queries: the mask pass's samples are `silhouette_pixels`; after the
+//! answer, a pass with the depth test off and the mask's stencil test counts `volume_fragments` (those the
+//! mask lets through), and with `unmasked_fill=on` one without the stencil test counts
+//! `unmasked_volume_fragments`; both are timed as the sub-phase `count_fragments`. With caster masks the
+//! compute passes count their own fragments and stencil updates, read back in the same sub-phase.
+
+mod casters;
+mod edges;
+pub mod shaders;
+mod tables;
+mod tiles;
+
+use casters::{CasterPasses, CasterPieces, LISTED_TRIANGLES, ListedPixels, Split, setup_room};
+use edges::{edge_cell_maps, edge_maps, edge_pass};
+use tiles::TileMarks;
+
+use super::shafts::CasterShafts;
+use super::{EdgeTexels, GpuMask, Hybrid};
+use shadow_core::FrameInputs;
+use shadow_core::Image;
+use shadow_core::frame::InstanceVolume;
+use shadow_core::geometry::volume::Caps;
+use shadow_core::geometry::volume::VolumeCounting;
+use shadow_core::light::LightView;
+use shadow_core::lookup::PixelClass;
+use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
+
+use shadow_wgpu::frame::GpuVisibility;
+use shadow_wgpu::gbuffer::GpuGBuffer;
+use shadow_wgpu::passes::maps::{DepthMaps, LookupParams, MapBindings, QueryExtras};
+use shadow_wgpu::passes::volumes::{
+    VolumeDraw, VolumePass, count_all_pipeline, counting_state, occlusion_query, read_query, upload_draws,
+    upload_volumes, volume_pipeline,
+};
+use shadow_wgpu::pipelines::{
+    DEPTH_STENCIL, FragmentEntry, VISIBILITY, attribute_entry, buffer_entry, depth_array_entry, float_array_entry,
+    full_screen_pipeline,
+};
+use shadow_wgpu::readback;
+use shadow_wgpu::{WgpuBackend, WgpuContext, WgpuError};
+
+/// The stencil bit of the computation mask.
+pub const MASK: u32 = 0x80;
+/// The stencil bits the volumes count in.
+pub const COUNT: u32 = 0x7f;
+
+/// The format of the debug view's class codes.
+const CODES: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
+
+/// Pipelines, the maps and volumes of the last build, and what the debug view needs of the last query.
+pub struct State {
+    /// The classifying maps (`shadow-map`'s own build).
+    map: DepthMaps,
+    bindings: MapBindings,
+    module: wgpu::ShaderModule,
+    mask: wgpu::RenderPipeline,
+    volumes_ccw: wgpu::RenderPipeline,
+    volumes_cw: wgpu::RenderPipeline,
+    answer_map: wgpu::RenderPipeline,
+    answer_shadowed: wgpu::RenderPipeline,
+    count_masked: wgpu::RenderPipeline,
+    count_all: wgpu::RenderPipeline,
+    /// The volumes rasterized through the mask: all of them, or with caster masks the large pieces.
+    draws: Option<Vec<VolumeDraw>>,
+    /// With caster masks.
+    casters: Option<Casters>,
+    /// With `gpu_mask=depth`: the scratch depth-stencil the mask is written into, at the view's size, and
+    /// the draw that sets depth 1 outside the mask.
+    scratch: Option<wgpu::Texture>,
+    far: Option<wgpu::RenderPipeline>,
+    /// With `scissor_tile` above 0: the tile marks, at the last view's grid.
+    tiles: Option<TileMarks>,
+    /// With `edge_texels=all`: the pass drawing the edge quads. The edge maps of the last build, a layer
+    /// per projection: with `all` the nearest edge's depth per texel, with `paired` the edge cells.
+    edge_pass: Option<wgpu::RenderPipeline>,
+    edge_maps: Option<wgpu::Texture>,
+    last: Option<LastQuery>,
+}
+
+/// What the caster masks keep: the compute passes, the answer's draw for the listed pixels, the last
+/// build's small pieces (and with `unmasked_fill=on` every volume, for the unmasked fill), and the listed
+/// pixels at the last view's size.
+struct Casters {
+    passes: CasterPasses,
+    answer: wgpu::RenderPipeline,
+    pieces: Option<CasterPieces>,
+    all_draws: Option<Vec<VolumeDraw>>,
+    listed: Option<ListedPixels>,
+}
+
+/// The volumes' depth-stencil state: z-fail counting in [`COUNT`]. The stencil mask: under the stencil
+/// test "bit 7 set", the depth test `Less`. The depth mask: no stencil test, the depth test turned around
+/// to a passing `GreaterEqual`; outside the mask only fragments at depth 1 (far caps) pass, and what they
+/// count there stays in the low bits, which the answer does not read outside the mask.
+fn volume_state(mask: GpuMask) -> wgpu::DepthStencilState {
+    let test = match mask {
+        GpuMask::Stencil => wgpu::CompareFunction::Equal,
+        GpuMask::Depth => wgpu::CompareFunction::Always,
+    };
+    let mut state = counting_state(VolumeCounting::ZFail, test, MASK, COUNT);
+    if mask == GpuMask::Depth {
+        state.depth_compare = Some(wgpu::CompareFunction::GreaterEqual);
+        for face in [&mut state.stencil.front, &mut state.stencil.back] {
+            face.pass_op = face.depth_fail_op;
+            face.depth_fail_op = wgpu::StencilOperation::Keep;
+        }
+    }
+    state
+}
+
+/// The mask pass's depth-stencil state: sets bit 7 on the pixels it keeps.
+fn mask_state() -> wgpu::DepthStencilState {
+    let set_mask = wgpu::StencilFaceState {
+        compare: wgpu::CompareFunction::Always,
+        pass_op: wgpu::StencilOperation::Replace,
+        ..Default::default()
+    };
+    wgpu::DepthStencilState {
+        stencil: wgpu::StencilState { front: set_mask, back: set_mask, read_mask: 0, write_mask: MASK },
+        ..stencil_test(wgpu::CompareFunction::Always, 0)
+    }
+}
+
+/// The depth mask's second draw: a full-screen triangle at depth 1, rasterized (no depth written by a
+/// shader, so hierarchical depth can follow it), drawn where bit 7 is clear.
+fn far_pass(cx: &WgpuContext, module: &wgpu::ShaderModule, groups: &[&wgpu::BindGroupLayout]) -> wgpu::RenderPipeline {
+    let groups: Vec<_> = groups.iter().map(|g| Some(*g)).collect();
+    let layout = cx.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("hybrid far"),
+        bind_group_layouts: &groups,
+        immediate_size: 0,
+    });
+    let outside = wgpu::StencilFaceState { compare: wgpu::CompareFunction::Equal, ..Default::default() };
+    cx.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("hybrid far"),
+        layout: Some(&layout),
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some("vs_hybrid_far"),
+            compilation_options: Default::default(),
+            buffers: &[],
+        },
+        primitive: Default::default(),
+        depth_stencil: Some(wgpu::DepthStencilState {
+            depth_write_enabled: Some(true),
+            stencil: wgpu::StencilState { front: outside, back: outside, read_mask: MASK, write_mask: 0 },
+            ..stencil_test(wgpu::CompareFunction::Always, 0)
+        }),
+        multisample: Default::default(),
+        fragment: None,
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
+/// A depth-stencil target of the G-buffer's size and format, for the depth mask.
+fn scratch_target(cx: &WgpuContext, width: u32, height: u32) -> wgpu::Texture {
+    cx.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("hybrid mask depth"),
+        size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: DEPTH_STENCIL,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    })
+}
+
+/// The bindings and the depth-stencil of the last query, for the classes view.
+struct LastQuery {
+    frame_group: wgpu::BindGroup,
+    map_group: wgpu::BindGroup,
+    depth: wgpu::Texture,
+}
+
+/// A depth-stencil state that only tests the stencil: `compare` against the reference under `read_mask`,
+/// the depth test off, nothing written.
+fn stencil_test(compare: wgpu::CompareFunction, read_mask: u32) -> wgpu::DepthStencilState {
+    let face = wgpu::StencilFaceState { compare, ..Default::default() };
+    wgpu::DepthStencilState {
+        format: DEPTH_STENCIL,
+        depth_write_enabled: Some(false),
+        depth_compare: Some(wgpu::CompareFunction::Always),
+        stencil: wgpu::StencilState { front: face, back: face, read_mask, write_mask: 0 },
+        bias: Default::default(),
+    }
+}
+
+/// The stencil tests of the answer's draws, each with its reference: outside the mask; inside it with a
+/// count that is not 0 (the stencil above `MASK`); inside it with a count of 0.
+const OUTSIDE: (wgpu::CompareFunction, u32, u32) = (wgpu::CompareFunction::Equal, MASK, 0);
+const SHADOWED: (wgpu::CompareFunction, u32, u32) = (wgpu::CompareFunction::Less, 0xff, MASK);
+const LIT: (wgpu::CompareFunction, u32, u32) = (wgpu::CompareFunction::Equal, 0xff, MASK);
+
+/// One pass of full-screen draws over the depth-stencil `depth` (each aspect loaded or cleared as its
+/// load op says), into `target` cleared to `clear` when given; each draw a pipeline and its stencil
+/// reference. With a `query` (an occlusion query set and its
+/// resolve buffer), counts the samples of the first draw that pass.
+fn full_screen_draws(
+    cx: &WgpuContext,
+    label: &str,
+    target: Option<(&wgpu::TextureView, wgpu::Color)>,
+    depth: (&wgpu::TextureView, wgpu::LoadOp<f32>, wgpu::LoadOp<u32>),
+    groups: [&wgpu::BindGroup; 2],
+    draws: &[(&wgpu::RenderPipeline, u32)],
+    query: Option<&(wgpu::QuerySet, wgpu::Buffer)>,
+) -> wgpu::CommandBuffer {
+    let mut enc = cx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
+    {
+        let colour = target.map(|(view, clear)| wgpu::RenderPassColorAttachment {
+            view,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations { load: wgpu::LoadOp::Clear(clear), store: wgpu::StoreOp::Store },
+        });
+        let colour = [colour];
+        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some(label),
+            color_attachments: if target.is_some() { &colour } else { &[] },
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: depth.0,
+                depth_ops: Some(wgpu::Operations { load: depth.1, store: wgpu::StoreOp::Store }),
+                stencil_ops: Some(wgpu::Operations { load: depth.2, store: wgpu::StoreOp::Store }),
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: query.map(|q| &q.0),
+            multiview_mask: None,
+        });
+        pass.push_debug_group(label);
+        for (i, g) in groups.iter().enumerate() {
+            pass.set_bind_group(i as u32, *g, &[]);
+        }
+        for (k, (pipeline, reference)) in draws.iter().enumerate() {
+            pass.set_pipeline(pipeline);
+            pass.set_stencil_reference(*reference);
+            if query.is_some() && k == 0 {
+                pass.begin_occlusion_query(0);
+                pass.draw(0..3, 0..1);
+                pass.end_occlusion_query();
+            } else {
+                pass.draw(0..3, 0..1);
+            }
+        }
+        pass.pop_debug_group();
+    }
+    if let Some((set, resolve)) = query {
+        enc.resolve_query_set(set, 0..1, resolve, 0);
+    }
+    enc.finish()
+}
+
+impl ShadowTechnique<WgpuBackend> for Hybrid {
+    type State = State;
+
+    fn name(&self) -> &'static str {
+        Self::NAME
+    }
+
+    fn create_state(&self, cx: &mut WgpuContext) -> Result<State, WgpuError> {
+        let map = DepthMaps::new(cx, &self.depth);
+        cx.scoped("creating the hybrid pipelines", |cx| {
+            let caster_masks = self.caster_masks.is_on();
+            let source = shaders::query(self.edge_texels, self.scissor_tile > 0, caster_masks);
+            let module = shadow_wgpu::shaders::module(&cx.device, "hybrid", source);
+            let volume_module =
+                shadow_wgpu::shaders::module(&cx.device, "shadow_volume", shadow_wgpu::shaders::shadow_volume());
+            let gpu_mask = self.gpu_mask;
+            let mut extras = vec![attribute_entry(4)];
+            match self.edge_texels {
+                EdgeTexels::Off => {}
+                EdgeTexels::All => extras.push(depth_array_entry(6)),
+                EdgeTexels::Paired => extras.push(float_array_entry(6)),
+            }
+            let storage = |read_only| wgpu::BufferBindingType::Storage { read_only };
+            if self.scissor_tile > 0 {
+                extras.push(buffer_entry(7, storage(false), wgpu::ShaderStages::FRAGMENT));
+            }
+            if caster_masks {
+                extras.push(buffer_entry(8, storage(false), wgpu::ShaderStages::FRAGMENT));
+                extras.push(buffer_entry(9, storage(false), wgpu::ShaderStages::FRAGMENT));
+            }
+            let bindings = MapBindings::new(cx, &extras);
+            let groups = [&cx.shared.frame_layout, bindings.layout()];
+            let mask = full_screen_pipeline(
+                &cx.device,
+                "hybrid mask",
+                &module,
+                "fs_hybrid_mask",
+                &groups,
+                None,
+                Some(mask_state()),
+            );
+            let far = (gpu_mask == GpuMask::Depth).then(|| far_pass(cx, &module, &groups));
+            let counting = volume_state(gpu_mask);
+            let volume = |front| volume_pipeline(cx, &volume_module, "vs_volume", front, counting.clone());
+            let (volumes_ccw, volumes_cw) = (volume(wgpu::FrontFace::Ccw), volume(wgpu::FrontFace::Cw));
+            let count = |state| volume_pipeline(cx, &volume_module, "vs_volume", wgpu::FrontFace::Ccw, state);
+            let count_masked = count(stencil_test(wgpu::CompareFunction::Equal, MASK));
+            let count_all = count_all_pipeline(cx, &volume_module);
+            let answer = |entry, (compare, read_mask, _): (_, u32, u32)| {
+                let state = stencil_test(compare, read_mask);
+                full_screen_pipeline(
+                    &cx.device,
+                    "hybrid answer",
+                    &module,
+                    entry,
+                    &groups,
+                    Some(VISIBILITY),
+                    Some(state),
+                )
+            };
+            let answer_map = answer("fs_hybrid_map", OUTSIDE);
+            let answer_shadowed = answer("fs_hybrid_shadowed", SHADOWED);
+            let casters = caster_masks.then(|| Casters {
+                passes: CasterPasses::new(cx),
+                answer: answer("fs_hybrid_listed", LIT),
+                pieces: None,
+                all_draws: None,
+                listed: None,
+            });
+            State {
+                map,
+                bindings,
+                module,
+                mask,
+                volumes_ccw,
+                volumes_cw,
+                answer_map,
+                answer_shadowed,
+                count_masked,
+                count_all,
+                draws: None,
+                casters,
+                scratch: None,
+                far,
+                tiles: None,
+                edge_pass: (self.edge_texels == EdgeTexels::All).then(|| edge_pass(cx)),
+                edge_maps: None,
+                last: None,
+            }
+        })
+    }
+
+    fn build(
+        &self,
+        cx: &mut WgpuContext,
+        state: &mut State,
+        frame: &FrameInputs,
+        light: &LightView,
+        stats: &mut FrameStats,
+    ) -> Result<(), WgpuError> {
+        state.map.render(cx, frame, light, self.depth.resolution)?;
+        cx.step("map");
+        let res = self.depth.resolution;
+        // The edge maps' segments come from the volumes' own silhouette pass (unused with
+        // `edge_texels=off`, where they cost two transforms per silhouette edge).
+        let (volumes, segments) = frame.shadow_volumes_and_segments(light, Caps::Both);
+        if let Some(pass) = &state.edge_pass {
+            state.edge_maps = Some(cx.scoped("the edge maps", |cx| edge_maps(cx, pass, &segments, light, res))?);
+        } else if self.edge_texels == EdgeTexels::Paired {
+            state.edge_maps = Some(cx.scoped("the edge cells", |cx| edge_cell_maps(cx, &segments, light, res))?);
+        }
+        cx.step("edges");
+        if let Some(casters) = &mut state.casters {
+            // The small pieces go to the compute passes (as many as the device lets them set up), the rest
+            // to the rasterizer.
+            InstanceVolume::count(&volumes, &mut stats.counters);
+            let shafts = CasterShafts::new(frame, light, &volumes);
+            let split = Split::new(frame, &volumes, &shafts, LISTED_TRIANGLES, setup_room(cx));
+            casters.pieces = Some(CasterPasses::upload(cx, frame, light, &split, &shafts)?);
+            state.draws = Some(upload_volumes(cx, frame, &split.raster)?);
+            casters.all_draws = self.unmasked_fill.is_on().then(|| upload_volumes(cx, frame, &volumes)).transpose()?;
+        } else {
+            state.draws = Some(upload_draws(cx, frame, &volumes, stats)?);
+        }
+        cx.step("pieces");
+        Ok(())
+    }
+
+    fn query(
+        &self,
+        cx: &mut WgpuContext,
+        state: &mut State,
+        frame: &FrameInputs,
+        light: &LightView,
+        g: &GpuGBuffer,
+        out: &mut GpuVisibility,
+        stats: &mut FrameStats,
+    ) -> Result<(), WgpuError> {
+        let not_built = || TechniqueError::NotBuilt(Self::NAME.into());
+        let draws = state.draws.as_ref().ok_or_else(not_built)?;
+        let maps = state.map.maps().ok_or_else(not_built)?;
+        let mut extras = vec![wgpu::BindGroupEntry {
+            binding: 4,
+            resource: wgpu::BindingResource::TextureView(&g.geometric_normal),
+        }];
+        let edge_view = state.edge_maps.as_ref().map(|t| {
+            t.create_view(&wgpu::TextureViewDescriptor {
+                dimension: Some(wgpu::TextureViewDimension::D2Array),
+                ..Default::default()
+            })
+        });
+        if let Some(view) = &edge_view {
+            extras.push(wgpu::BindGroupEntry { binding: 6, resource: wgpu::BindingResource::TextureView(view) });
+        } else if self.edge_texels.is_on() {
+            return Err(not_built().into());
+        }
+        // The depth-stencil the passes run over: the G-buffer's, or for the depth mask a copy of it that
+        // the mask pass sets to depth 1 outside the mask.
+        let target = match self.gpu_mask {
+            GpuMask::Stencil => g.depth.clone(),
+            GpuMask::Depth => {
+                let fits = state.scratch.as_ref().is_some_and(|t| (t.width(), t.height()) == (g.width, g.height));
+                if !fits {
+                    state.scratch = Some(scratch_target(cx, g.width, g.height));
+                }
+                state.scratch.clone().ok_or_else(not_built)?
+            }
+        };
+        let tile = self.scissor_tile;
+        if tile > 0 {
+            let (columns, rows) = (g.width.div_ceil(tile), g.height.div_ceil(tile));
+            if state.tiles.as_ref().is_none_or(|t| (t.columns, t.rows) != (columns, rows)) {
+                state.tiles = Some(TileMarks::new(cx, columns, rows));
+            }
+        }
+        let tiles = state.tiles.as_ref().filter(|_| tile > 0);
+        if let Some(t) = tiles {
+            extras.push(wgpu::BindGroupEntry { binding: 7, resource: t.marks.as_entire_binding() });
+        }
+        let tile_settings = [tile as f32, tiles.map_or(0.0, |t| t.columns as f32), 0.0, 0.0];
+        // With caster masks: their passes, the answer's draw, the build's pieces and the listed pixels,
+        // made anew for a new view size or more pieces.
+        let casters = match &mut state.casters {
+            Some(c) => {
+                let pieces = c.pieces.as_ref().ok_or_else(not_built)?;
+                let size = (g.width, g.height);
+                let listed = match c.listed.take() {
+                    Some(l) if l.size == size && l.capacity >= pieces.pieces && l.asked == self.pair_room => l,
+                    _ => cx.scoped("the hybrid listed pixels", |cx| {
+                        ListedPixels::new(cx, size, pieces.pieces, self.pair_room)
+                    })?,
+                };
+                Some((&c.passes, &c.answer, pieces, &*c.listed.insert(listed)))
+            }
+            None => None,
+        };
+        let listed = casters.map(|c| c.3);
+        if let Some(l) = listed {
+            extras.push(wgpu::BindGroupEntry { binding: 8, resource: l.listed.as_entire_binding() });
+            extras.push(wgpu::BindGroupEntry { binding: 9, resource: l.counts.as_entire_binding() });
+        }
+        let mut mask_draws = vec![(&state.mask, MASK)];
+        if let Some(far) = &state.far {
+            mask_draws.push((far, 0));
+        }
+        let depth = target.create_view(&Default::default());
+        let lookup = LookupParams { radius: 0.0, receiver_offset: self.depth.receiver_offset() };
+        let map_group = state.bindings.group(
+            cx,
+            maps,
+            light,
+            g,
+            lookup,
+            &QueryExtras { settings: tile_settings, entries: &extras },
+        );
+        let groups = [&g.frame_group, &map_group];
+        let (silhouettes, passed, rects) = cx.scoped("the hybrid passes", |cx| {
+            let silhouettes = occlusion_query(cx);
+            let mut enc = cx.device.create_command_encoder(&Default::default());
+            if target != g.depth {
+                enc.copy_texture_to_texture(
+                    g.depth.as_image_copy(),
+                    target.as_image_copy(),
+                    wgpu::Extent3d { width: g.width, height: g.height, depth_or_array_layers: 1 },
+                );
+            }
+            if let Some(t) = tiles {
+                enc.clear_buffer(&t.marks, 0, None);
+            }
+            if let Some(l) = listed {
+                l.clear(&mut enc);
+            }
+            cx.queue.submit([enc.finish()]);
+            cx.step("setup");
+            let mask = full_screen_draws(
+                cx,
+                "hybrid mask",
+                None,
+                (&depth, wgpu::LoadOp::Load, wgpu::LoadOp::Clear(0)),
+                groups,
+                &mask_draws,
+                Some(&silhouettes),
+            );
+            cx.queue.submit([mask]);
+            cx.step("mask");
+            if let Some((passes, _, pieces, l)) = casters {
+                let mut enc = cx.device.create_command_encoder(&Default::default());
+                passes.record(cx, &mut enc, pieces, l, g);
+                cx.queue.submit([enc.finish()]);
+                cx.step("casters");
+            }
+            let rects = tiles.map(|t| t.rectangles(cx, tile, (g.width, g.height))).transpose()?;
+            let counting = VolumePass {
+                label: "hybrid volumes",
+                ccw: &state.volumes_ccw,
+                cw: &state.volumes_cw,
+                stencil: wgpu::LoadOp::Load,
+                reference: MASK,
+                scissors: rects.as_deref(),
+            };
+            let passed = counting.run(cx, draws, frame, g, &depth);
+            cx.step("volumes");
+            let mut answers = vec![(&state.answer_map, OUTSIDE.2), (&state.answer_shadowed, SHADOWED.2)];
+            if let Some((_, answer, ..)) = casters {
+                answers.push((answer, LIT.2));
+            }
+            let answer = full_screen_draws(
+                cx,
+                "hybrid answer",
+                Some((&out.view, wgpu::Color::WHITE)),
+                (&depth, wgpu::LoadOp::Load, wgpu::LoadOp::Load),
+                groups,
+                &answers,
+                None,
+            );
+            cx.queue.submit([answer]);
+            cx.step("answer");
+            Ok::<_, WgpuError>((silhouettes, passed, rects.map(|r| r.len())))
+        })??;
+        // The counters are not the technique's work: after it is done, a sub-phase of their own.
+        cx.end_of_work();
+        cx.wait()?;
+        let t = std::time::Instant::now();
+        let masked = VolumePass { reference: MASK, ..VolumePass::count(&state.count_masked, "count masked fragments") };
+        let processed = cx.scoped("the masked fragment count", |cx| masked.run(cx, draws, frame, g, &depth))?;
+        let c = &mut stats.counters;
+        if let Some(n) = rects {
+            c.extra.insert("scissor_rects".into(), n as f64);
+        }
+        c.silhouette_pixels = Some(read_query(cx, &silhouettes)?);
+        let processed = read_query(cx, &processed)?;
+        // Z-fail updates the count where the depth test fails.
+        let rasterized_updates = processed - read_query(cx, &passed)?.min(processed);
+        // What the compute passes covered and updated at the listed pixels.
+        let [computed, computed_updates] = match casters {
+            Some((_, _, pieces, l)) => {
+                let [pixels, fragments, updates, tests, alone] = l.counters(cx)?;
+                c.extra.insert("listed_pieces".into(), pieces.pieces as f64);
+                c.extra.insert("listed_pixels".into(), pixels as f64);
+                c.extra.insert("listed_tests".into(), tests as f64);
+                c.extra.insert("listed_alone".into(), alone as f64);
+                [fragments, updates]
+            }
+            None => [0, 0],
+        };
+        c.volume_fragments = Some(processed + computed);
+        c.stencil_updates = Some(rasterized_updates + computed_updates);
+        if self.unmasked_fill.is_on() {
+            let every = VolumePass::count(&state.count_all, "count volume fragments");
+            let all_draws = state.casters.as_ref().and_then(|c| c.all_draws.as_deref()).unwrap_or(draws);
+            let all = cx.scoped("the volume fragment count", |cx| every.run(cx, all_draws, frame, g, &depth))?;
+            stats.counters.extra.insert("unmasked_volume_fragments".into(), read_query(cx, &all)? as f64);
+        }
+        stats.timings.extra.insert("count_fragments".into(), shadow_core::stats::ms(t.elapsed()));
+        state.last = Some(LastQuery { frame_group: g.frame_group.clone(), map_group, depth: target });
+        Ok(())
+    }
+
+    fn debug_views(&self, cx: &mut WgpuContext, state: &State) -> Result<Vec<DebugView>, WgpuError> {
+        let Some(last) = &state.last else { return Ok(Vec::new()) };
+        let image = cx.scoped("the hybrid classes view", |cx| classes(cx, state, last))??;
+        let image =
+            Image::from_fn(image.width(), image.height(), |x, y| PixelClass::from_code(*image.get(x, y)).colour());
+        Ok(vec![DebugView { name: "classes".into(), image }])
+    }
+}
+
+/// The class code of every pixel (Fig. 3-5), drawn under the answer's stencil tests: the map's class
+/// outside the mask, volume-shadowed and volume-lit inside it; 0 (no receiver) where nothing draws.
+fn classes(cx: &WgpuContext, state: &State, last: &LastQuery) -> Result<Image<u32>, WgpuError> {
+    let (w, h) = (last.depth.width(), last.depth.height());
+    let target = cx.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("hybrid classes"),
+        size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: CODES,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+        view_formats: &[],
+    });
+    let code = |test: (wgpu::CompareFunction, u32, u32), class: u32| {
+        let constants = [("CODE", f64::from(class)), ("SHADOWED_CODE", f64::from(PixelClass::VolumeShadowed as u32))];
+        let entry = FragmentEntry { name: "fs_hybrid_code", constants: &constants };
+        let groups = [&cx.shared.frame_layout, state.bindings.layout()];
+        let depth_stencil = Some(stencil_test(test.0, test.1));
+        let pipeline = full_screen_pipeline(
+            &cx.device,
+            "hybrid classes",
+            &state.module,
+            entry,
+            &groups,
+            Some(CODES),
+            depth_stencil,
+        );
+        (pipeline, test.2)
+    };
+    let draws =
+        [code(OUTSIDE, 0), code(SHADOWED, PixelClass::VolumeShadowed as u32), code(LIT, PixelClass::VolumeLit as u32)];
+    let draws: Vec<_> = draws.iter().map(|(p, r)| (p, *r)).collect();
+    let depth = last.depth.create_view(&Default::default());
+    let view = target.create_view(&Default::default());
+    let pass = full_screen_draws(
+        cx,
+        "hybrid classes",
+        Some((&view, wgpu::Color::TRANSPARENT)),
+        (&depth, wgpu::LoadOp::Load, wgpu::LoadOp::Load),
+        [&last.frame_group, &last.map_group],
+        &draws,
+        None,
+    );
+    cx.queue.submit([pass]);
+    readback::read_u32(cx, &target, 0)
+}

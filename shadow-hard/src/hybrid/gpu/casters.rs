@@ -1,0 +1,680 @@
+//! hybrid's caster masks on the GPU (`caster_masks=on`, ours; twin: cpu/casters.rs): each small piece of the z-fail volumes is counted only at the silhouette
+//! pixels its shaft holds ([`crate::hybrid::shafts`]), by compute passes instead of the rasterizer.
+//!
+//! The rasterizer cannot do this: the mask is a stencil bit, the same for every draw, and a piece's
+//! pixels are known only once the classification has run on the GPU (read back, they would stall the
+//! frame; as scissor rectangles, measured on the CPU, they would still leave 10% of tree's fill). So:
+//!
+//! - **Build** (CPU): the pieces of at most [`LISTED_TRIANGLES`] volume triangles (a tree's twigs, a
+//!   cloud's cubes) are written out as triangles, each piece's shafts beside its run of them, and a grid
+//!   per light projection lists the pieces whose shafts, widened by the largest tolerance a pixel there can
+//!   have, meet each cell. Larger pieces (a single big mesh) stay rasterized through the stencil mask.
+//! - **Query**: the mask pass lists its silhouette pixels, and the compute passes (casters.wgsl)
+//!   set each triangle up for the view (its rows of adj(M): homogeneous rasterization; copied into a
+//!   texture, as the shafts and the grid are uploaded into textures: on lavapipe a texel fetch is several
+//!   times faster than a load from a storage buffer, which Mesa 22.3 makes lane by lane) and gather each
+//!   piece's caps' screen bounds; pair each listed pixel with the pieces of its light-space cell whose
+//!   shafts hold it (each pair staged and counted as it is found, then given runs by a prefix sum and
+//!   moved into them, so the shaft grid is searched once a pixel); count each piece at its pixels, a
+//!   workgroup per piece, testing its triangles at each pixel's centre as the rasterizer would, and add the
+//!   count beside the pixel. The answer shadows a silhouette pixel whose stencil count or listed count is
+//!   not 0: every piece is closed and wound alike, so the pieces' counts at a point have one sign and
+//!   cannot cancel.
+//!
+//! The work is the CPU's caster masks' (a listed pixel times its pieces' triangles, every fragment those
+//! would make counted), with the same shafts: `volume_fragments` is what the compute passes cover plus
+//! what the stencil lets through of the rasterized pieces; `listed_tests` counts the pixel-triangle pairs
+//! tested, and `listed_alone` the listed pixels whose pairs did not fit in the room for them (the
+//! setting `pair_room`), each counted by one invocation over all its pieces.
+
+use std::ops::Range;
+
+use crate::hybrid::shafts::{CasterShafts, Shaft, ShaftGrid, tolerance};
+use bytemuck::{Pod, Zeroable};
+use shadow_core::FrameInputs;
+use shadow_core::LightKind;
+use shadow_core::frame::InstanceVolume;
+use shadow_core::geometry::LightSource;
+use shadow_core::geometry::volume::ShadowVolume;
+use shadow_core::glam::{Vec2, Vec4, Vec4Swizzles};
+use shadow_core::light::LightView;
+use wgpu::util::DeviceExt;
+
+use super::tables::{TABLE_ROW, table};
+use shadow_wgpu::context::{WgpuContext, WgpuError};
+use shadow_wgpu::gbuffer::GpuGBuffer;
+use shadow_wgpu::pipelines::buffer_entry;
+use shadow_wgpu::{readback, shaders};
+
+/// Pieces of at most this many volume triangles are counted by the compute passes at the pixels their
+/// shafts hold; larger ones are rasterized through the whole mask, where a pixel's cost does not grow
+/// with them. Measured on lavapipe (8 frames, two runs): double-torus's query is 31 to 33 ms with 256 or
+/// 1024 here and 71 to 73 with every piece counted by the compute passes; cylinder and primitives do not
+/// move measurably between 256, 1024 and every piece.
+pub(super) const LISTED_TRIANGLES: usize = 1024;
+
+/// The most projections a light has (a point light's cube faces).
+const PROJECTIONS: usize = 6;
+
+/// vec4 per triangle set up for the view (casters.wgsl's `SETUP`).
+const SETUP: u64 = 5;
+
+/// The most triangles the compute passes can take on `cx`'s device: as many as the tallest setup texture
+/// it allows holds (the triangle table, four texels a triangle, is shorter), within the largest storage
+/// binding for the setup buffer it is copied from.
+pub(super) fn setup_room(cx: &WgpuContext) -> usize {
+    let limits = cx.device.limits();
+    let binding = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
+    let row = u64::from(TABLE_ROW);
+    let rows = u64::from(limits.max_texture_dimension_2d).min(binding / (16 * row));
+    (rows * row / SETUP) as usize
+}
+
+/// Invocations per workgroup of the compute passes (casters.wgsl's `GROUP`).
+const GROUP: u32 = 64;
+
+/// The most workgroups along one dimension of a dispatch.
+const MAX_GROUPS: u32 = 65_535;
+
+/// Bytes of the listed pixels' header (`Listed` in shaders.rs: five counters).
+const HEADER: u64 = 20;
+
+/// Listed pixels per invocation of the passes over them, were every pixel of the view listed: their
+/// dispatches are sized by the view (the list's length is known only on the GPU), each invocation taking
+/// every so many.
+const PIXELS_PER_INVOCATION: u32 = 16;
+
+/// Workgroups of the pass over the pixels whose pairs did not fit (`cs_alone`): few, since there are
+/// usually none, and lavapipe pays for every workgroup it starts, work or none (256 took 2-3 ms on cubes
+/// and 6 on tree to find nothing; 64, 0.7 on cubes).
+const ALONE_GROUPS: u32 = 64;
+
+/// casters.wgsl's `CasterParams`.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct Params {
+    view_from_world: [[[f32; 4]; 4]; PROJECTIONS],
+    grid: [[f32; 4]; PROJECTIONS],
+    cells: [[u32; 4]; PROJECTIONS],
+    counts: [u32; 4],
+    light: [f32; 4],
+    lists: [u32; 4],
+}
+
+/// casters.wgsl's `PieceRun`.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct PieceRun {
+    first: u32,
+    sides: u32,
+    caps: u32,
+    quads: u32,
+}
+
+/// A piece counted by the compute passes.
+struct SmallPiece {
+    /// Its index in the shafts ([`CasterShafts::pieces`]).
+    shaft: usize,
+    /// Its run of [`Split::triangles`] (four vec4 each): `sides` sides, then near caps, then as many far
+    /// caps.
+    triangles: Range<u32>,
+    sides: u32,
+    /// Whether its sides come in quads, two triangles each ([`Split::write_piece`]).
+    quads: bool,
+}
+
+/// The volumes of a build split for the caster masks.
+pub(super) struct Split {
+    /// The small pieces' triangles, four vec4 each (casters.wgsl's `triangles`).
+    triangles: Vec<Vec4>,
+    /// The small pieces, in the order of their runs.
+    pieces: Vec<SmallPiece>,
+    /// What is left to rasterize: the large pieces, a volume per instance that has any.
+    pub(super) raster: Vec<InstanceVolume>,
+}
+
+impl Split {
+    /// Splits `volumes` (whose pieces `shafts` lists in order) into the pieces of at most `limit` volume
+    /// triangles, written out for the compute passes while their triangles number at most `room` in all,
+    /// and the rest.
+    pub(super) fn new(
+        frame: &FrameInputs,
+        volumes: &[InstanceVolume],
+        shafts: &CasterShafts,
+        limit: usize,
+        room: usize,
+    ) -> Self {
+        let mut split = Self { triangles: Vec::new(), pieces: Vec::new(), raster: Vec::new() };
+        let mut k = 0;
+        for iv in volumes {
+            let inst = &frame.instances[iv.instance];
+            let vol = &iv.volume;
+            let mut rest = ShadowVolume {
+                sides: Vec::new(),
+                caps_forward: Vec::new(),
+                caps_reversed: Vec::new(),
+                light: vol.light,
+                pieces: Vec::new(),
+            };
+            for piece in &vol.pieces {
+                let r = |r: &Range<u32>| r.start as usize..r.end as usize;
+                let (sides, forward, reversed) = (
+                    &vol.sides[r(&piece.sides)],
+                    &vol.caps_forward[r(&piece.caps_forward)],
+                    &vol.caps_reversed[r(&piece.caps_reversed)],
+                );
+                let n = sides.len() + 2 * (forward.len() + reversed.len());
+                if n > limit || split.triangle_count() as usize + n > room {
+                    rest.sides.extend_from_slice(sides);
+                    rest.caps_forward.extend_from_slice(forward);
+                    rest.caps_reversed.extend_from_slice(reversed);
+                } else {
+                    let first = split.triangle_count();
+                    let quads = split.write_piece(iv, inst, sides, forward, reversed);
+                    let triangles = first..split.triangle_count();
+                    split.pieces.push(SmallPiece { shaft: k, triangles, sides: sides.len() as u32, quads });
+                }
+                k += 1;
+            }
+            if rest.triangle_count() > 0 {
+                split.raster.push(InstanceVolume { instance: iv.instance, volume: rest, silhouette_edges: 0 });
+            }
+        }
+        debug_assert_eq!(k, shafts.pieces.len(), "the shafts list every piece");
+        split
+    }
+
+    fn triangle_count(&self) -> u32 {
+        (self.triangles.len() / 4) as u32
+    }
+
+    /// Writes one piece's triangles as the rasterizer would draw them (shadow_volume.rs's `upload`):
+    /// sides as built, near caps from the mesh's vertices, far caps extruded and turned around for faces
+    /// that cast as wound; each wound so its front face is counter-clockwise. In that order, sides, near
+    /// caps and far caps each in a run of their own, with the piece's index, so the caps can be passed
+    /// over together where their bounds on screen are away from a pixel.
+    ///
+    /// Returns whether the sides come in quads: every light but a directional one extrudes a silhouette
+    /// edge (a, b) into the two triangles (b, a, a_inf) and (b, a_inf, b_inf) (`geometry::volume::extrude`).
+    /// Each is then turned, keeping its winding, so that the quad's diagonal from b to a_inf is its second
+    /// edge (from its third corner to its first), where casters.wgsl's `add_quads` leaves it out.
+    fn write_piece(
+        &mut self,
+        iv: &InstanceVolume,
+        inst: &shadow_core::Instance,
+        sides: &[[Vec4; 3]],
+        forward: &[u32],
+        reversed: &[u32],
+    ) -> bool {
+        let m = inst.mirrored;
+        let (tris, positions) = (inst.mesh.triangles(), inst.mesh.positions());
+        let (instance, piece) = (iv.instance as u32, self.pieces.len() as u32);
+        let mut push = |[a, b, c]: [Vec4; 3], cw: bool, group: Group| {
+            let (b, c) = if cw { (c, b) } else { (b, c) };
+            let info = Vec4::new(
+                f32::from_bits(instance * 2 + u32::from(group != Group::Side)),
+                f32::from_bits(piece),
+                f32::from_bits(group as u32),
+                0.0,
+            );
+            self.triangles.extend([a, b, c, info]);
+        };
+        let quads = !matches!(iv.volume.light, LightSource::Directional(_)) && sides.len().is_multiple_of(2);
+        for (i, s) in sides.iter().enumerate() {
+            // The corner off the diagonal (a in the first triangle, b_inf in the second) goes where `push`
+            // leaves it in the middle (it swaps the last two corners when mirrored).
+            let (off, want) = (if i % 2 == 0 { 1 } else { 2 }, if m { 2 } else { 1 });
+            let turned = if quads { std::array::from_fn(|j| s[(j + off + 3 - want) % 3]) } else { *s };
+            push(turned, m, Group::Side);
+        }
+        let light = iv.volume.light;
+        let faces = || forward.iter().map(|&f| (f, m, true)).chain(reversed.iter().map(|&f| (f, !m, false)));
+        let corners = |f: u32| tris[f as usize].map(|v| positions[v as usize]);
+        for (f, near_cw, _) in faces() {
+            push(corners(f).map(|p| p.extend(1.0)), near_cw, Group::Near);
+        }
+        for (f, _, far_reverse) in faces() {
+            let far = corners(f).map(|p| light.extrude(p));
+            push(if far_reverse { [far[0], far[2], far[1]] } else { far }, m, Group::Far);
+        }
+        quads
+    }
+}
+
+/// The runs a piece's triangles come in (casters.wgsl's `group` of a triangle).
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Group {
+    Side = 0,
+    Near = 1,
+    Far = 2,
+}
+
+/// Per projection, a grid ([`ShaftGrid`]) over the light-space bounds of the small pieces' shafts within
+/// the projection's view (`windows`: silhouette pixels lie in it, the map classifying nothing else), each
+/// shaft widened by the largest sideways tolerance a pixel it can hold may have; a piece unbounded in the
+/// projection, or whose widening cannot be bounded, is listed in every cell.
+fn grids(shafts: &[&[Option<Shaft>]], windows: &[(Vec2, Vec2)], widest: f32, orthographic: &[bool]) -> Vec<ShaftGrid> {
+    // The box of a bounded shaft, widened; `None` where a pixel's tolerance cannot be bounded.
+    let widened = |s: &Shaft, j: usize| -> Option<(Vec2, Vec2)> {
+        let side = if orthographic[j] {
+            2.0 * widest
+        } else {
+            let d = s.near - widest;
+            if d <= 0.0 {
+                return None;
+            }
+            2.0 * widest / d
+        };
+        Some((s.lo.xy() - side, s.hi.xy() + side))
+    };
+    let everywhere = (Vec2::NEG_INFINITY, Vec2::INFINITY);
+    // About four cells a piece: a pixel tests the pieces of its own cell only.
+    let side = ((shafts.len() as f64).sqrt() * 2.0).clamp(1.0, 256.0) as usize;
+    windows
+        .iter()
+        .enumerate()
+        .map(|(j, window)| {
+            let boxes: Vec<Option<(Vec2, Vec2)>> =
+                shafts.iter().map(|s| s[j].as_ref().and_then(|s| widened(s, j))).collect();
+            let (lo, hi) = boxes
+                .iter()
+                .flatten()
+                .fold((Vec2::INFINITY, Vec2::NEG_INFINITY), |(lo, hi), b| (lo.min(b.0), hi.max(b.1)));
+            let listed: Vec<_> = boxes.iter().map(|b| Some(b.unwrap_or(everywhere))).collect();
+            ShaftGrid::new(lo.max(window.0), hi.min(window.1), side, &listed)
+        })
+        .collect()
+}
+
+/// `grids` as casters.wgsl reads them: every grid's cell starts, one after another and counted
+/// across all of them, one more, then every grid's lists.
+fn flattened(grids: &[ShaftGrid]) -> Vec<u32> {
+    let mut out = Vec::new();
+    let mut before = 0;
+    for g in grids {
+        out.extend(g.starts[..g.starts.len() - 1].iter().map(|s| s + before));
+        before += g.pieces.len() as u32;
+    }
+    out.push(before);
+    for g in grids {
+        out.extend_from_slice(&g.pieces);
+    }
+    out
+}
+
+/// A projection's view in its light space ([`crate::hybrid::shafts::light_coords`]), with a margin of a
+/// hundredth of its size.
+fn window(proj: &shadow_core::light::LightProjection) -> (Vec2, Vec2) {
+    let view_from_clip = proj.clip_from_view.inverse();
+    let (lo, hi) = [(-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0), (1.0, 1.0)].iter().fold(
+        (Vec2::INFINITY, Vec2::NEG_INFINITY),
+        |(lo, hi), &(x, y)| {
+            let v = view_from_clip.project_point3(shadow_core::glam::Vec3::new(x, y, 0.5));
+            let xy = if proj.orthographic { v.truncate() } else { v.truncate() / -v.z };
+            (lo.min(xy), hi.max(xy))
+        },
+    );
+    let margin = (hi - lo) * 0.01;
+    (lo - margin, hi + margin)
+}
+
+/// The compute passes' pipelines and their group-1 layout.
+pub(super) struct CasterPasses {
+    layout: wgpu::BindGroupLayout,
+    setup: wgpu::ComputePipeline,
+    tally: wgpu::ComputePipeline,
+    offsets: wgpu::ComputePipeline,
+    fill: wgpu::ComputePipeline,
+    pieces: wgpu::ComputePipeline,
+    alone: wgpu::ComputePipeline,
+}
+
+/// One build's small pieces on the GPU.
+pub(super) struct CasterPieces {
+    params: wgpu::Buffer,
+    triangles: wgpu::Texture,
+    setups: wgpu::Buffer,
+    setup_texels: wgpu::Texture,
+    runs: wgpu::Buffer,
+    shaft_texels: wgpu::Texture,
+    grid: wgpu::Texture,
+    /// Per instance of the frame, its `world_from_local`, a column a texel.
+    instance_texels: wgpu::Texture,
+    triangle_count: u32,
+    /// Pieces counted by the compute passes.
+    pub(super) pieces: usize,
+}
+
+/// The listed pixels and their counts, for one view size, and the compute passes' work buffer, for up to
+/// so many pieces too.
+pub(super) struct ListedPixels {
+    /// The header (counters) and the pixels.
+    pub(super) listed: wgpu::Buffer,
+    /// Per pixel of the view, the map's class the mask pass found there, or at the listed pixels the
+    /// count the compute passes found.
+    pub(super) counts: wgpu::Buffer,
+    /// Per piece its pixel count, first pair and cursor, the staged pairs' count, per listed pixel a flag,
+    /// then the pairs and the staged pairs (casters.wgsl's `work`).
+    work: wgpu::Buffer,
+    staging: wgpu::Buffer,
+    /// The view's size, and the pieces the work buffer has room for (at least those of the build it was
+    /// made for, rounded up to a power of two, so builds under a moving light reuse it).
+    pub(super) size: (u32, u32),
+    pub(super) capacity: usize,
+    /// The room for pairs asked for (`Hybrid::pair_room`).
+    pub(super) asked: Option<u32>,
+}
+
+/// Words of the work buffer per piece (casters.wgsl's `PIECE`): its pixels, first pair and
+/// cursor, and the screen bounds of its near and of its far caps.
+const PIECE: u64 = 11;
+
+/// Pairs of a listed pixel and a piece the work buffer has room for by default, per pixel of the view:
+/// tree has about 4 per silhouette pixel. A pixel whose pairs do not fit is counted by itself, more slowly.
+const PAIRS_PER_PIXEL: u64 = 8;
+
+impl ListedPixels {
+    /// Buffers for a view of `width x height`, `pieces` pieces and room for `asked` pairs (by default
+    /// [`PAIRS_PER_PIXEL`] per pixel), within the device's limits.
+    pub(super) fn new(cx: &WgpuContext, (width, height): (u32, u32), pieces: usize, asked: Option<u32>) -> Self {
+        use wgpu::BufferUsages as U;
+        let pixels = u64::from(width) * u64::from(height);
+        let buffer = |label, size, usage| {
+            cx.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size,
+                usage,
+                mapped_at_creation: false,
+            })
+        };
+        let capacity = pieces.next_power_of_two();
+        // The pieces' words, the staged pairs' count and the pixels' flags.
+        let fixed = PIECE * capacity as u64 + 1 + pixels;
+        let largest = {
+            let limits = cx.device.limits();
+            limits.max_storage_buffer_binding_size.min(limits.max_buffer_size) / 4
+        };
+        // Each pair's room is three words: its place in a run and, staged, its pixel and piece.
+        let pairs = asked.map_or(PAIRS_PER_PIXEL * pixels, u64::from).min(largest.saturating_sub(fixed) / 3);
+        Self {
+            listed: buffer("hybrid listed pixels", HEADER + 4 * pixels, U::STORAGE | U::COPY_SRC | U::COPY_DST),
+            counts: buffer("hybrid listed counts", 4 * pixels.max(1), U::STORAGE),
+            work: buffer("hybrid caster work", 4 * (fixed + 3 * pairs), U::STORAGE | U::COPY_DST),
+            staging: buffer("hybrid listed readback", HEADER, U::COPY_DST | U::MAP_READ),
+            size: (width, height),
+            capacity,
+            asked,
+        }
+    }
+
+    /// Empties the list (before the mask pass).
+    pub(super) fn clear(&self, enc: &mut wgpu::CommandEncoder) {
+        enc.clear_buffer(&self.listed, 0, Some(HEADER));
+    }
+
+    /// Reads back the pixels listed, the fragments the compute pass's triangles made at them, its stencil
+    /// updates, its pixel-triangle tests and the pixels counted alone.
+    pub(super) fn counters(&self, cx: &WgpuContext) -> Result<[u64; 5], WgpuError> {
+        let mut enc = cx.device.create_command_encoder(&Default::default());
+        enc.copy_buffer_to_buffer(&self.listed, 0, &self.staging, 0, HEADER);
+        cx.queue.submit([enc.finish()]);
+        let d = readback::map_read(cx, &self.staging, "reading the hybrid caster counters")?;
+        let word = |i: usize| u64::from(u32::from_le_bytes([d[4 * i], d[4 * i + 1], d[4 * i + 2], d[4 * i + 3]]));
+        Ok([word(0), word(1), word(2), word(3), word(4)])
+    }
+}
+
+/// A compute-stage binding of group 1.
+fn compute_entry(binding: u32, ty: wgpu::BindingType) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry { binding, visibility: wgpu::ShaderStages::COMPUTE, ty, count: None }
+}
+
+fn storage(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
+    buffer_entry(binding, wgpu::BufferBindingType::Storage { read_only }, wgpu::ShaderStages::COMPUTE)
+}
+
+impl CasterPasses {
+    pub(super) fn new(cx: &WgpuContext) -> Self {
+        let texture = |sample_type| wgpu::BindingType::Texture {
+            sample_type,
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        };
+        let floats = texture(wgpu::TextureSampleType::Float { filterable: false });
+        let layout = cx.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("hybrid casters"),
+            entries: &[
+                compute_entry(0, floats),
+                storage(8, false),
+                storage(9, false),
+                buffer_entry(11, wgpu::BufferBindingType::Uniform, wgpu::ShaderStages::COMPUTE),
+                compute_entry(12, texture(wgpu::TextureSampleType::Uint)),
+                storage(13, false),
+                storage(14, true),
+                compute_entry(15, texture(wgpu::TextureSampleType::Uint)),
+                storage(16, false),
+                compute_entry(17, floats),
+                compute_entry(18, floats),
+                compute_entry(19, floats),
+            ],
+        });
+        let module = shaders::module(&cx.device, "hybrid casters", super::shaders::casters());
+        let pipeline_layout = cx.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("hybrid casters"),
+            bind_group_layouts: &[Some(&cx.shared.frame_layout), Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipeline = |entry: &str| {
+            cx.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(entry),
+                layout: Some(&pipeline_layout),
+                module: &module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        };
+        Self {
+            setup: pipeline("cs_setup"),
+            tally: pipeline("cs_tally"),
+            offsets: pipeline("cs_offsets"),
+            fill: pipeline("cs_fill"),
+            pieces: pipeline("cs_pieces"),
+            alone: pipeline("cs_alone"),
+            layout,
+        }
+    }
+
+    /// Uploads a build's small pieces: their triangles, shafts and grids.
+    pub(super) fn upload(
+        cx: &WgpuContext,
+        frame: &FrameInputs,
+        light: &LightView,
+        split: &Split,
+        shafts: &CasterShafts,
+    ) -> Result<CasterPieces, WgpuError> {
+        let projections = light.projections.len().min(PROJECTIONS);
+        let piece_shafts: Vec<&[Option<Shaft>]> =
+            split.pieces.iter().map(|p| shafts.shafts[p.shaft].as_slice()).collect();
+        // The largest world tolerance of any pixel: the farthest corner of the frame's bounds from the eye.
+        let far = frame.bounds.corners().iter().map(|c| c.distance(frame.camera.eye)).fold(0.0f32, f32::max);
+        let widest = tolerance(far, frame.camera.near);
+        let orthographic: Vec<bool> = light.projections.iter().map(|p| p.orthographic).collect();
+        let windows: Vec<(Vec2, Vec2)> = light.projections[..projections].iter().map(window).collect();
+        let per_projection = grids(&piece_shafts, &windows, widest, &orthographic);
+        let grid = flattened(&per_projection);
+        let mut params = Params::zeroed();
+        let mut first_cell = 0u32;
+        for (j, (proj, g)) in light.projections.iter().zip(&per_projection).enumerate() {
+            params.view_from_world[j] = proj.view_from_world.to_cols_array_2d();
+            params.grid[j] = [g.origin.x, g.origin.y, g.scale.x, g.scale.y];
+            params.cells[j] = [g.side as u32, first_cell, u32::from(proj.orthographic), 0];
+            first_cell += (g.side * g.side) as u32;
+        }
+        let point = match light.light.kind {
+            LightKind::Point { position } => Some(position),
+            _ => None,
+        };
+        params.counts =
+            [u32::from(point.is_some()), projections as u32, split.pieces.len() as u32, split.triangle_count()];
+        params.light = point.unwrap_or_default().extend(frame.camera.near).to_array();
+        params.lists = [first_cell + 1, 0, 0, 0];
+        let runs: Vec<PieceRun> = split
+            .pieces
+            .iter()
+            .map(|piece| {
+                let (run, sides) = (&piece.triangles, piece.sides);
+                let caps = (run.end - run.start - sides) / 2;
+                PieceRun { first: run.start, sides, caps, quads: u32::from(piece.quads) }
+            })
+            .collect();
+        // Per piece, per projection: lo, hi, (near, 1 where bounded).
+        let shaft_texels: Vec<[f32; 4]> = split
+            .pieces
+            .iter()
+            .flat_map(|piece| {
+                shafts.shafts[piece.shaft][..projections].iter().flat_map(|s| match s {
+                    Some(s) => [s.lo.to_array(), s.hi.to_array(), [s.near, 1.0, 0.0, 0.0]],
+                    None => [[0.0; 4]; 3],
+                })
+            })
+            .collect();
+        let init = |label, contents: &[u8], usage| {
+            cx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
+        };
+        use wgpu::BufferUsages as U;
+        use wgpu::TextureFormat as F;
+        // A build with no small piece still binds its buffers: at least one element each.
+        let nonempty = |bytes: &[u8]| {
+            let mut v = bytes.to_vec();
+            v.resize(v.len().max(std::mem::size_of::<PieceRun>()), 0);
+            v
+        };
+        let shaft_bytes: &[u8] = bytemuck::cast_slice(&shaft_texels);
+        let instance_columns: Vec<[[f32; 4]; 4]> =
+            frame.instances.iter().map(|i| i.world_from_local.to_cols_array_2d()).collect();
+        let setup_texels =
+            table(cx, "hybrid caster setups", F::Rgba32Float, u64::from(split.triangle_count()) * SETUP, None)?;
+        Ok(CasterPieces {
+            params: init("hybrid caster params", bytemuck::bytes_of(&params), U::UNIFORM),
+            triangles: table(
+                cx,
+                "hybrid caster triangles",
+                F::Rgba32Uint,
+                split.triangles.len() as u64,
+                Some(bytemuck::cast_slice(&split.triangles)),
+            )?,
+            setups: cx.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("hybrid caster setups"),
+                size: u64::from(setup_texels.height()) * u64::from(TABLE_ROW) * 16,
+                usage: U::STORAGE | U::COPY_SRC,
+                mapped_at_creation: false,
+            }),
+            setup_texels,
+            runs: init("hybrid caster runs", &nonempty(bytemuck::cast_slice(&runs)), U::STORAGE),
+            shaft_texels: table(
+                cx,
+                "hybrid caster shafts",
+                F::Rgba32Float,
+                shaft_texels.len() as u64,
+                Some(shaft_bytes),
+            )?,
+            grid: table(cx, "hybrid caster grid", F::R32Uint, grid.len() as u64, Some(bytemuck::cast_slice(&grid)))?,
+            instance_texels: table(
+                cx,
+                "hybrid caster instances",
+                F::Rgba32Float,
+                4 * frame.instances.len() as u64,
+                Some(bytemuck::cast_slice(&instance_columns)),
+            )?,
+            triangle_count: split.triangle_count(),
+            pieces: split.pieces.len(),
+        })
+    }
+
+    /// Records the compute passes (casters.wgsl): set up the triangles for `g`'s view, pair each
+    /// listed pixel with its pieces, count each piece at its pixels.
+    pub(super) fn record(
+        &self,
+        cx: &WgpuContext,
+        enc: &mut wgpu::CommandEncoder,
+        pieces: &CasterPieces,
+        listed: &ListedPixels,
+        g: &GpuGBuffer,
+    ) {
+        fn buffer(binding: u32, b: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
+            wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() }
+        }
+        let (triangles, setups, shafts, grid, instances) = (
+            pieces.triangles.create_view(&Default::default()),
+            pieces.setup_texels.create_view(&Default::default()),
+            pieces.shaft_texels.create_view(&Default::default()),
+            pieces.grid.create_view(&Default::default()),
+            pieces.instance_texels.create_view(&Default::default()),
+        );
+        let view = |binding, v| wgpu::BindGroupEntry { binding, resource: wgpu::BindingResource::TextureView(v) };
+        let group = cx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("hybrid casters"),
+            layout: &self.layout,
+            entries: &[
+                view(0, &g.position),
+                buffer(8, &listed.listed),
+                buffer(9, &listed.counts),
+                buffer(11, &pieces.params),
+                view(12, &triangles),
+                buffer(13, &pieces.setups),
+                buffer(14, &pieces.runs),
+                view(15, &grid),
+                buffer(16, &listed.work),
+                view(17, &setups),
+                view(18, &shafts),
+                view(19, &instances),
+            ],
+        });
+        // The pieces' words and the staged pairs' count.
+        enc.clear_buffer(&listed.work, 0, Some(4 * (PIECE * pieces.pieces as u64 + 1)));
+        let begin = |enc: &mut wgpu::CommandEncoder| {
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("hybrid casters"),
+                timestamp_writes: None,
+            });
+            pass.set_bind_group(0, &g.frame_group, &[]);
+            pass.set_bind_group(1, &group, &[]);
+            pass.forget_lifetime()
+        };
+        let spread = |pass: &mut wgpu::ComputePass<'_>, pipeline, groups: u32| {
+            pass.set_pipeline(pipeline);
+            pass.dispatch_workgroups(groups.clamp(1, MAX_GROUPS), groups.div_ceil(MAX_GROUPS).max(1), 1);
+        };
+        if pieces.triangle_count > 0 {
+            let mut pass = begin(enc);
+            spread(&mut pass, &self.setup, pieces.triangle_count.div_ceil(GROUP));
+            drop(pass);
+            let size = pieces.setup_texels.size();
+            enc.copy_buffer_to_texture(
+                wgpu::TexelCopyBufferInfo {
+                    buffer: &pieces.setups,
+                    layout: wgpu::TexelCopyBufferLayout {
+                        offset: 0,
+                        bytes_per_row: Some(TABLE_ROW * 16),
+                        rows_per_image: None,
+                    },
+                },
+                pieces.setup_texels.as_image_copy(),
+                size,
+            );
+        }
+        let mut pass = begin(enc);
+        // The passes over the listed pixels, whose number only the GPU knows, are sized by the view.
+        let (w, h) = listed.size;
+        let over_pixels = (w * h).div_ceil(GROUP * PIXELS_PER_INVOCATION);
+        spread(&mut pass, &self.tally, over_pixels);
+        spread(&mut pass, &self.offsets, 1);
+        spread(&mut pass, &self.fill, over_pixels);
+        spread(&mut pass, &self.pieces, pieces.pieces as u32);
+        spread(&mut pass, &self.alone, ALONE_GROUPS);
+    }
+}
+
+#[cfg(test)]
+mod tests;

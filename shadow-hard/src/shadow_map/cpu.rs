@@ -1,0 +1,60 @@
+//! `shadow-map` on the CPU (twin: [`super::gpu`]): depth from the light, rendered with Vulkan's depth bias,
+//! compared at each receiver through the map filter (`passes::maps`).
+
+use shadow_core::light::LightView;
+use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
+use shadow_core::{FrameInputs, Image};
+use shadow_cpu::passes::maps::{depth_views, query_maps, render_depth_maps};
+use shadow_cpu::{CpuBackend, CpuContext, CpuError, GBuffer};
+
+use super::ShadowMap;
+
+/// The maps of the last build, one per light projection.
+#[derive(Default)]
+pub struct State {
+    maps: Vec<Image<f32>>,
+}
+
+impl ShadowTechnique<CpuBackend> for ShadowMap {
+    type State = State;
+
+    fn name(&self) -> &'static str {
+        Self::NAME
+    }
+
+    fn create_state(&self, _: &mut CpuContext) -> Result<State, CpuError> {
+        Ok(State::default())
+    }
+
+    fn build(
+        &self,
+        _: &mut CpuContext,
+        state: &mut State,
+        frame: &FrameInputs,
+        light: &LightView,
+        _: &mut FrameStats,
+    ) -> Result<(), CpuError> {
+        render_depth_maps(frame, light, self.map.resolution, self.map.depth_bias(), &mut state.maps)
+    }
+
+    fn query(
+        &self,
+        _: &mut CpuContext,
+        state: &mut State,
+        _: &FrameInputs,
+        light: &LightView,
+        g: &GBuffer,
+        out: &mut Image<f32>,
+        _: &mut FrameStats,
+    ) -> Result<(), CpuError> {
+        if state.maps.len() != light.projections.len() {
+            return Err(TechniqueError::NotBuilt(Self::NAME.into()).into());
+        }
+        query_maps(&state.maps, light, g, out, self.filter, self.filter_radius, self.map.receiver_offset());
+        Ok(())
+    }
+
+    fn debug_views(&self, _: &mut CpuContext, state: &State) -> Result<Vec<DebugView>, CpuError> {
+        Ok(depth_views("depth", &state.maps))
+    }
+}

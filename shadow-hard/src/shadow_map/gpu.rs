@@ -1,0 +1,61 @@
+//! `shadow-map` on the GPU (twin: [`super::cpu`]): the light pass of `passes::maps` renders depth with the
+//! pipeline's depth bias into one layer per projection; the query runs `shadow_lookup` of shadow_map.wgsl
+//! over the G-buffer, with the hardware comparison sampler for bilinear taps.
+
+use shadow_core::FrameInputs;
+use shadow_core::light::LightView;
+use shadow_core::technique::{FrameStats, ShadowTechnique, TechniqueError};
+use shadow_wgpu::passes::maps::{DepthMaps, LookupParams, MapQuery, QueryExtras};
+use shadow_wgpu::{GpuGBuffer, GpuVisibility, WgpuBackend, WgpuContext, WgpuError, shaders};
+
+use super::ShadowMap;
+
+/// The light pass with the maps of the last build, and the query pipeline.
+pub struct State {
+    maps: DepthMaps,
+    query: MapQuery,
+}
+
+impl ShadowTechnique<WgpuBackend> for ShadowMap {
+    type State = State;
+
+    fn name(&self) -> &'static str {
+        Self::NAME
+    }
+
+    fn create_state(&self, cx: &mut WgpuContext) -> Result<State, WgpuError> {
+        cx.scoped("creating the shadow-map pipelines", |cx| {
+            let module = shaders::module(&cx.device, "shadow_map", shaders::shadow_map());
+            State {
+                maps: DepthMaps::with_module(cx, &module, &self.map),
+                query: MapQuery::new(cx, &module, self.filter),
+            }
+        })
+    }
+
+    fn build(
+        &self,
+        cx: &mut WgpuContext,
+        state: &mut State,
+        frame: &FrameInputs,
+        light: &LightView,
+        _: &mut FrameStats,
+    ) -> Result<(), WgpuError> {
+        state.maps.render(cx, frame, light, self.map.resolution)
+    }
+
+    fn query(
+        &self,
+        cx: &mut WgpuContext,
+        state: &mut State,
+        _: &FrameInputs,
+        light: &LightView,
+        g: &GpuGBuffer,
+        out: &mut GpuVisibility,
+        _: &mut FrameStats,
+    ) -> Result<(), WgpuError> {
+        let maps = state.maps.maps().ok_or_else(|| TechniqueError::NotBuilt(Self::NAME.into()))?;
+        let lookup = LookupParams { radius: self.filter_radius, receiver_offset: self.map.receiver_offset() };
+        state.query.run(cx, maps, light, g, out, lookup, &QueryExtras::NONE)
+    }
+}

@@ -1,0 +1,410 @@
+//! Light depth maps on the GPU (twin: shadow-cpu's `passes::maps`): the light pass renders depth with the
+//! pipeline's depth bias into one layer per projection; a map query runs `shadow_lookup` of
+//! shadow_map.wgsl over the G-buffer, with the hardware comparison sampler for bilinear taps. Techniques
+//! that look into the maps their own way add a fragment entry and bindings from 4 on ([`MapQuery::with_entry`]).
+
+use bytemuck::{Pod, Zeroable};
+use shadow_core::FrameInputs;
+use shadow_core::light::LightView;
+use shadow_core::scene::LightKind;
+use shadow_core::technique::maps::DepthMap;
+use shadow_core::technique::settings::{BiasMode, Filter};
+use wgpu::util::DeviceExt;
+
+use crate::context::{WgpuContext, WgpuError};
+use crate::frame::{GpuVisibility, layer_view, layered};
+use crate::gbuffer::{GpuGBuffer, check_size, draw_instances};
+use crate::pipelines::{
+    FragmentEntry, MAP_DEPTH, POSITION_LAYOUT, VISIBILITY, ViewRaw, attribute_entry, buffer_entry, depth_array_entry,
+    full_screen_pipeline,
+};
+use crate::shaders;
+
+/// GPU twin of `MapParams` in shadow_map.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct MapParams {
+    proj: [[[f32; 4]; 4]; 6],
+    light: [f32; 4],
+    direction: [f32; 4],
+    settings: [f32; 4],
+    planes: [[[f32; 4]; 4]; 6],
+    extra: [f32; 4],
+}
+
+/// The bindings every map lookup shares (group 1, bindings 0 to 3: G-buffer positions, the maps, the
+/// comparison sampler, `MapParams`), with a technique's own from 4 on.
+pub struct MapBindings {
+    layout: wgpu::BindGroupLayout,
+    sampler: wgpu::Sampler,
+}
+
+/// What a map query adds to the shared bindings (0 to 3): settings and resources.
+pub struct QueryExtras<'a> {
+    /// Technique-specific settings (`MapParams.extra`).
+    pub settings: [f32; 4],
+    /// Bindings from 4 on.
+    pub entries: &'a [wgpu::BindGroupEntry<'a>],
+}
+
+impl QueryExtras<'_> {
+    /// None: the plain shadow-map query.
+    pub const NONE: QueryExtras<'static> = QueryExtras { settings: [0.0; 4], entries: &[] };
+}
+
+/// How a map lookup reads the maps: the filter's kernel radius in texels and the receiver offset
+/// towards the light (`bias=world`).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct LookupParams {
+    /// Kernel radius in texels (jittered and Poisson filters).
+    pub radius: f32,
+    /// World distance a receiver moves towards the light before the lookup.
+    pub receiver_offset: f32,
+}
+
+impl MapBindings {
+    /// The layout: the shared bindings 0 to 3 and `extra` from 4 on.
+    #[must_use]
+    pub fn new(cx: &WgpuContext, extra: &[wgpu::BindGroupLayoutEntry]) -> Self {
+        let mut entries = vec![
+            attribute_entry(0),
+            depth_array_entry(1),
+            wgpu::BindGroupLayoutEntry {
+                binding: 2,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
+                count: None,
+            },
+            buffer_entry(3, wgpu::BufferBindingType::Uniform, wgpu::ShaderStages::FRAGMENT),
+        ];
+        entries.extend_from_slice(extra);
+        let layout = cx
+            .device
+            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("map query"), entries: &entries });
+        let sampler = cx.device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("shadow comparison"),
+            address_mode_u: wgpu::AddressMode::ClampToEdge,
+            address_mode_v: wgpu::AddressMode::ClampToEdge,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            compare: Some(wgpu::CompareFunction::LessEqual),
+            ..Default::default()
+        });
+        Self { layout, sampler }
+    }
+
+    /// The group-1 layout, for pipelines that look into the maps.
+    #[must_use]
+    pub fn layout(&self) -> &wgpu::BindGroupLayout {
+        &self.layout
+    }
+
+    /// The group for looking into `maps` (one layer per projection of `light`) from the receivers of `g`.
+    #[must_use]
+    pub fn group(
+        &self,
+        cx: &WgpuContext,
+        maps: &wgpu::Texture,
+        light: &LightView,
+        g: &GpuGBuffer,
+        lookup: LookupParams,
+        extras: &QueryExtras<'_>,
+    ) -> wgpu::BindGroup {
+        let (mut proj, mut planes) = ([[[0.0f32; 4]; 4]; 6], [[[0.0f32; 4]; 4]; 6]);
+        for ((slot, plane), p) in proj.iter_mut().zip(&mut planes).zip(&light.projections) {
+            *slot = p.clip_from_world.to_cols_array_2d();
+            *plane = p.clip_plane_from_world_plane.to_cols_array_2d();
+        }
+        let (pos, dir, kind) = match light.light.kind {
+            LightKind::Spot { position, direction, .. } => (position, direction, 0.0),
+            LightKind::Directional { direction } => (glam::Vec3::ZERO, direction, 1.0),
+            LightKind::Point { position } => (position, glam::Vec3::NEG_Y, 2.0),
+        };
+        let params = MapParams {
+            proj,
+            light: pos.extend(kind).to_array(),
+            direction: dir.normalize().extend(0.0).to_array(),
+            settings: [0.0, lookup.radius, maps.width() as f32, lookup.receiver_offset],
+            planes,
+            extra: extras.settings,
+        };
+        let ubuf = cx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("map params"),
+            contents: bytemuck::bytes_of(&params),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let maps_view = maps.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        });
+        let mut entries = vec![
+            wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&g.position) },
+            wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&maps_view) },
+            wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&self.sampler) },
+            wgpu::BindGroupEntry { binding: 3, resource: ubuf.as_entire_binding() },
+        ];
+        entries.extend_from_slice(extras.entries);
+        cx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("map query"),
+            layout: &self.layout,
+            entries: &entries,
+        })
+    }
+}
+
+/// The lookup every map-based technique shares (twin: `query_maps` in shadow-cpu): a full-screen pass
+/// running `shadow_lookup` of shadow_map.wgsl over the G-buffer.
+pub struct MapQuery {
+    pipeline: wgpu::RenderPipeline,
+    bindings: MapBindings,
+}
+
+impl MapQuery {
+    /// Creates the query pipeline from the shadow-map module, specialized for `filter`.
+    #[must_use]
+    pub fn new(cx: &WgpuContext, module: &wgpu::ShaderModule, filter: Filter) -> Self {
+        let constants = [("FILTER", filter_code(filter))];
+        Self::with_entry(cx, module, FragmentEntry { name: "fs_shadow_map_query", constants: &constants }, &[])
+    }
+
+    /// A query pipeline running `entry` of `module` (the shadow-map shader with more after it), with the
+    /// shared bindings 0 to 3 and `extra` from 4 on.
+    #[must_use]
+    pub fn with_entry(
+        cx: &WgpuContext,
+        module: &wgpu::ShaderModule,
+        entry: FragmentEntry<'_>,
+        extra: &[wgpu::BindGroupLayoutEntry],
+    ) -> Self {
+        let bindings = MapBindings::new(cx, extra);
+        let pipeline = full_screen_pipeline(
+            &cx.device,
+            "map query",
+            module,
+            entry,
+            &[&cx.shared.frame_layout, bindings.layout()],
+            Some(VISIBILITY),
+            None,
+        );
+        Self { pipeline, bindings }
+    }
+
+    /// Writes the visibility of every receiver through the maps (one layer per light projection).
+    ///
+    /// # Errors
+    /// A GPU failure.
+    #[allow(clippy::too_many_arguments)]
+    pub fn run(
+        &self,
+        cx: &WgpuContext,
+        maps: &wgpu::Texture,
+        light: &LightView,
+        g: &GpuGBuffer,
+        out: &GpuVisibility,
+        lookup: LookupParams,
+        extras: &QueryExtras<'_>,
+    ) -> Result<(), WgpuError> {
+        cx.scoped("the shadow-map query", |cx| {
+            let group = self.bindings.group(cx, maps, light, g, lookup, extras);
+            super::full_screen(cx, "map query", &out.view, &self.pipeline, &[&g.frame_group, &group], None);
+        })
+    }
+}
+
+/// The depth-bias state of a shadow-map's light pass. wgpu takes the constant factor as an integer (in
+/// units of the format's resolution, as Vulkan does), so it is rounded.
+#[must_use]
+pub fn depth_bias(s: &DepthMap) -> wgpu::DepthBiasState {
+    match s.bias {
+        BiasMode::None | BiasMode::World => wgpu::DepthBiasState::default(),
+        BiasMode::Constant => {
+            wgpu::DepthBiasState { constant: s.bias_constant.round() as i32, slope_scale: 0.0, clamp: 0.0 }
+        }
+        BiasMode::Slope => {
+            wgpu::DepthBiasState { constant: s.bias_constant.round() as i32, slope_scale: s.bias_slope, clamp: 0.0 }
+        }
+    }
+}
+
+/// The light pass: casters' depth, both faces, with `bias`.
+#[must_use]
+pub fn light_pass_pipeline(
+    cx: &WgpuContext,
+    module: &wgpu::ShaderModule,
+    bias: wgpu::DepthBiasState,
+) -> wgpu::RenderPipeline {
+    light_pipeline(cx, module, bias, false)
+}
+
+/// The light pass with an object-ID target ([`ID_FORMAT`]): 1 + the instance index of the caster a texel
+/// shows (McCool's ID channel).
+#[must_use]
+pub fn light_id_pipeline(
+    cx: &WgpuContext,
+    module: &wgpu::ShaderModule,
+    bias: wgpu::DepthBiasState,
+) -> wgpu::RenderPipeline {
+    light_pipeline(cx, module, bias, true)
+}
+
+/// The format of the light pass's ID target.
+pub const ID_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
+
+fn light_pipeline(
+    cx: &WgpuContext,
+    module: &wgpu::ShaderModule,
+    bias: wgpu::DepthBiasState,
+    ids: bool,
+) -> wgpu::RenderPipeline {
+    let layout = cx.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("light pass"),
+        bind_group_layouts: &[Some(&cx.shared.frame_layout)],
+        immediate_size: 0,
+    });
+    let id_target = [Some(wgpu::ColorTargetState::from(ID_FORMAT))];
+    cx.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(if ids { "light pass with IDs" } else { "light pass" }),
+        layout: Some(&layout),
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some(if ids { "vs_light_id" } else { "vs_light_depth" }),
+            compilation_options: Default::default(),
+            buffers: &[Some(POSITION_LAYOUT)],
+        },
+        primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: MAP_DEPTH,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::Less),
+            stencil: Default::default(),
+            bias,
+        }),
+        multisample: Default::default(),
+        fragment: ids.then(|| wgpu::FragmentState {
+            module,
+            entry_point: Some("fs_light_id"),
+            compilation_options: Default::default(),
+            targets: &id_target,
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
+/// Renders the casters' depth from every projection of `light` into the layers of `maps` (meshes and
+/// `instances` already uploaded), and their IDs into the layers of `ids` when given (with a pipeline from
+/// [`light_id_pipeline`]).
+pub fn render_maps(
+    cx: &WgpuContext,
+    pipeline: &wgpu::RenderPipeline,
+    frame: &FrameInputs,
+    light: &LightView,
+    maps: &wgpu::Texture,
+    ids: Option<&wgpu::Texture>,
+    instances: &wgpu::Buffer,
+) {
+    let res = maps.width();
+    let mut enc = cx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("light pass") });
+    for (k, p) in light.projections.iter().enumerate() {
+        let group =
+            cx.shared.frame_group(&cx.device, &ViewRaw::new(p.clip_from_world, glam::Vec3::ZERO, res, res), instances);
+        let view = layer_view(maps, k as u32);
+        let id_view = ids.map(|t| layer_view(t, k as u32));
+        let id_attachment = id_view.as_ref().map(|view| wgpu::RenderPassColorAttachment {
+            view,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT), store: wgpu::StoreOp::Store },
+        });
+        let colour = [id_attachment];
+        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("light pass"),
+            color_attachments: if ids.is_some() { &colour } else { &[] },
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &view,
+                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, &group, &[]);
+        draw_instances(cx, &mut pass, frame, |i| i.casts_shadow, false);
+    }
+    cx.queue.submit([enc.finish()]);
+}
+
+/// A depth array of `layers` square maps.
+#[must_use]
+pub fn map_texture(cx: &WgpuContext, res: u32, layers: u32) -> wgpu::Texture {
+    layered(cx, "shadow maps", res, res, layers, MAP_DEPTH)
+}
+
+/// The value of the shader's `FILTER` constant.
+fn filter_code(f: Filter) -> f64 {
+    match f {
+        Filter::None => 0.0,
+        Filter::Bilinear => 1.0,
+        Filter::Pcf3x3 => 2.0,
+        Filter::Pcf4x4Jitter => 3.0,
+        Filter::Poisson16 => 4.0,
+    }
+}
+
+/// The light pass and the maps it last rendered: what every technique built on a depth map renders in its
+/// build (twin: shadow-cpu's `passes::maps::render_depth_maps`).
+pub struct DepthMaps {
+    pipeline: wgpu::RenderPipeline,
+    maps: Option<wgpu::Texture>,
+}
+
+impl DepthMaps {
+    /// The light pass for `map`'s bias, from the shadow-map shader.
+    #[must_use]
+    pub fn new(cx: &WgpuContext, map: &DepthMap) -> Self {
+        let module = shaders::module(&cx.device, "shadow_map", shaders::shadow_map());
+        Self::with_module(cx, &module, map)
+    }
+
+    /// [`DepthMaps::new`] from a module already holding the shadow-map shader.
+    #[must_use]
+    pub fn with_module(cx: &WgpuContext, module: &wgpu::ShaderModule, map: &DepthMap) -> Self {
+        Self { pipeline: light_pass_pipeline(cx, module, depth_bias(map)), maps: None }
+    }
+
+    /// Renders the casters' depth from every projection of `light` into one layer each of a
+    /// `resolution`-square depth array, reusing last frame's array when it fits.
+    ///
+    /// # Errors
+    /// A map larger than the device allows, or a GPU failure.
+    pub fn render(
+        &mut self,
+        cx: &mut WgpuContext,
+        frame: &FrameInputs,
+        light: &LightView,
+        resolution: u32,
+    ) -> Result<(), WgpuError> {
+        let layers = light.projections.len() as u32;
+        check_size(cx, "shadow map", resolution, resolution)?;
+        let maps = match &self.maps {
+            Some(m) if m.width() == resolution && m.depth_or_array_layers() == layers => m.clone(),
+            _ => {
+                let m = cx.scoped("allocating shadow maps", |cx| map_texture(cx, resolution, layers))?;
+                self.maps.insert(m).clone()
+            }
+        };
+        cx.cache.upload_meshes(&cx.device, frame);
+        let instances = cx.cache.instances(&cx.device, frame).clone();
+        cx.scoped("the shadow-map light pass", |cx| {
+            render_maps(cx, &self.pipeline, frame, light, &maps, None, &instances)
+        })
+    }
+
+    /// The maps of the last render, one layer per light projection.
+    #[must_use]
+    pub fn maps(&self) -> Option<&wgpu::Texture> {
+        self.maps.as_ref()
+    }
+}
