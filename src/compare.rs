@@ -104,9 +104,14 @@ pub struct CompareReport {
 #[must_use]
 pub fn reference_for(registry: &crate::TechniqueRegistry, techniques: &[TechniqueSpec]) -> TechniqueSpec {
     let soft = |t: &TechniqueSpec| registry.get(&t.name).is_ok_and(|e| e.soft);
-    let name =
-        if !techniques.is_empty() && techniques.iter().all(soft) { "area-light-reference" } else { "ray-traced" };
-    TechniqueSpec::named(name)
+    reference_of(registry, !techniques.is_empty() && techniques.iter().all(soft))
+}
+
+/// The registry's reference for soft techniques, or for hard ones.
+fn reference_of(registry: &crate::TechniqueRegistry, soft: bool) -> TechniqueSpec {
+    let found = registry.entries().iter().find(|e| e.reference && e.soft == soft);
+    let builtin = if soft { shadow_soft::AreaLightReference::NAME } else { shadow_hard::RayTraced::NAME };
+    TechniqueSpec::named(found.map_or(builtin, |e| e.name))
 }
 
 /// The references of a run: [`reference_for`], and for a mix of hard and soft techniques
@@ -119,7 +124,7 @@ pub fn references_for(
     let soft = |t: &TechniqueSpec| registry.get(&t.name).is_ok_and(|e| e.soft);
     let primary = reference_for(registry, techniques);
     let mixed = techniques.iter().any(soft) && !techniques.iter().all(soft);
-    (primary, mixed.then(|| TechniqueSpec::named("area-light-reference")))
+    (primary, mixed.then(|| reference_of(registry, true)))
 }
 
 /// Report keys of a frame's timings.

@@ -10,6 +10,7 @@ mod error;
 pub mod plot;
 pub mod registry;
 pub mod renderer;
+pub mod results;
 pub mod setup;
 pub mod sheet;
 

@@ -14,7 +14,7 @@ use shadow_core::inspect::Inspection;
 use shadow_core::scenes::{self, SceneParams};
 use shadow_core::technique::TechniqueSpec;
 use shadowlab::compare::{CompareJob, run_compare};
-use shadowlab::setup::{SceneSetup, parse_size};
+use shadowlab::setup::{OptionError, SceneSetup, parse_size};
 use shadowlab::{BackendChoice, Error, Renderer, TechniqueRegistry};
 
 /// Writes a line to standard output. A closed pipe (`shadowlab techniques | head -1`) ends the program
@@ -236,6 +236,28 @@ enum Command {
         #[arg(long)]
         out_dir: Option<PathBuf>,
     },
+    /// Measure every technique on every built-in scene (errors on both backends, frame times on one
+    /// scene) and write the results page.
+    Results {
+        /// The markdown file to write.
+        #[arg(long, short, default_value = "docs/results.md")]
+        out: PathBuf,
+        /// View size of the error measurements, WxH.
+        #[arg(long, default_value = "512x512")]
+        size: String,
+        /// Backend: both (the default; needs a GPU adapter, lavapipe will do) or cpu.
+        #[arg(long, default_value = "both")]
+        backend: String,
+        /// The scene timed.
+        #[arg(long, default_value = "cubes")]
+        bench_scene: String,
+        /// View size of the timing, WxH.
+        #[arg(long, default_value = "1024x768")]
+        bench_size: String,
+        /// Frames timed.
+        #[arg(long, default_value_t = 10)]
+        bench_frames: u32,
+    },
     /// Write a scene (built-in or loaded) as .glb with its camera and lights.
     Export {
         #[command(flatten)]
@@ -342,7 +364,45 @@ fn run(cli: Cli) -> Result<(), Error> {
             bench(&scene, &view, BenchArgs { technique, techniques, backend, frames, warmup, json, sweep, out_dir })
         }
         Command::Export { scene, out } => export(&scene, &out),
+        Command::Results { out, size, backend, bench_scene, bench_size, bench_frames } => {
+            results(&out, &size, &backend, bench_scene, &bench_size, bench_frames)
+        }
     }
+}
+
+fn results(
+    out: &Path,
+    size: &str,
+    backend: &str,
+    bench_scene: String,
+    bench_size: &str,
+    bench_frames: u32,
+) -> Result<(), Error> {
+    use shadowlab::results::{ResultsJob, run_results};
+    if bench_frames == 0 {
+        return Err(Error::Usage("--bench-frames must be at least 1".into()));
+    }
+    if !scenes::ALL.iter().any(|s| s.name == bench_scene) {
+        return Err(Error::Usage(format!("--bench-scene '{bench_scene}': not a built-in scene")));
+    }
+    let size = parse_size(size).map_err(|e| Error::Usage(e.to_string()))?;
+    let bench_size =
+        parse_size(bench_size).map_err(|e| Error::Usage(OptionError { flag: "--bench-size", ..e }.to_string()))?;
+    let mut renderer = Renderer::new(TechniqueRegistry::builtin());
+    let kinds = backends(&mut renderer, backend)?;
+    let command = std::env::args().skip(1).collect::<Vec<_>>().join(" ");
+    let job = ResultsJob {
+        command: format!("shadowlab {command}"),
+        size,
+        backends: kinds,
+        bench_scene,
+        bench_size,
+        bench_frames,
+    };
+    let text = run_results(&mut renderer, &job, |m| eprintln!("{m}"))?;
+    std::fs::write(out, text).map_err(|e| Error::Write { path: out.to_path_buf(), why: e.to_string() })?;
+    eprintln!("wrote {}", out.display());
+    Ok(())
 }
 
 fn print_json(v: &serde_json::Value) -> Result<(), Error> {
@@ -390,13 +450,20 @@ fn list_techniques(json: bool) -> Result<(), Error> {
             .iter()
             .map(|e| {
                 let keys: Vec<_> = (e.keys)().iter().map(|k| json!({"key": k.key, "default": k.default, "help": k.help})).collect();
-                json!({"name": e.name, "description": e.description, "paper": e.paper, "reference": e.reference, "settings": keys, "backends": backends(e)})
+                json!({"name": e.name, "description": e.description, "paper": e.paper, "reference": e.reference, "lights": e.lights.names(), "settings": keys, "backends": backends(e)})
             })
             .collect();
         return print_json(&json!(v));
     }
     for e in reg.entries() {
-        out!("{}  [{}]\n  {}\n  paper: {}", e.name, backends(e).join(", "), e.description, e.paper);
+        out!(
+            "{}  [{}]\n  {}\n  paper: {}\n  lights: {}",
+            e.name,
+            backends(e).join(", "),
+            e.description,
+            e.paper,
+            e.lights.names().join(", ")
+        );
         for k in (e.keys)() {
             out!("    {}={:<10} {}", k.key, k.default, k.help);
         }
@@ -505,7 +572,8 @@ fn compare(
 ) -> Result<(), Error> {
     view.check_adapter(backend)?;
     let mut renderer = Renderer::new(TechniqueRegistry::builtin()).with_adapter(view.adapter.clone());
-    let specs = technique_specs(&renderer, &technique, techniques.as_deref())?;
+    let (frame, w, h) = args.frame(view)?;
+    let specs = technique_specs(&renderer, &technique, techniques.as_deref(), &frame)?;
     let (reference, soft_reference) = match reference {
         Some(text) => {
             let spec = TechniqueSpec::parse(text)?;
@@ -518,7 +586,6 @@ fn compare(
         None => shadowlab::compare::references_for(renderer.registry(), &specs),
     };
     check_availability(&renderer, &specs, backend)?;
-    let (frame, w, h) = args.frame(view)?;
     let kinds = backends(&mut renderer, backend)?;
     let out = out_dir.unwrap_or_else(|| PathBuf::from(format!("out/compare-{}", args.name())));
     let job = CompareJob {
@@ -574,21 +641,21 @@ fn compare(
     Ok(())
 }
 
-/// The technique specs of --technique and --techniques (every non-reference technique when neither).
+/// The technique specs of --technique and --techniques (every non-reference technique when neither; of
+/// those, the ones that take every light of `frame`, the others named on stderr).
 fn technique_specs(
     renderer: &Renderer,
     technique: &[String],
     techniques: Option<&str>,
+    frame: &FrameInputs,
 ) -> Result<Vec<TechniqueSpec>, Error> {
     let mut specs: Vec<TechniqueSpec> = technique.iter().map(|t| TechniqueSpec::parse(t)).collect::<Result<_, _>>()?;
     let all = || {
-        renderer
-            .registry()
-            .entries()
-            .iter()
-            .filter(|e| !e.reference)
-            .map(|e| TechniqueSpec::named(e.name))
-            .collect::<Vec<_>>()
+        let (taken, left) = renderer.registry().measurable(frame);
+        if !left.is_empty() {
+            eprintln!("left out, as they or their reference take no light of this scene's kinds: {}", left.join(", "));
+        }
+        taken
     };
     match techniques {
         Some("all") => specs.extend(all()),
@@ -658,10 +725,10 @@ fn bench(args: &SceneArgs, view: &ViewArgs, b: BenchArgs) -> Result<(), Error> {
     let sweep = b.sweep.as_deref().map(parse_sweep).transpose()?;
     view.check_adapter(&b.backend)?;
     let mut renderer = Renderer::new(TechniqueRegistry::builtin()).with_adapter(view.adapter.clone());
-    let specs = technique_specs(&renderer, &b.technique, b.techniques.as_deref())?;
-    check_availability(&renderer, &specs, &b.backend)?;
     // The scene and its view are checked before the backend says which it is.
     let first = args.frame(view)?;
+    let specs = technique_specs(&renderer, &b.technique, b.techniques.as_deref(), &first.0)?;
+    check_availability(&renderer, &specs, &b.backend)?;
     // A triangle sweep's scenes are built up front too: a count too large is refused before anything runs.
     let mut sweep_scenes = Vec::new();
     if let Some(("tris", values)) = &sweep {

@@ -1,81 +1,16 @@
-//! The technique registry: name -> description, paper, settings keys with defaults, and a constructor per
-//! backend. Built-in, shadow-soft and user techniques register the same way; the CLI, the reports and the
-//! conformance tests enumerate it, so a new technique gets all of them for free.
+//! The technique registry: name -> description, paper, lights, settings keys with defaults, and a
+//! constructor per backend. Built-in, shadow-soft and user techniques register the same way (each
+//! technique's folder makes its own entry); the CLI, the reports and the conformance tests enumerate it, so
+//! a new technique gets all of them for free.
 
-use shadow_core::technique::settings::{SettingKey, SettingsError, TechniqueSettings, TechniqueSpec};
-use shadow_core::technique::{DynShadowTechnique, ShadowTechnique, Stateful};
+use shadow_core::FrameInputs;
+use shadow_core::technique::DynShadowTechnique;
+use shadow_core::technique::settings::{SettingsError, TechniqueSpec};
 use shadow_cpu::CpuBackend;
-use shadow_hard::{
-    DepthLayers, DualShadowMap, Hybrid, MidpointShadowMap, RayTraced, SecondDepthShadowMap, ShadowMap, ShadowVolume,
-    SilhouetteMap, VolumeReconstruction,
-};
-use shadow_soft::{AreaLightReference, Pcss, PenumbraMap, Smoothies};
 use shadow_wgpu::WgpuBackend;
 
-/// Builds a technique for the CPU backend from a spec.
-pub type CpuConstructor = fn(&TechniqueSpec) -> Result<Box<dyn DynShadowTechnique<CpuBackend>>, SettingsError>;
-
-/// Builds a technique for the wgpu backend from a spec.
-pub type WgpuConstructor = fn(&TechniqueSpec) -> Result<Box<dyn DynShadowTechnique<WgpuBackend>>, SettingsError>;
-
-type LayerFns = (
-    fn() -> &'static [SettingKey],
-    fn(&TechniqueSpec) -> Result<String, SettingsError>,
-    CpuConstructor,
-    WgpuConstructor,
-);
-
-/// One registered technique.
-#[derive(Clone)]
-pub struct TechniqueEntry {
-    /// Registry name.
-    pub name: &'static str,
-    /// One line on what it does.
-    pub description: &'static str,
-    /// The paper it follows.
-    pub paper: &'static str,
-    /// Whether it is a reference (measured against, not measured).
-    pub reference: bool,
-    /// Whether it renders soft shadows: measured against `area-light-reference` (hard techniques against
-    /// `ray-traced`).
-    pub soft: bool,
-    /// Settings keys with defaults.
-    pub keys: fn() -> &'static [SettingKey],
-    /// Canonical settings string of a spec (all keys, defaults filled in).
-    pub canonical: fn(&TechniqueSpec) -> Result<String, SettingsError>,
-    /// The CPU implementation, if any.
-    pub cpu: Option<CpuConstructor>,
-    /// The wgpu implementation, if any.
-    pub wgpu: Option<WgpuConstructor>,
-}
-
-impl TechniqueEntry {
-    /// The entry of a technique whose settings type is itself the technique on both backends (the usual
-    /// case: `S` implements `TechniqueSettings`, and `ShadowTechnique` for `CpuBackend` and `WgpuBackend`).
-    #[must_use]
-    pub fn on_both<S>(name: &'static str, description: &'static str, paper: &'static str) -> Self
-    where
-        S: TechniqueSettings + ShadowTechnique<CpuBackend> + ShadowTechnique<WgpuBackend> + 'static,
-    {
-        Self {
-            name,
-            description,
-            paper,
-            reference: false,
-            soft: false,
-            keys: S::keys,
-            canonical: canonical::<S>,
-            cpu: Some(plain::<CpuBackend, S>),
-            wgpu: Some(plain::<WgpuBackend, S>),
-        }
-    }
-
-    /// The same entry, for a soft technique (measured against `area-light-reference`).
-    #[must_use]
-    pub fn soft(self) -> Self {
-        Self { soft: true, ..self }
-    }
-}
+/// One registered technique, on the two backends (see [`shadow_core::technique::registry::Entry`]).
+pub type TechniqueEntry = shadow_core::technique::registry::Entry<CpuBackend, WgpuBackend>;
 
 /// Why a technique could not be made.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -107,186 +42,44 @@ pub struct TechniqueRegistry {
     entries: Vec<TechniqueEntry>,
 }
 
-fn canonical<S: TechniqueSettings>(spec: &TechniqueSpec) -> Result<String, SettingsError> {
-    Ok(S::parse(&spec.name, &spec.values)?.settings_string())
-}
-
-/// A constructor for a settings type whose value alone is the technique, on backend `B`.
-fn plain<B, S>(spec: &TechniqueSpec) -> Result<Box<dyn DynShadowTechnique<B>>, SettingsError>
-where
-    B: shadow_core::technique::Backend,
-    S: TechniqueSettings + shadow_core::technique::ShadowTechnique<B>,
-{
-    let s = S::parse(&spec.name, &spec.values)?;
-    let text = s.settings_string();
-    Ok(Stateful::boxed(s, text))
-}
-
-/// A depth-layer map: the settings type (one per name, for its defaults) wraps the shared technique.
-fn layers<B, S>(spec: &TechniqueSpec) -> Result<Box<dyn DynShadowTechnique<B>>, SettingsError>
-where
-    B: shadow_core::technique::Backend,
-    S: TechniqueSettings + Into<DepthLayers>,
-    DepthLayers: shadow_core::technique::ShadowTechnique<B>,
-{
-    let s = S::parse(&spec.name, &spec.values)?;
-    let text = s.settings_string();
-    Ok(Stateful::boxed(s.into(), text))
-}
-
-/// Shadow volumes: the name picks the counting.
-fn volume<B>(spec: &TechniqueSpec) -> Result<Box<dyn DynShadowTechnique<B>>, SettingsError>
-where
-    B: shadow_core::technique::Backend,
-    ShadowVolume: shadow_core::technique::ShadowTechnique<B>,
-{
-    ShadowVolume::parse(&spec.name, &spec.values)?;
-    let v = ShadowVolume::named(&spec.name).unwrap_or(ShadowVolume::ZFAIL);
-    Ok(Stateful::boxed(v, String::new()))
-}
-
 impl TechniqueRegistry {
-    /// The built-in techniques.
+    /// The built-in techniques, in the order `shadowlab techniques` lists them: the references first.
     #[must_use]
     pub fn builtin() -> Self {
         let mut r = Self::default();
-        r.register(TechniqueEntry {
-            name: "ray-traced",
-            description: "exact hard shadows: one shadow ray per pixel through a BVH",
-            paper: "reference",
-            reference: true,
-            soft: false,
-            keys: RayTraced::keys,
-            canonical: canonical::<RayTraced>,
-            cpu: Some(plain::<CpuBackend, RayTraced>),
-            wgpu: None,
-        });
-        r.register(TechniqueEntry {
-            name: "area-light-reference",
-            description: "soft shadows of a spherical light: stratified Monte Carlo shadow rays per pixel through a BVH",
-            paper: "reference (shadow-soft)",
-            reference: true,
-            soft: true,
-            keys: AreaLightReference::keys,
-            canonical: canonical::<AreaLightReference>,
-            cpu: Some(plain::<CpuBackend, AreaLightReference>),
-            wgpu: None,
-        });
-        r.register(TechniqueEntry::on_both::<ShadowMap>(
-            "shadow-map",
-            "depth map from the light with Vulkan depth bias and percentage-closer filtering",
-            "Williams 1978; Reeves et al. 1987 (survey: Nealen 2005)",
-        ));
-        r.register(TechniqueEntry::on_both::<SilhouetteMap>(
-            "silhouette-map",
-            "a shadow map plus silhouette points half a texel off: piecewise-linear shadow edges",
-            "Sen, Cammarano, Hanrahan 2003",
-        ));
-        r.register(TechniqueEntry::on_both::<VolumeReconstruction>(
-            "volume-reconstruction",
-            "a shadow volume rebuilt from the light's depth map, resolved with one stencil bit",
-            "McCool 2000",
-        ));
-        r.register(TechniqueEntry::on_both::<Hybrid>(
-            "hybrid",
-            "a shadow map, with z-fail shadow volumes at its silhouette pixels only (a computation mask)",
-            "Chan 2004 (thesis, chapter 3)",
-        ));
-        r.register(
-            TechniqueEntry::on_both::<Smoothies>(
-                "smoothies",
-                "fake soft shadows: a shadow map plus alpha ramps hung outward from the silhouettes (smoothies)",
-                "Chan-Durand 2003; Chan 2004 (thesis, chapter 4)",
-            )
-            .soft(),
-        );
-        r.register(
-            TechniqueEntry::on_both::<Pcss>(
-                "pcss",
-                "percentage-closer soft shadows: a blocker search sizes a PCF kernel to the penumbra",
-                "Fernando 2005",
-            )
-            .soft(),
-        );
-        r.register(
-            TechniqueEntry::on_both::<PenumbraMap>(
-                "penumbra-map",
-                "fake soft shadows: a shadow map plus cones and sheets at the silhouettes drawn into a penumbra map",
-                "Wyman-Hansen 2003 (compared in Chan 2004, thesis 4.5.1)",
-            )
-            .soft(),
-        );
-        r.register(TechniqueEntry {
-            name: "shadow-volume-zpass",
-            description: "stencil shadow volumes counted from the eye: wrong when the eye is in shadow",
-            paper: "Crow 1977; Heidmann 1991",
-            reference: false,
-            soft: false,
-            keys: ShadowVolume::keys,
-            canonical: canonical::<ShadowVolume>,
-            cpu: Some(volume::<CpuBackend>),
-            wgpu: Some(volume::<WgpuBackend>),
-        });
-        r.register(TechniqueEntry {
-            name: "shadow-volume-zfail",
-            description: "stencil shadow volumes counted from infinity, capped: right with the eye in shadow",
-            paper: "Everitt-Kilgard 2002",
-            reference: false,
-            soft: false,
-            keys: ShadowVolume::keys,
-            canonical: canonical::<ShadowVolume>,
-            cpu: Some(volume::<CpuBackend>),
-            wgpu: Some(volume::<WgpuBackend>),
-        });
-        let layer_entries: [(&'static str, &'static str, &'static str, LayerFns); 3] = [
-            (
-                "midpoint-shadow-map",
-                "a map of the midpoint between the two layers nearest the light (depth peeling)",
-                "Woo 1992 (in Weiskopf-Ertl 2003, section 3)",
-                (
-                    MidpointShadowMap::keys,
-                    canonical::<MidpointShadowMap>,
-                    layers::<CpuBackend, MidpointShadowMap>,
-                    layers::<WgpuBackend, MidpointShadowMap>,
-                ),
-            ),
-            (
-                "second-depth-shadow-map",
-                "a map of the second-nearest layer; meant for closed meshes",
-                "Wang-Molnar 1994 (in Weiskopf-Ertl 2003, section 2)",
-                (
-                    SecondDepthShadowMap::keys,
-                    canonical::<SecondDepthShadowMap>,
-                    layers::<CpuBackend, SecondDepthShadowMap>,
-                    layers::<WgpuBackend, SecondDepthShadowMap>,
-                ),
-            ),
-            (
-                "dual-shadow-map",
-                "nearest layer plus min(half the gap to the second, z_offset): an adaptive bias",
-                "Weiskopf-Ertl 2003",
-                (
-                    DualShadowMap::keys,
-                    canonical::<DualShadowMap>,
-                    layers::<CpuBackend, DualShadowMap>,
-                    layers::<WgpuBackend, DualShadowMap>,
-                ),
-            ),
-        ];
-        for (name, description, paper, (keys, canonical, cpu, wgpu)) in layer_entries {
-            r.register(TechniqueEntry {
-                name,
-                description,
-                paper,
-                reference: false,
-                soft: false,
-                keys,
-                canonical,
-                cpu: Some(cpu),
-                wgpu: Some(wgpu),
-            });
+        for entry in [
+            shadow_hard::ray_traced::entry(),
+            shadow_soft::area_light::entry(),
+            shadow_hard::shadow_map::entry(),
+            shadow_hard::silhouette_map::entry(),
+            shadow_hard::volume_reconstruction::entry(),
+            shadow_hard::hybrid::entry(),
+            shadow_soft::smoothies::entry(),
+            shadow_soft::pcss::entry(),
+            shadow_soft::penumbra_map::entry(),
+            shadow_hard::shadow_volume::zpass_entry(),
+            shadow_hard::shadow_volume::zfail_entry(),
+            shadow_hard::depth_layers::midpoint_entry(),
+            shadow_hard::depth_layers::second_depth_entry(),
+            shadow_hard::depth_layers::dual_entry(),
+        ] {
+            r.register(entry);
         }
         r
+    }
+
+    /// The techniques `compare` and `results` measure on `frame` when none is named: every one that is
+    /// not a reference and that takes every light of the frame, as do the references of its kind (hard or
+    /// soft), in registration order; and the names of those left out.
+    #[must_use]
+    pub fn measurable(&self, frame: &FrameInputs) -> (Vec<TechniqueSpec>, Vec<&'static str>) {
+        let lit = |e: &TechniqueEntry| frame.lights.iter().all(|l| e.lights.takes(l));
+        let (taken, left): (Vec<_>, Vec<_>) = self
+            .entries
+            .iter()
+            .filter(|e| !e.reference)
+            .partition(|e| lit(e) && self.entries.iter().filter(|r| r.reference && r.soft == e.soft).all(lit));
+        (taken.iter().map(|e| TechniqueSpec::named(e.name)).collect(), left.iter().map(|e| e.name).collect())
     }
 
     /// Adds (or replaces) a technique.

@@ -21,6 +21,9 @@ pub mod shadow_volume;
 pub mod silhouette_map;
 pub mod volume_reconstruction;
 
+/// A registry entry of a technique on the two backends.
+pub type Entry = shadow_core::technique::registry::Entry<shadow_cpu::CpuBackend, shadow_wgpu::WgpuBackend>;
+
 pub use depth_layers::{DepthLayers, DualShadowMap, MidpointShadowMap, SecondDepthShadowMap};
 pub use hybrid::Hybrid;
 pub use ray_traced::RayTraced;

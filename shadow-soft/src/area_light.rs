@@ -8,9 +8,11 @@
 //! as blocked (the surface is in the way), as `ray-traced` counts a surface facing away. Rays leave the
 //! surface as `ray-traced`'s do: offset along the face normal turned towards the viewer.
 
+use crate::Entry;
 use shadow_core::glam::Vec3;
 use shadow_core::light::LightView;
 use shadow_core::lookup::{hash_unit, pixel_hash};
+use shadow_core::technique::LightKinds;
 use shadow_core::technique::settings::{SettingKey, SettingsError, TechniqueSettings, Values};
 use shadow_core::technique::{FrameStats, ShadowTechnique, TechniqueError};
 use shadow_core::{FrameInputs, Image};
@@ -32,7 +34,14 @@ pub struct AreaLightReference {
     pub epsilon: f32,
 }
 
+impl AreaLightReference {
+    /// The technique's name.
+    pub const NAME: &'static str = "area-light-reference";
+}
+
 impl TechniqueSettings for AreaLightReference {
+    const LIGHTS: LightKinds = LightKinds::POSITIONED;
+
     fn keys() -> &'static [SettingKey] {
         &[
             SettingKey {
@@ -115,7 +124,7 @@ impl ShadowTechnique<CpuBackend> for AreaLightReference {
     type State = RayState;
 
     fn name(&self) -> &'static str {
-        "area-light-reference"
+        Self::NAME
     }
 
     fn create_state(&self, _: &mut CpuContext) -> Result<RayState, CpuError> {
@@ -162,6 +171,18 @@ impl ShadowTechnique<CpuBackend> for AreaLightReference {
         stats.counters.extra.insert("shadow_rays".into(), rays);
         Ok(())
     }
+}
+
+/// The registry entry: the soft techniques' reference, on the CPU.
+#[must_use]
+pub fn entry() -> Entry {
+    Entry::on_cpu::<AreaLightReference>(
+        AreaLightReference::NAME,
+        "soft shadows of a spherical light: stratified Monte Carlo shadow rays per pixel through a BVH",
+        "reference (shadow-soft)",
+    )
+    .reference()
+    .soft()
 }
 
 #[cfg(test)]

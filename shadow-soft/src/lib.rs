@@ -14,6 +14,9 @@ pub mod pcss;
 pub mod penumbra_map;
 pub mod smoothies;
 
+/// A registry entry of a technique on the two backends.
+pub type Entry = shadow_core::technique::registry::Entry<shadow_cpu::CpuBackend, shadow_wgpu::WgpuBackend>;
+
 pub use area_light::AreaLightReference;
 pub use pcss::Pcss;
 pub use penumbra_map::PenumbraMap;

@@ -122,6 +122,8 @@ pub struct AdapterSummary {
     pub kind: String,
     /// A software rasterizer (lavapipe, WARP, SwiftShader).
     pub software: bool,
+    /// The driver and its version, as the driver reports them (empty where it does not).
+    pub driver: String,
 }
 
 impl AdapterSummary {
@@ -131,6 +133,7 @@ impl AdapterSummary {
             backend: format!("{:?}", info.backend),
             kind: format!("{:?}", info.device_type),
             software: info.device_type == wgpu::DeviceType::Cpu,
+            driver: format!("{} {}", info.driver, info.driver_info).trim().to_string(),
         }
     }
 }

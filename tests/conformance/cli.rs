@@ -246,3 +246,43 @@ fn a_model_named_by_a_bare_file_name_finds_its_buffers() {
     assert_eq!(v["triangles"], 1);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn techniques_list_the_lights_they_take() {
+    let (code, out, err) = shadowlab(&["techniques", "--json"]);
+    assert_eq!(code, 0, "{err}");
+    let v: Vec<serde_json::Value> = serde_json::from_str(&out).unwrap();
+    let lights = |name: &str| v.iter().find(|t| t["name"] == name).map(|t| t["lights"].clone()).unwrap();
+    assert_eq!(lights("shadow-map"), serde_json::json!(["spot", "directional", "point"]));
+    assert_eq!(lights("pcss"), serde_json::json!(["spot"]));
+    assert_eq!(lights("smoothies"), serde_json::json!(["spot", "directional"]));
+    assert_eq!(lights("area-light-reference"), serde_json::json!(["spot", "point"]));
+}
+
+#[test]
+fn compare_of_every_technique_leaves_out_those_the_lights_refuse() {
+    // l-shape is lit by a directional light: no soft technique has a reference for it, and pcss takes
+    // spot lights only.
+    let out = std::env::temp_dir().join(format!("shadowlab-cli-lights-{}", std::process::id()));
+    let (code, stdout, err) = shadowlab(&[
+        "compare",
+        "--scene",
+        "l-shape",
+        "--size",
+        "32x32",
+        "--backend",
+        "cpu",
+        "--out-dir",
+        out.to_str().unwrap(),
+    ]);
+    let _ = std::fs::remove_dir_all(&out);
+    assert_eq!(code, 0, "{err}");
+    assert!(err.contains("pcss") && err.contains("smoothies"), "{err}");
+    assert!(stdout.contains("shadow-map") && !stdout.contains("pcss"), "{stdout}");
+    // Named explicitly, a technique refused by the light is an error naming both.
+    let png = out.with_extension("png");
+    let args = ["render", "--scene", "l-shape", "--size", "32x32", "--backend", "cpu", "--technique", "pcss", "--out"];
+    let (code, _, err) = shadowlab(&[&args[..], &[png.to_str().unwrap()]].concat());
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("pcss") && err.contains("directional"), "{err}");
+}

@@ -15,14 +15,15 @@
 //!   the same error on every backend.
 
 pub mod maps;
+pub mod registry;
 pub mod settings;
 
 use crate::frame::FrameInputs;
 use crate::image::{Image, Rgb8};
 use crate::light::LightView;
-use crate::scene::Light;
 use crate::stats::{Counters, Timings};
 
+pub use registry::LightKinds;
 pub use settings::{SettingKey, SettingsError, TechniqueSettings, TechniqueSpec, key_values};
 
 /// A backend: a bundle of associated types (after wgpu-hal's `Api`).
@@ -88,11 +89,6 @@ pub trait ShadowTechnique<B: Backend>: Send + Sync {
 
     /// The registry name.
     fn name(&self) -> &'static str;
-
-    /// Which lights the technique handles.
-    fn supports(&self, _light: &Light) -> bool {
-        true
-    }
 
     /// Creates the state once; it is reused for every later frame.
     ///
@@ -179,13 +175,21 @@ pub trait DynShadowTechnique<B: Backend>: Send {
 pub struct Stateful<B: Backend, T: ShadowTechnique<B>> {
     technique: T,
     settings: String,
+    lights: LightKinds,
     state: Option<T::State>,
 }
 
 impl<B: Backend, T: ShadowTechnique<B>> Stateful<B, T> {
-    /// Wraps a technique; `settings` is its canonical settings string for reports.
+    /// Wraps a technique taking every kind of light; `settings` is its canonical settings string for
+    /// reports.
     pub fn new(technique: T, settings: String) -> Self {
-        Self { technique, settings, state: None }
+        Self { technique, settings, lights: LightKinds::ALL, state: None }
+    }
+
+    /// The same, refusing lights of kinds outside `lights` before any build.
+    #[must_use]
+    pub fn taking(self, lights: LightKinds) -> Self {
+        Self { lights, ..self }
     }
 
     /// Boxed, ready for a registry.
@@ -213,7 +217,7 @@ impl<B: Backend, T: ShadowTechnique<B>> DynShadowTechnique<B> for Stateful<B, T>
         light: &LightView,
         stats: &mut FrameStats,
     ) -> Result<(), B::Error> {
-        if !self.technique.supports(&light.light) {
+        if !self.lights.takes(&light.light) {
             return Err(TechniqueError::UnsupportedLight {
                 technique: self.technique.name().into(),
                 light: light.light.type_name(),

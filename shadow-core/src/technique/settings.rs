@@ -206,6 +206,9 @@ impl Values<'_> {
 
 /// A typed settings struct of a technique.
 pub trait TechniqueSettings: Sized + Clone + Send + Sync + 'static {
+    /// The kinds of light the technique takes; others are refused before its build.
+    const LIGHTS: super::LightKinds = super::LightKinds::ALL;
+
     /// Every key, with its default and help.
     fn keys() -> &'static [SettingKey];
     /// Reads the struct from given-or-default values.

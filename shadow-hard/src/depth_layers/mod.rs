@@ -13,7 +13,12 @@ pub mod cpu;
 pub mod gpu;
 
 use shadow_core::technique::maps::{FILTER, FILTER_RADIUS, read_resolution, resolution_key};
-use shadow_core::technique::settings::{Filter, SettingKey, SettingsError, TechniqueSettings, Values};
+use shadow_core::technique::settings::{Filter, SettingKey, SettingsError, TechniqueSettings, TechniqueSpec, Values};
+use shadow_core::technique::{Backend, DynShadowTechnique, ShadowTechnique, Stateful};
+use shadow_cpu::CpuBackend;
+use shadow_wgpu::WgpuBackend;
+
+use crate::Entry;
 
 /// Which depth-layer map (Weiskopf-Ertl 2003): the name picks it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -177,6 +182,57 @@ layer_settings!(
     /// Settings of `dual-shadow-map` (Weiskopf-Ertl).
     DualShadowMap, LayerKind::Dual, "auto"
 );
+
+/// A depth-layer map on backend `B`: the settings type of the spec's name (one per name, for its
+/// defaults) made into the shared technique.
+fn layers<B, S>(spec: &TechniqueSpec) -> Result<Box<dyn DynShadowTechnique<B>>, SettingsError>
+where
+    B: Backend,
+    S: TechniqueSettings + Into<DepthLayers>,
+    DepthLayers: ShadowTechnique<B>,
+{
+    let s = S::parse(&spec.name, &spec.values)?;
+    let text = s.settings_string();
+    Ok(Stateful::boxed(s.into(), text))
+}
+
+/// The entry of the layer map `S`.
+fn entry<S>(name: &'static str, description: &'static str, paper: &'static str) -> Entry
+where
+    S: TechniqueSettings + Into<DepthLayers>,
+{
+    Entry::new::<S>(name, description, paper, Some(layers::<CpuBackend, S>), Some(layers::<WgpuBackend, S>))
+}
+
+/// The registry entry of Woo's midpoint map.
+#[must_use]
+pub fn midpoint_entry() -> Entry {
+    entry::<MidpointShadowMap>(
+        LayerKind::Midpoint.name(),
+        "a map of the midpoint between the two layers nearest the light (depth peeling)",
+        "Woo 1992 (in Weiskopf-Ertl 2003, section 3)",
+    )
+}
+
+/// The registry entry of Wang and Molnar's second-depth map.
+#[must_use]
+pub fn second_depth_entry() -> Entry {
+    entry::<SecondDepthShadowMap>(
+        LayerKind::SecondDepth.name(),
+        "a map of the second-nearest layer; meant for closed meshes",
+        "Wang-Molnar 1994 (in Weiskopf-Ertl 2003, section 2)",
+    )
+}
+
+/// The registry entry of Weiskopf and Ertl's dual map.
+#[must_use]
+pub fn dual_entry() -> Entry {
+    entry::<DualShadowMap>(
+        LayerKind::Dual.name(),
+        "nearest layer plus min(half the gap to the second, z_offset): an adaptive bias",
+        "Weiskopf-Ertl 2003",
+    )
+}
 
 #[cfg(test)]
 mod layer_tests {

@@ -27,7 +27,7 @@
 //! silhouette pixel; the CPU reads the marks back and the volume pass repeats its draws inside scissor
 //! rectangles around the marked tiles (runs along each row, merged down while the run below spans the same
 //! columns), so fragments elsewhere are never made; it trades the read-back and the repeated geometry for
-//! them (measured in the README: on an H100 from 0.63 to 1.56 times z-fail's query, against 0.67 to 1.30
+//! them (measured in docs/hybrid.md: on an H100 from 0.63 to 1.56 times z-fail's query, against 0.67 to 1.30
 //! without).
 //!
 //! With `edge_texels=all` (both backends) the build also draws the casters' silhouette edges into edge

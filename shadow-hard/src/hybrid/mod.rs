@@ -17,6 +17,7 @@ pub mod edge_map;
 pub mod gpu;
 pub mod shafts;
 
+use crate::Entry;
 use shadow_core::technique::maps::{BIAS, BIAS_CONSTANT, BIAS_SLOPE, BIAS_WORLD, DepthMap, resolution_key};
 use shadow_core::technique::settings::{OnOff, SettingKey, SettingsError, TechniqueSettings, Values};
 
@@ -203,4 +204,14 @@ impl TechniqueSettings for Hybrid {
 impl Hybrid {
     /// The technique's name.
     pub const NAME: &'static str = "hybrid";
+}
+
+/// The registry entry.
+#[must_use]
+pub fn entry() -> Entry {
+    Entry::on_both::<Hybrid>(
+        Hybrid::NAME,
+        "a shadow map, with z-fail shadow volumes at its silhouette pixels only (a computation mask)",
+        "Chan 2004 (thesis, chapter 3)",
+    )
 }

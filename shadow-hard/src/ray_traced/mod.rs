@@ -13,6 +13,7 @@
 
 pub mod cpu;
 
+use crate::Entry;
 use shadow_core::technique::settings::{SettingKey, SettingsError, TechniqueSettings, Values};
 
 /// `ray-traced`: one shadow ray per G-buffer pixel, the exact reference.
@@ -45,4 +46,15 @@ impl TechniqueSettings for RayTraced {
 impl RayTraced {
     /// The technique's name.
     pub const NAME: &'static str = "ray-traced";
+}
+
+/// The registry entry: the hard techniques' reference, on the CPU.
+#[must_use]
+pub fn entry() -> Entry {
+    Entry::on_cpu::<RayTraced>(
+        RayTraced::NAME,
+        "exact hard shadows: one shadow ray per pixel through a BVH",
+        "reference",
+    )
+    .reference()
 }

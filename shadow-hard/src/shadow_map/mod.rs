@@ -8,6 +8,7 @@
 pub mod cpu;
 pub mod gpu;
 
+use crate::Entry;
 use shadow_core::technique::maps::{
     BIAS, BIAS_CONSTANT, BIAS_SLOPE, BIAS_WORLD, DepthMap, FILTER, FILTER_RADIUS, resolution_key,
 };
@@ -62,6 +63,16 @@ impl TechniqueSettings for ShadowMap {
             m.bias_world.to_string(),
         ]
     }
+}
+
+/// The registry entry.
+#[must_use]
+pub fn entry() -> Entry {
+    Entry::on_both::<ShadowMap>(
+        ShadowMap::NAME,
+        "depth map from the light with Vulkan depth bias and percentage-closer filtering",
+        "Williams 1978; Reeves et al. 1987 (survey: Nealen 2005)",
+    )
 }
 
 #[cfg(test)]

@@ -14,7 +14,12 @@ pub mod cpu;
 pub mod gpu;
 
 use shadow_core::geometry::volume::VolumeCounting;
-use shadow_core::technique::settings::{SettingKey, SettingsError, TechniqueSettings, Values};
+use shadow_core::technique::settings::{SettingKey, SettingsError, TechniqueSettings, TechniqueSpec, Values};
+use shadow_core::technique::{Backend, DynShadowTechnique, ShadowTechnique, Stateful};
+use shadow_cpu::CpuBackend;
+use shadow_wgpu::WgpuBackend;
+
+use crate::Entry;
 
 /// `shadow-volume-zpass` and `shadow-volume-zfail`: stencil shadow volumes from silhouette edges.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -66,6 +71,39 @@ impl ShadowVolume {
             VolumeCounting::ZFail => Self::ZFAIL_NAME,
         }
     }
+}
+
+/// The counting a spec's name picks, as a technique on backend `B`.
+fn named<B: Backend>(spec: &TechniqueSpec) -> Result<Box<dyn DynShadowTechnique<B>>, SettingsError>
+where
+    ShadowVolume: ShadowTechnique<B>,
+{
+    ShadowVolume::parse(&spec.name, &spec.values)?;
+    Ok(Stateful::boxed(ShadowVolume::named(&spec.name).unwrap_or(ShadowVolume::ZFAIL), String::new()))
+}
+
+fn entry(name: &'static str, description: &'static str, paper: &'static str) -> Entry {
+    Entry::new::<ShadowVolume>(name, description, paper, Some(named::<CpuBackend>), Some(named::<WgpuBackend>))
+}
+
+/// The registry entry of z-pass volumes.
+#[must_use]
+pub fn zpass_entry() -> Entry {
+    entry(
+        ShadowVolume::ZPASS_NAME,
+        "stencil shadow volumes counted from the eye: wrong when the eye is in shadow",
+        "Crow 1977; Heidmann 1991",
+    )
+}
+
+/// The registry entry of z-fail volumes.
+#[must_use]
+pub fn zfail_entry() -> Entry {
+    entry(
+        ShadowVolume::ZFAIL_NAME,
+        "stencil shadow volumes counted from infinity, capped: right with the eye in shadow",
+        "Everitt-Kilgard 2002",
+    )
 }
 
 #[cfg(test)]

@@ -12,6 +12,7 @@ pub mod cpu;
 pub mod gpu;
 pub mod points;
 
+use crate::Entry;
 use shadow_core::technique::maps::{BIAS, BIAS_CONSTANT, BIAS_SLOPE, BIAS_WORLD, DepthMap, resolution_key};
 use shadow_core::technique::settings::{SettingKey, SettingsError, TechniqueSettings, Values};
 
@@ -79,6 +80,16 @@ impl TechniqueSettings for SilhouetteMap {
         v.extend([self.corner_margin.to_string(), self.corner_depth.to_string(), self.keep.to_string()]);
         v
     }
+}
+
+/// The registry entry.
+#[must_use]
+pub fn entry() -> Entry {
+    Entry::on_both::<SilhouetteMap>(
+        SilhouetteMap::NAME,
+        "a shadow map plus silhouette points half a texel off: piecewise-linear shadow edges",
+        "Sen, Cammarano, Hanrahan 2003",
+    )
 }
 
 #[cfg(test)]

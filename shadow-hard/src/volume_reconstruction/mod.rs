@@ -12,6 +12,7 @@ pub mod cpu;
 pub mod gpu;
 pub mod reconstruction;
 
+use crate::Entry;
 use shadow_core::technique::maps::{BIAS, BIAS_CONSTANT, BIAS_SLOPE, BIAS_WORLD, DepthMap, resolution_key};
 use shadow_core::technique::settings::{OnOff, SettingKey, SettingsError, TechniqueSettings, Values};
 
@@ -183,4 +184,14 @@ impl VolumeReconstruction {
 impl VolumeReconstruction {
     /// The technique's name.
     pub const NAME: &'static str = "volume-reconstruction";
+}
+
+/// The registry entry.
+#[must_use]
+pub fn entry() -> Entry {
+    Entry::on_both::<VolumeReconstruction>(
+        VolumeReconstruction::NAME,
+        "a shadow volume rebuilt from the light's depth map, resolved with one stencil bit",
+        "McCool 2000",
+    )
 }

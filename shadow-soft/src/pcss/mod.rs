@@ -24,7 +24,9 @@
 pub mod cpu;
 pub mod gpu;
 
+use crate::Entry;
 use shadow_core::light::{LightProjection, LightView};
+use shadow_core::technique::LightKinds;
 use shadow_core::technique::TechniqueError;
 use shadow_core::technique::maps::{BIAS, BIAS_CONSTANT, BIAS_SLOPE, BIAS_WORLD, DepthMap, resolution_key};
 use shadow_core::technique::settings::{SettingKey, SettingsError, TechniqueSettings, Values};
@@ -40,6 +42,8 @@ const KEYS: [SettingKey; 5] =
     [resolution_key("1024", "depth map side in texels (16 to 16384)"), BIAS, BIAS_CONSTANT, BIAS_SLOPE, BIAS_WORLD];
 
 impl TechniqueSettings for Pcss {
+    const LIGHTS: LightKinds = LightKinds::SPOT;
+
     fn keys() -> &'static [SettingKey] {
         &KEYS
     }
@@ -97,4 +101,15 @@ impl Pcss {
         // of the map.
         Ok(PcssLens { k: light.light.radius * p.clip_from_view.x_axis.x * 0.5, proj: *p })
     }
+}
+
+/// The registry entry.
+#[must_use]
+pub fn entry() -> Entry {
+    Entry::on_both::<Pcss>(
+        Pcss::NAME,
+        "percentage-closer soft shadows: a blocker search sizes a PCF kernel to the penumbra",
+        "Fernando 2005",
+    )
+    .soft()
 }

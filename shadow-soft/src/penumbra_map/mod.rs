@@ -25,9 +25,11 @@ pub mod cpu;
 pub mod geometry;
 pub mod gpu;
 
+use crate::Entry;
 use shadow_core::FrameInputs;
 use shadow_core::image::Image;
 use shadow_core::light::{LightProjection, LightView};
+use shadow_core::technique::LightKinds;
 use shadow_core::technique::maps::{BIAS, BIAS_CONSTANT, BIAS_SLOPE, BIAS_WORLD, DepthMap, resolution_key};
 use shadow_core::technique::settings::{SettingKey, SettingsError, TechniqueSettings, Values};
 use shadow_core::technique::{DebugView, FrameStats, TechniqueError};
@@ -49,6 +51,8 @@ const KEYS: [SettingKey; 5] = [
 ];
 
 impl TechniqueSettings for PenumbraMap {
+    const LIGHTS: LightKinds = LightKinds::SPOT;
+
     fn keys() -> &'static [SettingKey] {
         &KEYS
     }
@@ -100,6 +104,17 @@ impl PenumbraMap {
 pub fn debug_views(values: &Image<f32>) -> Vec<DebugView> {
     let grey = Image::from_fn(values.width(), values.height(), |x, y| [(values.get(x, y) * 255.0).round() as u8; 3]);
     vec![DebugView { name: "penumbra-map".into(), image: grey }]
+}
+
+/// The registry entry.
+#[must_use]
+pub fn entry() -> Entry {
+    Entry::on_both::<PenumbraMap>(
+        PenumbraMap::NAME,
+        "fake soft shadows: a shadow map plus cones and sheets at the silhouettes drawn into a penumbra map",
+        "Wyman-Hansen 2003 (compared in Chan 2004, thesis 4.5.1)",
+    )
+    .soft()
 }
 
 #[cfg(test)]

@@ -17,12 +17,14 @@ pub mod cpu;
 pub mod geometry;
 pub mod gpu;
 
+use crate::Entry;
 use shadow_core::glam::Vec3;
 use shadow_core::image::false_colour;
 use shadow_core::light::{LightProjection, LightView};
 use shadow_core::scene::LightKind;
 use shadow_core::technique::DebugView;
 use shadow_core::technique::FrameStats;
+use shadow_core::technique::LightKinds;
 use shadow_core::technique::TechniqueError;
 use shadow_core::technique::maps::{BIAS, BIAS_CONSTANT, BIAS_SLOPE, BIAS_WORLD, DepthMap, resolution_key};
 use shadow_core::technique::settings::{OnOff, SettingKey, SettingsError, TechniqueSettings, Values};
@@ -128,6 +130,8 @@ const KEYS: [SettingKey; 8] = [
 ];
 
 impl TechniqueSettings for Smoothies {
+    const LIGHTS: LightKinds = LightKinds::ONE_PROJECTION;
+
     fn keys() -> &'static [SettingKey] {
         &KEYS
     }
@@ -216,6 +220,17 @@ pub fn debug_views(depth: &Image<f32>, alpha: &Image<f32>) -> Vec<DebugView> {
         DebugView { name: "smoothie-alpha".into(), image: grey },
         DebugView { name: "smoothie-depth".into(), image: false_colour(depth, nearest, 1.0) },
     ]
+}
+
+/// The registry entry.
+#[must_use]
+pub fn entry() -> Entry {
+    Entry::on_both::<Smoothies>(
+        Smoothies::NAME,
+        "fake soft shadows: a shadow map plus alpha ramps hung outward from the silhouettes (smoothies)",
+        "Chan-Durand 2003; Chan 2004 (thesis, chapter 4)",
+    )
+    .soft()
 }
 
 #[cfg(test)]

@@ -1,0 +1,166 @@
+//! What a technique tells the registry about itself: its name, paper, the lights it takes, its settings
+//! keys and a constructor per backend. Each technique's folder builds its own [`Entry`]; the registry of
+//! the `shadowlab` crate lists them, so adding a technique is its folder plus one line there.
+//!
+//! The entry is generic over the two backends it may be built on (`C` the CPU reference, `G` the GPU), so
+//! this crate, which knows neither, can hold it.
+
+use super::settings::{SettingKey, SettingsError, TechniqueSettings, TechniqueSpec};
+use super::{Backend, DynShadowTechnique, ShadowTechnique, Stateful};
+use crate::scene::{Light, LightKind};
+
+/// The kinds of light a technique takes (`TechniqueSettings::LIGHTS`). A light of another kind is refused
+/// before the technique's build runs ([`crate::technique::TechniqueError::UnsupportedLight`]), and
+/// `compare` leaves the technique out of a scene lit by one.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LightKinds {
+    /// Spot lights.
+    pub spot: bool,
+    /// Directional lights.
+    pub directional: bool,
+    /// Point lights.
+    pub point: bool,
+}
+
+impl LightKinds {
+    /// Every kind.
+    pub const ALL: Self = Self { spot: true, directional: true, point: true };
+    /// Spot lights only.
+    pub const SPOT: Self = Self { spot: true, directional: false, point: false };
+    /// Lights with a position: spot and point.
+    pub const POSITIONED: Self = Self { spot: true, directional: false, point: true };
+    /// Lights with one projection: spot and directional.
+    pub const ONE_PROJECTION: Self = Self { spot: true, directional: true, point: false };
+
+    /// Whether `light` is of a kind taken.
+    #[must_use]
+    pub fn takes(self, light: &Light) -> bool {
+        match light.kind {
+            LightKind::Spot { .. } => self.spot,
+            LightKind::Directional { .. } => self.directional,
+            LightKind::Point { .. } => self.point,
+        }
+    }
+
+    /// The kinds taken, by name (as `Light::type_name` has them).
+    #[must_use]
+    pub fn names(self) -> Vec<&'static str> {
+        [(self.spot, "spot"), (self.directional, "directional"), (self.point, "point")]
+            .into_iter()
+            .filter_map(|(on, name)| on.then_some(name))
+            .collect()
+    }
+}
+
+/// Builds a technique for backend `B` from a spec.
+pub type Constructor<B> = fn(&TechniqueSpec) -> Result<Box<dyn DynShadowTechnique<B>>, SettingsError>;
+
+/// One technique as the registry holds it.
+pub struct Entry<C: Backend, G: Backend> {
+    /// Registry name.
+    pub name: &'static str,
+    /// One line on what it does.
+    pub description: &'static str,
+    /// The paper it follows.
+    pub paper: &'static str,
+    /// Whether it is a reference (measured against, not measured).
+    pub reference: bool,
+    /// Whether it renders soft shadows: measured against `area-light-reference` (hard techniques against
+    /// `ray-traced`).
+    pub soft: bool,
+    /// The lights it takes.
+    pub lights: LightKinds,
+    /// Settings keys with defaults.
+    pub keys: fn() -> &'static [SettingKey],
+    /// Canonical settings string of a spec (all keys, defaults filled in).
+    pub canonical: fn(&TechniqueSpec) -> Result<String, SettingsError>,
+    /// The CPU implementation, if any.
+    pub cpu: Option<Constructor<C>>,
+    /// The GPU implementation, if any.
+    pub wgpu: Option<Constructor<G>>,
+}
+
+impl<C: Backend, G: Backend> Clone for Entry<C, G> {
+    fn clone(&self) -> Self {
+        Self { ..*self }
+    }
+}
+
+impl<C: Backend, G: Backend> Entry<C, G> {
+    /// The entry of a technique declared by the settings type `S` (its keys, canonical string and lights),
+    /// made on each backend by the constructor given.
+    #[must_use]
+    pub fn new<S: TechniqueSettings>(
+        name: &'static str,
+        description: &'static str,
+        paper: &'static str,
+        cpu: Option<Constructor<C>>,
+        wgpu: Option<Constructor<G>>,
+    ) -> Self {
+        Self {
+            name,
+            description,
+            paper,
+            reference: false,
+            soft: false,
+            lights: S::LIGHTS,
+            keys: S::keys,
+            canonical: canonical::<S>,
+            cpu,
+            wgpu,
+        }
+    }
+
+    /// The entry of a technique whose settings type is itself the technique on both backends (the usual
+    /// case: `S` implements `TechniqueSettings`, and `ShadowTechnique` for `C` and `G`).
+    #[must_use]
+    pub fn on_both<S>(name: &'static str, description: &'static str, paper: &'static str) -> Self
+    where
+        S: TechniqueSettings + ShadowTechnique<C> + ShadowTechnique<G>,
+    {
+        Self::new::<S>(name, description, paper, Some(plain::<C, S>), Some(plain::<G, S>))
+    }
+
+    /// The entry of a technique on the CPU backend only (the references).
+    #[must_use]
+    pub fn on_cpu<S>(name: &'static str, description: &'static str, paper: &'static str) -> Self
+    where
+        S: TechniqueSettings + ShadowTechnique<C>,
+    {
+        Self::new::<S>(name, description, paper, Some(plain::<C, S>), None)
+    }
+
+    /// The same entry, for a soft technique (measured against `area-light-reference`).
+    #[must_use]
+    pub fn soft(self) -> Self {
+        Self { soft: true, ..self }
+    }
+
+    /// The same entry, for a reference.
+    #[must_use]
+    pub fn reference(self) -> Self {
+        Self { reference: true, ..self }
+    }
+}
+
+/// The canonical settings string of a spec for a settings type.
+///
+/// # Errors
+/// Unknown keys or bad values.
+pub fn canonical<S: TechniqueSettings>(spec: &TechniqueSpec) -> Result<String, SettingsError> {
+    Ok(S::parse(&spec.name, &spec.values)?.settings_string())
+}
+
+/// A constructor for a settings type whose value alone is the technique, on backend `B`.
+///
+/// # Errors
+/// Unknown keys or bad values.
+pub fn plain<B, S>(spec: &TechniqueSpec) -> Result<Box<dyn DynShadowTechnique<B>>, SettingsError>
+where
+    B: Backend,
+    S: TechniqueSettings + ShadowTechnique<B>,
+{
+    let s = S::parse(&spec.name, &spec.values)?;
+    let text = s.settings_string();
+    Ok(Box::new(Stateful::new(s, text).taking(S::LIGHTS)))
+}
