@@ -432,6 +432,20 @@ fn list_scenes(json: bool) -> Result<(), Error> {
     Ok(())
 }
 
+/// A setting as `techniques --json` lists it: what a viewer needs to make its control.
+fn setting_json(k: &shadow_core::technique::SettingKey) -> serde_json::Value {
+    use shadow_core::technique::settings::SettingKind;
+    let mut v = json!({"key": k.key, "default": k.default, "help": k.help, "also": k.word});
+    let (kind, values) = match k.kind {
+        SettingKind::Int { lo, hi } => ("int", json!([lo, hi])),
+        SettingKind::Float { lo, hi } => ("float", json!([lo, hi])),
+        SettingKind::Choice(names) => ("choice", json!(names)),
+    };
+    v["type"] = json!(kind);
+    v[if kind == "choice" { "choices" } else { "range" }] = values;
+    v
+}
+
 fn list_techniques(json: bool) -> Result<(), Error> {
     let reg = TechniqueRegistry::builtin();
     let backends = |e: &shadowlab::TechniqueEntry| {
@@ -449,7 +463,7 @@ fn list_techniques(json: bool) -> Result<(), Error> {
             .entries()
             .iter()
             .map(|e| {
-                let keys: Vec<_> = (e.keys)().iter().map(|k| json!({"key": k.key, "default": k.default, "help": k.help})).collect();
+                let keys: Vec<_> = (e.keys)().iter().map(setting_json).collect();
                 json!({"name": e.name, "description": e.description, "paper": e.paper, "reference": e.reference, "lights": e.lights.names(), "settings": keys, "backends": backends(e)})
             })
             .collect();

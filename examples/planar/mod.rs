@@ -9,7 +9,7 @@
 use glam::{Mat4, Vec3, Vec4};
 use shadow_core::light::LightView;
 use shadow_core::scene::LightKind;
-use shadow_core::technique::settings::{SettingKey, SettingsError, TechniqueSettings, Values};
+use shadow_core::technique::settings::SettingKey;
 use shadow_core::technique::{FrameStats, ShadowTechnique};
 use shadow_core::{FrameInputs, Image};
 use shadow_cpu::raster::{DepthStencil, RasterState, Soup, draw};
@@ -18,22 +18,11 @@ use shadow_wgpu::{GpuGBuffer, GpuVisibility, WgpuBackend, WgpuContext, WgpuError
 use shadowlab::{TechniqueEntry, TechniqueRegistry};
 use wgpu::util::DeviceExt;
 
-/// The settings: which horizontal plane receives.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct PlanarShadow {
-    /// Height of the receiving plane.
-    pub plane_y: f32,
-}
-
-impl TechniqueSettings for PlanarShadow {
-    fn keys() -> &'static [SettingKey] {
-        &[SettingKey { key: "plane_y", default: "0", help: "height of the horizontal receiving plane" }]
-    }
-    fn from_values(v: &Values<'_>) -> Result<Self, SettingsError> {
-        Ok(Self { plane_y: v.ranged("plane_y", -1e6, 1e6)? })
-    }
-    fn to_values(&self) -> Vec<String> {
-        vec![self.plane_y.to_string()]
+shadow_core::technique_settings! {
+    /// The settings: which horizontal plane receives.
+    pub struct PlanarShadow {
+        /// Height of the receiving plane.
+        pub plane_y: f32 = SettingKey::float("plane_y", "0", -1e6, 1e6, "height of the horizontal receiving plane"),
     }
 }
 

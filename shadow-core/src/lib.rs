@@ -30,7 +30,7 @@ pub use bounds::Aabb;
 pub use frame::{FrameInputs, Instance};
 pub use glam;
 pub use image::Image;
-pub use light::{LightView, LightViewKind};
+pub use light::LightView;
 pub use mesh::{Mesh, MeshError};
 pub use scene::{Camera, CameraKey, Light, LightKey, LightKind, Material, MaterialKey, MeshKey, Node, NodeKey, Scene};
 pub mod shading;

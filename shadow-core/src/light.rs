@@ -125,25 +125,13 @@ pub fn ndc_to_uv(ndc: Vec2) -> Vec2 {
     Vec2::new(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5)
 }
 
-/// Which kind of view a light has.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum LightViewKind {
-    /// One perspective view covering the cone.
-    Spot,
-    /// One orthographic view covering the scene.
-    Directional,
-    /// Six cube faces: +X, -X, +Y, -Y, +Z, -Z.
-    Point,
-}
-
 /// A light with its fitted projections.
 #[derive(Clone, Debug, PartialEq)]
 pub struct LightView {
     /// The light.
     pub light: Light,
-    /// Which layout `projections` has.
-    pub kind: LightViewKind,
-    /// One projection, or six cube faces in the order +X, -X, +Y, -Y, +Z, -Z.
+    /// One projection (a spot light's perspective view, a directional light's orthographic one), or a
+    /// point light's six cube faces in the order +X, -X, +Y, -Y, +Z, -Z.
     pub projections: Vec<LightProjection>,
 }
 
@@ -207,13 +195,13 @@ impl LightView {
         if boxes.is_empty() {
             return Err(LightViewError::EmptyScene);
         }
-        let (kind, projections) = match light.kind {
+        let projections = match light.kind {
             LightKind::Spot { position, direction, cone_angle } => {
                 let dir = direction.normalize();
                 let (near, far) = perspective_range(position, dir, &boxes);
                 let view = look_to_mat4(position, dir, safe_up(dir));
                 let proj = directx::perspective(cone_angle, 1.0, near, far);
-                (LightViewKind::Spot, vec![LightProjection::new(view, proj, near, far, false)])
+                vec![LightProjection::new(view, proj, near, far, false)]
             }
             LightKind::Directional { direction } => {
                 let dir = direction.normalize();
@@ -229,22 +217,19 @@ impl LightView {
                 let pad = (far - near) * 0.01 + 1e-4;
                 let (near, far) = (near - pad, far + pad);
                 let proj = directx::orthographic(mid.x - half, mid.x + half, mid.y - half, mid.y + half, near, far);
-                (LightViewKind::Directional, vec![LightProjection::new(view, proj, near, far, true)])
+                vec![LightProjection::new(view, proj, near, far, true)]
             }
-            LightKind::Point { position } => {
-                let faces = CUBE_FACES
-                    .iter()
-                    .map(|&(dir, up)| {
-                        let (near, far) = perspective_range(position, dir, &boxes);
-                        let view = look_to_mat4(position, dir, up);
-                        let proj = directx::perspective(std::f32::consts::FRAC_PI_2, 1.0, near, far);
-                        LightProjection::new(view, proj, near, far, false)
-                    })
-                    .collect();
-                (LightViewKind::Point, faces)
-            }
+            LightKind::Point { position } => CUBE_FACES
+                .iter()
+                .map(|&(dir, up)| {
+                    let (near, far) = perspective_range(position, dir, &boxes);
+                    let view = look_to_mat4(position, dir, up);
+                    let proj = directx::perspective(std::f32::consts::FRAC_PI_2, 1.0, near, far);
+                    LightProjection::new(view, proj, near, far, false)
+                })
+                .collect(),
         };
-        Ok(Self { light: *light, kind, projections })
+        Ok(Self { light: *light, projections })
     }
 
     /// The same view with a point light's six cube faces widened so that an `n x n` map's outermost

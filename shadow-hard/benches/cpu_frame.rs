@@ -58,7 +58,7 @@ fn whole_frame<T: ShadowTechnique<shadow_cpu::CpuBackend>>(b: Bencher, t: T) {
 fn cubes_shadow_map_2048(b: Bencher) {
     whole_frame(b, {
         let mut s = ShadowMap::defaults();
-        s.map.resolution = 2048;
+        s.resolution = 2048;
         s
     });
 }

@@ -88,7 +88,7 @@ fn shadow_map_error_falls_with_resolution() {
         Stateful::boxed(
             {
                 let mut s = ShadowMap::defaults();
-                s.map.resolution = res;
+                s.resolution = res;
                 s
             },
             String::new(),
@@ -121,7 +121,7 @@ fn bad_requests_are_refused_before_allocating() {
     let mut huge = Stateful::<CpuBackend, _>::new(
         {
             let mut s = ShadowMap::defaults();
-            s.map.resolution = 16384;
+            s.resolution = 16384;
             s
         },
         String::new(),

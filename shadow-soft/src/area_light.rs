@@ -13,7 +13,7 @@ use shadow_core::glam::Vec3;
 use shadow_core::light::LightView;
 use shadow_core::lookup::{hash_unit, pixel_hash};
 use shadow_core::technique::LightKinds;
-use shadow_core::technique::settings::{SettingKey, SettingsError, TechniqueSettings, Values};
+use shadow_core::technique::settings::{SettingKey, SettingsError, Values};
 use shadow_core::technique::{FrameStats, ShadowTechnique, TechniqueError};
 use shadow_core::{FrameInputs, Image};
 use shadow_cpu::bvh::SceneBvh;
@@ -24,50 +24,42 @@ use shadow_cpu::{CpuBackend, CpuContext, CpuError, GBuffer};
 /// The largest sample count, per pixel.
 pub const MAX_SAMPLES: u32 = 4096;
 
-/// `area-light-reference` settings.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct AreaLightReference {
-    /// Shadow rays per pixel: a square number, for a `sqrt(n) x sqrt(n)` grid of strata over the light's
-    /// cone of directions, one jittered ray in each.
-    pub samples: u32,
-    /// Ray origin offset along the normal, as a fraction of the scene's diagonal (as `ray-traced`'s).
-    pub epsilon: f32,
+shadow_core::technique_settings! {
+    /// `area-light-reference` settings.
+    pub struct AreaLightReference {
+        /// Shadow rays per pixel: a square number, for a `sqrt(n) x sqrt(n)` grid of strata over the light's
+        /// cone of directions, one jittered ray in each.
+        pub samples: u32 = SettingKey::int(
+            "samples",
+            "256",
+            1,
+            MAX_SAMPLES,
+            "shadow rays per pixel, a square number (1, 4, 9, ... 4096): one per stratum of the light's cone",
+        ),
+        /// Ray origin offset along the normal, as a fraction of the scene's diagonal (as `ray-traced`'s).
+        pub epsilon: f32 = SettingKey::float(
+            "epsilon",
+            "0.0000005",
+            0.0,
+            0.1,
+            "ray origin offset along the normal, as a fraction of the scene diagonal",
+        ),
+    }
+    lights = LightKinds::POSITIONED;
+    check = AreaLightReference::check;
 }
 
 impl AreaLightReference {
     /// The technique's name.
     pub const NAME: &'static str = "area-light-reference";
-}
 
-impl TechniqueSettings for AreaLightReference {
-    const LIGHTS: LightKinds = LightKinds::POSITIONED;
-
-    fn keys() -> &'static [SettingKey] {
-        &[
-            SettingKey {
-                key: "samples",
-                default: "256",
-                help: "shadow rays per pixel, a square number (1, 4, 9, ... 4096): one per stratum of the light's cone",
-            },
-            SettingKey {
-                key: "epsilon",
-                default: "0.0000005",
-                help: "ray origin offset along the normal, as a fraction of the scene diagonal",
-            },
-        ]
-    }
-
-    fn from_values(v: &Values<'_>) -> Result<Self, SettingsError> {
-        let samples: u32 = v.ranged("samples", 1, MAX_SAMPLES)?;
-        let side = samples.isqrt();
-        if side * side != samples {
+    /// The strata make a square grid.
+    fn check(&self, v: &Values<'_>) -> Result<(), SettingsError> {
+        let side = self.samples.isqrt();
+        if side * side != self.samples {
             return Err(v.bad("samples", "a square number (1, 4, 9, 16, ..., 4096)"));
         }
-        Ok(Self { samples, epsilon: v.ranged("epsilon", 0.0, 0.1)? })
-    }
-
-    fn to_values(&self) -> Vec<String> {
-        vec![self.samples.to_string(), self.epsilon.to_string()]
+        Ok(())
     }
 }
 
@@ -252,6 +244,7 @@ mod tests {
 
     #[test]
     fn samples_must_be_a_square_number() {
+        use shadow_core::technique::TechniqueSettings;
         let parse = |s: &str| AreaLightReference::parse("area-light-reference", &[("samples".into(), s.into())]);
         assert_eq!(parse("64").unwrap().samples, 64);
         let e = parse("200").unwrap_err().to_string();

@@ -6,7 +6,6 @@ use std::time::Instant;
 
 use shadow_core::image::Rgb8;
 use shadow_core::light::LightView;
-use shadow_core::scene::LightKind;
 use shadow_core::stats::{Phase, ms};
 use shadow_core::technique::{DynShadowTechnique, FrameStats};
 use shadow_core::{FrameInputs, Image};
@@ -15,7 +14,7 @@ use wgpu::util::DeviceExt;
 use crate::clock::PhaseClock;
 use crate::context::{WgpuBackend, WgpuContext, WgpuError};
 use crate::gbuffer::{self, GpuGBuffer};
-use crate::pipelines::{COLOR, VISIBILITY};
+use crate::pipelines::{COLOR, LightRaw, VISIBILITY};
 use crate::readback;
 
 /// One light's visibility on the GPU: a render target layer (R32Float, 1 lit, 0 shadowed).
@@ -52,38 +51,6 @@ pub const MAX_LIGHTS: usize = 256;
 struct LightTable {
     count: [u32; 4],
     lights: [LightRaw; MAX_LIGHTS],
-}
-
-/// GPU twin of `Light` in common.wgsl.
-#[repr(C)]
-#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-struct LightRaw {
-    kind: [u32; 4],
-    position: [f32; 4],
-    direction: [f32; 4],
-    cone: [f32; 4],
-    color: [f32; 4],
-}
-
-impl LightRaw {
-    fn of(l: &shadow_core::scene::Light) -> Self {
-        let (kind, position, direction, cone) = match l.kind {
-            LightKind::Spot { position, direction, .. } => {
-                let (outer, inner) = shadow_core::shading::cone_cosines(l).unwrap_or((0.0, 0.0));
-                (0, position, direction.normalize(), [outer, inner])
-            }
-            LightKind::Directional { direction } => (1, glam::Vec3::ZERO, direction.normalize(), [0.0, 0.0]),
-            LightKind::Point { position } => (2, position, glam::Vec3::NEG_Y, [0.0, 0.0]),
-        };
-        Self {
-            kind: [kind, 0, 0, 0],
-            position: position.extend(1.0).to_array(),
-            direction: direction.extend(0.0).to_array(),
-            // z: the range, 0 for none.
-            cone: [cone[0], cone[1], l.range.unwrap_or(0.0), 0.0],
-            color: (l.color * l.intensity).extend(1.0).to_array(),
-        }
-    }
 }
 
 /// A 2D array texture to render into, sample and copy from.
@@ -267,7 +234,7 @@ fn shade(
         let mut lights: LightTable = bytemuck::Zeroable::zeroed();
         lights.count[0] = frame.lights.len() as u32;
         for (slot, l) in lights.lights.iter_mut().zip(&frame.lights) {
-            *slot = LightRaw::of(l);
+            *slot = LightRaw::from(l);
         }
         let lbuf = cx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("lights"),

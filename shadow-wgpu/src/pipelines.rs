@@ -3,6 +3,7 @@
 
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
+use shadow_core::scene::{Light, LightKind};
 use wgpu::util::DeviceExt;
 
 use crate::shaders;
@@ -36,6 +37,39 @@ impl ViewRaw {
             clip_from_world: clip_from_world.to_cols_array_2d(),
             eye: eye.extend(1.0).to_array(),
             size: [w, h, 1.0 / w, 1.0 / h],
+        }
+    }
+}
+
+/// GPU twin of `Light` in common.wgsl: the one encoding of a light every pass reads (the shading's light
+/// table, every map lookup's `MapParams`), with a spot light's cone cosines computed once, here.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct LightRaw {
+    kind: [u32; 4],
+    position: [f32; 4],
+    direction: [f32; 4],
+    cone: [f32; 4],
+    color: [f32; 4],
+}
+
+impl From<&Light> for LightRaw {
+    fn from(l: &Light) -> Self {
+        let (kind, position, direction, cone) = match l.kind {
+            LightKind::Spot { position, direction, .. } => {
+                let (outer, inner) = shadow_core::shading::cone_cosines(l).unwrap_or((0.0, 0.0));
+                (0, position, direction.normalize(), [outer, inner])
+            }
+            LightKind::Directional { direction } => (1, Vec3::ZERO, direction.normalize(), [0.0, 0.0]),
+            LightKind::Point { position } => (2, position, Vec3::NEG_Y, [0.0, 0.0]),
+        };
+        Self {
+            kind: [kind, 0, 0, 0],
+            position: position.extend(1.0).to_array(),
+            direction: direction.extend(0.0).to_array(),
+            // z: the range, 0 for none.
+            cone: [cone[0], cone[1], l.range.unwrap_or(0.0), 0.0],
+            color: (l.color * l.intensity).extend(1.0).to_array(),
         }
     }
 }

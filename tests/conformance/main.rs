@@ -5,6 +5,7 @@ mod cli;
 mod depth_layers;
 mod gpu_clock;
 mod hybrid;
+mod settings;
 mod silhouette_map;
 mod smoothies;
 // The technique of examples/custom_technique.rs, registered at runtime like a user's would be.

@@ -3,51 +3,57 @@
 //! soft techniques add their own keys after these. Declared once here so their defaults and help read the
 //! same everywhere.
 
-use super::settings::{BiasMode, DepthBias, MAX_MAP_RESOLUTION, SettingKey, SettingsError, Values};
+use super::settings::{
+    BiasMode, DepthBias, Filter, MAX_MAP_RESOLUTION, SettingField, SettingKey, SettingsError, Values,
+};
 
 /// `bias`: how the map's depth is offset.
-pub const BIAS: SettingKey = SettingKey {
-    key: "bias",
-    default: "slope",
-    help: "none, constant or slope (Vulkan depth bias when the map is rendered), or world (bias_world)",
-};
+pub const BIAS: SettingKey = SettingKey::choice(
+    "bias",
+    "slope",
+    BiasMode::NAMES,
+    "none, constant or slope (Vulkan depth bias when the map is rendered), or world (bias_world)",
+);
 
 /// `bias_constant`: Vulkan's constant depth-bias factor.
-pub const BIAS_CONSTANT: SettingKey = SettingKey {
-    key: "bias_constant",
-    default: "4",
-    help: "constant bias factor, in units of the f32 depth resolution at the primitive",
-};
+pub const BIAS_CONSTANT: SettingKey = SettingKey::float(
+    "bias_constant",
+    "4",
+    0.0,
+    1e9,
+    "constant bias factor, in units of the f32 depth resolution at the primitive",
+);
 
 /// `bias_slope`: Vulkan's slope depth-bias factor.
-pub const BIAS_SLOPE: SettingKey = SettingKey {
-    key: "bias_slope",
-    default: "2",
-    help: "slope bias factor, times the primitive's largest depth change per texel",
-};
+pub const BIAS_SLOPE: SettingKey = SettingKey::float(
+    "bias_slope",
+    "2",
+    0.0,
+    1e4,
+    "slope bias factor, times the primitive's largest depth change per texel",
+);
 
 /// `bias_world`: the receiver offset of `bias=world`.
-pub const BIAS_WORLD: SettingKey = SettingKey {
-    key: "bias_world",
-    default: "0.05",
-    help: "for bias=world: receiver offset towards the light, in scene units",
-};
+pub const BIAS_WORLD: SettingKey = SettingKey::float(
+    "bias_world",
+    "0.05",
+    0.0,
+    1e6,
+    "for bias=world: receiver offset towards the light, in scene units",
+);
 
 /// `filter`: the lookup filter of a map.
 pub const FILTER: SettingKey =
-    SettingKey { key: "filter", default: "none", help: "none, bilinear, pcf3x3, pcf4x4-jitter or poisson16" };
+    SettingKey::choice("filter", "none", Filter::NAMES, "none, bilinear, pcf3x3, pcf4x4-jitter or poisson16");
 
 /// `filter_radius`: the kernel radius of the jittered and Poisson filters.
-pub const FILTER_RADIUS: SettingKey = SettingKey {
-    key: "filter_radius",
-    default: "1.5",
-    help: "kernel radius in texels for pcf4x4-jitter and poisson16",
-};
+pub const FILTER_RADIUS: SettingKey =
+    SettingKey::float("filter_radius", "1.5", 0.0, 64.0, "kernel radius in texels for pcf4x4-jitter and poisson16");
 
 /// A `res` key: the map side, with the technique's own default and help.
 #[must_use]
 pub const fn resolution_key(default: &'static str, help: &'static str) -> SettingKey {
-    SettingKey { key: "res", default, help }
+    SettingKey::int("res", default, 16, MAX_MAP_RESOLUTION, help)
 }
 
 /// A light depth map: its side and how its depth is biased.
@@ -69,16 +75,8 @@ pub struct DepthMap {
     pub bias_world: f32,
 }
 
-/// Reads the map resolution key `res`.
-///
-/// # Errors
-/// Out of 16..=[`MAX_MAP_RESOLUTION`].
-pub fn read_resolution(v: &Values<'_>) -> Result<u32, SettingsError> {
-    v.ranged("res", 16u32, MAX_MAP_RESOLUTION)
-}
-
 impl DepthMap {
-    /// The keys in [`DepthMap::read`]'s order for a map whose `res` key is `res`.
+    /// The keys a depth map reads, in order, for a map whose `res` key is `res`.
     #[must_use]
     pub const fn keys(res: SettingKey) -> [SettingKey; 5] {
         [res, BIAS, BIAS_CONSTANT, BIAS_SLOPE, BIAS_WORLD]
@@ -95,30 +93,27 @@ impl DepthMap {
     pub fn receiver_offset(&self) -> f32 {
         if self.bias == BiasMode::World { self.bias_world } else { 0.0 }
     }
+}
 
-    /// Reads `res` and the bias keys.
-    ///
-    /// # Errors
-    /// A value that does not parse or is out of range.
-    pub fn read(v: &Values<'_>) -> Result<Self, SettingsError> {
+/// A depth map reads its five keys ([`DepthMap::keys`]) together.
+impl SettingField for DepthMap {
+    fn read(v: &Values<'_>, keys: &[SettingKey]) -> Result<Self, SettingsError> {
         Ok(Self {
-            resolution: read_resolution(v)?,
-            bias: v.get("bias")?,
-            bias_constant: v.ranged("bias_constant", 0.0, 1e9)?,
-            bias_slope: v.ranged("bias_slope", 0.0, 1e4)?,
-            bias_world: v.ranged("bias_world", 0.0, 1e6)?,
+            resolution: v.read(&keys[0])?,
+            bias: v.read(&keys[1])?,
+            bias_constant: v.read(&keys[2])?,
+            bias_slope: v.read(&keys[3])?,
+            bias_world: v.read(&keys[4])?,
         })
     }
 
-    /// The values of [`DepthMap::keys`], in order.
-    #[must_use]
-    pub fn values(&self) -> Vec<String> {
-        vec![
+    fn write(&self, out: &mut Vec<String>) {
+        out.extend([
             self.resolution.to_string(),
             self.bias.to_string(),
             self.bias_constant.to_string(),
             self.bias_slope.to_string(),
             self.bias_world.to_string(),
-        ]
+        ]);
     }
 }

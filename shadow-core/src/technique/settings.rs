@@ -5,7 +5,6 @@
 
 use std::collections::BTreeMap;
 use std::fmt;
-use std::str::FromStr;
 
 /// Largest shadow-map side any technique accepts: 16384^2 f32 texels is 1 GiB, refused before allocating
 /// anything bigger.
@@ -129,8 +128,30 @@ impl fmt::Display for TechniqueSpec {
     }
 }
 
-/// One setting: key, default value and help text.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// What values a setting takes: the one description that parsing, validation, `shadowlab techniques` and a
+/// viewer's controls all read.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum SettingKind {
+    /// A whole number in `lo..=hi`.
+    Int {
+        /// Smallest.
+        lo: u32,
+        /// Largest.
+        hi: u32,
+    },
+    /// A number in `lo..=hi`.
+    Float {
+        /// Smallest.
+        lo: f32,
+        /// Largest.
+        hi: f32,
+    },
+    /// One of these names.
+    Choice(&'static [&'static str]),
+}
+
+/// One setting: key, default, the values it takes, and help text.
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SettingKey {
     /// The key.
     pub key: &'static str,
@@ -138,6 +159,146 @@ pub struct SettingKey {
     pub default: &'static str,
     /// What it does.
     pub help: &'static str,
+    /// The values it takes.
+    pub kind: SettingKind,
+    /// A word taken besides the kind's values (`auto`, or `0` for "off" below an integer range); the field
+    /// type says what it means.
+    pub word: Option<&'static str>,
+}
+
+impl SettingKey {
+    /// A whole number in `lo..=hi`.
+    #[must_use]
+    pub const fn int(key: &'static str, default: &'static str, lo: u32, hi: u32, help: &'static str) -> Self {
+        Self { key, default, help, kind: SettingKind::Int { lo, hi }, word: None }
+    }
+
+    /// A number in `lo..=hi`.
+    #[must_use]
+    pub const fn float(key: &'static str, default: &'static str, lo: f32, hi: f32, help: &'static str) -> Self {
+        Self { key, default, help, kind: SettingKind::Float { lo, hi }, word: None }
+    }
+
+    /// One of `names` (a `named_enum!`'s `NAMES`).
+    #[must_use]
+    pub const fn choice(
+        key: &'static str,
+        default: &'static str,
+        names: &'static [&'static str],
+        help: &'static str,
+    ) -> Self {
+        Self { key, default, help, kind: SettingKind::Choice(names), word: None }
+    }
+
+    /// The same setting, also taking `word`.
+    #[must_use]
+    pub const fn or(self, word: &'static str) -> Self {
+        Self { word: Some(word), ..self }
+    }
+
+    /// The same setting with another default.
+    #[must_use]
+    pub const fn with_default(self, default: &'static str) -> Self {
+        Self { default, ..self }
+    }
+
+    /// What the setting takes, for error messages: "a number from 16 to 16384", "auto, or 0 to 64",
+    /// "one of none, constant, slope".
+    #[must_use]
+    pub fn expected(&self) -> String {
+        let range = match self.kind {
+            SettingKind::Int { lo, hi } => format!("{lo} to {hi}"),
+            SettingKind::Float { lo, hi } => format!("{lo} to {hi}"),
+            SettingKind::Choice(names) => return format!("one of {}", names.join(", ")),
+        };
+        match self.word {
+            Some(word) => format!("{word}, or {range}"),
+            None => format!("a number from {range}"),
+        }
+    }
+}
+
+/// A field type a setting reads into and prints from.
+pub trait SettingValue: Sized {
+    /// The value of `text` for `key`, or `None` when `key` does not take it.
+    fn from_setting(text: &str, key: &SettingKey) -> Option<Self>;
+    /// The text the value prints as (and reads back from).
+    fn to_setting(&self) -> String;
+}
+
+impl SettingValue for u32 {
+    fn from_setting(text: &str, key: &SettingKey) -> Option<Self> {
+        let v: u32 = text.parse().ok()?;
+        match key.kind {
+            _ if key.word == Some(text) => Some(v),
+            SettingKind::Int { lo, hi } => (lo..=hi).contains(&v).then_some(v),
+            _ => None,
+        }
+    }
+    fn to_setting(&self) -> String {
+        self.to_string()
+    }
+}
+
+impl SettingValue for f32 {
+    fn from_setting(text: &str, key: &SettingKey) -> Option<Self> {
+        let v: f32 = text.parse().ok()?;
+        match key.kind {
+            SettingKind::Float { lo, hi } => (v >= lo && v <= hi).then_some(v),
+            _ => None,
+        }
+    }
+    fn to_setting(&self) -> String {
+        self.to_string()
+    }
+}
+
+/// A whole number, or the key's word for none (`auto`).
+impl SettingValue for Option<u32> {
+    fn from_setting(text: &str, key: &SettingKey) -> Option<Self> {
+        if key.word == Some(text) { Some(None) } else { u32::from_setting(text, key).map(Some) }
+    }
+    fn to_setting(&self) -> String {
+        self.map_or_else(|| "auto".to_string(), |n| n.to_string())
+    }
+}
+
+/// The keys a settings field reads: one, or a group (a depth map's five).
+pub trait KeySet {
+    /// The keys, in order.
+    fn key_list(&self) -> &[SettingKey];
+}
+
+impl KeySet for SettingKey {
+    fn key_list(&self) -> &[SettingKey] {
+        std::slice::from_ref(self)
+    }
+}
+
+impl<const N: usize> KeySet for [SettingKey; N] {
+    fn key_list(&self) -> &[SettingKey] {
+        self
+    }
+}
+
+/// A settings field: a value of one key, or a group of keys read together.
+pub trait SettingField: Sized {
+    /// Reads the field from its keys.
+    ///
+    /// # Errors
+    /// A value its key does not take.
+    fn read(v: &Values<'_>, keys: &[SettingKey]) -> Result<Self, SettingsError>;
+    /// Appends the values of its keys, in order.
+    fn write(&self, out: &mut Vec<String>);
+}
+
+impl<T: SettingValue> SettingField for T {
+    fn read(v: &Values<'_>, keys: &[SettingKey]) -> Result<Self, SettingsError> {
+        v.read(&keys[0])
+    }
+    fn write(&self, out: &mut Vec<String>) {
+        out.push(self.to_setting());
+    }
 }
 
 /// The values given for a technique, with the defaults of its keys behind them.
@@ -148,16 +309,26 @@ pub struct Values<'a> {
 }
 
 impl Values<'_> {
-    /// The value of `key` (given or default), parsed.
+    /// The value of `key` (given or default), read as its kind says.
     ///
     /// # Errors
-    /// [`SettingsError::BadValue`] when it does not parse.
-    pub fn get<T: FromStr>(&self, key: &str) -> Result<T, SettingsError>
-    where
-        T::Err: fmt::Display,
-    {
-        let text = self.text(key);
-        text.parse().map_err(|e: T::Err| self.bad(key, &e.to_string()))
+    /// [`SettingsError::BadValue`] when the key does not take it.
+    pub fn read<T: SettingValue>(&self, key: &SettingKey) -> Result<T, SettingsError> {
+        T::from_setting(self.text(key.key), key).ok_or_else(|| self.bad(key.key, &key.expected()))
+    }
+
+    /// The value of the key named `key`.
+    ///
+    /// # Errors
+    /// [`SettingsError::BadValue`] when the key does not take it.
+    ///
+    /// # Panics
+    /// When `key` is not one of the technique's keys: that is a bug in the settings struct.
+    pub fn get<T: SettingValue>(&self, key: &str) -> Result<T, SettingsError> {
+        match self.keys.iter().find(|k| k.key == key) {
+            Some(k) => self.read(k),
+            None => panic!("settings struct reads undeclared key '{key}'"),
+        }
     }
 
     /// The text of `key`, given or default.
@@ -184,23 +355,6 @@ impl Values<'_> {
             value: self.text(key).into(),
             expected: expected.into(),
         }
-    }
-
-    /// The value of `key` as a number in `lo..=hi`.
-    ///
-    /// # Errors
-    /// [`SettingsError::BadValue`] when it does not parse or is out of range.
-    pub fn ranged<T: FromStr + PartialOrd + fmt::Display + Copy>(
-        &self,
-        key: &str,
-        lo: T,
-        hi: T,
-    ) -> Result<T, SettingsError>
-    where
-        T::Err: fmt::Display,
-    {
-        let v: T = self.get(key).map_err(|_| self.bad(key, &format!("a number from {lo} to {hi}")))?;
-        if v >= lo && v <= hi { Ok(v) } else { Err(self.bad(key, &format!("a number from {lo} to {hi}"))) }
     }
 }
 
@@ -286,6 +440,88 @@ macro_rules! named_enum {
         impl ::std::fmt::Display for $name {
             fn fmt(&self, f: &mut ::std::fmt::Formatter<'_>) -> ::std::fmt::Result {
                 f.write_str(self.as_str())
+            }
+        }
+
+        impl $crate::technique::settings::SettingValue for $name {
+            fn from_setting(text: &str, _: &$crate::technique::settings::SettingKey) -> Option<Self> {
+                text.parse().ok()
+            }
+            fn to_setting(&self) -> String {
+                self.as_str().to_string()
+            }
+        }
+    };
+}
+
+/// Declares a technique's settings once: each field with the key (or group of keys, such as a depth
+/// map's) it reads, in the order the canonical settings string lists them. The struct, its
+/// [`TechniqueSettings`] (keys, parsing with every value checked against its key's kind, printing) and,
+/// when given, the light kinds it takes and a check across fields all come from this one table.
+///
+/// ```
+/// use shadow_core::technique::settings::{SettingKey, TechniqueSettings};
+///
+/// shadow_core::technique_settings! {
+///     /// A technique with one setting.
+///     pub struct Example {
+///         /// Height of the receiving plane.
+///         pub plane_y: f32 = SettingKey::float("plane_y", "0", -1e6, 1e6, "height of the plane"),
+///     }
+/// }
+///
+/// let e = Example::parse("example", &[("plane_y".into(), "2.5".into())]).unwrap();
+/// assert_eq!(e.plane_y, 2.5);
+/// assert_eq!(e.settings_string(), "plane_y=2.5");
+/// assert!(Example::parse("example", &[("plane_y".into(), "1e9".into())]).is_err());
+/// ```
+#[macro_export]
+macro_rules! technique_settings {
+    (
+        $(#[$m:meta])*
+        pub struct $name:ident {
+            $( $(#[$fm:meta])* pub $field:ident : $ty:ty = $key:expr ),+ $(,)?
+        }
+        $( lights = $lights:expr; )?
+        $( check = $check:expr; )?
+    ) => {
+        $(#[$m])*
+        #[derive(Clone, Copy, Debug, PartialEq)]
+        pub struct $name { $( $(#[$fm])* pub $field: $ty ),+ }
+
+        impl $crate::technique::settings::TechniqueSettings for $name {
+            $( const LIGHTS: $crate::technique::LightKinds = $lights; )?
+
+            fn keys() -> &'static [$crate::technique::settings::SettingKey] {
+                static KEYS: ::std::sync::OnceLock<::std::vec::Vec<$crate::technique::settings::SettingKey>> =
+                    ::std::sync::OnceLock::new();
+                KEYS.get_or_init(|| {
+                    let mut keys = ::std::vec::Vec::new();
+                    $( keys.extend_from_slice($crate::technique::settings::KeySet::key_list(&$key)); )+
+                    keys
+                })
+            }
+
+            fn from_values(
+                v: &$crate::technique::settings::Values<'_>,
+            ) -> Result<Self, $crate::technique::settings::SettingsError> {
+                let mut keys = Self::keys();
+                let settings = Self {
+                    $( $field: {
+                        let (own, rest) = keys.split_at($crate::technique::settings::KeySet::key_list(&$key).len());
+                        keys = rest;
+                        <$ty as $crate::technique::settings::SettingField>::read(v, own)?
+                    } ),+
+                };
+                let _ = keys;
+                $( ($check)(&settings, v)?; )?
+                Ok(settings)
+            }
+
+            fn to_values(&self) -> Vec<String> {
+                let mut out = Vec::new();
+                $( $crate::technique::settings::SettingField::write(&self.$field, &mut out); )+
+                out
             }
         }
     };

@@ -12,7 +12,7 @@
 pub mod cpu;
 pub mod gpu;
 
-use shadow_core::technique::maps::{FILTER, FILTER_RADIUS, read_resolution, resolution_key};
+use shadow_core::technique::maps::{FILTER, FILTER_RADIUS, resolution_key};
 use shadow_core::technique::settings::{Filter, SettingKey, SettingsError, TechniqueSettings, TechniqueSpec, Values};
 use shadow_core::technique::{Backend, DynShadowTechnique, ShadowTechnique, Stateful};
 use shadow_cpu::CpuBackend;
@@ -88,33 +88,42 @@ impl DepthLayers {
         }
     }
 
-    fn keys_with(culling: &'static str) -> [SettingKey; 6] {
+    const fn keys_with(culling: &'static str) -> [SettingKey; 6] {
         [
             resolution_key("1024", "map side in texels (16 to 16384)"),
             FILTER,
             FILTER_RADIUS,
-            SettingKey {
-                key: "z_offset",
-                default: "0.1",
-                help: "dual map: largest bias, in scene units along the light axis",
-            },
-            SettingKey {
-                key: "peel_epsilon",
-                default: "0.0000001",
-                help: "second layer: NDC depth within which a fragment counts as the first layer",
-            },
-            SettingKey { key: "culling", default: culling, help: "auto (back faces of closed meshes culled) or none" },
+            SettingKey::float(
+                "z_offset",
+                "0.1",
+                0.0,
+                1e9,
+                "dual map: largest bias, in scene units along the light axis",
+            ),
+            SettingKey::float(
+                "peel_epsilon",
+                "0.0000001",
+                0.0,
+                1.0,
+                "second layer: NDC depth within which a fragment counts as the first layer",
+            ),
+            SettingKey::choice(
+                "culling",
+                culling,
+                LayerCulling::NAMES,
+                "auto (back faces of closed meshes culled) or none",
+            ),
         ]
     }
 
     fn read(kind: LayerKind, v: &Values<'_>) -> Result<Self, SettingsError> {
         Ok(Self {
             kind,
-            resolution: read_resolution(v)?,
+            resolution: v.get("res")?,
             filter: v.get("filter")?,
-            filter_radius: v.ranged("filter_radius", 0.0, 64.0)?,
-            z_offset: v.ranged("z_offset", 0.0, 1e9)?,
-            peel_epsilon: v.ranged("peel_epsilon", 0.0, 1.0)?,
+            filter_radius: v.get("filter_radius")?,
+            z_offset: v.get("z_offset")?,
+            peel_epsilon: v.get("peel_epsilon")?,
             culling: v.get("culling")?,
         })
     }
@@ -141,8 +150,8 @@ macro_rules! layer_settings {
 
         impl TechniqueSettings for $name {
             fn keys() -> &'static [SettingKey] {
-                static KEYS: std::sync::OnceLock<[SettingKey; 6]> = std::sync::OnceLock::new();
-                KEYS.get_or_init(|| DepthLayers::keys_with($culling))
+                const KEYS: [SettingKey; 6] = DepthLayers::keys_with($culling);
+                &KEYS
             }
             fn from_values(v: &Values<'_>) -> Result<Self, SettingsError> {
                 Ok(Self(DepthLayers::read($kind, v)?))

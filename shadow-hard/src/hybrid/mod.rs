@@ -18,56 +18,102 @@ pub mod gpu;
 pub mod shafts;
 
 use crate::Entry;
-use shadow_core::technique::maps::{BIAS, BIAS_CONSTANT, BIAS_SLOPE, BIAS_WORLD, DepthMap, resolution_key};
-use shadow_core::technique::settings::{OnOff, SettingKey, SettingsError, TechniqueSettings, Values};
+use shadow_core::technique::maps::{DepthMap, resolution_key};
+use shadow_core::technique::settings::{OnOff, SettingKey};
 
-/// `hybrid` (Chan, thesis chapter 3): a shadow map classifies each receiver; where its four nearest
-/// depth tests disagree on a surface facing the light (a silhouette pixel) z-fail shadow volumes decide,
-/// confined to those pixels by a computation mask; everywhere else the map decides.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Hybrid {
-    /// The classifying map: resolution and bias as `shadow-map` has them (the filter is unused: the
-    /// classification reads the four nearest texels). Chan uses a lower resolution than a plain map needs,
-    /// the volumes drawing the edges.
-    pub depth: DepthMap,
-    /// Side in pixels of the CPU computation mask's tiles, which the rasterizer skips whole where no pixel
-    /// is masked in.
-    pub mask_tile: u32,
-    /// CPU: on, the mask's pixels are also ordered around the light's image, so each side of a volume drawn
-    /// through the whole mask (every volume with `caster_masks=off`, only the pieces too large to list
-    /// otherwise) is tested only at the silhouette pixels in its angle from there (all sides lie on lines
-    /// through it); off, walked row by row under the tiled mask. Same fragments either way. Off by default:
-    /// with caster masks the ordering costs more than it saves.
-    pub pencil: OnOff,
-    /// On, each connected component's volume is counted only at the silhouette pixels within the
-    /// light-space bounds of its shadow ([`shafts`]; its count is zero everywhere else): on the CPU
-    /// by listed draws, on the GPU by compute passes over the pixels the mask pass lists (pieces of more
-    /// than a thousand triangles stay rasterized under the mask); off, every volume through the whole
-    /// mask. Same picture either way, on the GPU but for the odd pixel where a volume side meets its
-    /// receiver to within rounding.
-    pub caster_masks: OnOff,
-    /// Where the GPU keeps the computation mask (the CPU always uses its tiles).
-    pub gpu_mask: GpuMask,
-    /// GPU: 0, the volumes are drawn over the whole view and the mask rejects fragments; N, the mask pass
-    /// also marks the N x N pixel tiles holding a silhouette pixel, the CPU reads the marks back and the
-    /// volumes are drawn only inside scissor rectangles around those tiles, so the rasterizer never makes
-    /// the fragments elsewhere (the draws are repeated per rectangle).
-    pub scissor_tile: u32,
-    /// Which receivers facing the light are also silhouette pixels because of the casters' silhouette
-    /// edges (drawn into a map of edge depths), so casters and gaps thinner than a texel, which the map
-    /// misses (Chan's Fig. 3-8), still get volumes; off: Chan's rule alone. `paired` by default (ours):
-    /// it keeps `tree` under 0.1% at 512^2 as `all` does, with a third more silhouette pixels than Chan's
-    /// rule on tree and nine tenths more on cubes, where `all` has twice and ten times as many.
-    pub edge_texels: EdgeTexels,
-    /// Whether the query also counts the volumes' unmasked fill (what `shadow-volume-zfail` rasterizes),
-    /// the counter `unmasked_volume_fragments`, in a pass of its own timed as `count_fragments`; off, the
-    /// frame costs what the technique costs.
-    pub unmasked_fill: OnOff,
-    /// GPU caster masks: how many pairs of a silhouette pixel and a piece whose shaft holds it the compute
-    /// passes have room for; `None`, eight per pixel of the view. A pixel whose pairs do not all fit counts
-    /// every one of its pieces by itself, in one invocation (slower, same count), so a small room changes
-    /// the time, never the picture.
-    pub pair_room: Option<u32>,
+shadow_core::technique_settings! {
+    /// `hybrid` (Chan, thesis chapter 3): a shadow map classifies each receiver; where its four nearest
+    /// depth tests disagree on a surface facing the light (a silhouette pixel) z-fail shadow volumes decide,
+    /// confined to those pixels by a computation mask; everywhere else the map decides.
+    pub struct Hybrid {
+        /// The classifying map: resolution and bias as `shadow-map` has them (the filter is unused: the
+        /// classification reads the four nearest texels). Chan uses a lower resolution than a plain map needs,
+        /// the volumes drawing the edges.
+        pub depth: DepthMap = DepthMap::keys(resolution_key("512", "classifying map side in texels (16 to 16384)")),
+        /// Side in pixels of the CPU computation mask's tiles, which the rasterizer skips whole where no pixel
+        /// is masked in.
+        pub mask_tile: u32 = SettingKey::int(
+            "mask_tile",
+            "8",
+            1,
+            64,
+            "CPU computation-mask tile side in pixels (1 to 64): tiles with no silhouette pixel are skipped whole",
+        ),
+        /// CPU: on, the mask's pixels are also ordered around the light's image, so each side of a volume drawn
+        /// through the whole mask (every volume with `caster_masks=off`, only the pieces too large to list
+        /// otherwise) is tested only at the silhouette pixels in its angle from there (all sides lie on lines
+        /// through it); off, walked row by row under the tiled mask. Same fragments either way. Off by default:
+        /// with caster masks the ordering costs more than it saves.
+        pub pencil: OnOff = SettingKey::choice(
+            "pencil",
+            "off",
+            OnOff::NAMES,
+            "CPU: on, the sides of volumes drawn through the whole mask are tested only at the silhouette pixels in their angle around the light's image; off, walked row by row",
+        ),
+        /// On, each connected component's volume is counted only at the silhouette pixels within the
+        /// light-space bounds of its shadow ([`shafts`]; its count is zero everywhere else): on the CPU
+        /// by listed draws, on the GPU by compute passes over the pixels the mask pass lists (pieces of more
+        /// than a thousand triangles stay rasterized under the mask); off, every volume through the whole
+        /// mask. Same picture either way, on the GPU but for the odd pixel where a volume side meets its
+        /// receiver to within rounding.
+        pub caster_masks: OnOff = SettingKey::choice(
+            "caster_masks",
+            "on",
+            OnOff::NAMES,
+            "on, each caster's volume is counted only at the silhouette pixels its shadow's bounds hold (GPU: by compute passes); off, through the whole mask",
+        ),
+        /// Where the GPU keeps the computation mask (the CPU always uses its tiles).
+        pub gpu_mask: GpuMask = SettingKey::choice(
+            "gpu_mask",
+            "stencil",
+            GpuMask::NAMES,
+            "GPU computation mask: stencil (a stencil bit) or depth (a scratch depth of 1 outside the mask)",
+        ),
+        /// GPU: 0, the volumes are drawn over the whole view and the mask rejects fragments; N, the mask pass
+        /// also marks the N x N pixel tiles holding a silhouette pixel, the CPU reads the marks back and the
+        /// volumes are drawn only inside scissor rectangles around those tiles, so the rasterizer never makes
+        /// the fragments elsewhere (the draws are repeated per rectangle).
+        pub scissor_tile: u32 = SettingKey::int(
+            "scissor_tile",
+            "0",
+            8,
+            512,
+            "GPU: 0, or draw the volumes only in scissor rectangles around the masked NxN tiles (8 to 512)",
+            ).or("0",
+        ),
+        /// Which receivers facing the light are also silhouette pixels because of the casters' silhouette
+        /// edges (drawn into a map of edge depths), so casters and gaps thinner than a texel, which the map
+        /// misses (Chan's Fig. 3-8), still get volumes; off: Chan's rule alone. `paired` by default (ours):
+        /// it keeps `tree` under 0.1% at 512^2 as `all` does, with a third more silhouette pixels than Chan's
+        /// rule on tree and nine tenths more on cubes, where `all` has twice and ten times as many.
+        pub edge_texels: EdgeTexels = SettingKey::choice(
+            "edge_texels",
+            "paired",
+            EdgeTexels::NAMES,
+            "off (Chan's rule), all (also mask receivers whose texels a silhouette edge in front crosses) or paired (only where two edges in front enter the receiver's footprint, or one ends there)",
+        ),
+        /// Whether the query also counts the volumes' unmasked fill (what `shadow-volume-zfail` rasterizes),
+        /// the counter `unmasked_volume_fragments`, in a pass of its own timed as `count_fragments`; off, the
+        /// frame costs what the technique costs.
+        pub unmasked_fill: OnOff = SettingKey::choice(
+            "unmasked_fill",
+            "off",
+            OnOff::NAMES,
+            "on: also count the volumes' fill without the mask (unmasked_volume_fragments), in an extra pass",
+        ),
+        /// GPU caster masks: how many pairs of a silhouette pixel and a piece whose shaft holds it the compute
+        /// passes have room for; `None`, eight per pixel of the view. A pixel whose pairs do not all fit counts
+        /// every one of its pieces by itself, in one invocation (slower, same count), so a small room changes
+        /// the time, never the picture.
+        pub pair_room: Option<u32> = SettingKey::int(
+            "pair_room",
+            "auto",
+            0,
+            MAX_PAIR_ROOM,
+            "GPU caster masks: room for pixel-piece pairs, auto (8 per view pixel) or 0 to 268435456; a pixel whose pairs do not fit counts its pieces alone, more slowly",
+            ).or("auto",
+        ),
+    }
 }
 
 /// The most pairs `hybrid`'s `pair_room` may ask for: 2^28, what a 4 GiB storage binding holds at three
@@ -108,96 +154,6 @@ shadow_core::named_enum! {
         /// Measured on an H100 (Vulkan), it is the slower of the two: the query takes 1.4 to 3.3 times the
         /// stencil mask's, whether the depth outside the mask is written by a shader or rasterized.
         Depth = "depth",
-    }
-}
-
-const HYBRID_KEYS: [SettingKey; 13] = [
-    resolution_key("512", "classifying map side in texels (16 to 16384)"),
-    BIAS,
-    BIAS_CONSTANT,
-    BIAS_SLOPE,
-    BIAS_WORLD,
-    SettingKey {
-        key: "mask_tile",
-        default: "8",
-        help: "CPU computation-mask tile side in pixels (1 to 64): tiles with no silhouette pixel are skipped whole",
-    },
-    SettingKey {
-        key: "pencil",
-        default: "off",
-        help: "CPU: on, the sides of volumes drawn through the whole mask are tested only at the silhouette pixels in their angle around the light's image; off, walked row by row",
-    },
-    SettingKey {
-        key: "caster_masks",
-        default: "on",
-        help: "on, each caster's volume is counted only at the silhouette pixels its shadow's bounds hold (GPU: by compute passes); off, through the whole mask",
-    },
-    SettingKey {
-        key: "gpu_mask",
-        default: "stencil",
-        help: "GPU computation mask: stencil (a stencil bit) or depth (a scratch depth of 1 outside the mask)",
-    },
-    SettingKey {
-        key: "scissor_tile",
-        default: "0",
-        help: "GPU: 0, or draw the volumes only in scissor rectangles around the masked NxN tiles (8 to 512)",
-    },
-    SettingKey {
-        key: "edge_texels",
-        default: "paired",
-        help: "off (Chan's rule), all (also mask receivers whose texels a silhouette edge in front crosses) or paired (only where two edges in front enter the receiver's footprint, or one ends there)",
-    },
-    SettingKey {
-        key: "unmasked_fill",
-        default: "off",
-        help: "on: also count the volumes' fill without the mask (unmasked_volume_fragments), in an extra pass",
-    },
-    SettingKey {
-        key: "pair_room",
-        default: "auto",
-        help: "GPU caster masks: room for pixel-piece pairs, auto (8 per view pixel) or 0 to 268435456; a pixel whose pairs do not fit counts its pieces alone, more slowly",
-    },
-];
-
-impl TechniqueSettings for Hybrid {
-    fn keys() -> &'static [SettingKey] {
-        &HYBRID_KEYS
-    }
-    fn from_values(v: &Values<'_>) -> Result<Self, SettingsError> {
-        Ok(Self {
-            depth: DepthMap::read(v)?,
-            mask_tile: v.ranged("mask_tile", 1, 64)?,
-            pencil: v.get("pencil")?,
-            caster_masks: v.get("caster_masks")?,
-            gpu_mask: v.get("gpu_mask")?,
-            scissor_tile: match v.text("scissor_tile") {
-                "0" => 0,
-                _ => v.ranged("scissor_tile", 8, 512).map_err(|_| v.bad("scissor_tile", "0, or 8 to 512"))?,
-            },
-            edge_texels: v.get("edge_texels")?,
-            unmasked_fill: v.get("unmasked_fill")?,
-            pair_room: match v.text("pair_room") {
-                "auto" => None,
-                _ => Some(
-                    v.ranged("pair_room", 0, MAX_PAIR_ROOM)
-                        .map_err(|_| v.bad("pair_room", "auto, or 0 to 268435456"))?,
-                ),
-            },
-        })
-    }
-    fn to_values(&self) -> Vec<String> {
-        let mut v = self.depth.values();
-        v.extend([
-            self.mask_tile.to_string(),
-            self.pencil.to_string(),
-            self.caster_masks.to_string(),
-            self.gpu_mask.to_string(),
-            self.scissor_tile.to_string(),
-            self.edge_texels.to_string(),
-            self.unmasked_fill.to_string(),
-            self.pair_room.map_or_else(|| "auto".to_string(), |n| n.to_string()),
-        ]);
-        v
     }
 }
 

@@ -14,32 +14,23 @@
 pub mod cpu;
 
 use crate::Entry;
-use shadow_core::technique::settings::{SettingKey, SettingsError, TechniqueSettings, Values};
+use shadow_core::technique::settings::SettingKey;
 
-/// `ray-traced`: one shadow ray per G-buffer pixel, the exact reference.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct RayTraced {
-    /// Shadow-ray origin offset along the geometric normal, as a fraction of the scene's bounding-box
-    /// diagonal (so the offset scales with the scene). The default, 5e-7, is a few f32 ulps of the scene's
-    /// size: enough to clear the rounding of the surface position, small enough not to shift rays past
-    /// sub-centimetre occluders (at 2e-5 the tree's thin branch shadows moved by a pixel in 0.1% of the
-    /// image; from 2e-6 down the reference stops changing).
-    pub epsilon: f32,
-}
-
-impl TechniqueSettings for RayTraced {
-    fn keys() -> &'static [SettingKey] {
-        &[SettingKey {
-            key: "epsilon",
-            default: "0.0000005",
-            help: "ray origin offset along the normal, as a fraction of the scene diagonal",
-        }]
-    }
-    fn from_values(v: &Values<'_>) -> Result<Self, SettingsError> {
-        Ok(Self { epsilon: v.ranged("epsilon", 0.0, 0.1)? })
-    }
-    fn to_values(&self) -> Vec<String> {
-        vec![self.epsilon.to_string()]
+shadow_core::technique_settings! {
+    /// `ray-traced`: one shadow ray per G-buffer pixel, the exact reference.
+    pub struct RayTraced {
+        /// Shadow-ray origin offset along the geometric normal, as a fraction of the scene's bounding-box
+        /// diagonal (so the offset scales with the scene). The default, 5e-7, is a few f32 ulps of the
+        /// scene's size: enough to clear the rounding of the surface position, small enough not to shift
+        /// rays past sub-centimetre occluders (at 2e-5 the tree's thin branch shadows moved by a pixel in
+        /// 0.1% of the image; from 2e-6 down the reference stops changing).
+        pub epsilon: f32 = SettingKey::float(
+            "epsilon",
+            "0.0000005",
+            0.0,
+            0.1,
+            "ray origin offset along the normal, as a fraction of the scene diagonal",
+        ),
     }
 }
 

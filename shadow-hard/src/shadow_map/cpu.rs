@@ -34,7 +34,7 @@ impl ShadowTechnique<CpuBackend> for ShadowMap {
         light: &LightView,
         _: &mut FrameStats,
     ) -> Result<(), CpuError> {
-        render_depth_maps(frame, light, self.map.resolution, self.map.depth_bias(), &mut state.maps)
+        render_depth_maps(frame, light, self.map().resolution, self.map().depth_bias(), &mut state.maps)
     }
 
     fn query(
@@ -50,7 +50,7 @@ impl ShadowTechnique<CpuBackend> for ShadowMap {
         if state.maps.len() != light.projections.len() {
             return Err(TechniqueError::NotBuilt(Self::NAME.into()).into());
         }
-        query_maps(&state.maps, light, g, out, self.filter, self.filter_radius, self.map.receiver_offset());
+        query_maps(&state.maps, light, g, out, self.filter, self.filter_radius, self.map().receiver_offset());
         Ok(())
     }
 

@@ -27,7 +27,7 @@ impl ShadowTechnique<WgpuBackend> for ShadowMap {
         cx.scoped("creating the shadow-map pipelines", |cx| {
             let module = shaders::module(&cx.device, "shadow_map", shaders::shadow_map());
             State {
-                maps: DepthMaps::with_module(cx, &module, &self.map),
+                maps: DepthMaps::with_module(cx, &module, &self.map()),
                 query: MapQuery::new(cx, &module, self.filter),
             }
         })
@@ -41,7 +41,7 @@ impl ShadowTechnique<WgpuBackend> for ShadowMap {
         light: &LightView,
         _: &mut FrameStats,
     ) -> Result<(), WgpuError> {
-        state.maps.render(cx, frame, light, self.map.resolution)
+        state.maps.render(cx, frame, light, self.map().resolution)
     }
 
     fn query(
@@ -55,7 +55,7 @@ impl ShadowTechnique<WgpuBackend> for ShadowMap {
         _: &mut FrameStats,
     ) -> Result<(), WgpuError> {
         let maps = state.maps.maps().ok_or_else(|| TechniqueError::NotBuilt(Self::NAME.into()))?;
-        let lookup = LookupParams { radius: self.filter_radius, receiver_offset: self.map.receiver_offset() };
+        let lookup = LookupParams { radius: self.filter_radius, receiver_offset: self.map().receiver_offset() };
         state.query.run(cx, maps, light, g, out, lookup, &QueryExtras::NONE)
     }
 }

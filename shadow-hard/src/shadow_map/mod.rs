@@ -12,56 +12,46 @@ use crate::Entry;
 use shadow_core::technique::maps::{
     BIAS, BIAS_CONSTANT, BIAS_SLOPE, BIAS_WORLD, DepthMap, FILTER, FILTER_RADIUS, resolution_key,
 };
-use shadow_core::technique::settings::{Filter, SettingKey, SettingsError, TechniqueSettings, Values};
+use shadow_core::technique::settings::{BiasMode, Filter};
+#[cfg(test)]
+use shadow_core::technique::settings::{SettingsError, TechniqueSettings};
 
-/// `shadow-map`: Williams' depth map with Vulkan depth bias and percentage-closer filtering.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ShadowMap {
-    /// The map: side and bias.
-    pub map: DepthMap,
-    /// Lookup filter.
-    pub filter: Filter,
-    /// Kernel radius in texels for `pcf4x4-jitter` and `poisson16`.
-    pub filter_radius: f32,
+shadow_core::technique_settings! {
+    /// `shadow-map`: Williams' depth map with Vulkan depth bias and percentage-closer filtering. The map's
+    /// keys come first and the filter's between the bias factors and `bias_world`, so the fields are flat
+    /// here; [`ShadowMap::map`] puts the map's together.
+    pub struct ShadowMap {
+        /// Map side in texels.
+        pub resolution: u32 = resolution_key("2048", "map side in texels (16 to 16384)"),
+        /// Bias mode.
+        pub bias: BiasMode = BIAS,
+        /// Vulkan constant depth-bias factor (see [`DepthMap::bias_constant`]).
+        pub bias_constant: f32 = BIAS_CONSTANT,
+        /// Vulkan slope depth-bias factor.
+        pub bias_slope: f32 = BIAS_SLOPE,
+        /// Lookup filter.
+        pub filter: Filter = FILTER,
+        /// Kernel radius in texels for `pcf4x4-jitter` and `poisson16`.
+        pub filter_radius: f32 = FILTER_RADIUS,
+        /// Receiver offset towards the light, in scene units, for `bias=world`.
+        pub bias_world: f32 = BIAS_WORLD,
+    }
 }
 
 impl ShadowMap {
     /// The technique's name.
     pub const NAME: &'static str = "shadow-map";
-}
 
-const KEYS: [SettingKey; 7] = [
-    resolution_key("2048", "map side in texels (16 to 16384)"),
-    BIAS,
-    BIAS_CONSTANT,
-    BIAS_SLOPE,
-    FILTER,
-    FILTER_RADIUS,
-    BIAS_WORLD,
-];
-
-impl TechniqueSettings for ShadowMap {
-    fn keys() -> &'static [SettingKey] {
-        &KEYS
-    }
-    fn from_values(v: &Values<'_>) -> Result<Self, SettingsError> {
-        Ok(Self {
-            map: DepthMap::read(v)?,
-            filter: v.get("filter")?,
-            filter_radius: v.ranged("filter_radius", 0.0, 64.0)?,
-        })
-    }
-    fn to_values(&self) -> Vec<String> {
-        let m = &self.map;
-        vec![
-            m.resolution.to_string(),
-            m.bias.to_string(),
-            m.bias_constant.to_string(),
-            m.bias_slope.to_string(),
-            self.filter.to_string(),
-            self.filter_radius.to_string(),
-            m.bias_world.to_string(),
-        ]
+    /// The map: side and bias.
+    #[must_use]
+    pub fn map(&self) -> DepthMap {
+        DepthMap {
+            resolution: self.resolution,
+            bias: self.bias,
+            bias_constant: self.bias_constant,
+            bias_slope: self.bias_slope,
+            bias_world: self.bias_world,
+        }
     }
 }
 

@@ -13,73 +13,53 @@ pub mod gpu;
 pub mod points;
 
 use crate::Entry;
-use shadow_core::technique::maps::{BIAS, BIAS_CONSTANT, BIAS_SLOPE, BIAS_WORLD, DepthMap, resolution_key};
-use shadow_core::technique::settings::{SettingKey, SettingsError, TechniqueSettings, Values};
+use shadow_core::technique::maps::{DepthMap, resolution_key};
+use shadow_core::technique::settings::SettingKey;
+#[cfg(test)]
+use shadow_core::technique::settings::TechniqueSettings;
 
 use points::{CornerDepth, Keep};
 
-/// `silhouette-map` (Sen, Cammarano, Hanrahan 2003): a shadow map plus a map of points on the
-/// silhouettes, shifted half a texel; the lookup reconstructs a piecewise-linear shadow edge.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SilhouetteMap {
-    /// The depth map: resolution and bias as `shadow-map` has them (its filter is unused: the
-    /// reconstruction replaces it).
-    pub depth: DepthMap,
-    /// The corner rule's enlargement of the clip square, in texels (section 3.1: "within limits of
-    /// precision"). At 0.01 a segment within a hundredth of a texel of a corner is stored in all four texels
-    /// around it, far above the rounding of texel coordinates (about 1e-4 at 4096 texels).
-    pub corner_margin: f32,
-    /// What each corner sample is compared with.
-    pub corner_depth: CornerDepth,
-    /// Which point a texel crossed by several silhouettes keeps.
-    pub keep: Keep,
+shadow_core::technique_settings! {
+    /// `silhouette-map` (Sen, Cammarano, Hanrahan 2003): a shadow map plus a map of points on the
+    /// silhouettes, shifted half a texel; the lookup reconstructs a piecewise-linear shadow edge.
+    pub struct SilhouetteMap {
+        /// The depth map: resolution and bias as `shadow-map` has them (its filter is unused: the
+        /// reconstruction replaces it).
+        pub depth: DepthMap = DepthMap::keys(resolution_key(
+            "1024",
+            "depth-map side in texels (16 to 16384); the silhouette map has one texel fewer",
+        )),
+        /// The corner rule's enlargement of the clip square, in texels (section 3.1: "within limits of
+        /// precision"). At 0.01 a segment within a hundredth of a texel of a corner is stored in all four texels
+        /// around it, far above the rounding of texel coordinates (about 1e-4 at 4096 texels).
+        pub corner_margin: f32 = SettingKey::float(
+            "corner_margin",
+            "0.01",
+            0.0,
+            0.25,
+            "corner rule: how far outside a texel, in texels, a segment still counts as crossing it",
+        ),
+        /// What each corner sample is compared with.
+        pub corner_depth: CornerDepth = SettingKey::choice(
+            "corner_depth",
+            "receiver-plane",
+            CornerDepth::NAMES,
+            "compare corner samples with the receiver plane's depth there, or the fragment's own (the paper)",
+        ),
+        /// Which point a texel crossed by several silhouettes keeps.
+        pub keep: Keep = SettingKey::choice(
+            "keep",
+            "nearest",
+            Keep::NAMES,
+            "the point a texel crossed by several silhouettes keeps: nearest the light, or last drawn (the paper)",
+        ),
+    }
 }
 
 impl SilhouetteMap {
     /// The technique's name.
     pub const NAME: &'static str = "silhouette-map";
-}
-
-const SILHOUETTE_KEYS: [SettingKey; 8] = [
-    resolution_key("1024", "depth-map side in texels (16 to 16384); the silhouette map has one texel fewer"),
-    BIAS,
-    BIAS_CONSTANT,
-    BIAS_SLOPE,
-    BIAS_WORLD,
-    SettingKey {
-        key: "corner_margin",
-        default: "0.01",
-        help: "corner rule: how far outside a texel, in texels, a segment still counts as crossing it",
-    },
-    SettingKey {
-        key: "corner_depth",
-        default: "receiver-plane",
-        help: "compare corner samples with the receiver plane's depth there, or the fragment's own (the paper)",
-    },
-    SettingKey {
-        key: "keep",
-        default: "nearest",
-        help: "the point a texel crossed by several silhouettes keeps: nearest the light, or last drawn (the paper)",
-    },
-];
-
-impl TechniqueSettings for SilhouetteMap {
-    fn keys() -> &'static [SettingKey] {
-        &SILHOUETTE_KEYS
-    }
-    fn from_values(v: &Values<'_>) -> Result<Self, SettingsError> {
-        Ok(Self {
-            depth: DepthMap::read(v)?,
-            corner_margin: v.ranged("corner_margin", 0.0, 0.25)?,
-            corner_depth: v.get("corner_depth")?,
-            keep: v.get("keep")?,
-        })
-    }
-    fn to_values(&self) -> Vec<String> {
-        let mut v = self.depth.values();
-        v.extend([self.corner_margin.to_string(), self.corner_depth.to_string(), self.keep.to_string()]);
-        v
-    }
 }
 
 /// The registry entry.

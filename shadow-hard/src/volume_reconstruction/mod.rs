@@ -13,8 +13,8 @@ pub mod gpu;
 pub mod reconstruction;
 
 use crate::Entry;
-use shadow_core::technique::maps::{BIAS, BIAS_CONSTANT, BIAS_SLOPE, BIAS_WORLD, DepthMap, resolution_key};
-use shadow_core::technique::settings::{OnOff, SettingKey, SettingsError, TechniqueSettings, Values};
+use shadow_core::technique::maps::{BIAS_SLOPE, DepthMap, resolution_key};
+use shadow_core::technique::settings::{OnOff, SettingKey, SettingsError, Values};
 
 shadow_core::named_enum! {
     /// The edge detector of `volume-reconstruction`.
@@ -53,121 +53,108 @@ shadow_core::named_enum! {
     }
 }
 
-/// `volume-reconstruction` (McCool 2000): a shadow volume rebuilt from the light's depth map, resolved
-/// with a one-bit parity stencil.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct VolumeReconstruction {
-    /// The depth map: resolution and bias as `shadow-map` has them (the filter is unused). The bias
-    /// moves the reconstructed boundary away from the light, as the paper's bias translation of the light
-    /// depths does; `bias=world` moves each vertex `bias_world` along its light ray.
-    pub depth: DepthMap,
-    /// Where the mesh's vertices are.
-    pub vertices: MeshVertices,
-    /// The detector.
-    pub edges: EdgeTest,
-    /// theta_L, theta_H, theta_S and the dangling-edge threshold, as fractions of the fitted light depth
-    /// range (far minus near), applied to linear depths.
-    pub theta_low: f32,
-    /// See `theta_low`.
-    pub theta_high: f32,
-    /// See `theta_low`.
-    pub theta_second: f32,
-    /// See `theta_low`.
-    pub theta_dangling: f32,
-    /// How many cells a dangling edge is followed under the lowered thresholds.
-    pub dangling_steps: u32,
-    /// Object-ID edges from an ID channel of the light pass.
-    pub ids: ObjectIds,
-    /// The near-plane cap: on, software caps (McCool section 6.2); off, none, so that where the eye's near
-    /// plane cuts the volume parity inverts (Fig. 7).
-    pub capping: OnOff,
-}
+/// The depth map's keys, with an eighth of shadow-map's slope bias: the mesh is drawn only across
+/// discontinuities, where its slopes fall away from the occluder, so the bias is needed only against
+/// false-positive cells lying on a surface, and a receiver's bias sinks the slopes' far ends behind it and
+/// erodes the shadow (cubes, map 512: slope 2 gives 1.03%, 0.25 gives 0.69%, shadow-map 0.92%; none leaves
+/// false-positive rows on strike).
+const DEPTH_KEYS: [SettingKey; 5] = {
+    let mut keys = DepthMap::keys(resolution_key("1024", "depth-map side in texels (16 to 16384)"));
+    keys[3] = BIAS_SLOPE.with_default("0.25");
+    keys
+};
 
-const RECONSTRUCTION_KEYS: [SettingKey; 14] = [
-    resolution_key("1024", "depth-map side in texels (16 to 16384)"),
-    BIAS,
-    BIAS_CONSTANT,
-    // An eighth of shadow-map's: the mesh is drawn only across discontinuities, where its slopes fall
-    // away from the occluder, so the bias is needed only against false-positive cells lying on a surface,
-    // and a receiver's bias sinks the slopes' far ends behind it and erodes the shadow (cubes, map 512:
-    // slope 2 gives 1.03%, 0.25 gives 0.69%, shadow-map 0.92%; none leaves false-positive rows on strike).
-    SettingKey { default: "0.25", ..BIAS_SLOPE },
-    BIAS_WORLD,
-    SettingKey {
-        key: "vertices",
-        default: "texel",
-        help: "texel (centres, midpoints and corners: shadow-map-sized shadows) or centre (the paper's)",
-    },
-    SettingKey {
-        key: "edges",
-        default: "second-derivative",
-        help: "second-derivative (thinned, section 3.3) or first-difference (section 3.1)",
-    },
-    SettingKey {
-        key: "theta_low",
-        default: "0.001",
-        help: "candidate edge threshold, fraction of the light depth range",
-    },
-    SettingKey { key: "theta_high", default: "0.01", help: "sure edge threshold, fraction of the light depth range" },
-    SettingKey {
-        key: "theta_second",
-        default: "0.0005",
-        help: "second-derivative zero-crossing strength, fraction of the light depth range",
-    },
-    SettingKey {
-        key: "theta_dangling",
-        default: "0.0001",
-        help: "lowered threshold along dangling edges, fraction of the light depth range",
-    },
-    SettingKey { key: "dangling_steps", default: "8", help: "cells a dangling edge is followed (0 to 64)" },
-    SettingKey {
-        key: "ids",
-        default: "off",
-        help: "object-ID edges: off, dangling (dangling edges follow ID boundaries) or all (ORed with depth edges)",
-    },
-    SettingKey { key: "capping", default: "on", help: "near-plane caps: on, or off to see the inversion" },
-];
-
-impl TechniqueSettings for VolumeReconstruction {
-    fn keys() -> &'static [SettingKey] {
-        &RECONSTRUCTION_KEYS
+shadow_core::technique_settings! {
+    /// `volume-reconstruction` (McCool 2000): a shadow volume rebuilt from the light's depth map, resolved
+    /// with a one-bit parity stencil.
+    pub struct VolumeReconstruction {
+        /// The depth map: resolution and bias as `shadow-map` has them (the filter is unused). The bias
+        /// moves the reconstructed boundary away from the light, as the paper's bias translation of the light
+        /// depths does; `bias=world` moves each vertex `bias_world` along its light ray.
+        pub depth: DepthMap = DEPTH_KEYS,
+        /// Where the mesh's vertices are.
+        pub vertices: MeshVertices = SettingKey::choice(
+            "vertices",
+            "texel",
+            MeshVertices::NAMES,
+            "texel (centres, midpoints and corners: shadow-map-sized shadows) or centre (the paper's)",
+        ),
+        /// The detector.
+        pub edges: EdgeTest = SettingKey::choice(
+            "edges",
+            "second-derivative",
+            EdgeTest::NAMES,
+            "second-derivative (thinned, section 3.3) or first-difference (section 3.1)",
+        ),
+        /// theta_L, theta_H, theta_S and the dangling-edge threshold, as fractions of the fitted light depth
+        /// range (far minus near), applied to linear depths.
+        pub theta_low: f32 = SettingKey::float(
+            "theta_low",
+            "0.001",
+            0.0,
+            1.0,
+            "candidate edge threshold, fraction of the light depth range",
+        ),
+        /// See `theta_low`.
+        pub theta_high: f32 = SettingKey::float(
+            "theta_high",
+            "0.01",
+            0.0,
+            1.0,
+            "sure edge threshold, fraction of the light depth range",
+        ),
+        /// See `theta_low`.
+        pub theta_second: f32 = SettingKey::float(
+            "theta_second",
+            "0.0005",
+            0.0,
+            1.0,
+            "second-derivative zero-crossing strength, fraction of the light depth range",
+        ),
+        /// See `theta_low`.
+        pub theta_dangling: f32 = SettingKey::float(
+            "theta_dangling",
+            "0.0001",
+            0.0,
+            1.0,
+            "lowered threshold along dangling edges, fraction of the light depth range",
+        ),
+        /// How many cells a dangling edge is followed under the lowered thresholds.
+        pub dangling_steps: u32 = SettingKey::int(
+            "dangling_steps",
+            "8",
+            0,
+            64,
+            "cells a dangling edge is followed (0 to 64)",
+        ),
+        /// Object-ID edges from an ID channel of the light pass.
+        pub ids: ObjectIds = SettingKey::choice(
+            "ids",
+            "off",
+            ObjectIds::NAMES,
+            "object-ID edges: off, dangling (dangling edges follow ID boundaries) or all (ORed with depth edges)",
+        ),
+        /// The near-plane cap: on, software caps (McCool section 6.2); off, none, so that where the eye's near
+        /// plane cuts the volume parity inverts (Fig. 7).
+        pub capping: OnOff = SettingKey::choice(
+            "capping",
+            "on",
+            OnOff::NAMES,
+            "near-plane caps: on, or off to see the inversion",
+        ),
     }
-    fn from_values(v: &Values<'_>) -> Result<Self, SettingsError> {
-        let r = Self {
-            depth: DepthMap::read(v)?,
-            vertices: v.get("vertices")?,
-            edges: v.get("edges")?,
-            theta_low: v.ranged("theta_low", 0.0, 1.0)?,
-            theta_high: v.ranged("theta_high", 0.0, 1.0)?,
-            theta_second: v.ranged("theta_second", 0.0, 1.0)?,
-            theta_dangling: v.ranged("theta_dangling", 0.0, 1.0)?,
-            dangling_steps: v.ranged("dangling_steps", 0, 64)?,
-            ids: v.get("ids")?,
-            capping: v.get("capping")?,
-        };
-        if r.theta_high < r.theta_low {
-            return Err(v.bad("theta_high", &format!("at least theta_low ({})", r.theta_low)));
-        }
-        Ok(r)
-    }
-    fn to_values(&self) -> Vec<String> {
-        let mut v = self.depth.values();
-        v.extend([
-            self.vertices.to_string(),
-            self.edges.to_string(),
-            self.theta_low.to_string(),
-            self.theta_high.to_string(),
-            self.theta_second.to_string(),
-            self.theta_dangling.to_string(),
-            self.dangling_steps.to_string(),
-            self.ids.to_string(),
-            self.capping.to_string(),
-        ]);
-        v
-    }
+    check = VolumeReconstruction::check;
 }
 
 impl VolumeReconstruction {
+    /// The check across fields: the sure-edge threshold is at least the candidate one.
+    fn check(&self, v: &Values<'_>) -> Result<(), SettingsError> {
+        if self.theta_high < self.theta_low {
+            return Err(v.bad("theta_high", &format!("at least theta_low ({})", self.theta_low)));
+        }
+        Ok(())
+    }
+
     /// The detector's thresholds in scene units for a light depth range of `range`.
     #[must_use]
     pub fn edge_settings(&self, range: f32) -> reconstruction::edges::EdgeSettings {

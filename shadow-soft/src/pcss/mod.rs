@@ -28,33 +28,15 @@ use crate::Entry;
 use shadow_core::light::{LightProjection, LightView};
 use shadow_core::technique::LightKinds;
 use shadow_core::technique::TechniqueError;
-use shadow_core::technique::maps::{BIAS, BIAS_CONSTANT, BIAS_SLOPE, BIAS_WORLD, DepthMap, resolution_key};
-use shadow_core::technique::settings::{SettingKey, SettingsError, TechniqueSettings, Values};
+use shadow_core::technique::maps::{DepthMap, resolution_key};
 
-/// `pcss` settings.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Pcss {
-    /// The depth map: resolution and bias, as `shadow-map` has them. The light's size is its radius.
-    pub depth: DepthMap,
-}
-
-const KEYS: [SettingKey; 5] =
-    [resolution_key("1024", "depth map side in texels (16 to 16384)"), BIAS, BIAS_CONSTANT, BIAS_SLOPE, BIAS_WORLD];
-
-impl TechniqueSettings for Pcss {
-    const LIGHTS: LightKinds = LightKinds::SPOT;
-
-    fn keys() -> &'static [SettingKey] {
-        &KEYS
+shadow_core::technique_settings! {
+    /// `pcss` settings.
+    pub struct Pcss {
+        /// The depth map: resolution and bias, as `shadow-map` has them. The light's size is its radius.
+        pub depth: DepthMap = DepthMap::keys(resolution_key("1024", "depth map side in texels (16 to 16384)")),
     }
-
-    fn from_values(v: &Values<'_>) -> Result<Self, SettingsError> {
-        Ok(Self { depth: DepthMap::read(v)? })
-    }
-
-    fn to_values(&self) -> Vec<String> {
-        self.depth.values()
-    }
+    lights = LightKinds::SPOT;
 }
 
 /// What the search and filter sizes need of the light and its projection.

@@ -30,40 +30,20 @@ use shadow_core::FrameInputs;
 use shadow_core::image::Image;
 use shadow_core::light::{LightProjection, LightView};
 use shadow_core::technique::LightKinds;
-use shadow_core::technique::maps::{BIAS, BIAS_CONSTANT, BIAS_SLOPE, BIAS_WORLD, DepthMap, resolution_key};
-use shadow_core::technique::settings::{SettingKey, SettingsError, TechniqueSettings, Values};
+use shadow_core::technique::maps::{DepthMap, resolution_key};
 use shadow_core::technique::{DebugView, FrameStats, TechniqueError};
 
-/// `penumbra-map` settings.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct PenumbraMap {
-    /// The depth map: resolution (the penumbra map's too) and bias, as `shadow-map` has them. The cones'
-    /// opening is the light's radius.
-    pub depth: DepthMap,
-}
-
-const KEYS: [SettingKey; 5] = [
-    resolution_key("1024", "depth map and penumbra map side in texels (16 to 16384)"),
-    BIAS,
-    BIAS_CONSTANT,
-    BIAS_SLOPE,
-    BIAS_WORLD,
-];
-
-impl TechniqueSettings for PenumbraMap {
-    const LIGHTS: LightKinds = LightKinds::SPOT;
-
-    fn keys() -> &'static [SettingKey] {
-        &KEYS
+shadow_core::technique_settings! {
+    /// `penumbra-map` settings.
+    pub struct PenumbraMap {
+        /// The depth map: resolution (the penumbra map's too) and bias, as `shadow-map` has them. The
+        /// cones' opening is the light's radius.
+        pub depth: DepthMap = DepthMap::keys(resolution_key(
+            "1024",
+            "depth map and penumbra map side in texels (16 to 16384)",
+        )),
     }
-
-    fn from_values(v: &Values<'_>) -> Result<Self, SettingsError> {
-        Ok(Self { depth: DepthMap::read(v)? })
-    }
-
-    fn to_values(&self) -> Vec<String> {
-        self.depth.values()
-    }
+    lights = LightKinds::SPOT;
 }
 
 /// The penumbra map's value for a cone or sheet fragment at linear depth `z_p`, hanging from a silhouette

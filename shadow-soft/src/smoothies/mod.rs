@@ -26,21 +26,38 @@ use shadow_core::technique::DebugView;
 use shadow_core::technique::FrameStats;
 use shadow_core::technique::LightKinds;
 use shadow_core::technique::TechniqueError;
-use shadow_core::technique::maps::{BIAS, BIAS_CONSTANT, BIAS_SLOPE, BIAS_WORLD, DepthMap, resolution_key};
-use shadow_core::technique::settings::{OnOff, SettingKey, SettingsError, TechniqueSettings, Values};
+use shadow_core::technique::maps::{DepthMap, resolution_key};
+use shadow_core::technique::settings::{OnOff, SettingKey, SettingValue};
 use shadow_core::{FrameInputs, Image};
 
-/// `smoothies` settings.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Smoothies {
-    /// The depth map: resolution (the smoothie buffer's too) and bias, as `shadow-map` has them.
-    pub depth: DepthMap,
-    /// The smoothie size `t`.
-    pub size: SmoothieSize,
-    /// Whether alpha is remapped by the distances (Eq. 4.1); off shows the fixed-width ramp of Fig. 4-4b.
-    pub remap: OnOff,
-    /// The penumbra's profile.
-    pub falloff: Falloff,
+shadow_core::technique_settings! {
+    /// `smoothies` settings.
+    pub struct Smoothies {
+        /// The depth map: resolution (the smoothie buffer's too) and bias, as `shadow-map` has them.
+        pub depth: DepthMap = DepthMap::keys(resolution_key(
+            "1024",
+            "depth map and smoothie buffer side in texels (16 to 16384)",
+        )),
+        /// The smoothie size `t`.
+        pub size: SmoothieSize = SettingKey::float(
+            "size",
+            "auto",
+            0.001,
+            1.0,
+            "smoothie size t in map coordinates (0.001 to 1), or auto: the light's radius seen at the casters",
+        )
+        .or("auto"),
+        /// Whether alpha is remapped by the distances (Eq. 4.1); off shows the fixed-width ramp of Fig. 4-4b.
+        pub remap: OnOff = SettingKey::choice(
+            "remap",
+            "on",
+            OnOff::NAMES,
+            "on: alpha / (1 - b/r) on linear depths (Eq. 4.1); off: linear ramp",
+        ),
+        /// The penumbra's profile.
+        pub falloff: Falloff = SettingKey::choice("falloff", "sinusoidal", Falloff::NAMES, "sinusoidal or linear"),
+    }
+    lights = LightKinds::ONE_PROJECTION;
 }
 
 /// The smoothie size `t`, in map coordinates (`[0, 1]` across the map).
@@ -52,6 +69,19 @@ pub enum SmoothieSize {
     Auto,
     /// A fixed size; the thesis uses 0.02 to 0.2 for scenes 10 units across.
     Fixed(f32),
+}
+
+/// `auto`, or a fixed size in the key's range.
+impl SettingValue for SmoothieSize {
+    fn from_setting(text: &str, key: &SettingKey) -> Option<Self> {
+        if key.word == Some(text) { Some(Self::Auto) } else { f32::from_setting(text, key).map(Self::Fixed) }
+    }
+    fn to_setting(&self) -> String {
+        match self {
+            Self::Auto => "auto".into(),
+            Self::Fixed(t) => t.to_string(),
+        }
+    }
 }
 
 shadow_core::named_enum! {
@@ -107,54 +137,6 @@ impl FalloffTable {
         let i = (x as usize).min(FALLOFF_TEXELS - 2);
         let f = x - i as f32;
         self.samples[i] * (1.0 - f) + self.samples[i + 1] * f
-    }
-}
-
-const KEYS: [SettingKey; 8] = [
-    resolution_key("1024", "depth map and smoothie buffer side in texels (16 to 16384)"),
-    BIAS,
-    BIAS_CONSTANT,
-    BIAS_SLOPE,
-    BIAS_WORLD,
-    SettingKey {
-        key: "size",
-        default: "auto",
-        help: "smoothie size t in map coordinates (0.001 to 1), or auto: the light's radius seen at the casters",
-    },
-    SettingKey {
-        key: "remap",
-        default: "on",
-        help: "on: alpha / (1 - b/r) on linear depths (Eq. 4.1); off: linear ramp",
-    },
-    SettingKey { key: "falloff", default: "sinusoidal", help: "sinusoidal or linear" },
-];
-
-impl TechniqueSettings for Smoothies {
-    const LIGHTS: LightKinds = LightKinds::ONE_PROJECTION;
-
-    fn keys() -> &'static [SettingKey] {
-        &KEYS
-    }
-
-    fn from_values(v: &Values<'_>) -> Result<Self, SettingsError> {
-        let size = match v.text("size") {
-            "auto" => SmoothieSize::Auto,
-            _ => SmoothieSize::Fixed(v.ranged("size", 0.001, 1.0).map_err(|_| v.bad("size", "auto or 0.001 to 1"))?),
-        };
-        Ok(Self { depth: DepthMap::read(v)?, size, remap: v.get("remap")?, falloff: v.get("falloff")? })
-    }
-
-    fn to_values(&self) -> Vec<String> {
-        let mut v = self.depth.values();
-        v.extend([
-            match self.size {
-                SmoothieSize::Auto => "auto".into(),
-                SmoothieSize::Fixed(t) => t.to_string(),
-            },
-            self.remap.to_string(),
-            self.falloff.to_string(),
-        ]);
-        v
     }
 }
 

@@ -6,7 +6,6 @@
 use bytemuck::{Pod, Zeroable};
 use shadow_core::FrameInputs;
 use shadow_core::light::LightView;
-use shadow_core::scene::LightKind;
 use shadow_core::technique::maps::DepthMap;
 use shadow_core::technique::settings::{BiasMode, Filter};
 use wgpu::util::DeviceExt;
@@ -15,8 +14,8 @@ use crate::context::{WgpuContext, WgpuError};
 use crate::frame::{GpuVisibility, layer_view, layered};
 use crate::gbuffer::{GpuGBuffer, check_size, draw_instances};
 use crate::pipelines::{
-    FragmentEntry, MAP_DEPTH, POSITION_LAYOUT, VISIBILITY, ViewRaw, attribute_entry, buffer_entry, depth_array_entry,
-    full_screen_pipeline,
+    FragmentEntry, LightRaw, MAP_DEPTH, POSITION_LAYOUT, VISIBILITY, ViewRaw, attribute_entry, buffer_entry,
+    depth_array_entry, full_screen_pipeline,
 };
 use crate::shaders;
 
@@ -25,8 +24,7 @@ use crate::shaders;
 #[derive(Clone, Copy, Pod, Zeroable)]
 struct MapParams {
     proj: [[[f32; 4]; 4]; 6],
-    light: [f32; 4],
-    direction: [f32; 4],
+    light: LightRaw,
     settings: [f32; 4],
     planes: [[[f32; 4]; 4]; 6],
     extra: [f32; 4],
@@ -115,15 +113,9 @@ impl MapBindings {
             *slot = p.clip_from_world.to_cols_array_2d();
             *plane = p.clip_plane_from_world_plane.to_cols_array_2d();
         }
-        let (pos, dir, kind) = match light.light.kind {
-            LightKind::Spot { position, direction, .. } => (position, direction, 0.0),
-            LightKind::Directional { direction } => (glam::Vec3::ZERO, direction, 1.0),
-            LightKind::Point { position } => (position, glam::Vec3::NEG_Y, 2.0),
-        };
         let params = MapParams {
             proj,
-            light: pos.extend(kind).to_array(),
-            direction: dir.normalize().extend(0.0).to_array(),
+            light: LightRaw::from(&light.light),
             settings: [0.0, lookup.radius, maps.width() as f32, lookup.receiver_offset],
             planes,
             extra: extras.settings,

@@ -3,10 +3,8 @@
 struct MapParams {
     // One projection, or six cube faces (+X, -X, +Y, -Y, +Z, -Z).
     proj: array<mat4x4<f32>, 6>,
-    // xyz: light position; w: kind (0 spot, 1 directional, 2 point: cube faces)
-    light: vec4<f32>,
-    // xyz: the direction the light travels (spot axis, directional light)
-    direction: vec4<f32>,
+    // The light (point lights: cube faces).
+    light: Light,
     // x: unused (the filter is the FILTER constant), y: radius in texels, z: map side,
     // w: receiver offset towards the light (bias=world)
     settings: vec4<f32>,
@@ -134,11 +132,9 @@ fn shadow_lookup(layer: i32, uv: vec2<f32>, depth: f32, pixel: vec2<u32>) -> f32
     return sum / 16.0;
 }
 
-// The direction towards the light of `map` (common.wgsl's `to_light`; the cone is not needed).
+// The direction towards the light of `map` (common.wgsl's `to_light`).
 fn map_to_light(p: vec3<f32>) -> vec3<f32> {
-    let kind = vec4<u32>(u32(map.light.w));
-    let light = Light(kind, vec4<f32>(map.light.xyz, 1.0), map.direction, vec4<f32>(0.0), vec4<f32>(0.0));
-    return to_light(light, p);
+    return to_light(map.light, p);
 }
 
 // Where a receiver looks into the maps. Twin: shadow-cpu's `MapPosition`.
@@ -157,8 +153,8 @@ fn map_point(receiver: vec3<f32>) -> MapPoint {
         p = p + map_to_light(p) * map.settings.w;
     }
     var layer = 0;
-    if (map.light.w == 2.0) {
-        layer = cube_face(p - map.light.xyz);
+    if (map.light.kind.x == 2u) {
+        layer = cube_face(p - map.light.position.xyz);
     }
     let c = map.proj[layer] * vec4<f32>(p, 1.0);
     let ndc = c.xyz / c.w;
