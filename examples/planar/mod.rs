@@ -9,8 +9,9 @@
 use glam::{Mat4, Vec3, Vec4};
 use shadow_core::light::LightView;
 use shadow_core::scene::LightKind;
+use shadow_core::technique::LightPass;
+use shadow_core::technique::ShadowTechnique;
 use shadow_core::technique::settings::SettingKey;
-use shadow_core::technique::{FrameStats, ShadowTechnique};
 use shadow_core::{FrameInputs, Image};
 use shadow_cpu::raster::{DepthStencil, RasterState, Soup, draw};
 use shadow_cpu::{CpuBackend, CpuContext, CpuError, GBuffer};
@@ -86,14 +87,8 @@ impl ShadowTechnique<CpuBackend> for PlanarShadow {
     fn create_state(&self, _: &mut CpuContext) -> Result<State, CpuError> {
         Ok(State::default())
     }
-    fn build(
-        &self,
-        _: &mut CpuContext,
-        state: &mut State,
-        _: &FrameInputs,
-        light: &LightView,
-        _: &mut FrameStats,
-    ) -> Result<(), CpuError> {
+    fn build(&self, _: &mut CpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), CpuError> {
+        let LightPass { light, .. } = pass;
         state.light = Some(light.clone());
         Ok(())
     }
@@ -101,12 +96,11 @@ impl ShadowTechnique<CpuBackend> for PlanarShadow {
         &self,
         _: &mut CpuContext,
         state: &mut State,
-        frame: &FrameInputs,
-        light: &LightView,
+        pass: LightPass<'_>,
         g: &GBuffer,
         out: &mut Image<f32>,
-        _: &mut FrameStats,
     ) -> Result<(), CpuError> {
+        let LightPass { frame, light, .. } = pass;
         let tris = self.projected(frame, state.light.as_ref().unwrap_or(light), g.clip_from_world);
         let mut ds = DepthStencil::new(g.width(), g.height(), 1.0, 0);
         let st = RasterState { depth: None, ..RasterState::default() };
@@ -207,26 +201,18 @@ impl ShadowTechnique<WgpuBackend> for PlanarShadow {
             GpuState { pipeline, layout }
         })
     }
-    fn build(
-        &self,
-        _: &mut WgpuContext,
-        _: &mut GpuState,
-        _: &FrameInputs,
-        _: &LightView,
-        _: &mut FrameStats,
-    ) -> Result<(), WgpuError> {
+    fn build(&self, _: &mut WgpuContext, _: &mut GpuState, _: LightPass<'_>) -> Result<(), WgpuError> {
         Ok(())
     }
     fn query(
         &self,
         cx: &mut WgpuContext,
         state: &mut GpuState,
-        frame: &FrameInputs,
-        light: &LightView,
+        pass: LightPass<'_>,
         g: &GpuGBuffer,
         out: &mut GpuVisibility,
-        _: &mut FrameStats,
     ) -> Result<(), WgpuError> {
+        let LightPass { frame, light, .. } = pass;
         let clip_from_world = g.camera.clip_from_world(g.width as f32 / g.height as f32);
         let tris = self.projected(frame, light, clip_from_world);
         cx.scoped("the planar-shadow pass", |cx| {

@@ -6,7 +6,7 @@ use std::time::Instant;
 use shadow_core::image::Rgb8;
 use shadow_core::light::LightView;
 use shadow_core::stats::{Phase, ms};
-use shadow_core::technique::{DynShadowTechnique, FrameStats};
+use shadow_core::technique::{DynShadowTechnique, FrameStats, LightPass};
 use shadow_core::{FrameInputs, Image};
 
 use crate::context::{CpuBackend, CpuContext, CpuError};
@@ -51,11 +51,11 @@ pub fn render_frame(
         let view = frame.light_view(light)?;
         let mut light_stats = FrameStats::default();
         let t = Instant::now();
-        technique.build(cx, frame, &view, &mut light_stats)?;
+        technique.build(cx, LightPass { frame, light: &view, stats: &mut light_stats })?;
         stats.timings.add(Phase::Build, ms(t.elapsed()));
         let mut vis = Image::new(width, height, 1.0f32);
         let t = Instant::now();
-        technique.query(cx, frame, &view, &gbuffer, &mut vis, &mut light_stats)?;
+        technique.query(cx, LightPass { frame, light: &view, stats: &mut light_stats }, &gbuffer, &mut vis)?;
         stats.timings.add(Phase::Query, ms(t.elapsed()));
         stats.counters.merge(&light_stats.counters);
         for (k, v) in light_stats.timings.extra {

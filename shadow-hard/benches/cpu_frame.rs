@@ -4,7 +4,7 @@
 use divan::Bencher;
 use shadow_core::FrameInputs;
 use shadow_core::scenes::{self, SceneParams};
-use shadow_core::technique::{FrameStats, ShadowTechnique, TechniqueSettings};
+use shadow_core::technique::{FrameStats, LightPass, ShadowTechnique, TechniqueSettings};
 use shadow_cpu::{CpuContext, gbuffer};
 use shadow_hard::{RayTraced, ShadowMap, ShadowVolume};
 
@@ -28,10 +28,11 @@ fn ray_traced_tree(b: Bencher) {
     let t = RayTraced::defaults();
     let mut state = t.create_state(&mut cx).expect("state");
     let mut stats = FrameStats::default();
-    t.build(&mut cx, &mut state, &f, &view, &mut stats).expect("build");
+    t.build(&mut cx, &mut state, LightPass { frame: &f, light: &view, stats: &mut stats }).expect("build");
     let mut out = shadow_core::Image::new(1024, 768, 1.0f32);
     b.counter(divan::counter::ItemsCount::new(g.covered_pixels())).bench_local(|| {
-        t.query(&mut cx, &mut state, &f, &view, &g, &mut out, &mut stats).expect("query");
+        t.query(&mut cx, &mut state, LightPass { frame: &f, light: &view, stats: &mut stats }, &g, &mut out)
+            .expect("query");
     });
 }
 
@@ -44,9 +45,10 @@ fn whole_frame<T: ShadowTechnique<shadow_cpu::CpuBackend>>(b: Bencher, t: T) {
     b.bench_local(|| {
         let mut stats = FrameStats::default();
         let g = gbuffer::render_reusing(&f, 1024, 768, spare.take()).expect("gbuffer");
-        t.build(&mut cx, &mut state, &f, &view, &mut stats).expect("build");
+        t.build(&mut cx, &mut state, LightPass { frame: &f, light: &view, stats: &mut stats }).expect("build");
         let mut out = shadow_core::Image::new(1024, 768, 1.0f32);
-        t.query(&mut cx, &mut state, &f, &view, &g, &mut out, &mut stats).expect("query");
+        t.query(&mut cx, &mut state, LightPass { frame: &f, light: &view, stats: &mut stats }, &g, &mut out)
+            .expect("query");
         let color = shadow_cpu::shade::shade(&g, &f.lights, &[&out]);
         spare = Some(g);
         color

@@ -9,13 +9,13 @@
 //! surface as `ray-traced`'s do: offset along the face normal turned towards the viewer.
 
 use crate::Entry;
+use shadow_core::Image;
 use shadow_core::glam::Vec3;
-use shadow_core::light::LightView;
 use shadow_core::lookup::{hash_unit, pixel_hash};
 use shadow_core::technique::LightKinds;
+use shadow_core::technique::LightPass;
 use shadow_core::technique::settings::{SettingKey, SettingsError, Values};
-use shadow_core::technique::{FrameStats, ShadowTechnique, TechniqueError};
-use shadow_core::{FrameInputs, Image};
+use shadow_core::technique::{ShadowTechnique, TechniqueError};
 use shadow_cpu::bvh::SceneBvh;
 use shadow_cpu::passes::per_receiver;
 use shadow_cpu::passes::rays::{RayOrigins, State as RayState};
@@ -123,14 +123,8 @@ impl ShadowTechnique<CpuBackend> for AreaLightReference {
         Ok(RayState::default())
     }
 
-    fn build(
-        &self,
-        cx: &mut CpuContext,
-        state: &mut RayState,
-        frame: &FrameInputs,
-        light: &LightView,
-        _: &mut FrameStats,
-    ) -> Result<(), CpuError> {
+    fn build(&self, cx: &mut CpuContext, state: &mut RayState, pass: LightPass<'_>) -> Result<(), CpuError> {
+        let LightPass { frame, light, .. } = pass;
         if light.light.position().is_none() {
             let technique = self.name().into();
             return Err(TechniqueError::UnsupportedLight { technique, light: light.light.type_name() }.into());
@@ -143,12 +137,11 @@ impl ShadowTechnique<CpuBackend> for AreaLightReference {
         &self,
         _: &mut CpuContext,
         state: &mut RayState,
-        frame: &FrameInputs,
-        light: &LightView,
+        pass: LightPass<'_>,
         g: &GBuffer,
         out: &mut Image<f32>,
-        stats: &mut FrameStats,
     ) -> Result<(), CpuError> {
+        let LightPass { frame, light, stats } = pass;
         let bvh = state.bvh(self.name())?;
         let Some(centre) = light.light.position() else {
             return Err(TechniqueError::NotBuilt(self.name().into()).into());
@@ -179,6 +172,7 @@ pub fn entry() -> Entry {
 
 #[cfg(test)]
 mod tests {
+    use shadow_core::FrameInputs;
     use shadow_core::glam::{Mat4, Vec3};
     use shadow_core::procedural;
     use shadow_core::scene::{Camera, Light, Material, Scene};

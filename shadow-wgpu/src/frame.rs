@@ -7,7 +7,7 @@ use std::time::Instant;
 use shadow_core::image::Rgb8;
 use shadow_core::light::LightView;
 use shadow_core::stats::{Phase, ms};
-use shadow_core::technique::{DynShadowTechnique, FrameStats};
+use shadow_core::technique::{DynShadowTechnique, FrameStats, LightPass};
 use shadow_core::{FrameInputs, Image};
 use wgpu::util::DeviceExt;
 
@@ -149,14 +149,14 @@ fn frame_phases(
         let mut light_stats = FrameStats::default();
         let t = Instant::now();
         let m0 = mark(cx);
-        technique.build(cx, frame, &view, &mut light_stats)?;
+        technique.build(cx, LightPass { frame, light: &view, stats: &mut light_stats })?;
         spans.push((Phase::Build, m0, work_end(cx), mark(cx), steps(cx)));
         cx.wait()?;
         stats.timings.add(Phase::Build, ms(t.elapsed()));
         let mut out = GpuVisibility { view: layer_view(&vis_tex, k as u32), width, height };
         let t = Instant::now();
         let m0 = mark(cx);
-        technique.query(cx, frame, &view, &g, &mut out, &mut light_stats)?;
+        technique.query(cx, LightPass { frame, light: &view, stats: &mut light_stats }, &g, &mut out)?;
         spans.push((Phase::Query, m0, work_end(cx), mark(cx), steps(cx)));
         cx.wait()?;
         stats.timings.add(Phase::Query, ms(t.elapsed()));

@@ -1,4 +1,4 @@
-//! Chan's claims for `hybrid` (thesis chapter 3), as issue 9 states them, at 512x512 against the ray-traced
+//! Chan's claims for `hybrid` (thesis chapter 3), held at 512x512 against the ray-traced
 //! reference (CPU backend, and for the caster masks both backends):
 //!
 //! - shadow-volume accuracy from a 512^2 classifying map: mismatch at or under 0.1% on every built-in

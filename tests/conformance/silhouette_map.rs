@@ -1,4 +1,4 @@
-//! Sen et al.'s claim, as issue 6 states it: at the same map size and bias, with no filter, a silhouette
+//! Sen et al.'s claim, held here: at the same map size and bias, with no filter, a silhouette
 //! map's mismatch near shadow edges is at most a third of the shadow map's, at no more than 0.1 points of
 //! interior mismatch, on the paper's kind of scenes at 512x512 with 256^2 and 512^2 maps.
 //!

@@ -1,4 +1,4 @@
-//! Chan's claims for `smoothies` (thesis chapter 4), as issue 10 states them, against the Monte Carlo
+//! Chan's claims for `smoothies` (thesis chapter 4) against the Monte Carlo
 //! `area-light-reference` (CPU backend):
 //!
 //! - the alpha remap (Eq. 4.1, Fig. 4-10): on `stacked-boxes` the upper box's shadow has a sharper edge on

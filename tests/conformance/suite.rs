@@ -15,10 +15,10 @@ use shadow_core::{FrameInputs, Scene};
 use shadowlab::{BackendKind, Renderer, TechniqueRegistry};
 
 const SIZE: u32 = 256;
-/// Cross-backend ceilings (DESIGN 9, issue 4): lit/shadowed disagreement and FLIP of the shaded images.
+/// Cross-backend ceilings (DESIGN 9): lit/shadowed disagreement and FLIP of the shaded images.
 const MAX_CROSS_MISMATCH: f64 = 0.005;
 const MAX_CROSS_FLIP: f64 = 0.02;
-/// Cross-backend RMSE of a soft technique's visibility (issue 10).
+/// Cross-backend RMSE of a soft technique's visibility.
 const MAX_CROSS_RMSE_SOFT: f64 = 0.02;
 /// How far the wgpu result's error may stray from the CPU's, in points of mismatch.
 const MAX_ERROR_GAP: f64 = 0.005;
@@ -37,7 +37,7 @@ fn reference_ceiling(technique: &str, scene: &str) -> Option<f64> {
         ("volume-reconstruction", _) => Some(0.01),
         // Against the area light (lit/shadowed split at 0.5): the penumbra only outside the hard edge.
         ("smoothies", _) => Some(0.015),
-        // The volumes decide at the map's silhouette pixels: their accuracy (issue 9).
+        // The volumes decide at the map's silhouette pixels: their accuracy.
         ("hybrid", _) => Some(0.001),
         // A technique registered later gets a loose ceiling until it is given its own row.
         _ => Some(0.10),

@@ -1,4 +1,4 @@
-//! McCool's claims, as issue 8 states them, at 512x512 against the ray-traced reference (CPU backend; the
+//! McCool's claims, held at 512x512 against the ray-traced reference (CPU backend; the
 //! suite holds the GPU to the CPU):
 //!
 //! - a reconstructed volume shadows as the shadow map at the same map size does: mismatch within 1.2x of

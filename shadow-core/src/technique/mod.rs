@@ -7,10 +7,10 @@
 //! backend crate. [`DynShadowTechnique`] is the one object-safe layer, for choosing at runtime.
 //!
 //! Refinements of the DESIGN 3 sketch, and why:
-//! - `build` and `query` both receive the frame and the light view: a query needs the light's projection
-//!   (shadow maps) or position (volumes), and passing it is simpler than every state keeping a copy.
-//! - Both receive `&mut FrameStats`, so techniques report counters and sub-phase times (a readback, say)
-//!   through one channel instead of a return value the frame driver has to merge.
+//! - `build` and `query` both receive a [`LightPass`]: the frame, the light's view and `&mut FrameStats`.
+//!   A query needs the light's projection (shadow maps) or position (volumes), and passing it is simpler
+//!   than every state keeping a copy; the stats let techniques report counters and sub-phase times (a
+//!   readback, say) through one channel instead of a return value the frame driver has to merge.
 //! - `Backend::Error: From<TechniqueError>`, so the shared checks (unsupported light, bad settings) give
 //!   the same error on every backend.
 
@@ -73,6 +73,17 @@ pub struct FrameStats {
     pub timings: Timings,
 }
 
+/// What a technique's build and query see of one light in one frame: the frame's inputs, the light's
+/// fitted view, and the stats they report into.
+pub struct LightPass<'a> {
+    /// The frame: instances, lights, camera.
+    pub frame: &'a FrameInputs,
+    /// The light and its fitted projections.
+    pub light: &'a LightView,
+    /// Counters and sub-phase times for this light.
+    pub stats: &'a mut FrameStats,
+}
+
 /// A named picture of a technique's internals (a depth map, an edge map, a silhouette-point overlay).
 #[derive(Clone, Debug)]
 pub struct DebugView {
@@ -100,29 +111,19 @@ pub trait ShadowTechnique<B: Backend>: Send + Sync {
     ///
     /// # Errors
     /// Backend failures, or settings the backend cannot meet.
-    fn build(
-        &self,
-        cx: &mut B::Context,
-        state: &mut Self::State,
-        frame: &FrameInputs,
-        light: &LightView,
-        stats: &mut FrameStats,
-    ) -> Result<(), B::Error>;
+    fn build(&self, cx: &mut B::Context, state: &mut Self::State, pass: LightPass<'_>) -> Result<(), B::Error>;
 
     /// Query phase: the light's visibility at every G-buffer pixel.
     ///
     /// # Errors
     /// Backend failures, or a query before a build.
-    #[allow(clippy::too_many_arguments)]
     fn query(
         &self,
         cx: &mut B::Context,
         state: &mut Self::State,
-        frame: &FrameInputs,
-        light: &LightView,
+        pass: LightPass<'_>,
         gbuffer: &B::GBuffer,
         out: &mut B::Visibility,
-        stats: &mut FrameStats,
     ) -> Result<(), B::Error>;
 
     /// Pictures of the internals after the last build (default: none).
@@ -144,13 +145,7 @@ pub trait DynShadowTechnique<B: Backend>: Send {
     ///
     /// # Errors
     /// As [`ShadowTechnique::build`], or [`TechniqueError::UnsupportedLight`].
-    fn build(
-        &mut self,
-        cx: &mut B::Context,
-        frame: &FrameInputs,
-        light: &LightView,
-        stats: &mut FrameStats,
-    ) -> Result<(), B::Error>;
+    fn build(&mut self, cx: &mut B::Context, pass: LightPass<'_>) -> Result<(), B::Error>;
     /// See [`ShadowTechnique::query`].
     ///
     /// # Errors
@@ -158,11 +153,9 @@ pub trait DynShadowTechnique<B: Backend>: Send {
     fn query(
         &mut self,
         cx: &mut B::Context,
-        frame: &FrameInputs,
-        light: &LightView,
+        pass: LightPass<'_>,
         gbuffer: &B::GBuffer,
         out: &mut B::Visibility,
-        stats: &mut FrameStats,
     ) -> Result<(), B::Error>;
     /// See [`ShadowTechnique::debug_views`].
     ///
@@ -210,17 +203,11 @@ impl<B: Backend, T: ShadowTechnique<B>> DynShadowTechnique<B> for Stateful<B, T>
         self.settings.clone()
     }
 
-    fn build(
-        &mut self,
-        cx: &mut B::Context,
-        frame: &FrameInputs,
-        light: &LightView,
-        stats: &mut FrameStats,
-    ) -> Result<(), B::Error> {
-        if !self.lights.takes(&light.light) {
+    fn build(&mut self, cx: &mut B::Context, pass: LightPass<'_>) -> Result<(), B::Error> {
+        if !self.lights.takes(&pass.light.light) {
             return Err(TechniqueError::UnsupportedLight {
                 technique: self.technique.name().into(),
-                light: light.light.type_name(),
+                light: pass.light.light.type_name(),
             }
             .into());
         }
@@ -228,20 +215,18 @@ impl<B: Backend, T: ShadowTechnique<B>> DynShadowTechnique<B> for Stateful<B, T>
             Some(s) => s,
             slot => slot.insert(self.technique.create_state(cx)?),
         };
-        self.technique.build(cx, state, frame, light, stats)
+        self.technique.build(cx, state, pass)
     }
 
     fn query(
         &mut self,
         cx: &mut B::Context,
-        frame: &FrameInputs,
-        light: &LightView,
+        pass: LightPass<'_>,
         gbuffer: &B::GBuffer,
         out: &mut B::Visibility,
-        stats: &mut FrameStats,
     ) -> Result<(), B::Error> {
         let state = self.state.as_mut().ok_or_else(|| TechniqueError::NotBuilt(self.technique.name().into()))?;
-        self.technique.query(cx, state, frame, light, gbuffer, out, stats)
+        self.technique.query(cx, state, pass, gbuffer, out)
     }
 
     fn debug_views(&mut self, cx: &mut B::Context) -> Result<Vec<DebugView>, B::Error> {

@@ -354,7 +354,7 @@ where
     F: Fn(&Fragment) -> Option<T> + Sync,
     B: Fn(&mut T, T) + Sync,
 {
-    draw_with(ds, color, src, st, Path::General, None, shader, blend)
+    draw_with(ds, color, src, st, (Path::General, None), shader, blend)
 }
 
 /// A draw whose colour is one value per primitive, `value(prim)`: a visibility buffer of primitive ids, an
@@ -382,7 +382,7 @@ where
         Some(k @ DepthKernel::Depth { write: true, .. }) => Path::Flat(k),
         _ => Path::General,
     };
-    draw_with(ds, color, src, st, path, None, shader, |d, v| *d = v)
+    draw_with(ds, color, src, st, (path, None), shader, |d, v| *d = v)
 }
 
 /// Depth (and stencil) only: shadow-map renders and shadow-volume counting take branch-free inner loops.
@@ -412,17 +412,15 @@ pub fn draw_depth_masked<S: TriangleSource + ?Sized>(
     }
     let mut none = Image::new(ds.width, ds.height, ());
     let path = DepthKernel::for_state(st).map_or(Path::General, Path::Depth);
-    draw_with(ds, &mut none, src, st, path, mask, |_| Some(()), |_, _| {})
+    draw_with(ds, &mut none, src, st, (path, mask), |_| Some(()), |_, _| {})
 }
 
-#[allow(clippy::too_many_arguments)]
 fn draw_with<T, S, F, B>(
     ds: &mut DepthStencil,
     color: &mut Image<T>,
     src: &S,
     st: &RasterState,
-    path: Path,
-    mask: Option<&ComputationMask>,
+    (path, mask): (Path, Option<&ComputationMask>),
     shader: F,
     blend: B,
 ) -> RasterCounters
@@ -493,7 +491,7 @@ where
                 let y0 = band as i32 * BAND_ROWS as i32;
                 let mut rows = BandRows { depth, stencil, color: col, y0, width: w as usize };
                 for &t in bin {
-                    raster_band(&setups[t as usize], &mut rows, st, path, mask, &shader, &blend, &mut c);
+                    raster_band(&setups[t as usize], &mut rows, st, (path, mask), (&shader, &blend), &mut c);
                 }
                 c
             })
@@ -691,15 +689,12 @@ fn row_fast(t: &Setup, k: DepthKernel, row: RowStart, depth: &mut [f32], stencil
 }
 
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
 fn raster_band<T, F, B>(
     t: &Setup,
     rows: &mut BandRows<'_, T>,
     st: &RasterState,
-    path: Path,
-    mask: Option<&ComputationMask>,
-    shader: &F,
-    blend: &B,
+    (path, mask): (Path, Option<&ComputationMask>),
+    (shader, blend): (&F, &B),
     c: &mut RasterCounters,
 ) where
     T: Copy,
@@ -730,7 +725,7 @@ fn raster_band<T, F, B>(
                         row_flat(t, compare, start, &mut rows.depth[lo..hi], &mut rows.color[lo..hi], v, c);
                     }
                 }
-                _ => row_general(t, rows, st, (y, py, row), (a, b, z_row, clamp), shader, blend, c),
+                _ => row_general(t, rows, st, (y, py, row), (a, b, z_row, clamp), (shader, blend), c),
             }
         };
         match mask {
@@ -743,15 +738,13 @@ fn raster_band<T, F, B>(
 /// Columns `a..=b` of row `y` (`py` its centre in fixed point, `row` its first index in the band) through
 /// the general per-fragment path.
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
 fn row_general<T, F, B>(
     t: &Setup,
     rows: &mut BandRows<'_, T>,
     st: &RasterState,
     (y, py, row): (i32, i64, usize),
     (xs, xe, z_row, clamp): (i32, i32, f32, bool),
-    shader: &F,
-    blend: &B,
+    (shader, blend): (&F, &B),
     c: &mut RasterCounters,
 ) where
     F: Fn(&Fragment) -> Option<T>,

@@ -10,8 +10,9 @@
 //! The combination is taken on linear depths (see `DepthLayers::combine`).
 
 use super::{DepthLayers, LayerCulling};
-use shadow_core::light::{LightProjection, LightView};
-use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
+use shadow_core::light::LightProjection;
+use shadow_core::technique::LightPass;
+use shadow_core::technique::{DebugView, ShadowTechnique, TechniqueError};
 use shadow_core::{FrameInputs, Image};
 
 use shadow_cpu::gbuffer::{GBuffer, clip_vertices};
@@ -81,14 +82,8 @@ impl ShadowTechnique<CpuBackend> for DepthLayers {
         Ok(State::default())
     }
 
-    fn build(
-        &self,
-        _: &mut CpuContext,
-        state: &mut State,
-        frame: &FrameInputs,
-        light: &LightView,
-        _: &mut FrameStats,
-    ) -> Result<(), CpuError> {
+    fn build(&self, _: &mut CpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), CpuError> {
+        let LightPass { frame, light, .. } = pass;
         check_maps(self.resolution, 3 * light.projections.len())?;
         state.z1.clear();
         state.z2.clear();
@@ -114,12 +109,11 @@ impl ShadowTechnique<CpuBackend> for DepthLayers {
         &self,
         _: &mut CpuContext,
         state: &mut State,
-        _: &FrameInputs,
-        light: &LightView,
+        pass: LightPass<'_>,
         g: &GBuffer,
         out: &mut Image<f32>,
-        _: &mut FrameStats,
     ) -> Result<(), CpuError> {
+        let LightPass { light, .. } = pass;
         if state.maps.len() != light.projections.len() {
             return Err(TechniqueError::NotBuilt(self.kind.name().into()).into());
         }

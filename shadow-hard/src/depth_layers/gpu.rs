@@ -7,9 +7,10 @@
 use super::{DepthLayers, LayerCulling, LayerKind};
 use bytemuck::{Pod, Zeroable};
 use shadow_core::FrameInputs;
-use shadow_core::light::{LightProjection, LightView};
+use shadow_core::light::LightProjection;
+use shadow_core::technique::LightPass;
 use shadow_core::technique::settings::Filter;
-use shadow_core::technique::{FrameStats, ShadowTechnique, TechniqueError};
+use shadow_core::technique::{ShadowTechnique, TechniqueError};
 use wgpu::util::DeviceExt;
 
 use shadow_wgpu::frame::{GpuVisibility, layer_view};
@@ -50,7 +51,7 @@ fn kind_code(k: LayerKind) -> f32 {
 }
 
 impl State {
-    fn new(cx: &WgpuContext, filter: Filter) -> Self {
+    fn new(cx: &WgpuContext, filter: Filter, lookup: LookupParams) -> Self {
         let module = shaders::module(&cx.device, "depth_layers", shader());
         let map_module = shaders::module(&cx.device, "shadow_map", shaders::shadow_map());
         let layout = cx.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -128,19 +129,24 @@ impl State {
             multiview_mask: None,
             cache: None,
         });
-        Self { passes, combine, layout, query: MapQuery::new(cx, &map_module, filter), maps: None, scratch: None }
+        Self {
+            passes,
+            combine,
+            layout,
+            query: MapQuery::new(cx, &map_module, filter).with_lookup(lookup),
+            maps: None,
+            scratch: None,
+        }
     }
 }
 
-/// Both layers and their combination for one projection, into layer `k` of `maps`.
-#[allow(clippy::too_many_arguments)]
+/// Both layers and their combination for projection `proj`, into layer `k` of `maps`.
 fn render_projection(
     s: &DepthLayers,
     cx: &WgpuContext,
     state: &State,
     frame: &FrameInputs,
-    proj: &LightProjection,
-    k: u32,
+    (k, proj): (u32, &LightProjection),
     maps: &wgpu::Texture,
     instances: &wgpu::Buffer,
 ) {
@@ -205,17 +211,13 @@ impl ShadowTechnique<WgpuBackend> for DepthLayers {
     }
 
     fn create_state(&self, cx: &mut WgpuContext) -> Result<State, WgpuError> {
-        cx.scoped("creating the depth-layer pipelines", |cx| State::new(cx, self.filter))
+        cx.scoped("creating the depth-layer pipelines", |cx| {
+            State::new(cx, self.filter, LookupParams { radius: self.filter_radius, receiver_offset: 0.0 })
+        })
     }
 
-    fn build(
-        &self,
-        cx: &mut WgpuContext,
-        state: &mut State,
-        frame: &FrameInputs,
-        light: &LightView,
-        _: &mut FrameStats,
-    ) -> Result<(), WgpuError> {
+    fn build(&self, cx: &mut WgpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), WgpuError> {
+        let LightPass { frame, light, .. } = pass;
         let (res, layers) = (self.resolution, light.projections.len() as u32);
         check_size(cx, "shadow map", res, res)?;
         if !state.maps.as_ref().is_some_and(|m| m.width() == res && m.depth_or_array_layers() == layers) {
@@ -230,7 +232,7 @@ impl ShadowTechnique<WgpuBackend> for DepthLayers {
         let maps = state.maps.clone().ok_or_else(|| TechniqueError::NotBuilt(self.kind.name().into()))?;
         cx.scoped("the depth-layer passes", |cx| {
             for (k, proj) in light.projections.iter().enumerate() {
-                render_projection(self, cx, state, frame, proj, k as u32, &maps, &instances);
+                render_projection(self, cx, state, frame, (k as u32, proj), &maps, &instances);
             }
         })
     }
@@ -239,15 +241,13 @@ impl ShadowTechnique<WgpuBackend> for DepthLayers {
         &self,
         cx: &mut WgpuContext,
         state: &mut State,
-        _: &FrameInputs,
-        light: &LightView,
+        pass: LightPass<'_>,
         g: &GpuGBuffer,
         out: &mut GpuVisibility,
-        _: &mut FrameStats,
     ) -> Result<(), WgpuError> {
+        let LightPass { light, .. } = pass;
         let maps = state.maps.as_ref().ok_or_else(|| TechniqueError::NotBuilt(self.kind.name().into()))?;
-        let lookup = LookupParams { radius: self.filter_radius, receiver_offset: 0.0 };
-        state.query.run(cx, maps, light, g, out, lookup, &QueryExtras::NONE)
+        state.query.run(cx, maps, light, g, out, &QueryExtras::NONE)
     }
 }
 

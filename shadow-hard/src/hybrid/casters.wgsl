@@ -23,7 +23,7 @@
 // included, with no clipping; its facing is det(M)'s sign, and its depth there (z . adj(M) p) / det(M),
 // used only to leave out what the near plane clips. Whether a side lies behind the receiver is not read
 // from that depth, which loses most of its digits to cancellation where a side meets the receiver (at
-// the shadow's edge: a first version took hundreds of pixels there the wrong way on tree), but from the
+// the shadow's edge, on tree, hundreds of pixels would fall on the wrong side), but from the
 // side's plane in world space: the eye ray meets it behind the receiver's G-buffer position exactly
 // where the eye and that position lie on one side of it.
 // Watertight: two triangles sharing an edge compute its row from the same two corners in one order (the

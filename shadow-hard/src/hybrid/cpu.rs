@@ -38,14 +38,15 @@ use super::edge_map::{edge_cells, edge_texel_quads};
 use super::{EdgeTexels, Hybrid};
 use glam::Vec3;
 use rayon::prelude::*;
+use shadow_core::Image;
 use shadow_core::frame::InstanceVolume;
 use shadow_core::geometry::volume::Caps;
 use shadow_core::geometry::volume::VolumeCounting;
 use shadow_core::light::LightView;
 use shadow_core::lookup::{MapClass, PixelClass, classify, near_edge, near_edge_pair};
 use shadow_core::stats::ms;
-use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
-use shadow_core::{FrameInputs, Image};
+use shadow_core::technique::LightPass;
+use shadow_core::technique::{DebugView, ShadowTechnique, TechniqueError};
 use std::time::Instant;
 
 use super::shafts::CasterShafts;
@@ -165,14 +166,8 @@ impl ShadowTechnique<CpuBackend> for Hybrid {
         Ok(State::default())
     }
 
-    fn build(
-        &self,
-        _: &mut CpuContext,
-        state: &mut State,
-        frame: &FrameInputs,
-        light: &LightView,
-        stats: &mut FrameStats,
-    ) -> Result<(), CpuError> {
+    fn build(&self, _: &mut CpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), CpuError> {
+        let LightPass { frame, light, stats } = pass;
         render_depth_maps(frame, light, self.depth.resolution, self.depth.depth_bias(), &mut state.maps)?;
         // The edge maps' segments come from the volumes' own silhouette pass (unused with
         // `edge_texels=off`, where they cost two transforms per silhouette edge).
@@ -194,12 +189,11 @@ impl ShadowTechnique<CpuBackend> for Hybrid {
         &self,
         _: &mut CpuContext,
         state: &mut State,
-        frame: &FrameInputs,
-        light: &LightView,
+        pass: LightPass<'_>,
         g: &GBuffer,
         out: &mut Image<f32>,
-        stats: &mut FrameStats,
     ) -> Result<(), CpuError> {
+        let LightPass { frame, light, stats } = pass;
         let volumes = state.volumes.as_ref().ok_or_else(|| TechniqueError::NotBuilt(Self::NAME.into()))?;
         if state.maps.len() != light.projections.len() {
             return Err(TechniqueError::NotBuilt(Self::NAME.into()).into());

@@ -20,8 +20,8 @@
 //! and the volumes count z-fail's way with the depth test turned around: a fragment behind the receiver
 //! fails `Less` exactly where it passes `GreaterEqual`, so the counting ops move from depth-fail to pass,
 //! and outside the mask (depth 1) every fragment fails the test, which hierarchical depth can do a tile at
-//! a time before rasterizing it. A first version wrote the silhouette pixels' depth from the mask shader
-//! instead; on an H100 both were slower than the stencil mask (see `GpuMask::Depth`).
+//! a time before rasterizing it. On an H100 it is slower than the stencil mask, and so is writing the
+//! silhouette pixels' depth from the mask shader instead (see `GpuMask::Depth`).
 //!
 //! With `scissor_tile=N` the mask pass also marks, in a storage buffer, each N x N pixel tile that holds a
 //! silhouette pixel; the CPU reads the marks back and the volume pass repeats its draws inside scissor
@@ -62,18 +62,17 @@ mod tiles;
 
 use casters::{CasterPasses, CasterPieces, LISTED_TRIANGLES, ListedPixels, Split, setup_room};
 use edges::{edge_cell_maps, edge_maps, edge_pass};
+use shadow_core::technique::LightPass;
 use tiles::TileMarks;
 
 use super::shafts::CasterShafts;
 use super::{EdgeTexels, GpuMask, Hybrid};
-use shadow_core::FrameInputs;
 use shadow_core::Image;
 use shadow_core::frame::InstanceVolume;
 use shadow_core::geometry::volume::Caps;
 use shadow_core::geometry::volume::VolumeCounting;
-use shadow_core::light::LightView;
 use shadow_core::lookup::PixelClass;
-use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
+use shadow_core::technique::{DebugView, ShadowTechnique, TechniqueError};
 
 use shadow_wgpu::frame::GpuVisibility;
 use shadow_wgpu::gbuffer::GpuGBuffer;
@@ -392,14 +391,8 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
         })
     }
 
-    fn build(
-        &self,
-        cx: &mut WgpuContext,
-        state: &mut State,
-        frame: &FrameInputs,
-        light: &LightView,
-        stats: &mut FrameStats,
-    ) -> Result<(), WgpuError> {
+    fn build(&self, cx: &mut WgpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), WgpuError> {
+        let LightPass { frame, light, stats } = pass;
         state.map.render(cx, frame, light, self.depth.resolution)?;
         cx.step("map");
         let res = self.depth.resolution;
@@ -432,12 +425,11 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
         &self,
         cx: &mut WgpuContext,
         state: &mut State,
-        frame: &FrameInputs,
-        light: &LightView,
+        pass: LightPass<'_>,
         g: &GpuGBuffer,
         out: &mut GpuVisibility,
-        stats: &mut FrameStats,
     ) -> Result<(), WgpuError> {
+        let LightPass { frame, light, stats } = pass;
         let not_built = || TechniqueError::NotBuilt(Self::NAME.into());
         let draws = state.draws.as_ref().ok_or_else(not_built)?;
         let maps = state.map.maps().ok_or_else(not_built)?;

@@ -1,9 +1,9 @@
 //! `ray-traced` on the CPU: one ray per receiver through the scene BVH (`passes::rays`).
 
-use shadow_core::light::LightView;
+use shadow_core::Image;
 use shadow_core::scene::LightKind;
-use shadow_core::technique::{FrameStats, ShadowTechnique};
-use shadow_core::{FrameInputs, Image};
+use shadow_core::technique::LightPass;
+use shadow_core::technique::ShadowTechnique;
 use shadow_cpu::passes::per_receiver;
 use shadow_cpu::passes::rays::{RayOrigins, State};
 use shadow_cpu::{CpuBackend, CpuContext, CpuError, GBuffer};
@@ -21,14 +21,8 @@ impl ShadowTechnique<CpuBackend> for RayTraced {
         Ok(State::default())
     }
 
-    fn build(
-        &self,
-        cx: &mut CpuContext,
-        state: &mut State,
-        frame: &FrameInputs,
-        _: &LightView,
-        _: &mut FrameStats,
-    ) -> Result<(), CpuError> {
+    fn build(&self, cx: &mut CpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), CpuError> {
+        let LightPass { frame, .. } = pass;
         state.build(cx, frame);
         Ok(())
     }
@@ -37,12 +31,11 @@ impl ShadowTechnique<CpuBackend> for RayTraced {
         &self,
         _: &mut CpuContext,
         state: &mut State,
-        frame: &FrameInputs,
-        light: &LightView,
+        pass: LightPass<'_>,
         g: &GBuffer,
         out: &mut Image<f32>,
-        stats: &mut FrameStats,
     ) -> Result<(), CpuError> {
+        let LightPass { frame, light, stats } = pass;
         let bvh = state.bvh(Self::NAME)?;
         let origins = RayOrigins::new(g, frame, self.epsilon);
         per_receiver(g, out, |_, _, i| {

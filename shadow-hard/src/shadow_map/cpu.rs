@@ -1,9 +1,9 @@
 //! `shadow-map` on the CPU (twin: [`super::gpu`]): depth from the light, rendered with Vulkan's depth bias,
 //! compared at each receiver through the map filter (`passes::maps`).
 
-use shadow_core::light::LightView;
-use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
-use shadow_core::{FrameInputs, Image};
+use shadow_core::Image;
+use shadow_core::technique::LightPass;
+use shadow_core::technique::{DebugView, ShadowTechnique, TechniqueError};
 use shadow_cpu::passes::maps::{depth_views, query_maps, render_depth_maps};
 use shadow_cpu::{CpuBackend, CpuContext, CpuError, GBuffer};
 
@@ -26,14 +26,8 @@ impl ShadowTechnique<CpuBackend> for ShadowMap {
         Ok(State::default())
     }
 
-    fn build(
-        &self,
-        _: &mut CpuContext,
-        state: &mut State,
-        frame: &FrameInputs,
-        light: &LightView,
-        _: &mut FrameStats,
-    ) -> Result<(), CpuError> {
+    fn build(&self, _: &mut CpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), CpuError> {
+        let LightPass { frame, light, .. } = pass;
         render_depth_maps(frame, light, self.map().resolution, self.map().depth_bias(), &mut state.maps)
     }
 
@@ -41,12 +35,11 @@ impl ShadowTechnique<CpuBackend> for ShadowMap {
         &self,
         _: &mut CpuContext,
         state: &mut State,
-        _: &FrameInputs,
-        light: &LightView,
+        pass: LightPass<'_>,
         g: &GBuffer,
         out: &mut Image<f32>,
-        _: &mut FrameStats,
     ) -> Result<(), CpuError> {
+        let LightPass { light, .. } = pass;
         if state.maps.len() != light.projections.len() {
             return Err(TechniqueError::NotBuilt(Self::NAME.into()).into());
         }

@@ -2,9 +2,8 @@
 //! pipeline's depth bias into one layer per projection; the query runs `shadow_lookup` of shadow_map.wgsl
 //! over the G-buffer, with the hardware comparison sampler for bilinear taps.
 
-use shadow_core::FrameInputs;
-use shadow_core::light::LightView;
-use shadow_core::technique::{FrameStats, ShadowTechnique, TechniqueError};
+use shadow_core::technique::LightPass;
+use shadow_core::technique::{ShadowTechnique, TechniqueError};
 use shadow_wgpu::passes::maps::{DepthMaps, LookupParams, MapQuery, QueryExtras};
 use shadow_wgpu::{GpuGBuffer, GpuVisibility, WgpuBackend, WgpuContext, WgpuError, shaders};
 
@@ -28,19 +27,16 @@ impl ShadowTechnique<WgpuBackend> for ShadowMap {
             let module = shaders::module(&cx.device, "shadow_map", shaders::shadow_map());
             State {
                 maps: DepthMaps::with_module(cx, &module, &self.map()),
-                query: MapQuery::new(cx, &module, self.filter),
+                query: MapQuery::new(cx, &module, self.filter).with_lookup(LookupParams {
+                    radius: self.filter_radius,
+                    receiver_offset: self.map().receiver_offset(),
+                }),
             }
         })
     }
 
-    fn build(
-        &self,
-        cx: &mut WgpuContext,
-        state: &mut State,
-        frame: &FrameInputs,
-        light: &LightView,
-        _: &mut FrameStats,
-    ) -> Result<(), WgpuError> {
+    fn build(&self, cx: &mut WgpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), WgpuError> {
+        let LightPass { frame, light, .. } = pass;
         state.maps.render(cx, frame, light, self.map().resolution)
     }
 
@@ -48,14 +44,12 @@ impl ShadowTechnique<WgpuBackend> for ShadowMap {
         &self,
         cx: &mut WgpuContext,
         state: &mut State,
-        _: &FrameInputs,
-        light: &LightView,
+        pass: LightPass<'_>,
         g: &GpuGBuffer,
         out: &mut GpuVisibility,
-        _: &mut FrameStats,
     ) -> Result<(), WgpuError> {
+        let LightPass { light, .. } = pass;
         let maps = state.maps.maps().ok_or_else(|| TechniqueError::NotBuilt(Self::NAME.into()))?;
-        let lookup = LookupParams { radius: self.filter_radius, receiver_offset: self.map().receiver_offset() };
-        state.query.run(cx, maps, light, g, out, lookup, &QueryExtras::NONE)
+        state.query.run(cx, maps, light, g, out, &QueryExtras::NONE)
     }
 }

@@ -1,11 +1,11 @@
 //! Stencil shadow volumes on the CPU (twin: [`super::gpu`]): the shared extrusion, counted by
 //! `passes::volumes` with the technique's counting.
 
+use shadow_core::Image;
 use shadow_core::frame::InstanceVolume;
 use shadow_core::geometry::volume::{Caps, VolumeCounting};
-use shadow_core::light::LightView;
-use shadow_core::technique::{FrameStats, ShadowTechnique, TechniqueError};
-use shadow_core::{FrameInputs, Image};
+use shadow_core::technique::LightPass;
+use shadow_core::technique::{ShadowTechnique, TechniqueError};
 use shadow_cpu::passes::per_receiver;
 use shadow_cpu::passes::volumes::{build_volumes, rasterize_volumes};
 use shadow_cpu::raster::DepthStencil;
@@ -30,14 +30,8 @@ impl ShadowTechnique<CpuBackend> for ShadowVolume {
         Ok(State::default())
     }
 
-    fn build(
-        &self,
-        _: &mut CpuContext,
-        state: &mut State,
-        frame: &FrameInputs,
-        light: &LightView,
-        stats: &mut FrameStats,
-    ) -> Result<(), CpuError> {
+    fn build(&self, _: &mut CpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), CpuError> {
+        let LightPass { frame, light, stats } = pass;
         let caps = if self.counting == VolumeCounting::ZFail { Caps::Both } else { Caps::None };
         state.volumes = Some(build_volumes(frame, light, caps, stats));
         Ok(())
@@ -47,12 +41,11 @@ impl ShadowTechnique<CpuBackend> for ShadowVolume {
         &self,
         _: &mut CpuContext,
         state: &mut State,
-        frame: &FrameInputs,
-        _: &LightView,
+        pass: LightPass<'_>,
         g: &GBuffer,
         out: &mut Image<f32>,
-        stats: &mut FrameStats,
     ) -> Result<(), CpuError> {
+        let LightPass { frame, stats, .. } = pass;
         let volumes = state.volumes.as_ref().ok_or_else(|| TechniqueError::NotBuilt(self.name().into()))?;
         let mut ds = DepthStencil::from_depth(&g.depth, 0);
         let c = rasterize_volumes(frame, g, volumes, self.counting, &mut ds, None);

@@ -5,10 +5,9 @@
 //! the depth test off, every rasterized volume fragment (inside the query phase, timed as its sub-phase
 //! `count_fragments` so it can be taken out).
 
-use shadow_core::FrameInputs;
 use shadow_core::geometry::volume::{Caps, VolumeCounting};
-use shadow_core::light::LightView;
-use shadow_core::technique::{FrameStats, ShadowTechnique, TechniqueError};
+use shadow_core::technique::LightPass;
+use shadow_core::technique::{ShadowTechnique, TechniqueError};
 use shadow_wgpu::passes::volumes::{
     StencilResolve, VolumeDraw, VolumePass, build_draws, count_all_pipeline, counting_state, read_query,
     volume_pipeline,
@@ -46,14 +45,8 @@ impl ShadowTechnique<WgpuBackend> for ShadowVolume {
         })
     }
 
-    fn build(
-        &self,
-        cx: &mut WgpuContext,
-        state: &mut State,
-        frame: &FrameInputs,
-        light: &LightView,
-        stats: &mut FrameStats,
-    ) -> Result<(), WgpuError> {
+    fn build(&self, cx: &mut WgpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), WgpuError> {
+        let LightPass { frame, light, stats } = pass;
         let caps = if self.counting == VolumeCounting::ZFail { Caps::Both } else { Caps::None };
         state.draws = build_draws(cx, frame, light, caps, stats)?;
         Ok(())
@@ -63,12 +56,11 @@ impl ShadowTechnique<WgpuBackend> for ShadowVolume {
         &self,
         cx: &mut WgpuContext,
         state: &mut State,
-        frame: &FrameInputs,
-        _: &LightView,
+        pass: LightPass<'_>,
         g: &GpuGBuffer,
         out: &mut GpuVisibility,
-        stats: &mut FrameStats,
     ) -> Result<(), WgpuError> {
+        let LightPass { frame, stats, .. } = pass;
         if state.draws.is_empty() && stats.counters.volume_triangles.is_none() {
             return Err(TechniqueError::NotBuilt(self.name().into()).into());
         }

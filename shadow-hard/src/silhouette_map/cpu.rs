@@ -11,15 +11,15 @@
 //! `silhouette_texels` (non-empty texels, all projections) and `silhouette_pixels` (pixels whose corner
 //! tests disagreed: Sen's P is this over `covered_pixels`).
 
+use shadow_core::technique::LightPass;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use super::SilhouetteMap;
 use super::points::CornerDepth;
 use super::points::{PointMap, overlay, project_segments, silhouette_lookup};
+use shadow_core::Image;
 use shadow_core::glam::Vec2;
-use shadow_core::light::LightView;
-use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
-use shadow_core::{FrameInputs, Image};
+use shadow_core::technique::{DebugView, ShadowTechnique, TechniqueError};
 
 use shadow_cpu::GBuffer;
 use shadow_cpu::passes::maps::depth_views;
@@ -45,14 +45,8 @@ impl ShadowTechnique<CpuBackend> for SilhouetteMap {
         Ok(State::default())
     }
 
-    fn build(
-        &self,
-        _: &mut CpuContext,
-        state: &mut State,
-        frame: &FrameInputs,
-        light: &LightView,
-        stats: &mut FrameStats,
-    ) -> Result<(), CpuError> {
+    fn build(&self, _: &mut CpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), CpuError> {
+        let LightPass { frame, light, stats } = pass;
         let res = self.depth.resolution;
         render_depth_maps(frame, light, res, self.depth.depth_bias(), &mut state.maps)?;
         let edges = frame.silhouette_segments(light);
@@ -72,12 +66,11 @@ impl ShadowTechnique<CpuBackend> for SilhouetteMap {
         &self,
         _: &mut CpuContext,
         state: &mut State,
-        _: &FrameInputs,
-        light: &LightView,
+        pass: LightPass<'_>,
         g: &GBuffer,
         out: &mut Image<f32>,
-        stats: &mut FrameStats,
     ) -> Result<(), CpuError> {
+        let LightPass { light, stats, .. } = pass;
         if state.maps.len() != light.projections.len() || state.points.len() != state.maps.len() {
             return Err(TechniqueError::NotBuilt(Self::NAME.into()).into());
         }

@@ -13,9 +13,9 @@
 use super::SilhouetteMap;
 use super::points::{CornerDepth, Keep, MapSegment, overlay, project_segments};
 use bytemuck::{Pod, Zeroable};
-use shadow_core::FrameInputs;
 use shadow_core::light::LightView;
-use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
+use shadow_core::technique::LightPass;
+use shadow_core::technique::{DebugView, ShadowTechnique, TechniqueError};
 use wgpu::util::DeviceExt;
 
 use shadow_wgpu::frame::{GpuVisibility, layer_view, layered};
@@ -150,7 +150,8 @@ impl State {
                     count: None,
                 },
             ],
-        );
+        )
+        .with_lookup(LookupParams { radius: 0.0, receiver_offset: s.depth.receiver_offset() });
         let counters = cx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("silhouette counters"),
             size: COUNTER_STRIDE + 4,
@@ -343,14 +344,8 @@ impl ShadowTechnique<WgpuBackend> for SilhouetteMap {
         cx.scoped("creating the silhouette-map pipelines", |cx| State::new(cx, self))
     }
 
-    fn build(
-        &self,
-        cx: &mut WgpuContext,
-        state: &mut State,
-        frame: &FrameInputs,
-        light: &LightView,
-        stats: &mut FrameStats,
-    ) -> Result<(), WgpuError> {
+    fn build(&self, cx: &mut WgpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), WgpuError> {
+        let LightPass { frame, light, stats } = pass;
         let res = self.depth.resolution;
         check_size(cx, "shadow map", res, res)?;
         state.allocate(cx, res, light.projections.len() as u32)?;
@@ -371,12 +366,11 @@ impl ShadowTechnique<WgpuBackend> for SilhouetteMap {
         &self,
         cx: &mut WgpuContext,
         state: &mut State,
-        _: &FrameInputs,
-        light: &LightView,
+        pass: LightPass<'_>,
         g: &GpuGBuffer,
         out: &mut GpuVisibility,
-        stats: &mut FrameStats,
     ) -> Result<(), WgpuError> {
+        let LightPass { light, stats, .. } = pass;
         let maps = state.maps.as_ref().ok_or_else(|| TechniqueError::NotBuilt(Self::NAME.into()))?;
         let points = maps.points.create_view(&wgpu::TextureViewDescriptor {
             dimension: Some(wgpu::TextureViewDimension::D2Array),
@@ -397,8 +391,7 @@ impl ShadowTechnique<WgpuBackend> for SilhouetteMap {
         ];
         let receiver_plane = if self.corner_depth == CornerDepth::ReceiverPlane { 1.0 } else { 0.0 };
         let extras = QueryExtras { settings: [receiver_plane, 0.0, 0.0, 0.0], entries: &entries };
-        let lookup = LookupParams { radius: 0.0, receiver_offset: self.depth.receiver_offset() };
-        state.query.run(cx, &maps.depth, light, g, out, lookup, &extras)?;
+        state.query.run(cx, &maps.depth, light, g, out, &extras)?;
         // The counters cost a compute pass and a readback that the technique itself does not need: a
         // sub-phase of their own, after the query's work is done, so they can be told apart.
         cx.wait()?;

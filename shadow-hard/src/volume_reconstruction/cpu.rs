@@ -12,11 +12,11 @@ use super::reconstruction::projection::{
     Projection, caps_for_view, coverage_view, edge_view, reconstruct_projection, record_build,
 };
 use super::{ObjectIds, VolumeReconstruction};
+use shadow_core::Image;
 use shadow_core::glam::{Mat4, Vec4};
 use shadow_core::image::Rgb8;
-use shadow_core::light::LightView;
-use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
-use shadow_core::{FrameInputs, Image};
+use shadow_core::technique::LightPass;
+use shadow_core::technique::{DebugView, ShadowTechnique, TechniqueError};
 
 use shadow_cpu::GBuffer;
 use shadow_cpu::passes::maps::{render_depth_and_id_maps, render_depth_maps};
@@ -73,14 +73,8 @@ impl ShadowTechnique<CpuBackend> for VolumeReconstruction {
         Ok(State::default())
     }
 
-    fn build(
-        &self,
-        _: &mut CpuContext,
-        state: &mut State,
-        frame: &FrameInputs,
-        light: &LightView,
-        stats: &mut FrameStats,
-    ) -> Result<(), CpuError> {
+    fn build(&self, _: &mut CpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), CpuError> {
+        let LightPass { frame, light, stats } = pass;
         let res = self.depth.resolution;
         let view = light.with_seamless_faces(res);
         let bias = self.depth.depth_bias();
@@ -104,12 +98,11 @@ impl ShadowTechnique<CpuBackend> for VolumeReconstruction {
         &self,
         _: &mut CpuContext,
         state: &mut State,
-        _: &FrameInputs,
-        _: &LightView,
+        pass: LightPass<'_>,
         g: &GBuffer,
         out: &mut Image<f32>,
-        stats: &mut FrameStats,
     ) -> Result<(), CpuError> {
+        let LightPass { stats, .. } = pass;
         if state.projections.is_empty() {
             return Err(TechniqueError::NotBuilt(Self::NAME.into()).into());
         }

@@ -17,10 +17,9 @@ use super::reconstruction::projection::{
     Projection, caps_for_view, coverage_view, edge_view, reconstruct_projection, record_build,
 };
 use super::{ObjectIds, VolumeReconstruction};
-use shadow_core::FrameInputs;
 use shadow_core::glam::Vec4;
-use shadow_core::light::LightView;
-use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
+use shadow_core::technique::LightPass;
+use shadow_core::technique::{DebugView, ShadowTechnique, TechniqueError};
 use wgpu::util::DeviceExt;
 
 use shadow_wgpu::frame::{GpuVisibility, layered};
@@ -142,14 +141,8 @@ impl ShadowTechnique<WgpuBackend> for VolumeReconstruction {
         })
     }
 
-    fn build(
-        &self,
-        cx: &mut WgpuContext,
-        state: &mut State,
-        frame: &FrameInputs,
-        light: &LightView,
-        stats: &mut FrameStats,
-    ) -> Result<(), WgpuError> {
+    fn build(&self, cx: &mut WgpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), WgpuError> {
+        let LightPass { frame, light, stats } = pass;
         let res = self.depth.resolution;
         check_size(cx, "depth map", res, res)?;
         let view = light.with_seamless_faces(res);
@@ -201,12 +194,11 @@ impl ShadowTechnique<WgpuBackend> for VolumeReconstruction {
         &self,
         cx: &mut WgpuContext,
         state: &mut State,
-        _: &FrameInputs,
-        _: &LightView,
+        pass: LightPass<'_>,
         g: &GpuGBuffer,
         out: &mut GpuVisibility,
-        stats: &mut FrameStats,
     ) -> Result<(), WgpuError> {
+        let LightPass { stats, .. } = pass;
         if state.projections.is_empty() {
             return Err(TechniqueError::NotBuilt(Self::NAME.into()).into());
         }

@@ -1,11 +1,11 @@
 //! `pcss` on the CPU backend, through its public depth-map API; the reference of the lookup, which
 //! query.wgsl mirrors.
 
+use shadow_core::Image;
 use shadow_core::glam::Vec2;
-use shadow_core::light::LightView;
 use shadow_core::lookup::{POISSON16, compare_bilinear, hash_unit, on_map, pixel_hash};
-use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
-use shadow_core::{FrameInputs, Image};
+use shadow_core::technique::LightPass;
+use shadow_core::technique::{DebugView, ShadowTechnique, TechniqueError};
 use shadow_cpu::passes::maps::{map_position, render_depth_maps};
 use shadow_cpu::passes::per_receiver;
 use shadow_cpu::{CpuBackend, CpuContext, CpuError, GBuffer};
@@ -64,14 +64,8 @@ impl ShadowTechnique<CpuBackend> for Pcss {
         Ok(State::default())
     }
 
-    fn build(
-        &self,
-        _: &mut CpuContext,
-        state: &mut State,
-        frame: &FrameInputs,
-        light: &LightView,
-        _: &mut FrameStats,
-    ) -> Result<(), CpuError> {
+    fn build(&self, _: &mut CpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), CpuError> {
+        let LightPass { frame, light, .. } = pass;
         state.lens = Some(Self::lens(light)?);
         render_depth_maps(frame, light, self.depth.resolution, self.depth.depth_bias(), &mut state.maps)
     }
@@ -80,12 +74,11 @@ impl ShadowTechnique<CpuBackend> for Pcss {
         &self,
         _: &mut CpuContext,
         state: &mut State,
-        _: &FrameInputs,
-        light: &LightView,
+        pass: LightPass<'_>,
         g: &GBuffer,
         out: &mut Image<f32>,
-        _: &mut FrameStats,
     ) -> Result<(), CpuError> {
+        let LightPass { light, .. } = pass;
         let (Some(lens), Some(map)) = (&state.lens, state.maps.first()) else {
             return Err(TechniqueError::NotBuilt(Self::NAME.into()).into());
         };
@@ -108,6 +101,7 @@ mod tests {
     use super::*;
     use shadow_core::bounds::Aabb;
     use shadow_core::glam::Vec3;
+    use shadow_core::light::LightView;
     use shadow_core::scene::Light;
 
     /// A spot light of radius 0.5 at height 10 looking straight down with a 90-degree cone (the map's

@@ -1,9 +1,8 @@
 //! `pcss` on the wgpu backend, through its public API: `shadow-map`'s light pass, then a query over the
 //! G-buffer with `shadow-map`'s bindings and the geometric normals (query.wgsl).
 
-use shadow_core::FrameInputs;
-use shadow_core::light::LightView;
-use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
+use shadow_core::technique::LightPass;
+use shadow_core::technique::{DebugView, ShadowTechnique, TechniqueError};
 use shadow_wgpu::passes::maps::{DepthMaps, LookupParams, MapQuery, QueryExtras};
 use shadow_wgpu::pipelines::{FragmentEntry, attribute_entry};
 use shadow_wgpu::{GpuGBuffer, GpuVisibility, WgpuBackend, WgpuContext, WgpuError, shaders};
@@ -28,19 +27,15 @@ impl ShadowTechnique<WgpuBackend> for Pcss {
         let map = DepthMaps::new(cx, &self.depth);
         cx.scoped("creating the pcss pipelines", |cx| {
             let module = shaders::module(&cx.device, "pcss query", query_shader());
-            let query = MapQuery::with_entry(cx, &module, FragmentEntry::from("fs_pcss_query"), &[attribute_entry(4)]);
+            let lookup = LookupParams { radius: 0.0, receiver_offset: self.depth.receiver_offset() };
+            let query = MapQuery::with_entry(cx, &module, FragmentEntry::from("fs_pcss_query"), &[attribute_entry(4)])
+                .with_lookup(lookup);
             State { map, query, lens: None }
         })
     }
 
-    fn build(
-        &self,
-        cx: &mut WgpuContext,
-        state: &mut State,
-        frame: &FrameInputs,
-        light: &LightView,
-        _: &mut FrameStats,
-    ) -> Result<(), WgpuError> {
+    fn build(&self, cx: &mut WgpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), WgpuError> {
+        let LightPass { frame, light, .. } = pass;
         state.lens = Some(Self::lens(light)?);
         state.map.render(cx, frame, light, self.depth.resolution)
     }
@@ -49,20 +44,18 @@ impl ShadowTechnique<WgpuBackend> for Pcss {
         &self,
         cx: &mut WgpuContext,
         state: &mut State,
-        _: &FrameInputs,
-        light: &LightView,
+        pass: LightPass<'_>,
         g: &GpuGBuffer,
         out: &mut GpuVisibility,
-        _: &mut FrameStats,
     ) -> Result<(), WgpuError> {
+        let LightPass { light, .. } = pass;
         let (Some(maps), Some(lens)) = (state.map.maps(), &state.lens) else {
             return Err(TechniqueError::NotBuilt(Self::NAME.into()).into());
         };
         let entries =
             [wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::TextureView(&g.geometric_normal) }];
-        let lookup = LookupParams { radius: 0.0, receiver_offset: self.depth.receiver_offset() };
         let extras = QueryExtras { settings: lens.uniform(), entries: &entries };
-        state.query.run(cx, maps, light, g, out, lookup, &extras)
+        state.query.run(cx, maps, light, g, out, &extras)
     }
 
     fn debug_views(&self, _: &mut WgpuContext, _: &State) -> Result<Vec<DebugView>, WgpuError> {

@@ -1,12 +1,13 @@
 //! `penumbra-map` on the CPU backend, through its public rasterizer and depth-map API; the reference of
 //! the passes build.wgsl and query.wgsl mirror.
 
+use shadow_core::Image;
 use shadow_core::glam::Vec2;
-use shadow_core::light::{LightProjection, LightView};
+use shadow_core::light::LightProjection;
 use shadow_core::lookup::{bilinear, on_map};
 use shadow_core::stats::ms;
-use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
-use shadow_core::{FrameInputs, Image};
+use shadow_core::technique::LightPass;
+use shadow_core::technique::{DebugView, ShadowTechnique, TechniqueError};
 use shadow_cpu::passes::maps::{map_position, render_depth_maps};
 use shadow_cpu::passes::per_receiver;
 use shadow_cpu::raster::{CullMode, DepthStencil, RasterState, Soup, draw};
@@ -85,14 +86,8 @@ impl ShadowTechnique<CpuBackend> for PenumbraMap {
         Ok(State::default())
     }
 
-    fn build(
-        &self,
-        _: &mut CpuContext,
-        state: &mut State,
-        frame: &FrameInputs,
-        light: &LightView,
-        stats: &mut FrameStats,
-    ) -> Result<(), CpuError> {
+    fn build(&self, _: &mut CpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), CpuError> {
+        let LightPass { frame, light, stats } = pass;
         // The sub-phase `penumbra_map`: the cones and sheets built and drawn (the depth map is shadow-map's).
         let t0 = Instant::now();
         let (proj, built) = Self::construct(frame, light, stats)?;
@@ -114,12 +109,11 @@ impl ShadowTechnique<CpuBackend> for PenumbraMap {
         &self,
         _: &mut CpuContext,
         state: &mut State,
-        _: &FrameInputs,
-        light: &LightView,
+        pass: LightPass<'_>,
         g: &GBuffer,
         out: &mut Image<f32>,
-        _: &mut FrameStats,
     ) -> Result<(), CpuError> {
+        let LightPass { light, .. } = pass;
         let (Some(penumbra), Some(map)) = (&state.penumbra, state.maps.first()) else {
             return Err(TechniqueError::NotBuilt(Self::NAME.into()).into());
         };

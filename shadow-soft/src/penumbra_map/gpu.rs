@@ -4,9 +4,9 @@
 //! on the CPU by the shared [`super::geometry`] and uploaded.
 
 use bytemuck::{Pod, Zeroable};
-use shadow_core::FrameInputs;
-use shadow_core::light::{LightProjection, LightView};
-use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
+use shadow_core::light::LightProjection;
+use shadow_core::technique::LightPass;
+use shadow_core::technique::{DebugView, ShadowTechnique, TechniqueError};
 use shadow_wgpu::frame::{layer_view, layered};
 use shadow_wgpu::passes::maps::{DepthMaps, LookupParams, MapQuery, QueryExtras};
 use shadow_wgpu::pipelines::{FragmentEntry, MAP_DEPTH, depth_entry};
@@ -100,19 +100,14 @@ impl ShadowTechnique<WgpuBackend> for PenumbraMap {
             let build = min_target::pipeline(cx, "penumbra map", &build_module, &build_layout, vertex, "fs_penumbra");
             let query_module = shaders::module(&cx.device, "penumbra query", query_shader());
             let entry = FragmentEntry::from("fs_penumbra_query");
-            let query = MapQuery::with_entry(cx, &query_module, entry, &[depth_entry(4)]);
+            let lookup = LookupParams { radius: 0.0, receiver_offset: self.depth.receiver_offset() };
+            let query = MapQuery::with_entry(cx, &query_module, entry, &[depth_entry(4)]).with_lookup(lookup);
             State { map, build_layout, build, query, penumbra: None }
         })
     }
 
-    fn build(
-        &self,
-        cx: &mut WgpuContext,
-        state: &mut State,
-        frame: &FrameInputs,
-        light: &LightView,
-        stats: &mut FrameStats,
-    ) -> Result<(), WgpuError> {
+    fn build(&self, cx: &mut WgpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), WgpuError> {
+        let LightPass { frame, light, stats } = pass;
         let t0 = std::time::Instant::now();
         let (proj, built) = Self::construct(frame, light, stats)?;
         let construct = t0.elapsed();
@@ -128,20 +123,18 @@ impl ShadowTechnique<WgpuBackend> for PenumbraMap {
         &self,
         cx: &mut WgpuContext,
         state: &mut State,
-        _: &FrameInputs,
-        light: &LightView,
+        pass: LightPass<'_>,
         g: &GpuGBuffer,
         out: &mut GpuVisibility,
-        _: &mut FrameStats,
     ) -> Result<(), WgpuError> {
+        let LightPass { light, .. } = pass;
         let (Some(maps), Some(penumbra)) = (state.map.maps(), &state.penumbra) else {
             return Err(TechniqueError::NotBuilt(Self::NAME.into()).into());
         };
         let view = layer_view(penumbra, 0);
         let entries = [wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::TextureView(&view) }];
-        let lookup = LookupParams { radius: 0.0, receiver_offset: self.depth.receiver_offset() };
         let extras = QueryExtras { settings: [0.0; 4], entries: &entries };
-        state.query.run(cx, maps, light, g, out, lookup, &extras)
+        state.query.run(cx, maps, light, g, out, &extras)
     }
 
     fn debug_views(&self, cx: &mut WgpuContext, state: &State) -> Result<Vec<DebugView>, WgpuError> {

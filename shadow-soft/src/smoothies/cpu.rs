@@ -1,11 +1,11 @@
 //! `smoothies` on the CPU backend, through its public rasterizer and depth-map API.
 
+use shadow_core::Image;
 use shadow_core::glam::{Vec2, Vec4};
-use shadow_core::light::LightView;
 use shadow_core::lookup::{bilinear, on_map};
 use shadow_core::stats::ms;
-use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
-use shadow_core::{FrameInputs, Image};
+use shadow_core::technique::LightPass;
+use shadow_core::technique::{DebugView, ShadowTechnique, TechniqueError};
 use shadow_cpu::passes::maps::{map_position, render_depth_maps};
 use shadow_cpu::passes::per_receiver;
 use shadow_cpu::raster::{CullMode, DepthStencil, RasterState, Soup, draw};
@@ -123,14 +123,8 @@ impl ShadowTechnique<CpuBackend> for Smoothies {
         Ok(State::default())
     }
 
-    fn build(
-        &self,
-        _: &mut CpuContext,
-        state: &mut State,
-        frame: &FrameInputs,
-        light: &LightView,
-        stats: &mut FrameStats,
-    ) -> Result<(), CpuError> {
+    fn build(&self, _: &mut CpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), CpuError> {
+        let LightPass { frame, light, stats } = pass;
         let proj = Self::projection(light)?;
         render_depth_maps(frame, light, self.depth.resolution, self.depth.depth_bias(), &mut state.maps)?;
         let t0 = Instant::now();
@@ -147,12 +141,11 @@ impl ShadowTechnique<CpuBackend> for Smoothies {
         &self,
         _: &mut CpuContext,
         state: &mut State,
-        _: &FrameInputs,
-        light: &LightView,
+        pass: LightPass<'_>,
         g: &GBuffer,
         out: &mut Image<f32>,
-        _: &mut FrameStats,
     ) -> Result<(), CpuError> {
+        let LightPass { light, .. } = pass;
         let not_built = || TechniqueError::NotBuilt(Self::NAME.into());
         let (Some(buffer), Some(map)) = (&state.buffer, state.maps.first()) else { return Err(not_built().into()) };
         let offset = self.depth.receiver_offset();

@@ -4,9 +4,9 @@
 //! the CPU by the shared [`super::geometry`] and uploaded, as the thesis's host code built them.
 
 use bytemuck::{Pod, Zeroable};
-use shadow_core::FrameInputs;
-use shadow_core::light::{LightProjection, LightView};
-use shadow_core::technique::{DebugView, FrameStats, ShadowTechnique, TechniqueError};
+use shadow_core::light::LightProjection;
+use shadow_core::technique::LightPass;
+use shadow_core::technique::{DebugView, ShadowTechnique, TechniqueError};
 use shadow_wgpu::frame::{layer_view, layered};
 use shadow_wgpu::passes::maps::{DepthMaps, LookupParams, MapQuery, QueryExtras};
 use shadow_wgpu::pipelines::{FragmentEntry, MAP_DEPTH, buffer_entry, depth_entry};
@@ -116,7 +116,9 @@ impl ShadowTechnique<WgpuBackend> for Smoothies {
             let query_module = shaders::module(&cx.device, "smoothie query", query_shader());
             let storage = wgpu::BufferBindingType::Storage { read_only: true };
             let extra = [depth_entry(4), depth_entry(5), buffer_entry(6, storage, wgpu::ShaderStages::FRAGMENT)];
-            let query = MapQuery::with_entry(cx, &query_module, FragmentEntry::from("fs_smoothie_query"), &extra);
+            let lookup = LookupParams { radius: 0.0, receiver_offset: self.depth.receiver_offset() };
+            let query = MapQuery::with_entry(cx, &query_module, FragmentEntry::from("fs_smoothie_query"), &extra)
+                .with_lookup(lookup);
             let falloff = cx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("smoothie falloff"),
                 contents: bytemuck::cast_slice(falloff.samples()),
@@ -126,14 +128,8 @@ impl ShadowTechnique<WgpuBackend> for Smoothies {
         })
     }
 
-    fn build(
-        &self,
-        cx: &mut WgpuContext,
-        state: &mut State,
-        frame: &FrameInputs,
-        light: &LightView,
-        stats: &mut FrameStats,
-    ) -> Result<(), WgpuError> {
+    fn build(&self, cx: &mut WgpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), WgpuError> {
+        let LightPass { frame, light, stats } = pass;
         let proj = Self::projection(light)?;
         state.map.render(cx, frame, light, self.depth.resolution)?;
         let t0 = std::time::Instant::now();
@@ -150,12 +146,11 @@ impl ShadowTechnique<WgpuBackend> for Smoothies {
         &self,
         cx: &mut WgpuContext,
         state: &mut State,
-        _: &FrameInputs,
-        light: &LightView,
+        pass: LightPass<'_>,
         g: &GpuGBuffer,
         out: &mut GpuVisibility,
-        _: &mut FrameStats,
     ) -> Result<(), WgpuError> {
+        let LightPass { light, .. } = pass;
         let not_built = || TechniqueError::NotBuilt(Self::NAME.into());
         let (Some(maps), Some(buffer)) = (state.map.maps(), &state.buffer) else { return Err(not_built().into()) };
         let views = buffer.each_ref().map(|t| layer_view(t, 0));
@@ -164,9 +159,8 @@ impl ShadowTechnique<WgpuBackend> for Smoothies {
             wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&views[1]) },
             wgpu::BindGroupEntry { binding: 6, resource: state.falloff.as_entire_binding() },
         ];
-        let lookup = LookupParams { radius: 0.0, receiver_offset: self.depth.receiver_offset() };
         let extras = QueryExtras { settings: [0.0; 4], entries: &entries };
-        state.query.run(cx, maps, light, g, out, lookup, &extras)
+        state.query.run(cx, maps, light, g, out, &extras)
     }
 
     fn debug_views(&self, cx: &mut WgpuContext, state: &State) -> Result<Vec<DebugView>, WgpuError> {

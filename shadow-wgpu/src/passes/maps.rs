@@ -149,6 +149,7 @@ impl MapBindings {
 pub struct MapQuery {
     pipeline: wgpu::RenderPipeline,
     bindings: MapBindings,
+    lookup: LookupParams,
 }
 
 impl MapQuery {
@@ -178,14 +179,20 @@ impl MapQuery {
             Some(VISIBILITY),
             None,
         );
-        Self { pipeline, bindings }
+        Self { pipeline, bindings, lookup: LookupParams::default() }
+    }
+
+    /// The same query, reading the maps with `lookup` (the kernel radius and the receiver offset its
+    /// settings ask for; none by default).
+    #[must_use]
+    pub fn with_lookup(self, lookup: LookupParams) -> Self {
+        Self { lookup, ..self }
     }
 
     /// Writes the visibility of every receiver through the maps (one layer per light projection).
     ///
     /// # Errors
     /// A GPU failure.
-    #[allow(clippy::too_many_arguments)]
     pub fn run(
         &self,
         cx: &WgpuContext,
@@ -193,11 +200,10 @@ impl MapQuery {
         light: &LightView,
         g: &GpuGBuffer,
         out: &GpuVisibility,
-        lookup: LookupParams,
         extras: &QueryExtras<'_>,
     ) -> Result<(), WgpuError> {
         cx.scoped("the shadow-map query", |cx| {
-            let group = self.bindings.group(cx, maps, light, g, lookup, extras);
+            let group = self.bindings.group(cx, maps, light, g, self.lookup, extras);
             super::full_screen(cx, "map query", &out.view, &self.pipeline, &[&g.frame_group, &group], None);
         })
     }
