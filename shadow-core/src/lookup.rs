@@ -202,20 +202,6 @@ pub fn classify(map: &Image<f32>, uv: Vec2, depth: f32, faces_light: bool) -> Ma
     }
 }
 
-/// Whether a silhouette edge nearer the light than `depth` (by [`EDGE_MARGIN`]) crosses one of the four texels nearest `uv` in
-/// `edges`, a map of the nearest edge's NDC depth per texel (1 where none; `hybrid`'s `edge_texels`; WGSL
-/// twin: `near_edge` in shadow-wgpu's edges_all.wgsl). Outside the map, no.
-#[must_use]
-#[inline]
-pub fn near_edge(edges: &Image<f32>, uv: Vec2, depth: f32) -> bool {
-    if !on_map(uv) {
-        return false;
-    }
-    let st = uv * edges.width() as f32 - Vec2::splat(0.5);
-    let (x, y) = (floor(st.x) as i32, floor(st.y) as i32);
-    texels_2x2(edges, x, y).iter().any(|&edge| edge < depth - EDGE_MARGIN)
-}
-
 /// The cell of an `edge_cells` (shadow-hard's `hybrid::edge_map`) map of a map of side `res` that
 /// holds `uv`: the square between the four texels a lookup at `uv` reads, `(0, 0)` to `(res, res)` for
 /// `uv` on the map.
@@ -231,7 +217,7 @@ pub fn cell_of(res: u32, uv: Vec2) -> (u32, u32) {
 /// square between the four texels of `map` nearest `uv`, where Chan's rule may miss a sliver, a gap or a
 /// corner between them (`hybrid`'s `edge_texels=paired`; `cells` from
 /// `edge_cells` (shadow-hard's `hybrid::edge_map`), side one more than `map`'s; WGSL twin:
-/// `near_edge` in edges_all.wgsl). Outside the map, no.
+/// `near_edge` in edges_paired.wgsl). Outside the map, no.
 ///
 /// Not where the edges are hidden ([`hidden`]): when all four texels hold a surface nearer the light than
 /// the nearest of the edges (by [`EDGE_MARGIN`]), those surfaces cover the whole square in front of the
@@ -263,7 +249,7 @@ pub fn hidden(map: &Image<f32>, x: u32, y: u32, nearest: f32) -> bool {
     texels_2x2(map, x as i32 - 1, y as i32 - 1).iter().all(|&t| t < nearest - EDGE_MARGIN)
 }
 
-/// How much nearer the light than a receiver (NDC depth) an edge must be to count in [`near_edge`]: a
+/// How much nearer the light than a receiver (NDC depth) an edge must be to count in [`near_edge_pair`]: a
 /// surface's own rim lies at the depth of its silhouette edge, where which of the two rounds nearer differs
 /// between backends by a few ulps; a caster that shadows the receiver is orders of magnitude nearer.
 pub const EDGE_MARGIN: f32 = 1e-5;
@@ -347,11 +333,6 @@ mod tests {
                         _ => MapClass::Silhouette,
                     };
                     assert_eq!(classify(&map, uv, depth, true), want, "uv {uv}, depth {depth}");
-                    // The same texels read as an edge map.
-                    let near = [(x, y), (x + 1, y), (x, y + 1), (x + 1, y + 1)]
-                        .iter()
-                        .any(|&(x, y)| *map.get_clamped(x, y) < depth - EDGE_MARGIN);
-                    assert_eq!(near_edge(&map, uv, depth), on_map(uv) && near, "uv {uv}, depth {depth}");
                 }
             }
         }

@@ -46,16 +46,13 @@ fn reference_ceiling(technique: &str, scene: &str) -> Option<f64> {
 
 /// Settings other than the defaults that take a different path through a backend, run as techniques of
 /// their own.
-const VARIANTS: [&str; 7] = [
+const VARIANTS: [&str; 6] = [
     // The light pass's object-ID channel: an R32Uint target read back on the GPU.
     "volume-reconstruction:ids=dangling",
     // The unmasked volume pass that counts what the computation mask saves.
     "hybrid:unmasked_fill=on",
     // The computation mask kept in a scratch depth buffer, the volumes' depth test turned around.
     "hybrid:gpu_mask=depth",
-    // Silhouette edges drawn into edge maps (per cube face for point lights) widen the mask (the default,
-    // edge_texels=paired, uploads edge cells instead).
-    "hybrid:edge_texels=all",
     // Chan's rule alone.
     "hybrid:edge_texels=off",
     // The GPU's tile marks, read back, and the volumes drawn in scissor rectangles around them.
@@ -187,8 +184,7 @@ fn every_technique_agrees_across_backends_and_with_the_reference() {
             // Relative tolerances: rasterized counts agree to rounding; silhouette_pixels counts per-pixel
             // depth comparisons, which flip where a corner sample ties the receiver to an ulp.
             // Hybrid counts its volume fragments under a mask made of silhouette pixels: a pixel that ties
-            // one way on one backend brings its whole overdraw along (cylinder at 256x256 with
-            // edge_texels=all: 226 and 223 silhouette pixels, 882 and 870 fragments), so twice theirs.
+            // one way on one backend brings its whole overdraw along, so twice theirs.
             let volume_tolerance = if spec.name == "hybrid" { 0.02 } else { 0.001 };
             // Both backends' caster masks (on unless turned off) count each small caster only where its
             // shadow can be, but they choose the pieces counted that way differently (the CPU by triangles

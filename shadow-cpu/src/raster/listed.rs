@@ -3,15 +3,15 @@
 //!
 //! A draw's list is short (tens to hundreds of pixels) and its triangles few (one connected component's
 //! shadow volume), so each triangle is tested at the listed pixels in the rows it spans, found by binary
-//! search, with the walk's own edge functions, top-left rule and depth plane (the pencil's candidate
-//! test, [`super::pencil`]): the same fragments, depths and stencil increments as a row walk under a mask
+//! search, with the walk's own edge functions, top-left rule and depth plane (the candidate
+//! test, [`super::candidates`]): the same fragments, depths and stencil increments as a row walk under a mask
 //! holding just those pixels. The draws run in
 //! parallel, each counting into deltas of its own list, added into the stencil afterwards (counting ops
 //! commute).
 
 use rayon::prelude::*;
 
-use super::pencil::CandidateTest;
+use super::candidates::CandidateTest;
 use super::{
     CompareFn, DepthKernel, DepthStencil, HALF, ONE, RasterCounters, RasterState, Setup, TriangleSource, guard_band,
     setup,

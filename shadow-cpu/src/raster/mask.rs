@@ -1,11 +1,7 @@
 //! A computation mask (Chan, thesis 3.2 and 3.4.2): one bit per pixel saying whether later draws may touch
 //! it, and one per square tile saying whether any of its pixels may, so the rasterizer rejects unmasked
 //! tiles whole, as hardware culls tiles early, before any depth or stencil work. The pixels' bits are
-//! kept in 64-bit words per row, so a span meets the mask a word at a time; on request the masked-in
-//! pixels are also ordered around a point ([`ComputationMask::ordered_around`], [`Pencil`]) for counting
-//! draws whose triangles all lie on lines through it.
-
-use super::pencil::Pencil;
+//! kept in 64-bit words per row, so a span meets the mask a word at a time.
 
 /// Which pixels a draw may touch, with a coarse per-tile summary.
 #[derive(Clone, Debug, PartialEq)]
@@ -21,8 +17,6 @@ pub struct ComputationMask {
     /// the mask in a word or two, whatever the pixels in it.
     bits: Vec<u64>,
     words: usize,
-    /// The masked-in pixels in angular order around a point, when asked for ([`Self::ordered_around`]).
-    pencil: Option<Pencil>,
 }
 
 impl ComputationMask {
@@ -50,23 +44,7 @@ impl ComputationMask {
                         - sums[ty * (tw + 1) + tx];
             }
         }
-        Self { width, height, tile, tiles, sums, bits, words, pencil: None }
-    }
-
-    /// The mask with its pixels also sorted by angle around the image of the clip-space point `apex`
-    /// (homogeneous): counting draws whose triangles lie in a pencil of lines through it (shadow volumes'
-    /// sides, around the light's image) then test a triangle only at the masked-in pixels in its angle.
-    /// Without effect when the image is at infinity.
-    #[must_use]
-    pub fn ordered_around(mut self, apex: glam::Vec4) -> Self {
-        self.pencil = Pencil::new(&self, apex);
-        self
-    }
-
-    /// The angular order, if any.
-    #[must_use]
-    pub fn pencil(&self) -> Option<&Pencil> {
-        self.pencil.as_ref()
+        Self { width, height, tile, tiles, sums, bits, words }
     }
 
     /// Whether any tile meeting the pixel rectangle `x0..=x1`, `y0..=y1` (clamped to the target) has a

@@ -50,11 +50,11 @@ macro_rules! with_depth_test {
 }
 use with_depth_test;
 
+mod candidates;
 pub mod clip;
 mod listed;
 pub mod mask;
 mod masked;
-pub mod pencil;
 mod source;
 mod spans;
 pub mod state;
@@ -394,10 +394,8 @@ pub fn draw_depth<S: TriangleSource + ?Sized>(ds: &mut DepthStencil, src: &S, st
 /// as the mask allows before any depth or stencil work: a triangle is not binned into a band where its
 /// bounds meet no masked-in tile; with a fast kernel (depth tests, stencil counting) its tile rows are
 /// tested against the mask's tiles and only those meeting a masked-in one are walked, row by row, each
-/// span cut to the mask's runs. A counting draw under a mask ordered around a point
-/// ([`ComputationMask::ordered_around`]: the light's image, for shadow volumes) tests the triangles that
-/// point bounds cheaply at the masked-in pixels in their angle instead ([`pencil`]). Either way the same
-/// fragments, depths and counters; only masked-in fragments are counted.
+/// span cut to the mask's runs. The same fragments, depths and counters as the unmasked draw at the
+/// masked-in pixels; only masked-in fragments are counted.
 ///
 /// # Panics
 /// When the mask is not the size of `ds`: a caller bug.
@@ -459,23 +457,12 @@ where
         for b in &mut bins {
             b.clear();
         }
-        // A counting draw under a mask in pencil order leaves to the walk only what the pencil can't bound
-        // cheaply.
-        let counting = match path {
-            Path::Depth(DepthKernel::Count { compare, front, back }) => Some((compare, front, back)),
-            _ => None,
-        };
-        let mut pencil = mask.and_then(ComputationMask::pencil).zip(counting).map(|(p, k)| (p, k, p.plan(&setups)));
-        let walked = pencil
-            .as_mut()
-            .map_or_else(|| (0..setups.len() as u32).collect(), |(_, _, plan)| std::mem::take(&mut plan.walked));
-        for &i in &walked {
-            let t = &setups[i as usize];
+        for (i, t) in setups.iter().enumerate() {
             for band in (t.min_y as u32 / BAND_ROWS)..=(t.max_y as u32 / BAND_ROWS) {
                 let (y0, y1) =
                     ((band * BAND_ROWS).max(t.min_y as u32), ((band + 1) * BAND_ROWS - 1).min(t.max_y as u32));
                 if mask.is_none_or(|m| m.any_in(t.min_x as u32, y0, t.max_x as u32, y1)) {
-                    bins[band as usize].push(i);
+                    bins[band as usize].push(i as u32);
                 }
             }
         }
@@ -500,10 +487,6 @@ where
                 a
             });
         total += counters;
-        if let Some((p, counting, plan)) = &pencil {
-            let clamp = st.depth.is_some_and(|d| d.clamp);
-            total += p.count(&setups, plan, *counting, clamp, (&ds.depth, &mut ds.stencil));
-        }
     }
     total
 }

@@ -191,9 +191,6 @@ pub struct RasterCounters {
     pub passed: u64,
     /// Fragments whose stencil op was anything but Keep.
     pub stencil_updates: u64,
-    /// Triangles (after clipping) counted at the masked-in pixels in their angle around the mask's apex
-    /// ([`crate::raster::ComputationMask::ordered_around`]) rather than walked row by row.
-    pub pencil_triangles: u64,
 }
 
 impl std::ops::AddAssign for RasterCounters {
@@ -202,6 +199,5 @@ impl std::ops::AddAssign for RasterCounters {
         self.fragments += o.fragments;
         self.passed += o.passed;
         self.stencil_updates += o.stencil_updates;
-        self.pencil_triangles += o.pencil_triangles;
     }
 }

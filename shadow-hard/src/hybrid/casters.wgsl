@@ -11,10 +11,9 @@
 // (those of its light-space grid cell whose shafts hold it) and counts the pixels of each piece;
 // cs_offsets gives each piece its run of pairs; cs_fill writes them; cs_pieces counts each piece at its
 // pixels, a workgroup per piece (its invocations read one triangle at a time, the same for all); cs_alone
-// counts the pixels whose pairs did not fit, every piece of theirs, as one invocation per pixel. Counting
-// every pixel as cs_alone does, its invocations each reading their own pieces' triangles, was measured
-// slower on lavapipe: tree's query 89 to 103 ms against 64 to 82 (three runs in turn, 8 frames); cubes'
-// within the noise.
+// counts the pixels whose pairs did not fit, every piece of theirs, as one invocation per pixel. A
+// workgroup per piece rather than an invocation per pixel: the invocations then read the same triangle
+// at once instead of each its own pieces' (on tree a third faster on lavapipe; cubes alike).
 //
 // The count at a pixel is the rasterizer's, taken by homogeneous rasterization (Olano and Greer 1997): a
 // triangle with clip-space corners a, b, c (columns of M, in x, y, w) covers the pixel at NDC point p
@@ -71,10 +70,9 @@ fn triangle_at(i: u32) -> vec4<f32> {
 // row (z . adj(M)) with the cap flag in w, and the world plane through the triangle, turned so the eye
 // lies on its positive side.
 @group(1) @binding(13) var<storage, read_write> setups: array<vec4<f32>>;
-// The same, copied into a texture (TABLE_ROW texels a row) after cs_setup, for the passes that read them.
-// On lavapipe (Mesa 22.3.6, which loads from a storage buffer lane by lane) two more texel fetches per
-// triangle test added 15 ms to tree's cs_pieces where two more storage loads added 65, and reading the
-// setups from the texture took that pass from 118-142 ms to 47.
+// The same, copied into a texture (TABLE_ROW texels a row) after cs_setup, for the passes that read them:
+// lavapipe (Mesa 22.3) loads from a storage buffer lane by lane and fetches texels a quad at a time, so
+// reading the setups from the texture makes cs_pieces two to three times faster there.
 @group(1) @binding(17) var setup_texels: texture_2d<f32>;
 
 // Per piece, per projection, the shaft as `holds` reads it, in three texels: its least and greatest
@@ -96,7 +94,7 @@ fn setup_at(i: u32) -> vec4<f32> {
 }
 
 // Per instance of the frame, its world_from_local, a column a texel (the frame's `instances` hold the same,
-// but in a storage buffer: 16 lane-by-lane loads per triangle set up cost tree's cs_setup 4 ms on lavapipe).
+// but in a storage buffer, which lavapipe loads lane by lane: 16 loads per triangle set up).
 @group(1) @binding(19) var instance_texels: texture_2d<f32>;
 
 fn instance_at(i: u32) -> mat4x4<f32> {

@@ -15,16 +15,10 @@
 //! With `edge_texels=paired` (the default; ours) a receiver facing the light is a silhouette pixel too
 //! where two silhouette edges in front of it enter the square between its four texels and may cut off a
 //! part of it that holds none of them (`edge_cells`, `near_edge_pair`): a branch, a gap or a corner thinner
-//! than a texel, which Chan's rule misses; `all` masks every receiver whose texels an edge crosses.
-//!
-//! With `pencil=on` the mask's pixels are also ordered around the light's image
-//! (`ComputationMask::ordered_around`), for the volumes still drawn through the whole mask: every volume
-//! side lies on lines through it, so a side, a sliver hundreds of rows long, is tested only at the few
-//! silhouette pixels in its angle from there rather than walked row by row (Chan's hardware rejects
-//! masked-off tiles for free; a software rasterizer still pays for every row it walks). Same fragments.
+//! than a texel, which Chan's rule misses.
 //!
 //! Counters: `silhouette_pixels`; `volume_fragments`, the fragments rasterized under the masks (the work
-//! actually done); `pencil_triangles`, the volume triangles tested in pencil order; `caster_pieces`, of
+//! actually done); `caster_pieces`, of
 //! them `caster_pieces_skipped` (no silhouette pixel in their shadow) and `caster_pieces_listed` (counted
 //! at their own `caster_listed_pixels`), the rest drawn through the whole mask; `mask_tiles` and
 //! `mask_tiles_total`; with `unmasked_fill=on`, `unmasked_volume_fragments`, what `shadow-volume-zfail`
@@ -34,8 +28,8 @@
 
 mod casters;
 
-use super::edge_map::{edge_cells, edge_texel_quads};
-use super::{EdgeTexels, Hybrid};
+use super::Hybrid;
+use super::edge_map::edge_cells;
 use glam::Vec3;
 use rayon::prelude::*;
 use shadow_core::Image;
@@ -43,7 +37,7 @@ use shadow_core::frame::InstanceVolume;
 use shadow_core::geometry::volume::Caps;
 use shadow_core::geometry::volume::VolumeCounting;
 use shadow_core::light::LightView;
-use shadow_core::lookup::{MapClass, PixelClass, classify, near_edge, near_edge_pair};
+use shadow_core::lookup::{MapClass, PixelClass, classify, near_edge_pair};
 use shadow_core::stats::ms;
 use shadow_core::technique::LightPass;
 use shadow_core::technique::{DebugView, ShadowTechnique, TechniqueError};
@@ -55,7 +49,7 @@ use shadow_cpu::GBuffer;
 use shadow_cpu::passes::maps::{map_position, render_depth_maps};
 use shadow_cpu::passes::per_receiver;
 use shadow_cpu::passes::volumes::rasterize_volumes;
-use shadow_cpu::raster::{ComputationMask, CullMode, DepthState, DepthStencil, RasterState, Soup, draw_depth};
+use shadow_cpu::raster::{ComputationMask, DepthStencil};
 use shadow_cpu::{CpuBackend, CpuContext, CpuError};
 
 /// The maps and volumes of the last build; what the last query decided with (for the debug view, which
@@ -92,13 +86,12 @@ impl LastQuery {
     }
 }
 
-/// The map's class of every receiver pixel (`Lit` elsewhere), rows in parallel; with `edge_maps` (of
-/// `edge_texels`), a receiver facing the light near an edge in front of it, or an edge pair, is a
-/// silhouette pixel too.
+/// The map's class of every receiver pixel (`Lit` elsewhere), rows in parallel; with `edge_maps` (the
+/// edge cells of `edge_texels=paired`), a receiver facing the light where an edge pair in front of it may
+/// hide something is a silhouette pixel too.
 fn classify_receivers(
     maps: &[Image<f32>],
     edge_maps: &[Image<f32>],
-    edge_texels: EdgeTexels,
     light: &LightView,
     g: &GBuffer,
     receiver_offset: f32,
@@ -120,10 +113,7 @@ fn classify_receivers(
                 MapClass::Silhouette if !faces_light() => MapClass::Shadowed,
                 class => class,
             };
-            let near = |e: &Image<f32>| match edge_texels {
-                EdgeTexels::Paired => near_edge_pair(e, map, m.uv, m.depth),
-                _ => near_edge(e, m.uv, m.depth),
-            };
+            let near = |cells: &Image<f32>| near_edge_pair(cells, map, m.uv, m.depth);
             if *class != MapClass::Silhouette && edge_maps.get(m.projection).is_some_and(near) && faces_light() {
                 *class = MapClass::Silhouette;
             }
@@ -132,27 +122,10 @@ fn classify_receivers(
     classes
 }
 
-/// The edge maps of `edge_texels`, one per projection of `light`, from the casters' silhouette `segments`
-/// (world space): with `all`, their texel quads drawn into a map of the nearest edge's depth per texel;
-/// with `paired`, their cells (`edge_cells`).
-fn edge_maps(
-    segments: &[[Vec3; 2]],
-    light: &LightView,
-    maps: &[Image<f32>],
-    res: u32,
-    mode: EdgeTexels,
-) -> Vec<Image<f32>> {
-    let nearest = RasterState { cull: CullMode::None, depth: Some(DepthState::LESS_WRITE), ..RasterState::default() };
-    let edge_map = |(p, map)| match mode {
-        EdgeTexels::Paired => edge_cells(segments, p, res, Some(map)),
-        _ => {
-            let quads = edge_texel_quads(segments, p, res);
-            let mut ds = DepthStencil::new(res, res, 1.0, 0);
-            draw_depth(&mut ds, &Soup { triangles: &quads, prim_base: 0, flip: false }, &nearest);
-            ds.into_depth_image()
-        }
-    };
-    light.projections.iter().zip(maps).map(edge_map).collect()
+/// The edge cells of `edge_texels=paired`, one map per projection of `light`, from the casters'
+/// silhouette `segments` (world space).
+fn edge_maps(segments: &[[Vec3; 2]], light: &LightView, maps: &[Image<f32>], res: u32) -> Vec<Image<f32>> {
+    light.projections.iter().zip(maps).map(|(p, map)| edge_cells(segments, p, res, Some(map))).collect()
 }
 
 impl ShadowTechnique<CpuBackend> for Hybrid {
@@ -176,7 +149,7 @@ impl ShadowTechnique<CpuBackend> for Hybrid {
         state.edge_maps.clear();
         if self.edge_texels.is_on() {
             let t = Instant::now();
-            state.edge_maps = edge_maps(&segments, light, &state.maps, self.depth.resolution, self.edge_texels);
+            state.edge_maps = edge_maps(&segments, light, &state.maps, self.depth.resolution);
             stats.timings.extra.insert("edge_maps".into(), ms(t.elapsed()));
         }
         state.shafts =
@@ -200,13 +173,9 @@ impl ShadowTechnique<CpuBackend> for Hybrid {
         }
         let (w, h) = (g.width(), g.height());
         let t = Instant::now();
-        let map_class =
-            classify_receivers(&state.maps, &state.edge_maps, self.edge_texels, light, g, self.depth.receiver_offset());
+        let map_class = classify_receivers(&state.maps, &state.edge_maps, light, g, self.depth.receiver_offset());
         let silhouette = |x, y| *map_class.get(x, y) == MapClass::Silhouette;
-        let mut mask = ComputationMask::from_fn(w, h, self.mask_tile, silhouette);
-        if self.pencil.is_on() {
-            mask = mask.ordered_around(g.clip_from_world * light.source().homogeneous());
-        }
+        let mask = ComputationMask::from_fn(w, h, self.mask_tile, silhouette);
         stats.timings.extra.insert("classify".into(), ms(t.elapsed()));
         let t = Instant::now();
         let mut ds = DepthStencil::from_depth(&g.depth, 0);
@@ -232,7 +201,6 @@ impl ShadowTechnique<CpuBackend> for Hybrid {
         counters.silhouette_pixels = Some(mask.count() as u64);
         counters.volume_fragments = Some(c.fragments);
         counters.stencil_updates = Some(c.stencil_updates);
-        counters.extra.insert("pencil_triangles".into(), c.pencil_triangles as f64);
         let (tiles, all_tiles) = mask.tiles_in();
         counters.extra.insert("mask_tiles".into(), tiles as f64);
         counters.extra.insert("mask_tiles_total".into(), all_tiles as f64);

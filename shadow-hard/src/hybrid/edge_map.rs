@@ -1,16 +1,14 @@
-//! Silhouette edges as light-space maps, for `hybrid`'s `edge_texels` (both backends): what Chan's rule
+//! Silhouette edges as a light-space map, for `hybrid`'s `edge_texels` (both backends): what Chan's rule
 //! cannot see between a shadow map's texel centres.
 //!
-//! - [`edge_texel_quads`] (`edge_texels=all`): the texels each segment crosses, as triangles a rasterizer
-//!   draws into a depth target, nearest edge per texel.
-//! - [`edge_cells`] (`edge_texels=paired`): the squares between four texel centres, a bilinear lookup's
-//!   footprint, that two segments or more enter, with the nearest one's depth. A straight edge alone across
+//! [`edge_cells`]: the squares between four texel centres, a bilinear lookup's footprint, that two
+//! segments or more enter, with the nearest one's depth. A straight edge alone across
 //!   such a square leaves texel centres on both of its sides, where the depth tests then disagree, so Chan's
 //!   rule already sends the receiver to the volumes; only a sliver, a gap or a corner between two edges
 //!   can hide between the centres. Every vertex of a silhouette loop ends two segments, so "two enter"
 //!   also holds where a loop turns.
 
-use glam::{DVec2, Vec2, Vec3, Vec4};
+use glam::{DVec2, Vec3, Vec4};
 
 use rayon::prelude::*;
 
@@ -57,35 +55,6 @@ fn clip_to_view(proj: &LightProjection, [a, b]: [Vec3; 2], margin: f32) -> Optio
     }
     let (pa, pb) = (ca.lerp(cb, t0), ca.lerp(cb, t1));
     Some(Clipped { ends: [pa.truncate() / pa.w, pb.truncate() / pb.w], cut: [t0 > 0.0, t1 < 1.0] })
-}
-
-/// The texels of an `res x res` map of projection `proj` that world segments cross, as
-/// clip-space triangles for a rasterizer: each segment's projection thickened and lengthened by half a
-/// texel's diagonal, so every texel whose square it touches has its centre covered (`hybrid`'s
-/// `edge_texels=all`). Corners carry their end's NDC depth, so a depth test "less" keeps the nearest edge
-/// in each texel. Segments are first clipped to the view (its near plane, and a few texels past its
-/// sides).
-#[must_use]
-pub fn edge_texel_quads(segments: &[[Vec3; 2]], proj: &LightProjection, res: u32) -> Vec<[Vec4; 3]> {
-    let reach = std::f32::consts::SQRT_2 / res as f32; // half a texel's diagonal, in NDC (2 / res a texel)
-    let mut out = Vec::with_capacity(segments.len() * 2);
-    for &segment in segments {
-        let Some(Clipped { ends: [na, nb], .. }) = clip_to_view(proj, segment, 4.0 * reach) else {
-            continue;
-        };
-        let along = (nb - na).truncate().try_normalize().unwrap_or(Vec2::X) * reach;
-        let across = along.perp();
-        let corner = |p: Vec3, d: Vec2| Vec4::new(p.x + d.x, p.y + d.y, p.z.clamp(0.0, 1.0), 1.0);
-        let quad = [
-            corner(na, -along - across),
-            corner(nb, along - across),
-            corner(nb, along + across),
-            corner(na, -along + across),
-        ];
-        out.push([quad[0], quad[1], quad[2]]);
-        out.push([quad[0], quad[2], quad[3]]);
-    }
-    out
 }
 
 /// Stands for a cut end in a cell's first segments: never a segment [`may_hide`] can clear.
@@ -330,6 +299,7 @@ fn chord([a, b]: [DVec2; 2]) -> Option<[DVec2; 2]> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use glam::Vec2;
 
     /// A 1:1 orthographic view: clip = world.
     fn straight_on() -> LightProjection {
@@ -342,42 +312,6 @@ mod tests {
             far: 1.0,
             orthographic: true,
         }
-    }
-
-    /// Whether world segment `seg` (seen straight on) touches the square `[lo, lo + size]^2` (NDC x, y),
-    /// from dense samples along it.
-    fn touches(seg: [Vec3; 2], lo: Vec2, size: f32) -> bool {
-        (0..=2000).any(|k| {
-            let p = seg[0].lerp(seg[1], k as f32 / 2000.0).truncate();
-            p.cmpge(lo).all() && p.cmple(lo + size).all()
-        })
-    }
-
-    #[test]
-    fn edge_quads_cover_every_texel_a_segment_touches() {
-        // A diagonal segment across a 16^2 map: every texel whose square it crosses has its centre inside
-        // one of the quads, at the segment's depth.
-        let res = 16;
-        let seg = [Vec3::new(-0.7, -0.3, 0.25), Vec3::new(0.6, 0.45, 0.25)];
-        let tris = edge_texel_quads(&[seg], &straight_on(), res);
-        assert_eq!(tris.len(), 2);
-        let inside = |p: Vec2, t: &[Vec4; 3]| {
-            let c = t.map(|v| v.truncate().truncate());
-            let side = |a: Vec2, b: Vec2| (b - a).perp_dot(p - a);
-            let s = [side(c[0], c[1]), side(c[1], c[2]), side(c[2], c[0])];
-            s.iter().all(|&v| v >= 0.0) || s.iter().all(|&v| v <= 0.0)
-        };
-        let texel = 2.0 / res as f32;
-        for j in 0..res {
-            for i in 0..res {
-                let lo = Vec2::new(-1.0 + i as f32 * texel, -1.0 + j as f32 * texel);
-                if touches(seg, lo, texel) {
-                    let centre = lo + Vec2::splat(texel / 2.0);
-                    assert!(tris.iter().any(|t| inside(centre, t)), "texel ({i}, {j}) missed");
-                }
-            }
-        }
-        assert!(tris.iter().flatten().all(|v| v.z == 0.25 && v.w == 1.0));
     }
 
     #[test]

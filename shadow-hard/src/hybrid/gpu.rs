@@ -30,11 +30,10 @@
 //! them (measured in docs/hybrid.md: on an H100 from 0.63 to 1.56 times z-fail's query, against 0.67 to 1.30
 //! without).
 //!
-//! With `edge_texels=all` (both backends) the build also draws the casters' silhouette edges into edge
-//! maps, and the classification masks every receiver facing the light whose texels an edge nearer than it
-//! crosses (edges_all.wgsl), so casters thinner than a texel still get volumes; with `paired`, only
-//! where two edges enter the square between its four texels and may hide something there (the edge
-//! cells, made by shared code on the CPU and uploaded; edges_paired.wgsl).
+//! With `edge_texels=paired` (both backends) the classification also masks every receiver facing the
+//! light where two silhouette edges in front of it enter the square between its four texels and may hide
+//! something there (the edge cells, made by shared code on the CPU and uploaded; edges_paired.wgsl), so
+//! casters thinner than a texel still get volumes.
 //!
 //! With `caster_masks=on` (the default, as on the CPU; ours) each small piece of the volumes (one connected
 //! component's) is counted only at the silhouette pixels its shaft holds, by compute passes over the
@@ -45,8 +44,8 @@
 //! answer outside the mask: a full-screen pass can write a colour or set the stencil for the pixels it
 //! keeps, but not both for different pixels, and one more 4-texel lookup costs less than a class target
 //! written and read. With them the mask pass also leaves each pixel's class in the per-pixel buffer the
-//! compute passes write the listed pixels' counts to, and the answer reads it there (lavapipe, six runs
-//! in turn: tree's query 47-56 ms against 51-63 classifying twice, cubes' 24-35 against 26-43).
+//! compute passes write the listed pixels' counts to, and the answer reads it there, which is cheaper
+//! than classifying twice.
 //!
 //! Counters come from occlusion queries: the mask pass's samples are `silhouette_pixels`; after the
 //! answer, a pass with the depth test off and the mask's stencil test counts `volume_fragments` (those the
@@ -61,12 +60,12 @@ mod tables;
 mod tiles;
 
 use casters::{CasterPasses, CasterPieces, LISTED_TRIANGLES, ListedPixels, Split, setup_room};
-use edges::{edge_cell_maps, edge_maps, edge_pass};
+use edges::edge_cell_maps;
 use shadow_core::technique::LightPass;
 use tiles::TileMarks;
 
 use super::shafts::CasterShafts;
-use super::{EdgeTexels, GpuMask, Hybrid};
+use super::{GpuMask, Hybrid};
 use shadow_core::Image;
 use shadow_core::frame::InstanceVolume;
 use shadow_core::geometry::volume::Caps;
@@ -82,8 +81,7 @@ use shadow_wgpu::passes::volumes::{
     upload_volumes, volume_pipeline,
 };
 use shadow_wgpu::pipelines::{
-    DEPTH_STENCIL, FragmentEntry, VISIBILITY, attribute_entry, buffer_entry, depth_array_entry, float_array_entry,
-    full_screen_pipeline,
+    DEPTH_STENCIL, FragmentEntry, VISIBILITY, attribute_entry, buffer_entry, float_array_entry, full_screen_pipeline,
 };
 use shadow_wgpu::readback;
 use shadow_wgpu::{WgpuBackend, WgpuContext, WgpuError};
@@ -119,9 +117,7 @@ pub struct State {
     far: Option<wgpu::RenderPipeline>,
     /// With `scissor_tile` above 0: the tile marks, at the last view's grid.
     tiles: Option<TileMarks>,
-    /// With `edge_texels=all`: the pass drawing the edge quads. The edge maps of the last build, a layer
-    /// per projection: with `all` the nearest edge's depth per texel, with `paired` the edge cells.
-    edge_pass: Option<wgpu::RenderPipeline>,
+    /// With `edge_texels=paired`: the edge cells of the last build, a layer per projection.
     edge_maps: Option<wgpu::Texture>,
     last: Option<LastQuery>,
 }
@@ -316,10 +312,8 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
                 shadow_wgpu::shaders::module(&cx.device, "shadow_volume", shadow_wgpu::shaders::shadow_volume());
             let gpu_mask = self.gpu_mask;
             let mut extras = vec![attribute_entry(4)];
-            match self.edge_texels {
-                EdgeTexels::Off => {}
-                EdgeTexels::All => extras.push(depth_array_entry(6)),
-                EdgeTexels::Paired => extras.push(float_array_entry(6)),
+            if self.edge_texels.is_on() {
+                extras.push(float_array_entry(6));
             }
             let storage = |read_only| wgpu::BufferBindingType::Storage { read_only };
             if self.scissor_tile > 0 {
@@ -384,7 +378,6 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
                 scratch: None,
                 far,
                 tiles: None,
-                edge_pass: (self.edge_texels == EdgeTexels::All).then(|| edge_pass(cx)),
                 edge_maps: None,
                 last: None,
             }
@@ -399,9 +392,7 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
         // The edge maps' segments come from the volumes' own silhouette pass (unused with
         // `edge_texels=off`, where they cost two transforms per silhouette edge).
         let (volumes, segments) = frame.shadow_volumes_and_segments(light, Caps::Both);
-        if let Some(pass) = &state.edge_pass {
-            state.edge_maps = Some(cx.scoped("the edge maps", |cx| edge_maps(cx, pass, &segments, light, res))?);
-        } else if self.edge_texels == EdgeTexels::Paired {
+        if self.edge_texels.is_on() {
             state.edge_maps = Some(cx.scoped("the edge cells", |cx| edge_cell_maps(cx, &segments, light, res))?);
         }
         cx.step("edges");

@@ -39,17 +39,6 @@ shadow_core::technique_settings! {
             64,
             "CPU computation-mask tile side in pixels (1 to 64): tiles with no silhouette pixel are skipped whole",
         ),
-        /// CPU: on, the mask's pixels are also ordered around the light's image, so each side of a volume drawn
-        /// through the whole mask (every volume with `caster_masks=off`, only the pieces too large to list
-        /// otherwise) is tested only at the silhouette pixels in its angle from there (all sides lie on lines
-        /// through it); off, walked row by row under the tiled mask. Same fragments either way. Off by default:
-        /// with caster masks the ordering costs more than it saves.
-        pub pencil: OnOff = SettingKey::choice(
-            "pencil",
-            "off",
-            OnOff::NAMES,
-            "CPU: on, the sides of volumes drawn through the whole mask are tested only at the silhouette pixels in their angle around the light's image; off, walked row by row",
-        ),
         /// On, each connected component's volume is counted only at the silhouette pixels within the
         /// light-space bounds of its shadow ([`shafts`]; its count is zero everywhere else): on the CPU
         /// by listed draws, on the GPU by compute passes over the pixels the mask pass lists (pieces of more
@@ -79,18 +68,19 @@ shadow_core::technique_settings! {
             8,
             512,
             "GPU: 0, or draw the volumes only in scissor rectangles around the masked NxN tiles (8 to 512)",
-            ).or("0",
-        ),
+        )
+        .or("0"),
         /// Which receivers facing the light are also silhouette pixels because of the casters' silhouette
         /// edges (drawn into a map of edge depths), so casters and gaps thinner than a texel, which the map
         /// misses (Chan's Fig. 3-8), still get volumes; off: Chan's rule alone. `paired` by default (ours):
-        /// it keeps `tree` under 0.1% at 512^2 as `all` does, with a third more silhouette pixels than Chan's
-        /// rule on tree and nine tenths more on cubes, where `all` has twice and ten times as many.
+        /// it keeps `tree` under 0.1% at 512^2 with a third more silhouette pixels than Chan's rule on tree
+        /// and nine tenths more on cubes. Masking every receiver whose texels an edge crosses did as well
+        /// for error with twice and ten times as many, so only the pairs are kept.
         pub edge_texels: EdgeTexels = SettingKey::choice(
             "edge_texels",
             "paired",
             EdgeTexels::NAMES,
-            "off (Chan's rule), all (also mask receivers whose texels a silhouette edge in front crosses) or paired (only where two edges in front enter the receiver's footprint, or one ends there)",
+            "off (Chan's rule) or paired (also mask receivers where two silhouette edges in front enter their footprint, or one ends there)",
         ),
         /// Whether the query also counts the volumes' unmasked fill (what `shadow-volume-zfail` rasterizes),
         /// the counter `unmasked_volume_fragments`, in a pass of its own timed as `count_fragments`; off, the
@@ -111,8 +101,8 @@ shadow_core::technique_settings! {
             0,
             MAX_PAIR_ROOM,
             "GPU caster masks: room for pixel-piece pairs, auto (8 per view pixel) or 0 to 268435456; a pixel whose pairs do not fit counts its pieces alone, more slowly",
-            ).or("auto",
-        ),
+        )
+        .or("auto"),
     }
 }
 
@@ -125,8 +115,6 @@ shadow_core::named_enum! {
     pub enum EdgeTexels {
         /// None: Chan's rule alone.
         Off = "off",
-        /// Where an edge nearer the light crosses one of the receiver's four texels.
-        All = "all",
         /// Where two edges nearer the light enter the square between the receiver's four texel centres
         /// (its bilinear footprint), or one ends there. One straight edge across the square leaves texel
         /// centres on both of its sides, so Chan's rule already sees it; only a sliver, a gap or a corner

@@ -1,6 +1,7 @@
 // hybrid (Chan, thesis chapter 3): the map's classification of each receiver, the computation mask it
-// makes in the stencil's bit 7, and the passes that answer from the mask (twin: cpu.rs). Follows shadow_map.wgsl, whose bindings 0 to 3 it shares, one of the two
-// `near_edge` (edges_all.wgsl, or never), one of the two `mark_tile` and one of the two sets of
+// makes in the stencil's bit 7, and the passes that answer from the mask (twin: cpu.rs). Follows
+// shadow_map.wgsl, whose bindings 0 to 3 it shares, one of the two `near_edge` (edges_paired.wgsl, or
+// never), one of the two `mark_tile` and one of the two sets of
 // `list_pixel`, `listed_shadowed`, `remember_class` and `remembered_class` (caster masks; shaders.rs).
 
 @group(1) @binding(4) var g_geometric_normal: texture_2d<f32>;

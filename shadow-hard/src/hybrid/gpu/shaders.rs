@@ -9,7 +9,6 @@ use crate::hybrid::EdgeTexels;
 const QUERY: &str = include_str!("../query.wgsl");
 const CASTERS: &str = include_str!("../casters.wgsl");
 const EDGES_OFF: &str = include_str!("../edges_off.wgsl");
-const EDGES_ALL: &str = include_str!("../edges_all.wgsl");
 const EDGES_PAIRED: &str = include_str!("../edges_paired.wgsl");
 const TILE_MARKS: &str = include_str!("../tile_marks.wgsl");
 const TILE_MARKS_OFF: &str = include_str!("../tile_marks_off.wgsl");
@@ -17,16 +16,12 @@ const CASTER_LISTS: &str = include_str!("../caster_lists.wgsl");
 const LISTED_COUNTS: &str = include_str!("../listed_counts.wgsl");
 const LISTED_OFF: &str = include_str!("../listed_off.wgsl");
 
-/// The edge pass: clip-space quads into a depth target.
-pub const EDGE_PASS: &str = include_str!("../edge_pass.wgsl");
-
 /// The classification, the mask and the answer, after the shadow-map shader; with `caster_masks`, the
 /// mask pass also lists the silhouette pixels and the answer reads their counts.
 #[must_use]
 pub fn query(edge_texels: EdgeTexels, tile_marks: bool, caster_masks: bool) -> String {
     let edges = match edge_texels {
         EdgeTexels::Off => EDGES_OFF,
-        EdgeTexels::All => EDGES_ALL,
         EdgeTexels::Paired => EDGES_PAIRED,
     };
     let tiles = if tile_marks { TILE_MARKS } else { TILE_MARKS_OFF };
@@ -45,9 +40,8 @@ pub fn casters() -> String {
 pub fn all() -> Vec<(&'static str, String)> {
     vec![
         ("hybrid", query(EdgeTexels::Off, false, false)),
-        ("hybrid edge_texels=all, tile marks", query(EdgeTexels::All, true, false)),
+        ("hybrid tile marks", query(EdgeTexels::Off, true, false)),
         ("hybrid edge_texels=paired, caster masks", query(EdgeTexels::Paired, false, true)),
         ("hybrid caster masks", casters()),
-        ("hybrid edge pass", EDGE_PASS.to_string()),
     ]
 }
