@@ -14,6 +14,8 @@ use shadow_core::{FrameInputs, Image};
 use crate::Error;
 use crate::renderer::{BackendKind, Renderer, RunOutput};
 use crate::sheet::{SheetItem, contact_sheet, disagreement_inset};
+use shadow_core::technique::maps::RESOLUTION;
+use shadow_cpu::CpuFrame;
 
 /// What to compare.
 pub struct CompareJob<'a> {
@@ -157,6 +159,209 @@ fn save(img: &Image<Rgb8>, dir: &Path, name: &str) -> Result<(), Error> {
     img.save_png(dir.join(name)).map_err(Error::from)
 }
 
+/// The references a job is measured against, on the CPU: the primary one's frame (its G-buffer, light view
+/// and visibility), the measured and reached pixels, and the soft techniques' own reference when the job
+/// mixes kinds (same view, same G-buffer and mask).
+struct References {
+    frame: CpuFrame,
+    mask: Image<bool>,
+    reach: Image<bool>,
+    /// The soft reference's spec, shaded picture and visibility.
+    soft: Option<(TechniqueSpec, Image<Rgb8>, Image<f32>)>,
+}
+
+impl References {
+    /// Renders the references of `job`, with their contact-sheet tiles and files.
+    fn render(
+        renderer: &mut Renderer,
+        job: &CompareJob<'_>,
+        any_soft: bool,
+        sheet: &mut Vec<SheetItem>,
+        progress: &mut impl FnMut(&str),
+    ) -> Result<Self, Error> {
+        let reference = &job.reference;
+        progress(&format!("reference: {reference} on cpu"));
+        let (frame, _) = renderer.run_cpu_frame(job.frame, job.width, job.height, reference)?;
+        let view = frame.light_views.first().ok_or_else(|| Error::Usage("the scene has no light".into()))?;
+        let g = &frame.gbuffer;
+        let mask = measured_pixels(&g.receiver, &g.position, &g.geometric_normal, view);
+        let reach = Image::from_fn(job.width, job.height, |x, y| {
+            *g.receiver.get(x, y) && view.in_domain(*g.position.get(x, y))
+        });
+        // A reference's tile shows its visibility where the others show their errors.
+        let tile = |spec: &TechniqueSpec, color: &Image<Rgb8>, vis: &Image<f32>| SheetItem {
+            label: format!("{}\nreference", spec.name),
+            picture: color.clone(),
+            errors: Some(visibility_to_rgb(vis, &mask)),
+        };
+        sheet.push(tile(reference, &frame.color, &frame.visibility[0]));
+        if let Some(dir) = &job.out_dir {
+            save(&frame.color, dir, "reference.png")?;
+            save(&visibility_to_rgb(&frame.visibility[0], &mask), dir, "reference.vis.png")?;
+        }
+        let soft = match &job.soft_reference {
+            Some(spec) if any_soft => {
+                progress(&format!("reference: {spec} on cpu"));
+                let (soft_frame, _) = renderer.run_cpu_frame(job.frame, job.width, job.height, spec)?;
+                let vis = soft_frame.visibility.into_iter().next().unwrap_or_else(|| frame.visibility[0].clone());
+                sheet.push(tile(spec, &soft_frame.color, &vis));
+                if let Some(dir) = &job.out_dir {
+                    save(&soft_frame.color, dir, &format!("reference-{}.png", spec.name))?;
+                    save(&visibility_to_rgb(&vis, &mask), dir, &format!("reference-{}.vis.png", spec.name))?;
+                }
+                Some((spec.clone(), soft_frame.color, vis))
+            }
+            _ => None,
+        };
+        Ok(Self { frame, mask, reach, soft })
+    }
+
+    /// The reference a technique of this kind is measured against: spec, shaded picture, visibility, and
+    /// whether it is the soft one.
+    fn of<'a>(
+        &'a self,
+        job: &'a CompareJob<'_>,
+        soft: bool,
+    ) -> (&'a TechniqueSpec, &'a Image<Rgb8>, &'a Image<f32>, bool) {
+        match &self.soft {
+            Some((spec, color, vis)) if soft => (spec, color, vis, true),
+            _ => (&job.reference, &self.frame.color, &self.frame.visibility[0], false),
+        }
+    }
+}
+
+/// The map side of a spec whose technique has a `res` key (given, or its default), for the acne probe.
+fn map_resolution(renderer: &Renderer, spec: &TechniqueSpec) -> Option<u32> {
+    let key = (renderer.registry().get(&spec.name).ok()?.keys)().iter().find(|k| k.key == RESOLUTION)?;
+    let given = spec.values.iter().find(|(k, _)| k == RESOLUTION).map(|(_, v)| v.as_str());
+    given.unwrap_or(key.default).parse().ok()
+}
+
+/// One technique on one backend: the run and its report entry, its files written.
+struct Measured {
+    run: RunOutput,
+    entry: ResultEntry,
+    against_soft: bool,
+}
+
+/// Runs `spec` (the `index`-th asked for) on `backend` and measures it against its kind's reference; the
+/// run's contact-sheet tile goes on `sheet`.
+fn measure(
+    renderer: &mut Renderer,
+    job: &CompareJob<'_>,
+    refs: &References,
+    probe: &shadow_cpu::acne::AcneProbe<'_>,
+    (index, spec): (usize, &TechniqueSpec),
+    backend: BackendKind,
+    sheet: &mut Vec<SheetItem>,
+) -> Result<Measured, Error> {
+    let soft = renderer.registry().get(&spec.name).is_ok_and(|e| e.soft);
+    let (reference, ref_color, ref_vis, against_soft) = refs.of(job, soft);
+    let mask = &refs.mask;
+    let run = renderer.run(backend, job.frame, job.width, job.height, spec)?;
+    let metrics = compare_visibility(&run.visibility[0], ref_vis, mask)?;
+    let flip = flip_mean(&run.color, ref_color, mask)?;
+    let errors = error_map_over(&run.visibility[0], ref_vis, mask, &refs.reach, &run.color);
+    // A technique asked for more than once is told apart by its place and the settings it was given.
+    let same_name = job.techniques.iter().filter(|s| s.name == spec.name).count() > 1;
+    let file = if same_name {
+        format!("{}-{}-{}", spec.name, index + 1, backend.name())
+    } else {
+        format!("{}-{}", spec.name, backend.name())
+    };
+    if let Some(dir) = &job.out_dir {
+        save(&run.color, dir, &format!("{file}.png"))?;
+        save(&visibility_to_rgb(&run.visibility[0], mask), dir, &format!("{file}.vis.png"))?;
+        save(&errors, dir, &format!("{file}.err.png"))?;
+        for v in &run.debug_views {
+            save(&v.image, dir, &format!("{file}.{}.png", v.name))?;
+        }
+    }
+    // Map-based techniques (a `res` setting) also get acne told apart from undersampling.
+    let acne = map_resolution(renderer, spec).filter(|_| !soft).map(|r| probe.texel_acne(&run.visibility[0], r));
+    let back = back_false_light(&run.visibility[0], ref_vis, mask, &refs.reach)?;
+    let given = if same_name {
+        spec.values.iter().map(|(k, v)| format!("{k}={v} ")).collect::<String>()
+    } else {
+        String::new()
+    };
+    // Soft techniques are scored by RMSE: a penumbra has no lit/shadowed state to mismatch.
+    let score =
+        if soft { format!("RMSE {:.4}", metrics.rmse) } else { format!("mismatch {:.3}%", metrics.mismatch * 100.0) };
+    sheet.push(SheetItem {
+        label: format!("{}\n{given}{} {score}", spec.name, backend.name()),
+        picture: run.color.clone(),
+        errors: Some(errors),
+    });
+    let mut vs_reference = metrics_map(&metrics, flip);
+    vs_reference.insert("back_false_light".into(), back);
+    if let Some(a) = acne {
+        vs_reference.insert("texel_acne".into(), a);
+    }
+    let entry = ResultEntry {
+        technique: run.technique.clone(),
+        settings: run.settings.clone(),
+        backend: backend.name().into(),
+        reference: reference.to_string(),
+        timings_ms: timings_map(&run.stats),
+        counters: run.stats.counters.entries().into_iter().collect(),
+        vs_reference,
+        file,
+        metrics,
+        flip,
+    };
+    Ok(Measured { run, entry, against_soft })
+}
+
+/// Every pair of runs of one technique and settings on two backends, compared with each other.
+fn cross_backend(runs: &[Measured], mask: &Image<bool>) -> Result<Vec<CrossEntry>, Error> {
+    let mut out = Vec::new();
+    for (i, a) in runs.iter().map(|m| &m.run).enumerate() {
+        for b in runs[i + 1..].iter().map(|m| &m.run) {
+            if a.technique == b.technique && a.settings == b.settings && a.backend != b.backend {
+                let m = compare_visibility(&b.visibility[0], &a.visibility[0], mask)?;
+                out.push(CrossEntry {
+                    technique: a.technique.clone(),
+                    settings: a.settings.clone(),
+                    mismatch: m.mismatch,
+                    rmse: m.rmse,
+                    flip_mean: flip_mean(&b.color, &a.color, mask)?,
+                });
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// Writes the contact sheet (with the inset where the techniques disagree most) and both reports.
+fn write_reports(
+    dir: &Path,
+    job: &CompareJob<'_>,
+    refs: &References,
+    (sheet, runs): (&[SheetItem], &[Measured]),
+    report: &CompareReport,
+) -> Result<(), Error> {
+    let ref_vis = &refs.frame.visibility[0];
+    let pairs: Vec<(&Image<f32>, &Image<f32>)> = runs
+        .iter()
+        .map(|m| {
+            let against = match &refs.soft {
+                Some((_, _, vis)) if m.against_soft => vis,
+                _ => ref_vis,
+            };
+            (&m.run.visibility[0], against)
+        })
+        .collect();
+    let inset = disagreement_inset(&pairs, ref_vis, &refs.mask, (job.width.min(job.height) / 8).max(8));
+    save(&contact_sheet(sheet, 320, Some(inset)), dir, "contact.png")?;
+    let json = serde_json::to_string_pretty(report).map_err(|e| Error::Usage(e.to_string()))?;
+    let write = |name: &str, text: &str| {
+        std::fs::write(dir.join(name), text).map_err(|e| Error::Write { path: dir.join(name), why: e.to_string() })
+    };
+    write("report.json", &json)?;
+    write("report.md", &report_markdown(report))
+}
+
 /// Runs the job, writes its files, and returns the report.
 ///
 /// # Errors
@@ -169,173 +374,35 @@ pub fn run_compare(
     if let Some(dir) = &job.out_dir {
         std::fs::create_dir_all(dir).map_err(|e| Error::Write { path: dir.clone(), why: e.to_string() })?;
     }
-    let reference = &job.reference;
-    progress(&format!("reference: {reference} on cpu"));
-    let (ref_frame, _) = renderer.run_cpu_frame(job.frame, job.width, job.height, reference)?;
-    let view = ref_frame.light_views.first().ok_or_else(|| Error::Usage("the scene has no light".into()))?;
-    let g = &ref_frame.gbuffer;
-    let mask = measured_pixels(&g.receiver, &g.position, &g.geometric_normal, view);
-    let reach =
-        Image::from_fn(job.width, job.height, |x, y| *g.receiver.get(x, y) && view.in_domain(*g.position.get(x, y)));
-    let ref_vis = &ref_frame.visibility[0];
+    let any_soft = job.techniques.iter().any(|s| renderer.registry().get(&s.name).is_ok_and(|e| e.soft));
+    let mut sheet = Vec::new();
+    let refs = References::render(renderer, job, any_soft, &mut sheet, &mut progress)?;
     let bvh = renderer.bvh(job.frame);
     let probe = shadow_cpu::acne::AcneProbe {
         frame: job.frame,
-        light: view,
-        gbuffer: g,
+        light: &refs.frame.light_views[0],
+        gbuffer: &refs.frame.gbuffer,
         bvh: &bvh,
-        reference: ref_vis,
-        mask: &mask,
+        reference: &refs.frame.visibility[0],
+        mask: &refs.mask,
     };
-    // A reference's tile shows its visibility where the others show their errors.
-    let mut sheet = vec![SheetItem {
-        label: format!("{}\nreference", reference.name),
-        picture: ref_frame.color.clone(),
-        errors: Some(visibility_to_rgb(ref_vis, &mask)),
-    }];
-    if let Some(dir) = &job.out_dir {
-        save(&ref_frame.color, dir, "reference.png")?;
-        save(&visibility_to_rgb(ref_vis, &mask), dir, "reference.vis.png")?;
-    }
-    // The soft techniques' own reference, when the run mixes kinds: same view, same G-buffer and mask.
-    let soft: Vec<bool> =
-        job.techniques.iter().map(|s| renderer.registry().get(&s.name).is_ok_and(|e| e.soft)).collect();
-    let soft_reference = match &job.soft_reference {
-        Some(spec) if soft.contains(&true) => {
-            progress(&format!("reference: {spec} on cpu"));
-            let (frame, _) = renderer.run_cpu_frame(job.frame, job.width, job.height, spec)?;
-            sheet.push(SheetItem {
-                label: format!("{}\nreference", spec.name),
-                picture: frame.color.clone(),
-                errors: Some(visibility_to_rgb(&frame.visibility[0], &mask)),
-            });
-            if let Some(dir) = &job.out_dir {
-                save(&frame.color, dir, &format!("reference-{}.png", spec.name))?;
-                save(
-                    &visibility_to_rgb(&frame.visibility[0], &mask),
-                    dir,
-                    &format!("reference-{}.vis.png", spec.name),
-                )?;
-            }
-            Some((spec, frame.color, frame.visibility.into_iter().next()))
-        }
-        _ => None,
-    };
-
-    let mut results = Vec::new();
-    let mut runs: Vec<RunOutput> = Vec::new();
-    // Which reference each run was measured against: false for the first, true for the soft one.
-    let mut against_soft: Vec<bool> = Vec::new();
+    let mut runs = Vec::new();
     for (i, spec) in job.techniques.iter().enumerate() {
-        let same_name = job.techniques.iter().filter(|s| s.name == spec.name).count() > 1;
-        // Each technique against its own kind's reference.
-        let soft = soft[i];
-        let (reference, ref_color, ref_vis) = match &soft_reference {
-            Some((spec_ref, color, Some(vis))) if soft => (*spec_ref, color, vis),
-            _ => (reference, &ref_frame.color, ref_vis),
-        };
         for &backend in &job.backends {
             progress(&format!("{spec} on {}", backend.name()));
-            let run = renderer.run(backend, job.frame, job.width, job.height, spec)?;
-            let metrics = compare_visibility(&run.visibility[0], ref_vis, &mask)?;
-            let flip = flip_mean(&run.color, ref_color, &mask)?;
-            let errors = error_map_over(&run.visibility[0], ref_vis, &mask, &reach, &run.color);
-            let file = if same_name {
-                format!("{}-{}-{}", spec.name, i + 1, backend.name())
-            } else {
-                format!("{}-{}", spec.name, backend.name())
-            };
-            if let Some(dir) = &job.out_dir {
-                save(&run.color, dir, &format!("{file}.png"))?;
-                save(&visibility_to_rgb(&run.visibility[0], &mask), dir, &format!("{file}.vis.png"))?;
-                save(&errors, dir, &format!("{file}.err.png"))?;
-                for v in &run.debug_views {
-                    save(&v.image, dir, &format!("{file}.{}.png", v.name))?;
-                }
-            }
-            // Map-based techniques (a `res` setting) also get acne told apart from undersampling.
-            let res =
-                run.settings.split(',').find_map(|kv| kv.strip_prefix("res=")).and_then(|v| v.parse::<u32>().ok());
-            let acne = res.filter(|_| !soft).map(|r| probe.texel_acne(&run.visibility[0], r));
-            let back = back_false_light(&run.visibility[0], ref_vis, &mask, &reach)?;
-            // A technique asked for more than once is told apart by the settings it was given.
-            let given = if same_name {
-                spec.values.iter().map(|(k, v)| format!("{k}={v} ")).collect::<String>()
-            } else {
-                String::new()
-            };
-            // Soft techniques are scored by RMSE: a penumbra has no lit/shadowed state to mismatch.
-            let score = if soft {
-                format!("RMSE {:.4}", metrics.rmse)
-            } else {
-                format!("mismatch {:.3}%", metrics.mismatch * 100.0)
-            };
-            let label = format!("{}\n{given}{} {score}", spec.name, backend.name());
-            sheet.push(SheetItem { label, picture: run.color.clone(), errors: Some(errors) });
-            results.push(ResultEntry {
-                technique: run.technique.clone(),
-                settings: run.settings.clone(),
-                backend: backend.name().into(),
-                reference: reference.to_string(),
-                timings_ms: timings_map(&run.stats),
-                counters: run.stats.counters.entries().into_iter().collect(),
-                vs_reference: {
-                    let mut m = metrics_map(&metrics, flip);
-                    m.insert("back_false_light".into(), back);
-                    if let Some(a) = acne {
-                        m.insert("texel_acne".into(), a);
-                    }
-                    m
-                },
-                file,
-                metrics,
-                flip,
-            });
-            runs.push(run);
-            against_soft.push(soft && soft_reference.is_some());
+            runs.push(measure(renderer, job, &refs, &probe, (i, spec), backend, &mut sheet)?);
         }
     }
-
-    let mut cross_backend = Vec::new();
-    for (i, a) in runs.iter().enumerate() {
-        for b in &runs[i + 1..] {
-            if a.technique == b.technique && a.settings == b.settings && a.backend != b.backend {
-                let m = compare_visibility(&b.visibility[0], &a.visibility[0], &mask)?;
-                let flip = flip_mean(&b.color, &a.color, &mask)?;
-                cross_backend.push(CrossEntry {
-                    technique: a.technique.clone(),
-                    settings: a.settings.clone(),
-                    mismatch: m.mismatch,
-                    rmse: m.rmse,
-                    flip_mean: flip,
-                });
-            }
-        }
-    }
-
     let report = CompareReport {
         scene: job.scene.clone(),
         width: job.width,
         height: job.height,
-        results,
-        cross_backend,
+        results: runs.iter().map(|m| m.entry.clone()).collect(),
+        cross_backend: cross_backend(&runs, &refs.mask)?,
         reference: job.reference.to_string(),
     };
     if let Some(dir) = &job.out_dir {
-        let soft_vis = soft_reference.as_ref().and_then(|(_, _, v)| v.as_ref());
-        let pairs: Vec<(&Image<f32>, &Image<f32>)> = runs
-            .iter()
-            .zip(&against_soft)
-            .map(|(run, &soft)| (&run.visibility[0], if soft { soft_vis.unwrap_or(ref_vis) } else { ref_vis }))
-            .collect();
-        let inset = disagreement_inset(&pairs, ref_vis, &mask, (job.width.min(job.height) / 8).max(8));
-        save(&contact_sheet(&sheet, 320, Some(inset)), dir, "contact.png")?;
-        let json = serde_json::to_string_pretty(&report).map_err(|e| Error::Usage(e.to_string()))?;
-        let write = |name: &str, text: &str| {
-            std::fs::write(dir.join(name), text).map_err(|e| Error::Write { path: dir.join(name), why: e.to_string() })
-        };
-        write("report.json", &json)?;
-        write("report.md", &report_markdown(&report))?;
+        write_reports(dir, job, &refs, (&sheet, &runs), &report)?;
     }
     Ok(report)
 }

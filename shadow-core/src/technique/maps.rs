@@ -50,10 +50,13 @@ pub const FILTER: SettingKey =
 pub const FILTER_RADIUS: SettingKey =
     SettingKey::float("filter_radius", "1.5", 0.0, 64.0, "kernel radius in texels for pcf4x4-jitter and poisson16");
 
+/// The name of the map-side key every technique built on a depth map has.
+pub const RESOLUTION: &str = "res";
+
 /// A `res` key: the map side, with the technique's own default and help.
 #[must_use]
 pub const fn resolution_key(default: &'static str, help: &'static str) -> SettingKey {
-    SettingKey::int("res", default, 16, MAX_MAP_RESOLUTION, help)
+    SettingKey::int(RESOLUTION, default, 16, MAX_MAP_RESOLUTION, help)
 }
 
 /// A light depth map: its side and how its depth is biased.

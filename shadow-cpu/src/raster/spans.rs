@@ -2,9 +2,9 @@
 //! spans, solving the edge functions with the top-left rule, `E_k(256 x + 128, py) + tl_k >= 0`), and as a
 //! cheap superset over a slab of rows ([`slab_columns`], to test a tile row against a mask).
 
-use super::{HALF, ONE, Setup};
 #[cfg(test)]
-use super::{ceil_div, floor_div};
+use super::setup::{ceil_div, floor_div};
+use super::{HALF, ONE, Setup};
 
 /// The columns of row `py` (fixed point) inside all three edges, solved by division: what [`EdgeWalk`]
 /// steps to, row after row.
