@@ -55,6 +55,7 @@
 
 mod casters;
 mod edges;
+mod query;
 pub mod shaders;
 mod tables;
 mod tiles;
@@ -75,10 +76,9 @@ use shadow_core::technique::{DebugView, ShadowTechnique, TechniqueError};
 
 use shadow_wgpu::frame::GpuVisibility;
 use shadow_wgpu::gbuffer::GpuGBuffer;
-use shadow_wgpu::passes::maps::{DepthMaps, LookupParams, MapBindings, QueryExtras};
+use shadow_wgpu::passes::maps::{DepthMaps, MapBindings};
 use shadow_wgpu::passes::volumes::{
-    VolumeDraw, VolumePass, count_all_pipeline, counting_state, occlusion_query, read_query, upload_draws,
-    upload_volumes, volume_pipeline,
+    VolumeDraw, count_all_pipeline, counting_state, upload_draws, upload_volumes, volume_pipeline,
 };
 use shadow_wgpu::pipelines::{
     DEPTH_STENCIL, FragmentEntry, VISIBILITY, attribute_entry, buffer_entry, float_array_entry, full_screen_pipeline,
@@ -421,182 +421,34 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
         out: &mut GpuVisibility,
     ) -> Result<(), WgpuError> {
         let LightPass { frame, light, stats } = pass;
-        let not_built = || TechniqueError::NotBuilt(Self::NAME.into());
-        let draws = state.draws.as_ref().ok_or_else(not_built)?;
-        let maps = state.map.maps().ok_or_else(not_built)?;
-        let mut extras = vec![wgpu::BindGroupEntry {
-            binding: 4,
-            resource: wgpu::BindingResource::TextureView(&g.geometric_normal),
-        }];
-        let edge_view = state.edge_maps.as_ref().map(|t| {
-            t.create_view(&wgpu::TextureViewDescriptor {
-                dimension: Some(wgpu::TextureViewDimension::D2Array),
-                ..Default::default()
-            })
-        });
-        if let Some(view) = &edge_view {
-            extras.push(wgpu::BindGroupEntry { binding: 6, resource: wgpu::BindingResource::TextureView(view) });
-        } else if self.edge_texels.is_on() {
-            return Err(not_built().into());
+        let not_built = || WgpuError::from(TechniqueError::NotBuilt(Self::NAME.into()));
+        if self.edge_texels.is_on() && state.edge_maps.is_none() {
+            return Err(not_built());
         }
-        // The depth-stencil the passes run over: the G-buffer's, or for the depth mask a copy of it that
-        // the mask pass sets to depth 1 outside the mask.
+        // The views' resources first, made anew for a new view size: the depth-stencil the passes run
+        // over (the G-buffer's, or for the depth mask a copy the mask pass sets to depth 1 outside the
+        // mask), the tile marks and the caster masks' listed pixels.
         let target = match self.gpu_mask {
             GpuMask::Stencil => g.depth.clone(),
-            GpuMask::Depth => {
-                let fits = state.scratch.as_ref().is_some_and(|t| (t.width(), t.height()) == (g.width, g.height));
-                if !fits {
-                    state.scratch = Some(scratch_target(cx, g.width, g.height));
-                }
-                state.scratch.clone().ok_or_else(not_built)?
-            }
+            GpuMask::Depth => query::scratch_depth(cx, &mut state.scratch, g),
         };
-        let tile = self.scissor_tile;
-        if tile > 0 {
-            let (columns, rows) = (g.width.div_ceil(tile), g.height.div_ceil(tile));
-            if state.tiles.as_ref().is_none_or(|t| (t.columns, t.rows) != (columns, rows)) {
-                state.tiles = Some(TileMarks::new(cx, columns, rows));
-            }
+        query::fit_tiles(cx, &mut state.tiles, self.scissor_tile, g);
+        if let Some(c) = &mut state.casters {
+            query::fit_listed(cx, c, g, self.pair_room)?;
         }
-        let tiles = state.tiles.as_ref().filter(|_| tile > 0);
-        if let Some(t) = tiles {
-            extras.push(wgpu::BindGroupEntry { binding: 7, resource: t.marks.as_entire_binding() });
-        }
-        let tile_settings = [tile as f32, tiles.map_or(0.0, |t| t.columns as f32), 0.0, 0.0];
-        // With caster masks: their passes, the answer's draw, the build's pieces and the listed pixels,
-        // made anew for a new view size or more pieces.
-        let casters = match &mut state.casters {
-            Some(c) => {
-                let pieces = c.pieces.as_ref().ok_or_else(not_built)?;
-                let size = (g.width, g.height);
-                let listed = match c.listed.take() {
-                    Some(l) if l.size == size && l.capacity >= pieces.pieces && l.asked == self.pair_room => l,
-                    _ => cx.scoped("the hybrid listed pixels", |cx| {
-                        ListedPixels::new(cx, size, pieces.pieces, self.pair_room)
-                    })?,
-                };
-                Some((&c.passes, &c.answer, pieces, &*c.listed.insert(listed)))
-            }
-            None => None,
+        let (map_group, target) = {
+            let state = &*state;
+            let inputs = query::Inputs::of(self, state, g, target).ok_or_else(not_built)?;
+            let map_group = inputs.map_group(cx, state, light, self.depth.receiver_offset());
+            let counts = cx.scoped("the hybrid passes", |cx| inputs.record(cx, state, (frame, &map_group), out))??;
+            // The counters are not the technique's work: after it is done, a sub-phase of their own.
+            cx.end_of_work();
+            cx.wait()?;
+            let t = std::time::Instant::now();
+            inputs.count(cx, state, (frame, counts), stats)?;
+            stats.timings.extra.insert("count_fragments".into(), shadow_core::stats::ms(t.elapsed()));
+            (map_group, inputs.target)
         };
-        let listed = casters.map(|c| c.3);
-        if let Some(l) = listed {
-            extras.push(wgpu::BindGroupEntry { binding: 8, resource: l.listed.as_entire_binding() });
-            extras.push(wgpu::BindGroupEntry { binding: 9, resource: l.counts.as_entire_binding() });
-        }
-        let mut mask_draws = vec![(&state.mask, MASK)];
-        if let Some(far) = &state.far {
-            mask_draws.push((far, 0));
-        }
-        let depth = target.create_view(&Default::default());
-        let lookup = LookupParams { radius: 0.0, receiver_offset: self.depth.receiver_offset() };
-        let map_group = state.bindings.group(
-            cx,
-            maps,
-            light,
-            g,
-            lookup,
-            &QueryExtras { settings: tile_settings, entries: &extras },
-        );
-        let groups = [&g.frame_group, &map_group];
-        let (silhouettes, passed, rects) = cx.scoped("the hybrid passes", |cx| {
-            let silhouettes = occlusion_query(cx);
-            let mut enc = cx.device.create_command_encoder(&Default::default());
-            if target != g.depth {
-                enc.copy_texture_to_texture(
-                    g.depth.as_image_copy(),
-                    target.as_image_copy(),
-                    wgpu::Extent3d { width: g.width, height: g.height, depth_or_array_layers: 1 },
-                );
-            }
-            if let Some(t) = tiles {
-                enc.clear_buffer(&t.marks, 0, None);
-            }
-            if let Some(l) = listed {
-                l.clear(&mut enc);
-            }
-            cx.queue.submit([enc.finish()]);
-            cx.step("setup");
-            let mask = full_screen_draws(
-                cx,
-                "hybrid mask",
-                None,
-                (&depth, wgpu::LoadOp::Load, wgpu::LoadOp::Clear(0)),
-                groups,
-                &mask_draws,
-                Some(&silhouettes),
-            );
-            cx.queue.submit([mask]);
-            cx.step("mask");
-            if let Some((passes, _, pieces, l)) = casters {
-                let mut enc = cx.device.create_command_encoder(&Default::default());
-                passes.record(cx, &mut enc, pieces, l, g);
-                cx.queue.submit([enc.finish()]);
-                cx.step("casters");
-            }
-            let rects = tiles.map(|t| t.rectangles(cx, tile, (g.width, g.height))).transpose()?;
-            let counting = VolumePass {
-                label: "hybrid volumes",
-                ccw: &state.volumes_ccw,
-                cw: &state.volumes_cw,
-                stencil: wgpu::LoadOp::Load,
-                reference: MASK,
-                scissors: rects.as_deref(),
-            };
-            let passed = counting.run(cx, draws, frame, g, &depth);
-            cx.step("volumes");
-            let mut answers = vec![(&state.answer_map, OUTSIDE.2), (&state.answer_shadowed, SHADOWED.2)];
-            if let Some((_, answer, ..)) = casters {
-                answers.push((answer, LIT.2));
-            }
-            let answer = full_screen_draws(
-                cx,
-                "hybrid answer",
-                Some((&out.view, wgpu::Color::WHITE)),
-                (&depth, wgpu::LoadOp::Load, wgpu::LoadOp::Load),
-                groups,
-                &answers,
-                None,
-            );
-            cx.queue.submit([answer]);
-            cx.step("answer");
-            Ok::<_, WgpuError>((silhouettes, passed, rects.map(|r| r.len())))
-        })??;
-        // The counters are not the technique's work: after it is done, a sub-phase of their own.
-        cx.end_of_work();
-        cx.wait()?;
-        let t = std::time::Instant::now();
-        let masked = VolumePass { reference: MASK, ..VolumePass::count(&state.count_masked, "count masked fragments") };
-        let processed = cx.scoped("the masked fragment count", |cx| masked.run(cx, draws, frame, g, &depth))?;
-        let c = &mut stats.counters;
-        if let Some(n) = rects {
-            c.extra.insert("scissor_rects".into(), n as f64);
-        }
-        c.silhouette_pixels = Some(read_query(cx, &silhouettes)?);
-        let processed = read_query(cx, &processed)?;
-        // Z-fail updates the count where the depth test fails.
-        let rasterized_updates = processed - read_query(cx, &passed)?.min(processed);
-        // What the compute passes covered and updated at the listed pixels.
-        let [computed, computed_updates] = match casters {
-            Some((_, _, pieces, l)) => {
-                let [pixels, fragments, updates, tests, alone] = l.counters(cx)?;
-                c.extra.insert("listed_pieces".into(), pieces.pieces as f64);
-                c.extra.insert("listed_pixels".into(), pixels as f64);
-                c.extra.insert("listed_tests".into(), tests as f64);
-                c.extra.insert("listed_alone".into(), alone as f64);
-                [fragments, updates]
-            }
-            None => [0, 0],
-        };
-        c.volume_fragments = Some(processed + computed);
-        c.stencil_updates = Some(rasterized_updates + computed_updates);
-        if self.unmasked_fill.is_on() {
-            let every = VolumePass::count(&state.count_all, "count volume fragments");
-            let all_draws = state.casters.as_ref().and_then(|c| c.all_draws.as_deref()).unwrap_or(draws);
-            let all = cx.scoped("the volume fragment count", |cx| every.run(cx, all_draws, frame, g, &depth))?;
-            stats.counters.extra.insert("unmasked_volume_fragments".into(), read_query(cx, &all)? as f64);
-        }
-        stats.timings.extra.insert("count_fragments".into(), shadow_core::stats::ms(t.elapsed()));
         state.last = Some(LastQuery { frame_group: g.frame_group.clone(), map_group, depth: target });
         Ok(())
     }
