@@ -488,7 +488,7 @@ fn parse_sweep(sweep: &str) -> Result<(&str, Vec<u32>), Error> {
 }
 
 fn bench(args: &SceneArgs, view: &ViewArgs, b: BenchArgs) -> Result<(), Error> {
-    use shadowlab::bench::{BenchJob, bench_table, run_bench, sweep_scene};
+    use shadowlab::bench::sweep_scene;
     if b.frames == 0 {
         return Err(Error::Usage("--frames must be at least 1".into()));
     }
@@ -507,32 +507,69 @@ fn bench(args: &SceneArgs, view: &ViewArgs, b: BenchArgs) -> Result<(), Error> {
         }
     }
     let kinds = backends(&mut renderer, &b.backend)?;
-    let Some((key, values)) = sweep else {
-        let (frame, w, h) = first;
-        let job = BenchJob {
-            scene: args.name(),
-            frame: &frame,
-            width: w,
-            height: h,
-            frames: b.frames,
-            warmup: b.warmup,
-            techniques: specs,
-            backends: kinds,
-        };
-        let bar = progress_bar(job.steps());
-        let r = run_bench(&mut renderer, &job, |m| report_progress(&bar, m))?;
-        if let Some(bar) = bar {
-            bar.finish_and_clear();
+    match sweep {
+        None => bench_once(&mut renderer, (args, first), specs, kinds, &b),
+        Some((key, values)) => {
+            let sweep = Sweep { key, values, scenes: sweep_scenes };
+            bench_sweep(&mut renderer, (args, view), &sweep, specs, kinds, &b)
         }
-        if b.json {
-            return print_json(&serde_json::to_value(&r).map_err(|e| Error::Usage(e.to_string()))?);
-        }
-        out_raw!("{}", bench_table(&r));
-        return Ok(());
+    }
+}
+
+/// One bench run of the scene's own frame: the table, or JSON.
+fn bench_once(
+    renderer: &mut Renderer,
+    (args, (frame, w, h)): (&SceneArgs, (FrameInputs, u32, u32)),
+    specs: Vec<TechniqueSpec>,
+    kinds: Vec<shadowlab::BackendKind>,
+    b: &BenchArgs,
+) -> Result<(), Error> {
+    use shadowlab::bench::{BenchJob, bench_table, run_bench};
+    let job = BenchJob {
+        scene: args.name(),
+        frame: &frame,
+        width: w,
+        height: h,
+        frames: b.frames,
+        warmup: b.warmup,
+        techniques: specs,
+        backends: kinds,
     };
-    let has_res =
-        |s: &TechniqueSpec| renderer.registry().get(&s.name).is_ok_and(|e| (e.keys)().iter().any(|k| k.key == "res"));
-    let specs: Vec<TechniqueSpec> = if key == "res" { specs.into_iter().filter(has_res).collect() } else { specs };
+    let bar = progress_bar(job.steps());
+    let r = run_bench(renderer, &job, |m| report_progress(&bar, m))?;
+    if let Some(bar) = bar {
+        bar.finish_and_clear();
+    }
+    if b.json {
+        return print_json(&serde_json::to_value(&r).map_err(|e| Error::Usage(e.to_string()))?);
+    }
+    out_raw!("{}", bench_table(&r));
+    Ok(())
+}
+
+/// A `--sweep`: the parameter, its values, and for a triangle sweep the scene of each value.
+struct Sweep<'a> {
+    key: &'a str,
+    values: Vec<u32>,
+    scenes: Vec<shadow_core::Scene>,
+}
+
+/// A bench run per value of a sweep, written as sweep.csv and plotted as sweep.png.
+fn bench_sweep(
+    renderer: &mut Renderer,
+    (args, view): (&SceneArgs, &ViewArgs),
+    sweep: &Sweep<'_>,
+    specs: Vec<TechniqueSpec>,
+    kinds: Vec<shadowlab::BackendKind>,
+    b: &BenchArgs,
+) -> Result<(), Error> {
+    use shadow_core::technique::maps::RESOLUTION;
+    use shadowlab::bench::{BenchJob, run_bench};
+    let key = sweep.key;
+    let has_res = |s: &TechniqueSpec| {
+        renderer.registry().get(&s.name).is_ok_and(|e| (e.keys)().iter().any(|k| k.key == RESOLUTION))
+    };
+    let specs: Vec<TechniqueSpec> = if key == RESOLUTION { specs.into_iter().filter(has_res).collect() } else { specs };
     if specs.is_empty() {
         return Err(Error::Usage("--sweep res needs a technique with a res setting".into()));
     }
@@ -542,13 +579,13 @@ fn bench(args: &SceneArgs, view: &ViewArgs, b: BenchArgs) -> Result<(), Error> {
     let mut series: std::collections::BTreeMap<String, Vec<(f64, f64)>> = Default::default();
     // Per value, as `BenchJob::steps` counts them: per backend, each technique prepared, then the frames.
     let steps = kinds.len() as u64 * (specs.len() as u64 + u64::from(b.warmup + b.frames));
-    let bar = progress_bar(values.len() as u64 * steps);
-    for (i, &v) in values.iter().enumerate() {
-        let (frame, w, h) = if key == "res" {
+    let bar = progress_bar(sweep.values.len() as u64 * steps);
+    for (i, &v) in sweep.values.iter().enumerate() {
+        let (frame, w, h) = if key == RESOLUTION {
             args.frame(view)?
         } else {
             let (w, h) = view.size()?;
-            let scene = &sweep_scenes[i];
+            let scene = &sweep.scenes[i];
             let cam = scene.cameras().next().map(|(k, _)| k).ok_or_else(|| Error::Usage("no camera".into()))?;
             (FrameInputs::from_scene(scene, cam)?, w, h)
         };
@@ -556,9 +593,9 @@ fn bench(args: &SceneArgs, view: &ViewArgs, b: BenchArgs) -> Result<(), Error> {
             .iter()
             .map(|s| {
                 let mut s = s.clone();
-                if key == "res" {
-                    s.values.retain(|(k, _)| k != "res");
-                    s.values.push(("res".into(), v.to_string()));
+                if key == RESOLUTION {
+                    s.values.retain(|(k, _)| k != RESOLUTION);
+                    s.values.push((RESOLUTION.into(), v.to_string()));
                 }
                 s
             })
@@ -573,7 +610,7 @@ fn bench(args: &SceneArgs, view: &ViewArgs, b: BenchArgs) -> Result<(), Error> {
             techniques: with_value,
             backends: kinds.clone(),
         };
-        let r = run_bench(&mut renderer, &job, |m| report_progress(&bar, &format!("{key}={v}: {m}")))?;
+        let r = run_bench(renderer, &job, |m| report_progress(&bar, &format!("{key}={v}: {m}")))?;
         for e in &r.results {
             let med = |k: &str| e.timings_ms.get(k).map_or(0.0, |t| t.median);
             let phases = ["gbuffer", "build", "query", "shade", "total"].map(|k| format!("{:.3}", med(k))).join(",");
@@ -586,7 +623,7 @@ fn bench(args: &SceneArgs, view: &ViewArgs, b: BenchArgs) -> Result<(), Error> {
     }
     std::fs::write(out.join("sweep.csv"), &csv)
         .map_err(|e| Error::Write { path: out.join("sweep.csv"), why: e.to_string() })?;
-    let x_label = if key == "res" { "shadow map side (texels)" } else { "triangles" };
+    let x_label = if key == RESOLUTION { "shadow map side (texels)" } else { "triangles" };
     let series: Vec<(String, Vec<(f64, f64)>)> = series.into_iter().collect();
     shadowlab::plot::line_plot(&format!("{} frame time", args.name()), x_label, "median ms per frame", &series)
         .save_png(out.join("sweep.png"))?;
