@@ -176,27 +176,7 @@ fn frame_phases(
     stats.timings.total = ms(start.elapsed());
     stats.counters.covered_pixels = Some(read_count(cx, &covered)?);
     if let Some(c) = &cx.clock {
-        let at = c.read(cx)?;
-        let mut add = |key: String, a: u32, b: u32| {
-            *stats.timings.extra.entry(key).or_insert(0.0) += at[b as usize] - at[a as usize];
-        };
-        for (phase, a, work, b, steps) in spans {
-            if let (Some(a), Some(b)) = (a, b) {
-                let key = format!("gpu_{}", phase.key());
-                let mut from = a;
-                for (name, end) in steps {
-                    add(format!("{key}.{name}"), from, end);
-                    from = end;
-                }
-                match work {
-                    Some(w) => {
-                        add(key, a, w);
-                        add("gpu_counters".into(), w, b);
-                    }
-                    None => add(key, a, b),
-                }
-            }
-        }
+        add_gpu_times(&c.read(cx)?, spans, &mut stats);
     }
 
     let color = readback::read_rgb8(cx, &color_tex)?;
@@ -204,6 +184,32 @@ fn frame_phases(
         .map(|k| readback::read_f32(cx, &vis_tex, k, wgpu::TextureAspect::All))
         .collect::<Result<_, _>>()?;
     Ok(WgpuFrame { light_views, visibility, color, stats })
+}
+
+/// Adds each span's GPU time from the clock's readings `at`: per phase `gpu_PHASE` (the technique's own
+/// work, up to its end-of-work marker), its named steps `gpu_PHASE.STEP`, and `gpu_counters`, the rest of
+/// a phase after its end of work (the counters' passes and read-backs).
+fn add_gpu_times(at: &[f64], spans: Vec<Span>, stats: &mut FrameStats) {
+    let mut add = |key: String, a: u32, b: u32| {
+        *stats.timings.extra.entry(key).or_insert(0.0) += at[b as usize] - at[a as usize];
+    };
+    for (phase, a, work, b, steps) in spans {
+        if let (Some(a), Some(b)) = (a, b) {
+            let key = format!("gpu_{}", phase.key());
+            let mut from = a;
+            for (name, end) in steps {
+                add(format!("{key}.{name}"), from, end);
+                from = end;
+            }
+            match work {
+                Some(w) => {
+                    add(key, a, w);
+                    add("gpu_counters".into(), w, b);
+                }
+                None => add(key, a, b),
+            }
+        }
+    }
 }
 
 /// The receiver count of [`shade`]'s occlusion query.
