@@ -164,6 +164,40 @@ fn overwritten<T: Clone>(old: Option<Vec<T>>, n: usize, value: T) -> Vec<T> {
     old.filter(|v| v.len() == n).unwrap_or_else(|| vec![value; n])
 }
 
+/// The camera's rays through pixel centres.
+struct EyeRays {
+    eye: Vec3,
+    world_from_clip: Mat4,
+    width: u32,
+    height: u32,
+}
+
+/// Where the eye ray through pixel `(x, y)` meets triangle `t` of instance `inst`: the world point, the
+/// interpolated shading normal and the face normal, both turned to the side that is seen (the shading
+/// normal only for two-sided materials).
+#[inline]
+fn surface(t: &Triangle, inst: &shadow_core::Instance, rays: &EyeRays, (x, y): (usize, usize)) -> (Vec3, Vec3, Vec3) {
+    let ndc = glam::Vec2::new(
+        (x as f32 + 0.5) / rays.width as f32 * 2.0 - 1.0,
+        1.0 - (y as f32 + 0.5) / rays.height as f32 * 2.0,
+    );
+    let dir = rays.world_from_clip.project_point3(ndc.extend(0.5)) - rays.eye;
+    let (world, b) = ray_triangle(rays.eye, dir, t.corners);
+    let interp = t.normals[0] * b[0] + t.normals[1] * b[1] + t.normals[2] * b[2];
+    let mut shading = (t.normal_from_local * interp).normalize_or(Vec3::Y);
+    let mut geometric = t.face.unwrap_or(shading);
+    if inst.mirrored {
+        geometric = -geometric;
+    }
+    if geometric.dot(rays.eye - world) < 0.0 {
+        geometric = -geometric;
+        if inst.two_sided {
+            shading = -shading;
+        }
+    }
+    (world, shading, geometric)
+}
+
 /// [`render`], reusing the storage of a previous frame's G-buffer.
 ///
 /// # Errors
@@ -210,7 +244,7 @@ pub fn render_reusing(
         frame.instances.iter().map(|i| shadow_core::affine::normal_matrix(i.world_from_local)).collect();
     let (mut position, mut normal, mut geometric_normal, mut albedo) = (position, normal, geometric_normal, albedo);
     let w = width as usize;
-    let world_from_clip = clip_from_world.inverse();
+    let eye_rays = EyeRays { eye: camera.eye, world_from_clip: clip_from_world.inverse(), width, height };
     let mut instance = overwritten(old.instance, n, NO_INSTANCE);
     position
         .par_chunks_mut(w)
@@ -239,25 +273,7 @@ pub fn render_reusing(
                     }
                 };
                 let inst = &frame.instances[t.instance];
-                let ndc = glam::Vec2::new(
-                    (x as f32 + 0.5) / width as f32 * 2.0 - 1.0,
-                    1.0 - (y as f32 + 0.5) / height as f32 * 2.0,
-                );
-                let dir = world_from_clip.project_point3(ndc.extend(0.5)) - camera.eye;
-                let (world, b) = ray_triangle(camera.eye, dir, t.corners);
-                let interp = t.normals[0] * b[0] + t.normals[1] * b[1] + t.normals[2] * b[2];
-                let mut shading = (t.normal_from_local * interp).normalize_or(Vec3::Y);
-                let mut geometric = t.face.unwrap_or(shading);
-                if inst.mirrored {
-                    geometric = -geometric;
-                }
-                // Turn the face normal to the side that is seen; shading normals too for two-sided materials.
-                if geometric.dot(camera.eye - world) < 0.0 {
-                    geometric = -geometric;
-                    if inst.two_sided {
-                        shading = -shading;
-                    }
-                }
+                let (world, shading, geometric) = surface(&t, inst, &eye_rays, (x, y));
                 (pos[x], nrm[x], geo[x], alb[x], rec[x], ins[x]) =
                     (world, shading, geometric, inst.base_color, inst.receives_shadow, t.instance as u32);
             }

@@ -50,6 +50,52 @@ fn kind_code(k: LayerKind) -> f32 {
     }
 }
 
+/// A map depth target written with `compare`.
+fn depth_state(compare: wgpu::CompareFunction) -> wgpu::DepthStencilState {
+    wgpu::DepthStencilState {
+        format: MAP_DEPTH,
+        depth_write_enabled: Some(true),
+        depth_compare: Some(compare),
+        stencil: Default::default(),
+        bias: Default::default(),
+    }
+}
+
+/// One light pass of the layers: the nearest layer, or with `peel` the next one behind the first; back
+/// faces culled when `cull`, fronts wound clockwise (mirrored instances) when `cw`.
+fn layer_pipeline(
+    cx: &WgpuContext,
+    layout: &wgpu::PipelineLayout,
+    module: &wgpu::ShaderModule,
+    (peel, cull, cw): (bool, bool, bool),
+) -> wgpu::RenderPipeline {
+    cx.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("depth layer"),
+        layout: Some(layout),
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some("vs_layer"),
+            compilation_options: Default::default(),
+            buffers: &[Some(POSITION_LAYOUT)],
+        },
+        primitive: wgpu::PrimitiveState {
+            front_face: if cw { wgpu::FrontFace::Cw } else { wgpu::FrontFace::Ccw },
+            cull_mode: cull.then_some(wgpu::Face::Back),
+            ..Default::default()
+        },
+        depth_stencil: Some(depth_state(wgpu::CompareFunction::Less)),
+        multisample: Default::default(),
+        fragment: peel.then(|| wgpu::FragmentState {
+            module,
+            entry_point: Some("fs_peel"),
+            compilation_options: Default::default(),
+            targets: &[],
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
 impl State {
     fn new(cx: &WgpuContext, filter: Filter, lookup: LookupParams) -> Self {
         let module = shaders::module(&cx.device, "depth_layers", shader());
@@ -68,43 +114,12 @@ impl State {
             bind_group_layouts: &groups,
             immediate_size: 0,
         });
-        let depth_state = |compare, write| wgpu::DepthStencilState {
-            format: MAP_DEPTH,
-            depth_write_enabled: Some(write),
-            depth_compare: Some(compare),
-            stencil: Default::default(),
-            bias: Default::default(),
-        };
         let mut passes = Vec::new();
         for peel in [false, true] {
             for cull in [false, true] {
                 for cw in [false, true] {
                     debug_assert_eq!(passes.len(), pass_index(peel, cull, cw));
-                    passes.push(cx.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                        label: Some("depth layer"),
-                        layout: Some(&pl),
-                        vertex: wgpu::VertexState {
-                            module: &module,
-                            entry_point: Some("vs_layer"),
-                            compilation_options: Default::default(),
-                            buffers: &[Some(POSITION_LAYOUT)],
-                        },
-                        primitive: wgpu::PrimitiveState {
-                            front_face: if cw { wgpu::FrontFace::Cw } else { wgpu::FrontFace::Ccw },
-                            cull_mode: cull.then_some(wgpu::Face::Back),
-                            ..Default::default()
-                        },
-                        depth_stencil: Some(depth_state(wgpu::CompareFunction::Less, true)),
-                        multisample: Default::default(),
-                        fragment: peel.then(|| wgpu::FragmentState {
-                            module: &module,
-                            entry_point: Some("fs_peel"),
-                            compilation_options: Default::default(),
-                            targets: &[],
-                        }),
-                        multiview_mask: None,
-                        cache: None,
-                    }));
+                    passes.push(layer_pipeline(cx, &pl, &module, (peel, cull, cw)));
                 }
             }
         }
@@ -118,7 +133,7 @@ impl State {
                 buffers: &[],
             },
             primitive: Default::default(),
-            depth_stencil: Some(depth_state(wgpu::CompareFunction::Always, true)),
+            depth_stencil: Some(depth_state(wgpu::CompareFunction::Always)),
             multisample: Default::default(),
             fragment: Some(wgpu::FragmentState {
                 module: &module,

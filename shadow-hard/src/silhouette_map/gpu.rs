@@ -65,59 +65,100 @@ fn storage_entry(binding: u32, read_only: bool, visibility: wgpu::ShaderStages) 
     buffer_entry(binding, wgpu::BufferBindingType::Storage { read_only }, visibility)
 }
 
+/// Pass 2's pipeline and its layout: each silhouette segment a widened quad into the point map, the depth
+/// test keeping the nearest point (`keep=nearest`) or none (`keep=last`: rasterization order decides).
+fn points_pipeline(
+    cx: &WgpuContext,
+    build_module: &wgpu::ShaderModule,
+    keep: Keep,
+) -> (wgpu::RenderPipeline, wgpu::BindGroupLayout) {
+    let both = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
+    let points_layout = cx.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("silhouette points"),
+        entries: &[
+            storage_entry(0, true, both),
+            depth_array_entry(1),
+            buffer_entry(2, wgpu::BufferBindingType::Uniform, both),
+        ],
+    });
+    let pl = cx.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("silhouette points"),
+        bind_group_layouts: &[Some(&points_layout)],
+        immediate_size: 0,
+    });
+    let compare = match keep {
+        Keep::Nearest => wgpu::CompareFunction::LessEqual,
+        Keep::Last => wgpu::CompareFunction::Always,
+    };
+    let points = cx.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("silhouette points"),
+        layout: Some(&pl),
+        vertex: wgpu::VertexState {
+            module: build_module,
+            entry_point: Some("vs_segment_quad"),
+            compilation_options: Default::default(),
+            buffers: &[],
+        },
+        primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: MAP_DEPTH,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(compare),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module: build_module,
+            entry_point: Some("fs_silhouette_point"),
+            compilation_options: Default::default(),
+            targets: &[Some(wgpu::ColorTargetState {
+                format: POINTS,
+                blend: None,
+                write_mask: wgpu::ColorWrites::ALL,
+            })],
+        }),
+        multiview_mask: None,
+        cache: None,
+    });
+    (points, points_layout)
+}
+
+/// The query's pipeline: the map lookup's bindings and the points (4), the G-buffer's face normals (5), the
+/// counters (6) and the corners' sampler (7).
+fn query_pipeline(cx: &WgpuContext, map_module: &wgpu::ShaderModule) -> MapQuery {
+    MapQuery::with_entry(
+        cx,
+        map_module,
+        "fs_silhouette_query".into(),
+        &[
+            wgpu::BindGroupLayoutEntry {
+                binding: 4,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                    view_dimension: wgpu::TextureViewDimension::D2Array,
+                    multisampled: false,
+                },
+                count: None,
+            },
+            attribute_entry(5),
+            storage_entry(6, false, wgpu::ShaderStages::FRAGMENT),
+            wgpu::BindGroupLayoutEntry {
+                binding: 7,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::NonFiltering),
+                count: None,
+            },
+        ],
+    )
+}
+
 impl State {
     fn new(cx: &WgpuContext, s: &SilhouetteMap) -> Self {
         let map_module = shaders::module(&cx.device, "silhouette_query", query_shader());
         let build_module = shaders::module(&cx.device, "silhouette_build", build_shader());
-        let both = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
-        let points_layout = cx.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("silhouette points"),
-            entries: &[
-                storage_entry(0, true, both),
-                depth_array_entry(1),
-                buffer_entry(2, wgpu::BufferBindingType::Uniform, both),
-            ],
-        });
-        let pl = cx.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("silhouette points"),
-            bind_group_layouts: &[Some(&points_layout)],
-            immediate_size: 0,
-        });
-        let compare = match s.keep {
-            Keep::Nearest => wgpu::CompareFunction::LessEqual,
-            Keep::Last => wgpu::CompareFunction::Always,
-        };
-        let points = cx.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("silhouette points"),
-            layout: Some(&pl),
-            vertex: wgpu::VertexState {
-                module: &build_module,
-                entry_point: Some("vs_segment_quad"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: MAP_DEPTH,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(compare),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &build_module,
-                entry_point: Some("fs_silhouette_point"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format: POINTS,
-                    blend: None,
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let (points, points_layout) = points_pipeline(cx, &build_module, s.keep);
         let count = cx.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
             label: Some("count silhouette texels"),
             layout: None,
@@ -126,32 +167,8 @@ impl State {
             compilation_options: Default::default(),
             cache: None,
         });
-        let query = MapQuery::with_entry(
-            cx,
-            &map_module,
-            "fs_silhouette_query".into(),
-            &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 4,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                        view_dimension: wgpu::TextureViewDimension::D2Array,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
-                attribute_entry(5),
-                storage_entry(6, false, wgpu::ShaderStages::FRAGMENT),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 7,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::NonFiltering),
-                    count: None,
-                },
-            ],
-        )
-        .with_lookup(LookupParams { radius: 0.0, receiver_offset: s.depth.receiver_offset() });
+        let lookup = LookupParams { radius: 0.0, receiver_offset: s.depth.receiver_offset() };
+        let query = query_pipeline(cx, &map_module).with_lookup(lookup);
         let counters = cx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("silhouette counters"),
             size: COUNTER_STRIDE + 4,
