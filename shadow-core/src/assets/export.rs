@@ -9,7 +9,7 @@ use std::path::Path;
 use glam::{Mat4, Quat, Vec3};
 use serde_json::{Value, json};
 
-use crate::scene::{LightKind, MeshKey, Scene};
+use crate::scene::{Light, LightKind, MeshKey, Scene};
 use crate::shading;
 
 /// Why a scene could not be written.
@@ -98,24 +98,7 @@ pub fn glb_bytes(scene: &Scene) -> Vec<u8> {
     }
     let mut lights = vec![];
     for (_, l) in scene.lights() {
-        let color = l.color.to_array();
-        let (light, pos, dir) = match l.kind {
-            LightKind::Spot { position, direction, cone_angle } => (
-                json!({"type": "spot", "color": color, "intensity": l.intensity, "spot": {"innerConeAngle": shading::cone_cosines(l).map_or(0.0, |(_, inner)| inner.acos()), "outerConeAngle": cone_angle * 0.5}}),
-                position,
-                direction,
-            ),
-            LightKind::Directional { direction } => {
-                (json!({"type": "directional", "color": color, "intensity": l.intensity}), Vec3::ZERO, direction)
-            }
-            LightKind::Point { position } => {
-                (json!({"type": "point", "color": color, "intensity": l.intensity}), position, Vec3::NEG_Z)
-            }
-        };
-        let mut light = light;
-        if let (Some(range), Some(o)) = (l.range, light.as_object_mut()) {
-            o.insert("range".into(), json!(range));
-        }
+        let (light, pos, dir) = light_json(l);
         lights.push(light);
         let mut n = node_trs(pos, look_rotation(dir));
         if let Some(o) = n.as_object_mut() {
@@ -145,7 +128,33 @@ pub fn glb_bytes(scene: &Scene) -> Vec<u8> {
             o.insert("extensions".into(), json!({"KHR_lights_punctual": {"lights": lights}}));
         }
     }
-    let mut js = doc.to_string().into_bytes();
+    glb_container(doc.to_string().into_bytes(), &bin)
+}
+
+/// A light as KHR_lights_punctual has it, with the position and direction of its node.
+fn light_json(l: &Light) -> (Value, Vec3, Vec3) {
+    let color = l.color.to_array();
+    let (mut light, pos, dir) = match l.kind {
+        LightKind::Spot { position, direction, cone_angle } => (
+            json!({"type": "spot", "color": color, "intensity": l.intensity, "spot": {"innerConeAngle": shading::cone_cosines(l).map_or(0.0, |(_, inner)| inner.acos()), "outerConeAngle": cone_angle * 0.5}}),
+            position,
+            direction,
+        ),
+        LightKind::Directional { direction } => {
+            (json!({"type": "directional", "color": color, "intensity": l.intensity}), Vec3::ZERO, direction)
+        }
+        LightKind::Point { position } => {
+            (json!({"type": "point", "color": color, "intensity": l.intensity}), position, Vec3::NEG_Z)
+        }
+    };
+    if let (Some(range), Some(o)) = (l.range, light.as_object_mut()) {
+        o.insert("range".into(), json!(range));
+    }
+    (light, pos, dir)
+}
+
+/// The GLB container: the header, the JSON chunk (padded with spaces) and the binary chunk.
+fn glb_container(mut js: Vec<u8>, bin: &[u8]) -> Vec<u8> {
     pad4(&mut js, b' ');
     let total = 12 + 8 + js.len() + 8 + bin.len();
     let mut out = Vec::with_capacity(total);
@@ -157,7 +166,7 @@ pub fn glb_bytes(scene: &Scene) -> Vec<u8> {
     out.extend_from_slice(&js);
     out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
     out.extend_from_slice(&0x004E_4942u32.to_le_bytes());
-    out.extend_from_slice(&bin);
+    out.extend_from_slice(bin);
     out
 }
 

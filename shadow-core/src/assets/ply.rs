@@ -211,8 +211,8 @@ pub(super) fn load(path: &Path) -> Result<Scene, AssetError> {
     parse(path).map_err(|f| AssetError::new(path, f))
 }
 
-fn parse(path: &Path) -> Result<Scene, AssetFault> {
-    let bytes = decompress(read_model(path)?)?;
+/// The header's encoding and elements, and the body after the `end_header` line.
+fn split_header(bytes: &[u8]) -> Result<(Vec<Element>, Body<'_>), AssetFault> {
     if !bytes.starts_with(b"ply") {
         return Err(AssetFault::Malformed("the file does not start with 'ply'".into()));
     }
@@ -231,33 +231,42 @@ fn parse(path: &Path) -> Result<Scene, AssetFault> {
     }
     let body_start = (start + 1).min(bytes.len());
     let first_line = 1 + bytes[..body_start].iter().filter(|&&b| b == b'\n').count();
-    let mut body = Body { bytes: &bytes[body_start..], pos: 0, encoding, line: first_line, offset: body_start };
+    Ok((elements, Body { bytes: &bytes[body_start..], pos: 0, encoding, line: first_line, offset: body_start }))
+}
 
+/// Refuses an element whose count the rest of the data cannot hold, before anything is reserved: every
+/// instance takes at least one byte (binary) or one token (ASCII, two bytes with a separator).
+fn check_count(e: &Element, body: &Body<'_>) -> Result<(), AssetFault> {
+    let min_size: usize = match body.encoding {
+        Encoding::Ascii => 2 * e.properties.len().max(1),
+        _ => e
+            .properties
+            .iter()
+            .map(|p| match p {
+                Property::Scalar(_, t) => t.size(),
+                Property::List(_, c, _) => c.size(),
+            })
+            .sum::<usize>()
+            .max(1),
+    };
+    if e.count.checked_mul(min_size).is_none_or(|need| need > body.remaining()) {
+        return Err(AssetFault::Truncated(format!(
+            "element '{}' claims {} entries, more than the data holds",
+            e.name, e.count
+        )));
+    }
+    Ok(())
+}
+
+fn parse(path: &Path) -> Result<Scene, AssetFault> {
+    let bytes = decompress(read_model(path)?)?;
+    let (elements, mut body) = split_header(&bytes)?;
     let mut positions: Vec<Vec3> = Vec::new();
     let mut normals: Vec<Vec3> = Vec::new();
     let mut triangles: Vec<[u32; 3]> = Vec::new();
     let mut faces_seen = 0usize;
     for e in &elements {
-        // Every instance takes at least one byte (binary) or one token (ASCII, two bytes with a separator):
-        // refuse counts the data cannot hold before reserving anything.
-        let min_size: usize = match encoding {
-            Encoding::Ascii => 2 * e.properties.len().max(1),
-            _ => e
-                .properties
-                .iter()
-                .map(|p| match p {
-                    Property::Scalar(_, t) => t.size(),
-                    Property::List(_, c, _) => c.size(),
-                })
-                .sum::<usize>()
-                .max(1),
-        };
-        if e.count.checked_mul(min_size).is_none_or(|need| need > body.remaining()) {
-            return Err(AssetFault::Truncated(format!(
-                "element '{}' claims {} entries, more than the data holds",
-                e.name, e.count
-            )));
-        }
+        check_count(e, &body)?;
         let is_vertex = e.name == "vertex";
         let is_face = e.name == "face";
         let is_strips = e.name == "tristrips";
