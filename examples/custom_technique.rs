@@ -42,8 +42,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
     };
     let scene = SceneSetup::new(&scene_name).build()?;
-    let cam = scene.cameras().next().map(|(k, _)| k).ok_or("the scene has no camera")?;
-    let frame = FrameInputs::from_scene(&scene, cam)?;
+    let frame = FrameInputs::from_first_camera(&scene)?;
     let job = CompareJob {
         scene: scene_name,
         frame: &frame,

@@ -35,8 +35,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let spec = TechniqueSpec::parse(&args.next().unwrap_or_else(|| "shadow-volume-zfail".into()))?;
 
     let scene = SceneSetup::new(&model).build()?;
-    let cam = scene.cameras().next().map(|(k, _)| k).ok_or("no camera")?;
-    let frame = FrameInputs::from_scene(&scene, cam)?;
+    let frame = FrameInputs::from_first_camera(&scene)?;
     let mut renderer = Renderer::new(TechniqueRegistry::builtin());
     let (backends, note) = renderer.resolve(choice)?;
     eprintln!("{note}");

@@ -50,6 +50,7 @@ impl Error {
                 | Self::Registry(_)
                 | Self::Settings(_)
                 | Self::Usage(_)
+                | Self::Frame(shadow_core::frame::FrameError::NoCamera)
         )
     }
 

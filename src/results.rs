@@ -51,8 +51,7 @@ pub fn machine() -> String {
 /// The frame of a built-in scene from its own camera.
 fn scene_frame(name: &str) -> Result<FrameInputs, Error> {
     let scene = scenes::build(name, &SceneParams::default()).map_err(|e| Error::Usage(format!("{name}: {e}")))?;
-    let camera = scene.cameras().next().ok_or_else(|| Error::Usage(format!("{name} has no camera")))?.0;
-    Ok(FrameInputs::from_scene(&scene, camera)?)
+    Ok(FrameInputs::from_first_camera(&scene)?)
 }
 
 /// Runs the job and returns the markdown of `docs/results.md`.

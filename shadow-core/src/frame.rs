@@ -81,6 +81,9 @@ pub enum FrameError {
     /// The scene draws nothing.
     #[error("the scene has no meshes to draw")]
     Empty,
+    /// The scene has no camera to look from.
+    #[error("the scene has no camera")]
+    NoCamera,
     /// More triangles than a frame can number: both backends give each drawn triangle a 32-bit id.
     #[error("the scene draws {triangles} triangles, over the limit of {} a frame can number", MAX_FRAME_TRIANGLES)]
     TooManyTriangles {
@@ -156,6 +159,15 @@ impl FrameInputs {
     pub fn from_scene(scene: &Scene, camera: CameraKey) -> Result<Self, FrameError> {
         let cam = *scene.camera(camera).ok_or(SceneError::UnknownKey("camera"))?;
         Self::new(scene, cam, scene.lights().map(|(_, l)| *l).collect())
+    }
+
+    /// The frame of `scene` seen from its first camera, lit by all its lights.
+    ///
+    /// # Errors
+    /// [`FrameError::NoCamera`], or as [`FrameInputs::from_scene`].
+    pub fn from_first_camera(scene: &Scene) -> Result<Self, FrameError> {
+        let (camera, _) = scene.cameras().next().ok_or(FrameError::NoCamera)?;
+        Self::from_scene(scene, camera)
     }
 
     /// Total triangles drawn.

@@ -28,7 +28,8 @@ impl ShadowTechnique<CpuBackend> for ShadowMap {
 
     fn build(&self, _: &mut CpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), CpuError> {
         let LightPass { frame, light, .. } = pass;
-        render_depth_maps(frame, light, self.map().resolution, self.map().depth_bias(), &mut state.maps)
+        let map = self.map();
+        render_depth_maps(frame, light, map.resolution, map.depth_bias(), &mut state.maps)
     }
 
     fn query(

@@ -116,9 +116,7 @@ impl SceneArgs {
     pub(crate) fn frame(&self, view: &ViewArgs) -> Result<(FrameInputs, u32, u32), Error> {
         let (w, h) = view.size()?;
         let scene = self.setup().build()?;
-        let cam =
-            scene.cameras().next().map(|(k, _)| k).ok_or_else(|| Error::Usage("the scene has no camera".into()))?;
-        Ok((FrameInputs::from_scene(&scene, cam)?, w, h))
+        Ok((FrameInputs::from_first_camera(&scene)?, w, h))
     }
 
     pub(crate) fn name(&self) -> String {

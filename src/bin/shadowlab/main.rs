@@ -585,9 +585,7 @@ fn bench_sweep(
             args.frame(view)?
         } else {
             let (w, h) = view.size()?;
-            let scene = &sweep.scenes[i];
-            let cam = scene.cameras().next().map(|(k, _)| k).ok_or_else(|| Error::Usage("no camera".into()))?;
-            (FrameInputs::from_scene(scene, cam)?, w, h)
+            (FrameInputs::from_first_camera(&sweep.scenes[i])?, w, h)
         };
         let with_value: Vec<TechniqueSpec> = specs
             .iter()
