@@ -249,7 +249,39 @@ fn gltf_document(r: &mut Rng, bin: bool) -> (Value, Vec<u8>, bool) {
     let n = 3 * r.count(40).min(4000) as usize + 9;
     let data = floats(r, n);
     let mut names_outside = false;
-    let buffers: Vec<Value> = (0..1 + r.below(3))
+    let buffers = gltf_buffers(r, bin, &data, &mut names_outside);
+    let views = gltf_views(r, &data, buffers.len() as u64);
+    let accessors = gltf_accessors(r, &data, views.len() as u64);
+    let meshes = gltf_meshes(r, accessors.len() as u64);
+    let (nodes, shape) = gltf_nodes(r, meshes.len() as u64);
+    let count = nodes.len() as u64;
+    let mut doc = json!({
+        "asset": {"version": "2.0"},
+        "buffers": buffers, "bufferViews": views, "accessors": accessors, "meshes": meshes, "nodes": nodes,
+        "extensions": {"KHR_lights_punctual": {"lights": [{"type": "spot", "spot": {"outerConeAngle": json_number(r)}, "intensity": json_number(r)}]}},
+    });
+    if r.chance(0.7) {
+        let roots: Vec<i64> = if r.hostile() {
+            (0..1 + r.below(3)).map(|_| r.index(count) - 1).collect()
+        } else if shape <= 1 {
+            vec![0]
+        } else {
+            (0..count as i64).collect()
+        };
+        doc["scenes"] = json!([{"nodes": roots}]);
+        doc["scene"] = json!(0);
+    }
+    if r.hostile() && r.chance(0.2) {
+        doc["extensionsRequired"] =
+            json!([*r.pick(&["KHR_draco_mesh_compression", "EXT_unknown", "KHR_lights_punctual"])]);
+    }
+    (doc, data, names_outside)
+}
+
+/// One to three buffers: the GLB's BIN chunk first where `bin`, else data URIs, files beside the model
+/// (or outside its folder: `names_outside`) and, when hostile, URLs and wrong lengths.
+fn gltf_buffers(r: &mut Rng, bin: bool, data: &[u8], names_outside: &mut bool) -> Vec<Value> {
+    (0..1 + r.below(3))
         .map(|i| {
             let len = if r.hostile() { r.count(1 << 16) } else { data.len() as u64 };
             if bin && i == 0 {
@@ -260,15 +292,18 @@ fn gltf_document(r: &mut Rng, bin: bool) -> (Value, Vec<u8>, bool) {
                 1 => (*r.pick(&["https://example.invalid/b.bin", "file:///etc/hostname", "C:\\b.bin", ""])).into(),
                 _ => {
                     let (path, outside) = reference(r, "bin");
-                    names_outside |= outside;
+                    *names_outside |= outside;
                     path
                 }
             };
             json!({"uri": uri, "byteLength": len})
         })
-        .collect();
-    let nb = buffers.len() as u64;
-    let views: Vec<Value> = (0..1 + r.below(4))
+        .collect()
+}
+
+/// Views into `nb` buffers, hostile ones out of range, offset or strided.
+fn gltf_views(r: &mut Rng, data: &[u8], nb: u64) -> Vec<Value> {
+    (0..1 + r.below(4))
         .map(|_| {
             if !r.hostile() {
                 return json!({"buffer": 0, "byteLength": data.len().min(512)});
@@ -282,9 +317,12 @@ fn gltf_document(r: &mut Rng, bin: bool) -> (Value, Vec<u8>, bool) {
             }
             v
         })
-        .collect();
-    let nv = views.len() as u64;
-    let accessors: Vec<Value> = (0..1 + r.below(6))
+        .collect()
+}
+
+/// Accessors of `nv` views, hostile ones of other types, counts, offsets or sparse.
+fn gltf_accessors(r: &mut Rng, data: &[u8], nv: u64) -> Vec<Value> {
+    (0..1 + r.below(6))
         .map(|_| {
             if !r.hostile() {
                 let count = 3 * (1 + r.below(data.len().min(512) as u64 / 36));
@@ -309,9 +347,12 @@ fn gltf_document(r: &mut Rng, bin: bool) -> (Value, Vec<u8>, bool) {
             }
             a
         })
-        .collect();
-    let na = accessors.len() as u64;
-    let meshes: Vec<Value> = (0..1 + r.below(3))
+        .collect()
+}
+
+/// Meshes of primitives over `na` accessors, hostile ones of other modes or with indices.
+fn gltf_meshes(r: &mut Rng, na: u64) -> Vec<Value> {
+    (0..1 + r.below(3))
         .map(|_| {
             let prims: Vec<Value> = (0..1 + r.below(3))
                 .map(|_| {
@@ -329,10 +370,12 @@ fn gltf_document(r: &mut Rng, bin: bool) -> (Value, Vec<u8>, bool) {
                 .collect();
             json!({"primitives": prims})
         })
-        .collect();
-    let nm = meshes.len() as u64;
-    // The node graph: sometimes a deep chain or a wide hub, otherwise random children (cycles and two
-    // parents included).
+        .collect()
+}
+
+/// The nodes, drawing `nm` meshes, and the graph's shape (0: a deep chain, 1: a wide hub, else random
+/// children, cycles and two parents included).
+fn gltf_nodes(r: &mut Rng, nm: u64) -> (Vec<Value>, u64) {
     let shape = r.below(10);
     let count = match shape {
         0 => 2000 + r.below(12_000),
@@ -366,27 +409,7 @@ fn gltf_document(r: &mut Rng, bin: bool) -> (Value, Vec<u8>, bool) {
             n
         })
         .collect();
-    let mut doc = json!({
-        "asset": {"version": "2.0"},
-        "buffers": buffers, "bufferViews": views, "accessors": accessors, "meshes": meshes, "nodes": nodes,
-        "extensions": {"KHR_lights_punctual": {"lights": [{"type": "spot", "spot": {"outerConeAngle": json_number(r)}, "intensity": json_number(r)}]}},
-    });
-    if r.chance(0.7) {
-        let roots: Vec<i64> = if r.hostile() {
-            (0..1 + r.below(3)).map(|_| r.index(count) - 1).collect()
-        } else if shape <= 1 {
-            vec![0]
-        } else {
-            (0..count as i64).collect()
-        };
-        doc["scenes"] = json!([{"nodes": roots}]);
-        doc["scene"] = json!(0);
-    }
-    if r.hostile() && r.chance(0.2) {
-        doc["extensionsRequired"] =
-            json!([*r.pick(&["KHR_draco_mesh_compression", "EXT_unknown", "KHR_lights_punctual"])]);
-    }
-    (doc, data, names_outside)
+    (nodes, shape)
 }
 
 fn base64(bytes: &[u8]) -> String {

@@ -22,6 +22,7 @@ pub mod metrics;
 pub mod procedural;
 pub mod scene;
 pub mod scenes;
+pub mod script;
 pub mod stats;
 pub mod technique;
 pub mod text;

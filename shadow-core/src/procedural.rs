@@ -392,19 +392,18 @@ pub fn implicit(f: impl Fn(Vec3) -> f32, lo: Vec3, hi: Vec3, cells: u32) -> Resu
     if triangles.is_empty() {
         return Err(ShapeError::Mesh { shape: "implicit", source: MeshError::Empty });
     }
-    let e = h * 0.25;
-    let normals = positions
-        .iter()
-        .map(|&p| {
-            let g = Vec3::new(
-                f(p + Vec3::X * e) - f(p - Vec3::X * e),
-                f(p + Vec3::Y * e) - f(p - Vec3::Y * e),
-                f(p + Vec3::Z * e) - f(p - Vec3::Z * e),
-            );
-            g.normalize_or_zero()
-        })
-        .collect();
+    let normals = positions.iter().map(|&p| gradient_direction(&f, p, h * 0.25)).collect();
     Mesh::with_normals(positions, normals, triangles).map_err(|source| ShapeError::Mesh { shape: "implicit", source })
+}
+
+/// The direction of `f`'s gradient at `p`, by central differences `e` apart (zero where it vanishes).
+fn gradient_direction(f: &impl Fn(Vec3) -> f32, p: Vec3, e: f32) -> Vec3 {
+    let g = Vec3::new(
+        f(p + Vec3::X * e) - f(p - Vec3::X * e),
+        f(p + Vec3::Y * e) - f(p - Vec3::Y * e),
+        f(p + Vec3::Z * e) - f(p - Vec3::Z * e),
+    );
+    g.normalize_or_zero()
 }
 
 #[cfg(test)]

@@ -1,12 +1,10 @@
-//! One frame on the CPU (DESIGN 5): G-buffer, then per light a build and a query, then shading. Every
-//! phase is timed.
-
-use std::time::Instant;
+//! One frame on the CPU: the frame script of shadow-core ([`shadow_core::script`]) with the CPU's steps.
+//! The CPU runs each step to the end before returning, so every phase's time is its own.
 
 use shadow_core::image::Rgb8;
 use shadow_core::light::LightView;
-use shadow_core::stats::{Phase, ms};
-use shadow_core::technique::{DynShadowTechnique, FrameStats, LightPass};
+use shadow_core::script::{FrameRun, FrameSteps, run_frame};
+use shadow_core::technique::{DynShadowTechnique, FrameStats};
 use shadow_core::{FrameInputs, Image};
 
 use crate::context::{CpuBackend, CpuContext, CpuError};
@@ -38,38 +36,47 @@ pub fn render_frame(
     height: u32,
     technique: &mut dyn DynShadowTechnique<CpuBackend>,
 ) -> Result<CpuFrame, CpuError> {
-    let start = Instant::now();
-    let mut stats = FrameStats::default();
+    let steps = CpuSteps { width, height, visibility: Vec::with_capacity(frame.lights.len()) };
+    let FrameRun { output: (gbuffer, visibility, color), light_views, stats } = run_frame(cx, frame, steps, technique)?;
+    Ok(CpuFrame { gbuffer, light_views, visibility, color, stats })
+}
 
-    let t = Instant::now();
-    let gbuffer = gbuffer::render_reusing(frame, width, height, cx.take_spare())?;
-    stats.timings.add(Phase::GBuffer, ms(t.elapsed()));
+/// The CPU's steps: images in memory, one per light's visibility.
+struct CpuSteps {
+    width: u32,
+    height: u32,
+    visibility: Vec<Image<f32>>,
+}
 
-    let mut visibility = Vec::with_capacity(frame.lights.len());
-    let mut light_views = Vec::with_capacity(frame.lights.len());
-    for light in &frame.lights {
-        let view = frame.light_view(light)?;
-        let mut light_stats = FrameStats::default();
-        let t = Instant::now();
-        technique.build(cx, LightPass { frame, light: &view, stats: &mut light_stats })?;
-        stats.timings.add(Phase::Build, ms(t.elapsed()));
-        let mut vis = Image::new(width, height, 1.0f32);
-        let t = Instant::now();
-        technique.query(cx, LightPass { frame, light: &view, stats: &mut light_stats }, &gbuffer, &mut vis)?;
-        stats.timings.add(Phase::Query, ms(t.elapsed()));
-        stats.counters.merge(&light_stats.counters);
-        for (k, v) in light_stats.timings.extra {
-            *stats.timings.extra.entry(k).or_insert(0.0) += v;
-        }
-        visibility.push(vis);
-        light_views.push(view);
+impl FrameSteps<CpuBackend> for CpuSteps {
+    type Shaded = Image<Rgb8>;
+    type Output = (GBuffer, Vec<Image<f32>>, Image<Rgb8>);
+
+    fn gbuffer(&mut self, cx: &mut CpuContext, frame: &FrameInputs) -> Result<GBuffer, CpuError> {
+        gbuffer::render_reusing(frame, self.width, self.height, cx.take_spare())
     }
 
-    let t = Instant::now();
-    let refs: Vec<&Image<f32>> = visibility.iter().collect();
-    let color = shade(&gbuffer, &frame.lights, &refs);
-    stats.timings.add(Phase::Shade, ms(t.elapsed()));
-    stats.timings.total = ms(start.elapsed());
-    stats.counters.covered_pixels = Some(gbuffer.covered_pixels());
-    Ok(CpuFrame { gbuffer, light_views, visibility, color, stats })
+    fn visibility(&mut self, _cx: &mut CpuContext, _k: usize) -> Result<Image<f32>, CpuError> {
+        Ok(Image::new(self.width, self.height, 1.0))
+    }
+
+    fn keep(&mut self, _k: usize, visibility: Image<f32>) {
+        self.visibility.push(visibility);
+    }
+
+    fn shade(&mut self, _cx: &mut CpuContext, frame: &FrameInputs, gbuffer: &GBuffer) -> Result<Image<Rgb8>, CpuError> {
+        let refs: Vec<&Image<f32>> = self.visibility.iter().collect();
+        Ok(shade(gbuffer, &frame.lights, &refs))
+    }
+
+    fn finish(
+        self,
+        _cx: &mut CpuContext,
+        gbuffer: GBuffer,
+        color: Image<Rgb8>,
+        stats: &mut FrameStats,
+    ) -> Result<Self::Output, CpuError> {
+        stats.counters.covered_pixels = Some(gbuffer.covered_pixels());
+        Ok((gbuffer, self.visibility, color))
+    }
 }

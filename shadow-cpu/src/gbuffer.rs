@@ -198,6 +198,58 @@ fn surface(t: &Triangle, inst: &shadow_core::Instance, rays: &EyeRays, (x, y): (
     (world, shading, geometric)
 }
 
+/// The surface attributes of every pixel, row after row.
+struct Surfaces {
+    position: Vec<Vec3>,
+    normal: Vec<Vec3>,
+    geometric_normal: Vec<Vec3>,
+    albedo: Vec<Vec3>,
+    receiver: Vec<bool>,
+    instance: Vec<u32>,
+}
+
+/// Resolves each pixel's visible primitive (its id in `all`, [`NO_INSTANCE`] for none) to the surface
+/// attributes, writing every pixel of every image in one pass (the background's too: the buffers are not
+/// cleared first). The triangle's world corners and face normal are those of the pixel before on most
+/// pixels of a row.
+fn resolve(frame: &FrameInputs, all: &Batch<'_>, visible: &[u32], eye_rays: &EyeRays, s: &mut Surfaces) {
+    let normal_from_local: Vec<Mat3> =
+        frame.instances.iter().map(|i| shadow_core::affine::normal_matrix(i.world_from_local)).collect();
+    let w = eye_rays.width as usize;
+    s.position
+        .par_chunks_mut(w)
+        .zip(s.normal.par_chunks_mut(w))
+        .zip(s.geometric_normal.par_chunks_mut(w))
+        .zip(s.albedo.par_chunks_mut(w))
+        .zip(s.receiver.par_chunks_mut(w))
+        .zip(s.instance.par_chunks_mut(w))
+        .zip(visible.par_chunks(w))
+        .enumerate()
+        .for_each(|(y, ((((((pos, nrm), geo), alb), rec), ins), vis))| {
+            let mut last: Option<(u32, Triangle)> = None;
+            for (x, &prim) in vis.iter().enumerate() {
+                if prim == NO_INSTANCE {
+                    (pos[x], nrm[x], geo[x], alb[x], rec[x], ins[x]) =
+                        (Vec3::ZERO, Vec3::Y, Vec3::Y, Vec3::ZERO, false, NO_INSTANCE);
+                    continue;
+                }
+                let t = match last {
+                    Some((p, t)) if p == prim => t,
+                    _ => {
+                        let (k, triangle) = all.part_of(prim);
+                        let t = Triangle::new(frame, k, triangle as usize, normal_from_local[k]);
+                        last = Some((prim, t));
+                        t
+                    }
+                };
+                let inst = &frame.instances[t.instance];
+                let (world, shading, geometric) = surface(&t, inst, eye_rays, (x, y));
+                (pos[x], nrm[x], geo[x], alb[x], rec[x], ins[x]) =
+                    (world, shading, geometric, inst.base_color, inst.receives_shadow, t.instance as u32);
+            }
+        });
+}
+
 /// [`render`], reusing the storage of a previous frame's G-buffer.
 ///
 /// # Errors
@@ -230,54 +282,24 @@ pub fn render_reusing(
     let mut ds = DepthStencil::from_parts(width, height, refill(old.depth, n, 1.0), vec![0; n]);
     let mut visible =
         Image::from_vec(width, height, refill(old.visible, n, NO_INSTANCE)).unwrap_or_else(|| unreachable!("n pixels"));
-    let mut receiver = overwritten(old.receiver, n, false);
+    let receiver = overwritten(old.receiver, n, false);
     // Every instance in one draw, in order (the same fragments as a draw each), each pixel left with the id
     // of its primitive in the batch.
     let all =
         Batch::new(frame.instances.iter().zip(&clip).map(|(inst, clip)| Indexed::instance(inst, clip)).collect())?;
     draw_flat(&mut ds, &mut visible, &all, &RasterState::default(), |prim| prim);
 
-    // Resolve: each pixel's primitive to the surface attributes, every pixel of every image written in one
-    // pass (the background's too: the buffers are not cleared first). The triangle's world corners and face
-    // normal are those of the pixel before on most pixels of a row.
-    let normal_from_local: Vec<Mat3> =
-        frame.instances.iter().map(|i| shadow_core::affine::normal_matrix(i.world_from_local)).collect();
-    let (mut position, mut normal, mut geometric_normal, mut albedo) = (position, normal, geometric_normal, albedo);
-    let w = width as usize;
     let eye_rays = EyeRays { eye: camera.eye, world_from_clip: clip_from_world.inverse(), width, height };
-    let mut instance = overwritten(old.instance, n, NO_INSTANCE);
-    position
-        .par_chunks_mut(w)
-        .zip(normal.par_chunks_mut(w))
-        .zip(geometric_normal.par_chunks_mut(w))
-        .zip(albedo.par_chunks_mut(w))
-        .zip(receiver.par_chunks_mut(w))
-        .zip(instance.par_chunks_mut(w))
-        .zip(visible.data().par_chunks(w))
-        .enumerate()
-        .for_each(|(y, ((((((pos, nrm), geo), alb), rec), ins), vis))| {
-            let mut last: Option<(u32, Triangle)> = None;
-            for (x, &prim) in vis.iter().enumerate() {
-                if prim == NO_INSTANCE {
-                    (pos[x], nrm[x], geo[x], alb[x], rec[x], ins[x]) =
-                        (Vec3::ZERO, Vec3::Y, Vec3::Y, Vec3::ZERO, false, NO_INSTANCE);
-                    continue;
-                }
-                let t = match last {
-                    Some((p, t)) if p == prim => t,
-                    _ => {
-                        let (k, triangle) = all.part_of(prim);
-                        let t = Triangle::new(frame, k, triangle as usize, normal_from_local[k]);
-                        last = Some((prim, t));
-                        t
-                    }
-                };
-                let inst = &frame.instances[t.instance];
-                let (world, shading, geometric) = surface(&t, inst, &eye_rays, (x, y));
-                (pos[x], nrm[x], geo[x], alb[x], rec[x], ins[x]) =
-                    (world, shading, geometric, inst.base_color, inst.receives_shadow, t.instance as u32);
-            }
-        });
+    let mut surfaces = Surfaces {
+        position,
+        normal,
+        geometric_normal,
+        albedo,
+        receiver,
+        instance: overwritten(old.instance, n, NO_INSTANCE),
+    };
+    resolve(frame, &all, visible.data(), &eye_rays, &mut surfaces);
+    let Surfaces { position, normal, geometric_normal, albedo, receiver, instance } = surfaces;
     fn image<T>(w: u32, h: u32, data: Vec<T>) -> Image<T> {
         Image::from_vec(w, h, data).unwrap_or_else(|| unreachable!("one entry per pixel"))
     }

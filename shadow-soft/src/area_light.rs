@@ -126,8 +126,7 @@ impl ShadowTechnique<CpuBackend> for AreaLightReference {
     fn build(&self, cx: &mut CpuContext, state: &mut RayState, pass: LightPass<'_>) -> Result<(), CpuError> {
         let LightPass { frame, light, .. } = pass;
         if light.light.position().is_none() {
-            let technique = self.name().into();
-            return Err(TechniqueError::UnsupportedLight { technique, light: light.light.type_name() }.into());
+            return Err(TechniqueError::unsupported_light(self.name(), &light.light).into());
         }
         state.build(cx, frame);
         Ok(())

@@ -34,7 +34,7 @@ use shadow_core::technique::TechniqueError;
 pub fn spot_projection<'a>(light: &'a LightView, technique: &str) -> Result<&'a LightProjection, TechniqueError> {
     match (light.light.kind, light.projections.as_slice()) {
         (LightKind::Spot { .. }, [p]) => Ok(p),
-        _ => Err(TechniqueError::UnsupportedLight { technique: technique.into(), light: light.light.type_name() }),
+        _ => Err(TechniqueError::unsupported_light(technique, &light.light)),
     }
 }
 

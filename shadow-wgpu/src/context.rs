@@ -198,67 +198,79 @@ fn missing(adapter: &wgpu::Adapter) -> Option<String> {
         .map(|f| format!("rendering to {f:?}"))
 }
 
+/// The adapter `choice` asks for: one named like it, else the best that can render shadowlab's targets.
+fn choose_adapter(choice: &AdapterChoice) -> Result<wgpu::Adapter, WgpuError> {
+    let adapters = pollster::block_on(instance().enumerate_adapters(wgpu::Backends::all()));
+    // Each adapter once, with its API: llvmpipe is both a Vulkan and an OpenGL adapter of one name.
+    let mut all: Vec<String> =
+        adapters.iter().map(|a| format!("{} ({:?})", a.get_info().name, a.get_info().backend)).collect();
+    all.dedup();
+    match choice.wanted() {
+        Some(name) => named_adapter(adapters, &name, &all),
+        None => best_adapter(adapters, choice.allow_software, &all),
+    }
+}
+
+/// Of the adapters named like `name` (llvmpipe is both a Vulkan and an OpenGL one), one that can render
+/// shadowlab's targets; else the first, refused later with what it lacks. `all` names every adapter.
+fn named_adapter(adapters: Vec<wgpu::Adapter>, name: &str, all: &[String]) -> Result<wgpu::Adapter, WgpuError> {
+    let n = name.to_lowercase();
+    let mut named: Vec<wgpu::Adapter> =
+        adapters.into_iter().filter(|a| a.get_info().name.to_lowercase().contains(&n)).collect();
+    named.sort_by_key(|a| missing(a).is_some());
+    named.into_iter().next().ok_or_else(|| {
+        WgpuError::NoAdapter(format!(
+            "none named like '{name}' (adapters: {})",
+            if all.is_empty() { "none".into() } else { all.join(", ") }
+        ))
+    })
+}
+
+/// The best ranked adapter that can render shadowlab's targets, software ones only if allowed; the error
+/// says why none fits. `all` names every adapter.
+fn best_adapter(
+    adapters: Vec<wgpu::Adapter>,
+    allow_software: bool,
+    all: &[String],
+) -> Result<wgpu::Adapter, WgpuError> {
+    let unfit: Vec<String> = adapters
+        .iter()
+        .filter_map(|a| {
+            missing(a).map(|what| format!("{} ({:?}) lacks {what}", a.get_info().name, a.get_info().backend))
+        })
+        .collect();
+    let mut candidates: Vec<wgpu::Adapter> = adapters
+        .into_iter()
+        .filter(|a| allow_software || a.get_info().device_type != wgpu::DeviceType::Cpu)
+        .filter(|a| missing(a).is_none())
+        .collect();
+    candidates.sort_by_key(|a| rank(&a.get_info()));
+    candidates.into_iter().next().ok_or_else(|| {
+        WgpuError::NoAdapter(if all.is_empty() {
+            "no adapter at all (install a Vulkan driver; mesa-vulkan-drivers gives a software one)".into()
+        } else if unfit.len() == all.len() {
+            format!(
+                "no adapter can render shadowlab's targets: {} (install a Vulkan driver; \
+                 mesa-vulkan-drivers gives a software one)",
+                unfit.join(", ")
+            )
+        } else {
+            format!(
+                "no hardware adapter (software ones: {}); use one with --backend wgpu, or name it with \
+                 --adapter NAME",
+                all.join(", ")
+            )
+        })
+    })
+}
+
 impl WgpuContext {
     /// Opens an adapter and a device.
     ///
     /// # Errors
     /// No matching adapter, a missing feature, or a device that cannot be created.
     pub fn new(choice: &AdapterChoice) -> Result<Self, WgpuError> {
-        let inst = instance();
-        let adapters = pollster::block_on(inst.enumerate_adapters(wgpu::Backends::all()));
-        let wanted = choice.wanted();
-        // Each adapter once, with its API: llvmpipe is both a Vulkan and an OpenGL adapter of one name.
-        let mut all: Vec<String> =
-            adapters.iter().map(|a| format!("{} ({:?})", a.get_info().name, a.get_info().backend)).collect();
-        all.dedup();
-        let adapter = match &wanted {
-            Some(name) => {
-                let n = name.to_lowercase();
-                // Of the adapters so named (llvmpipe is both a Vulkan and an OpenGL one), one that can
-                // render shadowlab's targets; else the first, refused below with what it lacks.
-                let mut named: Vec<wgpu::Adapter> =
-                    adapters.into_iter().filter(|a| a.get_info().name.to_lowercase().contains(&n)).collect();
-                named.sort_by_key(|a| missing(a).is_some());
-                named.into_iter().next().ok_or_else(|| {
-                    WgpuError::NoAdapter(format!(
-                        "none named like '{name}' (adapters: {})",
-                        if all.is_empty() { "none".into() } else { all.join(", ") }
-                    ))
-                })?
-            }
-            None => {
-                let unfit: Vec<String> = adapters
-                    .iter()
-                    .filter_map(|a| {
-                        missing(a)
-                            .map(|what| format!("{} ({:?}) lacks {what}", a.get_info().name, a.get_info().backend))
-                    })
-                    .collect();
-                let mut candidates: Vec<wgpu::Adapter> = adapters
-                    .into_iter()
-                    .filter(|a| choice.allow_software || a.get_info().device_type != wgpu::DeviceType::Cpu)
-                    .filter(|a| missing(a).is_none())
-                    .collect();
-                candidates.sort_by_key(|a| rank(&a.get_info()));
-                candidates.into_iter().next().ok_or_else(|| {
-                    WgpuError::NoAdapter(if all.is_empty() {
-                        "no adapter at all (install a Vulkan driver; mesa-vulkan-drivers gives a software one)".into()
-                    } else if unfit.len() == all.len() {
-                        format!(
-                            "no adapter can render shadowlab's targets: {} (install a Vulkan driver; \
-                             mesa-vulkan-drivers gives a software one)",
-                            unfit.join(", ")
-                        )
-                    } else {
-                        format!(
-                            "no hardware adapter (software ones: {}); use one with --backend wgpu, or name it with \
-                             --adapter NAME",
-                            all.join(", ")
-                        )
-                    })
-                })?
-            }
-        };
+        let adapter = choose_adapter(choice)?;
         let info = adapter.get_info();
         let summary = AdapterSummary::of(&info);
         let features = adapter.features();
@@ -352,6 +364,14 @@ impl WgpuContext {
         if let Some(clock) = &self.clock {
             clock.mark_step(&self.device, &self.queue, name);
         }
+    }
+
+    /// Submits recorded work to the queue. The backend's passes and the techniques hand their work to
+    /// the GPU only through here (the clock's markers aside), in the order the frame script runs them, so
+    /// where a frame's work goes is decided in one place: a frame recorded into a host's own submission
+    /// would collect it here instead of submitting.
+    pub fn submit(&self, work: wgpu::CommandBuffer) {
+        self.queue.submit([work]);
     }
 
     /// Waits for all submitted work.

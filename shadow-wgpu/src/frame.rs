@@ -1,13 +1,13 @@
-//! One frame on the GPU (DESIGN 5): G-buffer, then per light a build and a query into a layer of the
-//! visibility array, then shading; results read back into images. Every phase ends with the queue
-//! drained, so its wall-clock time is the GPU's time for it.
-
-use std::time::Instant;
+//! One frame on the GPU: the frame script of shadow-core ([`shadow_core::script`]) with the GPU's
+//! instrumented steps. Each light's visibility is a layer of one array texture; shading reads them all.
+//! Every phase ends with the queue drained, so its wall-clock time is the GPU's time for it, and the
+//! results are read back into images.
 
 use shadow_core::image::Rgb8;
 use shadow_core::light::LightView;
-use shadow_core::stats::{Phase, ms};
-use shadow_core::technique::{DynShadowTechnique, FrameStats, LightPass};
+use shadow_core::script::{FrameRun, FrameSteps, run_frame};
+use shadow_core::stats::Phase;
+use shadow_core::technique::{DynShadowTechnique, FrameStats};
 use shadow_core::{FrameInputs, Image};
 use wgpu::util::DeviceExt;
 
@@ -88,7 +88,8 @@ pub fn layer_view(tex: &wgpu::Texture, layer: u32) -> wgpu::TextureView {
     })
 }
 
-/// Renders a frame with one technique for every light of the frame.
+/// Renders a frame with one technique for every light of the frame, waiting after each phase and
+/// reading every target back.
 ///
 /// # Errors
 /// A bad view size, an unsupported light, or a GPU failure.
@@ -99,91 +100,106 @@ pub fn render_frame(
     height: u32,
     technique: &mut dyn DynShadowTechnique<WgpuBackend>,
 ) -> Result<WgpuFrame, WgpuError> {
-    let start = Instant::now();
     let most = MAX_LIGHTS.min(cx.device.limits().max_texture_array_layers as usize);
     if frame.lights.len() > most {
         return Err(WgpuError::TooManyLights { lights: frame.lights.len(), most });
     }
     cx.clock = PhaseClock::new(cx);
-    let result = frame_phases(cx, frame, width, height, technique, start);
+    let steps = MeasuredSteps::new(cx, frame, width, height);
+    let result = run_frame(cx, frame, steps, technique);
     cx.clock = None;
-    result
+    let FrameRun { output: (visibility, color), light_views, stats } = result?;
+    Ok(WgpuFrame { light_views, visibility, color, stats })
 }
 
-/// A phase and its clock markers, for GPU times: start, end of the technique's own work (see
-/// [`WgpuContext::end_of_work`]) and end.
-type Span = (Phase, Option<u32>, Option<u32>, Option<u32>, Vec<(&'static str, u32)>);
-
-/// [`render_frame`]'s phases, with the clock in the context.
-fn frame_phases(
-    cx: &mut WgpuContext,
-    frame: &FrameInputs,
+/// The GPU's instrumented steps: each phase ends with the queue drained, so its wall-clock time is the
+/// GPU's, and between timestamp markers where the adapter has them; the targets are read back at the end.
+struct MeasuredSteps {
     width: u32,
     height: u32,
-    technique: &mut dyn DynShadowTechnique<WgpuBackend>,
-    start: Instant,
-) -> Result<WgpuFrame, WgpuError> {
-    let mut stats = FrameStats::default();
-    let mut spans: Vec<Span> = Vec::new();
-    let mark = |cx: &mut WgpuContext| {
-        let mut clock = cx.clock.take()?;
-        let index = clock.mark(cx);
-        cx.clock = Some(clock);
-        index
-    };
-    let work_end = |cx: &mut WgpuContext| cx.clock.as_mut().and_then(PhaseClock::take_work_end);
-    let steps = |cx: &mut WgpuContext| cx.clock.as_mut().map(PhaseClock::take_steps).unwrap_or_default();
+    lights: u32,
+    /// One layer per light's visibility.
+    visibility: wgpu::Texture,
+    /// The marker that began the phase under way.
+    start: Option<u32>,
+    spans: Vec<Span>,
+}
 
-    let t = Instant::now();
-    let m0 = mark(cx);
-    let g = gbuffer::render(cx, frame, width, height)?;
-    spans.push((Phase::GBuffer, m0, None, mark(cx), steps(cx)));
-    cx.wait()?;
-    stats.timings.add(Phase::GBuffer, ms(t.elapsed()));
+/// A phase's clock markers: its start, the end of the technique's own work (see
+/// [`WgpuContext::end_of_work`]), its end, and the ends of its named steps.
+struct Span {
+    phase: Phase,
+    start: Option<u32>,
+    work_end: Option<u32>,
+    end: Option<u32>,
+    steps: Vec<(&'static str, u32)>,
+}
 
-    let layers = frame.lights.len().max(1) as u32;
-    let vis_tex = layered(cx, "visibility", width, height, layers, VISIBILITY);
-    let mut light_views = Vec::new();
-    for (k, light) in frame.lights.iter().enumerate() {
-        let view = frame.light_view(light)?;
-        let mut light_stats = FrameStats::default();
-        let t = Instant::now();
-        let m0 = mark(cx);
-        technique.build(cx, LightPass { frame, light: &view, stats: &mut light_stats })?;
-        spans.push((Phase::Build, m0, work_end(cx), mark(cx), steps(cx)));
-        cx.wait()?;
-        stats.timings.add(Phase::Build, ms(t.elapsed()));
-        let mut out = GpuVisibility { view: layer_view(&vis_tex, k as u32), width, height };
-        let t = Instant::now();
-        let m0 = mark(cx);
-        technique.query(cx, LightPass { frame, light: &view, stats: &mut light_stats }, &g, &mut out)?;
-        spans.push((Phase::Query, m0, work_end(cx), mark(cx), steps(cx)));
-        cx.wait()?;
-        stats.timings.add(Phase::Query, ms(t.elapsed()));
-        stats.counters.merge(&light_stats.counters);
-        for (key, v) in light_stats.timings.extra {
-            *stats.timings.extra.entry(key).or_insert(0.0) += v;
+impl MeasuredSteps {
+    fn new(cx: &WgpuContext, frame: &FrameInputs, width: u32, height: u32) -> Self {
+        let lights = frame.lights.len() as u32;
+        let visibility = layered(cx, "visibility", width, height, lights.max(1), VISIBILITY);
+        Self { width, height, lights, visibility, start: None, spans: Vec::new() }
+    }
+}
+
+/// Submits a clock marker, where the frame has a clock.
+fn mark(cx: &mut WgpuContext) -> Option<u32> {
+    let mut clock = cx.clock.take()?;
+    let index = clock.mark(cx);
+    cx.clock = Some(clock);
+    index
+}
+
+impl FrameSteps<WgpuBackend> for MeasuredSteps {
+    /// The shaded texture and the receiver count's resolve buffer.
+    type Shaded = (wgpu::Texture, wgpu::Buffer);
+    /// Visibility per light and the shaded image, read back.
+    type Output = (Vec<Image<f32>>, Image<Rgb8>);
+
+    fn gbuffer(&mut self, cx: &mut WgpuContext, frame: &FrameInputs) -> Result<GpuGBuffer, WgpuError> {
+        gbuffer::render(cx, frame, self.width, self.height)
+    }
+
+    fn visibility(&mut self, _cx: &mut WgpuContext, k: usize) -> Result<GpuVisibility, WgpuError> {
+        Ok(GpuVisibility { view: layer_view(&self.visibility, k as u32), width: self.width, height: self.height })
+    }
+
+    fn keep(&mut self, _k: usize, _visibility: GpuVisibility) {}
+
+    fn shade(&mut self, cx: &mut WgpuContext, frame: &FrameInputs, g: &GpuGBuffer) -> Result<Self::Shaded, WgpuError> {
+        shade(cx, frame, g, &self.visibility)
+    }
+
+    fn finish(
+        self,
+        cx: &mut WgpuContext,
+        _gbuffer: GpuGBuffer,
+        (color, covered): Self::Shaded,
+        stats: &mut FrameStats,
+    ) -> Result<Self::Output, WgpuError> {
+        stats.counters.covered_pixels = Some(read_count(cx, &covered)?);
+        if let Some(clock) = &cx.clock {
+            add_gpu_times(&clock.read(cx)?, self.spans, stats);
         }
-        light_views.push(view);
+        let color = readback::read_rgb8(cx, &color)?;
+        let visibility = (0..self.lights)
+            .map(|k| readback::read_f32(cx, &self.visibility, k, wgpu::TextureAspect::All))
+            .collect::<Result<_, _>>()?;
+        Ok((visibility, color))
     }
 
-    let t = Instant::now();
-    let m0 = mark(cx);
-    let (color_tex, covered) = shade(cx, frame, &g, &vis_tex)?;
-    spans.push((Phase::Shade, m0, None, mark(cx), steps(cx)));
-    cx.wait()?;
-    stats.timings.add(Phase::Shade, ms(t.elapsed()));
-    stats.timings.total = ms(start.elapsed());
-    stats.counters.covered_pixels = Some(read_count(cx, &covered)?);
-    if let Some(c) = &cx.clock {
-        add_gpu_times(&c.read(cx)?, spans, &mut stats);
+    fn begin(&mut self, cx: &mut WgpuContext, _phase: Phase) {
+        self.start = mark(cx);
     }
 
-    let color = readback::read_rgb8(cx, &color_tex)?;
-    let visibility = (0..frame.lights.len() as u32)
-        .map(|k| readback::read_f32(cx, &vis_tex, k, wgpu::TextureAspect::All))
-        .collect::<Result<_, _>>()?;
-    Ok(WgpuFrame { light_views, visibility, color, stats })
+    fn end(&mut self, cx: &mut WgpuContext, phase: Phase) -> Result<(), WgpuError> {
+        let work_end = cx.clock.as_mut().and_then(PhaseClock::take_work_end);
+        let end = mark(cx);
+        let steps = cx.clock.as_mut().map(PhaseClock::take_steps).unwrap_or_default();
+        self.spans.push(Span { phase, start: self.start.take(), work_end, end, steps });
+        cx.wait()
+    }
 }
 
 /// Adds each span's GPU time from the clock's readings `at`: per phase `gpu_PHASE` (the technique's own
@@ -193,21 +209,20 @@ fn add_gpu_times(at: &[f64], spans: Vec<Span>, stats: &mut FrameStats) {
     let mut add = |key: String, a: u32, b: u32| {
         *stats.timings.extra.entry(key).or_insert(0.0) += at[b as usize] - at[a as usize];
     };
-    for (phase, a, work, b, steps) in spans {
-        if let (Some(a), Some(b)) = (a, b) {
-            let key = format!("gpu_{}", phase.key());
-            let mut from = a;
-            for (name, end) in steps {
-                add(format!("{key}.{name}"), from, end);
-                from = end;
+    for span in spans {
+        let (Some(a), Some(b)) = (span.start, span.end) else { continue };
+        let key = format!("gpu_{}", span.phase.key());
+        let mut from = a;
+        for (name, end) in span.steps {
+            add(format!("{key}.{name}"), from, end);
+            from = end;
+        }
+        match span.work_end {
+            Some(w) => {
+                add(key, a, w);
+                add("gpu_counters".into(), w, b);
             }
-            match work {
-                Some(w) => {
-                    add(key, a, w);
-                    add("gpu_counters".into(), w, b);
-                }
-                None => add(key, a, b),
-            }
+            None => add(key, a, b),
         }
     }
 }
@@ -222,7 +237,7 @@ fn read_count(cx: &WgpuContext, q: &wgpu::Buffer) -> Result<u64, WgpuError> {
     });
     let mut enc = cx.device.create_command_encoder(&Default::default());
     enc.copy_buffer_to_buffer(q, 0, &staging, 0, 8);
-    cx.queue.submit([enc.finish()]);
+    cx.submit(enc.finish());
     let d = readback::map_read(cx, &staging, "counting receivers")?;
     Ok(u64::from_le_bytes([d[0], d[1], d[2], d[3], d[4], d[5], d[6], d[7]]))
 }
@@ -304,7 +319,7 @@ fn shade(
             }
         }
         enc.resolve_query_set(&query, 0..1, &resolved, 0);
-        cx.queue.submit([enc.finish()]);
+        cx.submit(enc.finish());
         (color, resolved)
     })
 }

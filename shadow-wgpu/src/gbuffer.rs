@@ -121,7 +121,7 @@ pub fn render(cx: &mut WgpuContext, frame: &FrameInputs, width: u32, height: u32
             draw_instances(cx, &mut pass, frame, |_| true, true);
             pass.pop_debug_group();
         }
-        cx.queue.submit([enc.finish()]);
+        cx.submit(enc.finish());
         GpuGBuffer {
             width,
             height,

@@ -37,7 +37,7 @@ fn read_layer(
         },
         wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
     );
-    cx.queue.submit([enc.finish()]);
+    cx.submit(enc.finish());
     let data = map_read(cx, &buffer, "readback")?;
     let mut out = Vec::with_capacity((row * h) as usize);
     for y in 0..h as usize {

@@ -11,10 +11,12 @@
 //!   is exactly z-fail's; the caster masks change no pixel on the CPU and only pixels at a rounding tie
 //!   on the GPU, where they also keep the fill under a tenth of z-fail's.
 
-use shadow_core::FrameInputs;
+use shadow_core::glam::{Mat4, Vec3};
 use shadow_core::scenes::{self, SceneParams};
 use shadow_core::technique::TechniqueSpec;
+use shadow_core::{Camera, FrameInputs, Light, Material, Scene};
 use shadowlab::compare::{CompareJob, ResultEntry, run_compare};
+use shadowlab::renderer::RunOutput;
 use shadowlab::{BackendKind, Renderer, TechniqueRegistry};
 
 fn run(scene: &str, specs: &[&str]) -> Vec<ResultEntry> {
@@ -84,6 +86,99 @@ fn the_computation_mask_saves_nine_tenths_of_the_fill() {
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
+/// A scene whose only caster is too large for the GPU's compute passes (a sphere of 8 192 triangles over a
+/// ground that casts nothing): no piece there, only the rasterized one.
+fn lone_sphere() -> Scene {
+    let mut s = Scene::new();
+    let grey = s.add_material(Material::colored("grey", Vec3::splat(0.75)));
+    let sphere = s.add_mesh(shadow_core::procedural::sphere(0.4, 128, 32).expect("shape"));
+    s.add_instance("sphere", sphere, grey, Mat4::from_translation(Vec3::new(0.0, 0.5, 0.0))).expect("sphere");
+    let ground = s.add_mesh(scenes::ground_quad());
+    let ground = s.add_instance("ground", ground, grey, Mat4::IDENTITY).expect("ground");
+    s.set_shadow_flags(ground, false, true).expect("ground's flags");
+    s.add_camera(Camera::look_at(Vec3::new(0.0, 1.1, 2.2), Vec3::new(0.0, 0.35, 0.0), 45.0));
+    s.add_light(Light::spot(Vec3::new(2.0, 4.0, 1.5), Vec3::ZERO, 60.0));
+    s
+}
+
+/// Mirrored instances (negative determinants: front faces wind the other way, and the compute passes'
+/// side quads are laid out for that), tilted cubes on a ground.
+fn mirrored_cubes() -> Scene {
+    let mut s = Scene::new();
+    let grey = s.add_material(Material::colored("grey", Vec3::splat(0.75)));
+    let cube = s.add_mesh(shadow_core::procedural::cuboid(Vec3::splat(0.15)).expect("shape"));
+    for i in 0..9 {
+        let (x, z) = ((i % 3) as f32 * 0.5 - 0.5, (i / 3) as f32 * 0.5 - 0.5);
+        let tilt = Mat4::from_rotation_y(0.4 * i as f32) * Mat4::from_rotation_x(0.3 + 0.2 * i as f32);
+        let world = Mat4::from_translation(Vec3::new(x, 0.5 + 0.05 * i as f32, z))
+            * tilt
+            * Mat4::from_scale(Vec3::new(-1.0, 1.0, 1.0));
+        s.add_instance(&format!("mirrored cube {i}"), cube, grey, world).expect("cube");
+    }
+    let ground = s.add_mesh(scenes::ground_quad());
+    let ground = s.add_instance("ground", ground, grey, Mat4::IDENTITY).expect("ground");
+    s.set_shadow_flags(ground, false, true).expect("ground's flags");
+    s.add_camera(Camera::look_at(Vec3::new(0.8, 1.6, 2.2), Vec3::new(0.0, 0.3, 0.0), 45.0));
+    s.add_light(Light::spot(Vec3::new(1.0, 3.0, 0.8), Vec3::ZERO, 60.0));
+    s
+}
+
+/// Lights inside the casters (six cube faces, pieces across their planes; a spot light's plane through
+/// the cloud), and a directional light over the tree, beside the scene's own.
+fn lights_among_the_casters(scene: &str) -> Vec<(&'static str, Light)> {
+    let inside = Vec3::new(0.3, 2.2, 0.4);
+    match scene {
+        "cubes" => vec![
+            ("point light inside", Light::point(inside)),
+            ("spot light inside", Light::spot(inside, inside - Vec3::Y, 120.0)),
+        ],
+        "tree" => vec![
+            ("directional light", Light::directional(Vec3::new(-1.0, -3.0, -2.0))),
+            ("point light in the branches", Light::point(Vec3::new(0.0, 1.8, 0.0))),
+        ],
+        _ => Vec::new(),
+    }
+}
+
+/// Caster masks `on` against the whole mask `off` on one backend: the report row, and what fails.
+fn compare_masks(
+    case: &str,
+    name: &str,
+    backend: BackendKind,
+    on: &RunOutput,
+    off: &RunOutput,
+) -> (String, Vec<String>) {
+    let mut failures = Vec::new();
+    let differ = on.visibility[0].data().iter().zip(off.visibility[0].data()).filter(|(a, b)| a != b).count();
+    let (c, off_fragments) = (&on.stats.counters, off.stats.counters.volume_fragments.expect("fragments"));
+    let (fragments, pixels) = (c.volume_fragments.expect("fragments"), c.silhouette_pixels.expect("pixels"));
+    let row = format!(
+        "{case:<34} {backend:?}: {differ} pixels differ, {pixels} silhouette pixels, fragments \
+                 {fragments} (whole mask {off_fragments})"
+    );
+    let cpu = backend == BackendKind::Cpu;
+    // On the GPU, a tie a pixel wide along some shadow edges: tree has 25 of 262 144.
+    if differ > if cpu { 0 } else { 60 } {
+        failures.push(format!("{case} ({backend:?}): {differ} pixels differ from the whole mask's"));
+    }
+    // Nothing shadowed, nothing to test: every case has shadows at the silhouette pixels.
+    if pixels == 0 || !on.visibility[0].data().contains(&0.0) {
+        failures.push(format!("{case} ({backend:?}): no silhouette pixel or no shadow"));
+    }
+    let listed_pieces = c.extra.get("listed_pieces").copied();
+    if !cpu && (name == "lone sphere") != (listed_pieces == Some(0.0)) {
+        failures.push(format!("{case}: {listed_pieces:?} pieces counted by the compute passes"));
+    }
+    if !cpu && c.extra.get("listed_pixels").copied() != Some(pixels as f64) {
+        failures.push(format!("{case}: the mask pass listed {:?} of {pixels} pixels", c.extra.get("listed_pixels")));
+    }
+    if fragments > off_fragments {
+        failures
+            .push(format!("{case} ({backend:?}): more fragments with caster masks ({fragments} > {off_fragments})"));
+    }
+    (row, failures)
+}
+
 /// Caster masks (ours: each connected component's volume counted only at the silhouette pixels its
 /// shaft holds) against the whole mask, on every built-in scene and under point, spot and directional
 /// lights among the casters, on both backends. On the CPU (listed draws through the rasterizer's own
@@ -95,9 +190,6 @@ fn the_computation_mask_saves_nine_tenths_of_the_fill() {
 /// Without a wgpu adapter the GPU half prints one line and is skipped, unless SHADOWLAB_REQUIRE_GPU=1.
 #[test]
 fn caster_masks_keep_the_picture_on_both_backends() {
-    use shadow_core::glam::{Mat4, Vec3};
-    use shadow_core::{Camera, Light, Material, Scene};
-
     let mut renderer = Renderer::new(TechniqueRegistry::builtin());
     let gpu = match renderer.resolve(shadowlab::BackendChoice::Wgpu) {
         Ok(_) => true,
@@ -112,63 +204,15 @@ fn caster_masks_keep_the_picture_on_both_backends() {
     let (masked, whole, zfail) =
         (spec("hybrid:res=512"), spec("hybrid:res=512,caster_masks=off"), spec("shadow-volume-zfail"));
     let (mut rows, mut failures) = (Vec::new(), Vec::new());
-    // The built-in scenes, and one whose only caster is too large for the GPU's compute passes (a sphere
-    // of 8 192 triangles over a ground that casts nothing): no piece there, only the rasterized one.
-    let lone_sphere = {
-        let mut s = Scene::new();
-        let grey = s.add_material(Material::colored("grey", Vec3::splat(0.75)));
-        let sphere = s.add_mesh(shadow_core::procedural::sphere(0.4, 128, 32).expect("shape"));
-        s.add_instance("sphere", sphere, grey, Mat4::from_translation(Vec3::new(0.0, 0.5, 0.0))).expect("sphere");
-        let ground = s.add_mesh(scenes::ground_quad());
-        let ground = s.add_instance("ground", ground, grey, Mat4::IDENTITY).expect("ground");
-        s.set_shadow_flags(ground, false, true).expect("ground's flags");
-        s.add_camera(Camera::look_at(Vec3::new(0.0, 1.1, 2.2), Vec3::new(0.0, 0.35, 0.0), 45.0));
-        s.add_light(Light::spot(Vec3::new(2.0, 4.0, 1.5), Vec3::ZERO, 60.0));
-        s
-    };
-    // Mirrored instances (negative determinants: front faces wind the other way, and the compute passes'
-    // side quads are laid out for that), tilted cubes on a ground.
-    let mirrored = {
-        let mut s = Scene::new();
-        let grey = s.add_material(Material::colored("grey", Vec3::splat(0.75)));
-        let cube = s.add_mesh(shadow_core::procedural::cuboid(Vec3::splat(0.15)).expect("shape"));
-        for i in 0..9 {
-            let (x, z) = ((i % 3) as f32 * 0.5 - 0.5, (i / 3) as f32 * 0.5 - 0.5);
-            let tilt = Mat4::from_rotation_y(0.4 * i as f32) * Mat4::from_rotation_x(0.3 + 0.2 * i as f32);
-            let world = Mat4::from_translation(Vec3::new(x, 0.5 + 0.05 * i as f32, z))
-                * tilt
-                * Mat4::from_scale(Vec3::new(-1.0, 1.0, 1.0));
-            s.add_instance(&format!("mirrored cube {i}"), cube, grey, world).expect("cube");
-        }
-        let ground = s.add_mesh(scenes::ground_quad());
-        let ground = s.add_instance("ground", ground, grey, Mat4::IDENTITY).expect("ground");
-        s.set_shadow_flags(ground, false, true).expect("ground's flags");
-        s.add_camera(Camera::look_at(Vec3::new(0.8, 1.6, 2.2), Vec3::new(0.0, 0.3, 0.0), 45.0));
-        s.add_light(Light::spot(Vec3::new(1.0, 3.0, 0.8), Vec3::ZERO, 60.0));
-        s
-    };
     let built: Vec<(&str, Scene)> =
         scenes::names().iter().map(|&n| (n, scenes::build(n, &SceneParams::default()).expect("scene"))).collect();
+    let (lone_sphere, mirrored) = (lone_sphere(), mirrored_cubes());
     let own = [("lone sphere", &lone_sphere), ("mirrored cubes", &mirrored)];
     for (name, s) in built.iter().map(|(n, s)| (*n, s)).chain(own) {
         let cam_key = s.cameras().next().expect("camera").0;
         let cam = *s.camera(cam_key).expect("camera");
         let mut cases = vec![(name.to_string(), FrameInputs::from_scene(s, cam_key).expect("frame"))];
-        // Lights inside the casters (six cube faces, pieces across their planes; a spot light's plane
-        // through the cloud), and a directional light over the tree.
-        let inside = Vec3::new(0.3, 2.2, 0.4);
-        let extra = match name {
-            "cubes" => vec![
-                ("point light inside", Light::point(inside)),
-                ("spot light inside", Light::spot(inside, inside - Vec3::Y, 120.0)),
-            ],
-            "tree" => vec![
-                ("directional light", Light::directional(Vec3::new(-1.0, -3.0, -2.0))),
-                ("point light in the branches", Light::point(Vec3::new(0.0, 1.8, 0.0))),
-            ],
-            _ => Vec::new(),
-        };
-        for (what, light) in extra {
+        for (what, light) in lights_among_the_casters(name) {
             cases.push((format!("{name}, {what}"), FrameInputs::new(s, cam, vec![light]).expect("frame")));
         }
         for (case, frame) in &cases {
@@ -178,39 +222,11 @@ fn caster_masks_keep_the_picture_on_both_backends() {
                 if gpu { &[BackendKind::Cpu, BackendKind::Wgpu] } else { &[BackendKind::Cpu] };
             for &backend in backends {
                 let (on, off) = (run(backend, &masked), run(backend, &whole));
-                let differ =
-                    on.visibility[0].data().iter().zip(off.visibility[0].data()).filter(|(a, b)| a != b).count();
+                let (mut row, found) = compare_masks(case, name, backend, &on, &off);
+                failures.extend(found);
                 let (c, off_fragments) = (&on.stats.counters, off.stats.counters.volume_fragments.expect("fragments"));
-                let (fragments, pixels) =
-                    (c.volume_fragments.expect("fragments"), c.silhouette_pixels.expect("pixels"));
-                let mut row = format!(
-                    "{case:<34} {backend:?}: {differ} pixels differ, {pixels} silhouette pixels, fragments \
-                     {fragments} (whole mask {off_fragments})"
-                );
+                let fragments = c.volume_fragments.expect("fragments");
                 let cpu = backend == BackendKind::Cpu;
-                // On the GPU, a tie a pixel wide along some shadow edges: tree has 25 of 262 144.
-                if differ > if cpu { 0 } else { 60 } {
-                    failures.push(format!("{case} ({backend:?}): {differ} pixels differ from the whole mask's"));
-                }
-                // Nothing shadowed, nothing to test: every case has shadows at the silhouette pixels.
-                if pixels == 0 || !on.visibility[0].data().contains(&0.0) {
-                    failures.push(format!("{case} ({backend:?}): no silhouette pixel or no shadow"));
-                }
-                let listed_pieces = c.extra.get("listed_pieces").copied();
-                if !cpu && (name == "lone sphere") != (listed_pieces == Some(0.0)) {
-                    failures.push(format!("{case}: {listed_pieces:?} pieces counted by the compute passes"));
-                }
-                if !cpu && c.extra.get("listed_pixels").copied() != Some(pixels as f64) {
-                    failures.push(format!(
-                        "{case}: the mask pass listed {:?} of {pixels} pixels",
-                        c.extra.get("listed_pixels")
-                    ));
-                }
-                if fragments > off_fragments {
-                    failures.push(format!(
-                        "{case} ({backend:?}): more fragments with caster masks ({fragments} > {off_fragments})"
-                    ));
-                }
                 // Many casters crossing each other's shadows: most fragments go.
                 let default_light = case.as_str() == name;
                 if default_light && (name == "cubes" || name == "tree") && fragments * 4 > off_fragments {

@@ -8,10 +8,13 @@
 use std::path::{Path, PathBuf};
 
 use shadow_core::image::{error_map, visibility_to_rgb};
-use shadow_core::metrics::{compare_visibility, flip_mean, measured_pixels};
+use shadow_core::metrics::{VisibilityMetrics, compare_visibility, flip_mean, measured_pixels};
 use shadow_core::scenes::{self, SceneParams};
+use shadow_core::stats::Counters;
 use shadow_core::technique::{TechniqueError, TechniqueSpec};
-use shadow_core::{FrameInputs, Scene};
+use shadow_core::{FrameInputs, Image, Scene};
+use shadow_cpu::CpuFrame;
+use shadowlab::renderer::RunOutput;
 use shadowlab::{BackendKind, Renderer, TechniqueRegistry};
 
 const SIZE: u32 = 256;
@@ -90,6 +93,143 @@ fn out_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("target/conformance")
 }
 
+/// Every technique on both backends by its defaults, then the variants.
+fn specs(registry: &TechniqueRegistry) -> Vec<TechniqueSpec> {
+    let mut specs: Vec<TechniqueSpec> = registry
+        .entries()
+        .iter()
+        .filter(|e| e.cpu.is_some() && e.wgpu.is_some())
+        .map(|e| TechniqueSpec::named(e.name))
+        .collect();
+    assert!(!specs.is_empty(), "no technique on both backends");
+    specs.extend(VARIANTS.iter().map(|v| TechniqueSpec::parse(v).expect("a variant's spec")));
+    specs
+}
+
+/// The area light's reference frame, or `None` for a light it does not take (a directional one: the area
+/// light needs a position).
+fn area_light_reference(renderer: &mut Renderer, frame: &FrameInputs, scene_name: &str) -> Option<CpuFrame> {
+    let spec = TechniqueSpec::named("area-light-reference");
+    match renderer.run_cpu_frame(frame, SIZE, SIZE, &spec) {
+        Ok((f, _)) => Some(f),
+        Err(e) if matches!(e.technique(), Some(TechniqueError::UnsupportedLight { .. })) => None,
+        Err(e) => panic!("{scene_name}: area-light reference: {e}"),
+    }
+}
+
+/// One technique on one scene, measured.
+struct Case<'a> {
+    scene: &'a str,
+    spec: &'a TechniqueSpec,
+    soft: bool,
+    /// The backends' visibility against each other.
+    cross: VisibilityMetrics,
+    /// FLIP between the backends' shaded images.
+    flip: f64,
+    /// Each backend's mismatch against the reference.
+    cpu_err: f64,
+    gpu_err: f64,
+}
+
+impl Case<'_> {
+    /// Every ceiling the case goes over, with its numbers; empty when it passes.
+    fn failures(&self, cpu: &Counters, gpu: &Counters) -> Vec<String> {
+        let (cross, flip, cpu_err, gpu_err) = (&self.cross, self.flip, self.cpu_err, self.gpu_err);
+        let mut why = Vec::new();
+        if cross.mismatch > MAX_CROSS_MISMATCH {
+            why.push(format!(
+                "cross-backend mismatch {:.3}% > {:.3}%",
+                cross.mismatch * 100.0,
+                MAX_CROSS_MISMATCH * 100.0
+            ));
+        }
+        if flip > MAX_CROSS_FLIP {
+            why.push(format!("cross-backend FLIP {flip:.4} > {MAX_CROSS_FLIP}"));
+        }
+        if self.soft && cross.rmse > MAX_CROSS_RMSE_SOFT {
+            why.push(format!("cross-backend visibility RMSE {:.4} > {MAX_CROSS_RMSE_SOFT}", cross.rmse));
+        }
+        counter_disagreements(self.spec, cpu, gpu, &mut why);
+        if (gpu_err - cpu_err).abs() > MAX_ERROR_GAP {
+            why.push(format!("wgpu error {:.3}% vs cpu {:.3}%", gpu_err * 100.0, cpu_err * 100.0));
+        }
+        if let Some(ceiling) = reference_ceiling(&self.spec.name, self.scene) {
+            for (backend, err) in [("cpu", cpu_err), ("wgpu", gpu_err)] {
+                if err > ceiling {
+                    why.push(format!(
+                        "{backend} mismatch vs reference {:.3}% > ceiling {:.3}%",
+                        err * 100.0,
+                        ceiling * 100.0
+                    ));
+                }
+            }
+        }
+        why
+    }
+}
+
+/// The counters both backends report must agree (occlusion queries and atomics against CPU counts); adds
+/// each that does not to `why`.
+fn counter_disagreements(spec: &TechniqueSpec, c: &Counters, w: &Counters, why: &mut Vec<String>) {
+    let extra = |c: &Counters, k: &str| c.extra.get(k).map(|v| *v as u64);
+    // Relative tolerances: rasterized counts agree to rounding; silhouette_pixels counts per-pixel
+    // depth comparisons, which flip where a corner sample ties the receiver to an ulp.
+    // Hybrid counts its volume fragments under a mask made of silhouette pixels: a pixel that ties
+    // one way on one backend brings its whole overdraw along, so twice theirs.
+    let volume_tolerance = if spec.name == "hybrid" { 0.02 } else { 0.001 };
+    // Both backends' caster masks (on unless turned off) count each small caster only where its
+    // shadow can be, but they choose the pieces counted that way differently (the CPU by triangles
+    // times pixels, the GPU by triangles alone: primitives' sphere is listed on one and drawn through
+    // the whole mask on the other), so that fill is not compared here (the pictures still are;
+    // `hybrid:caster_masks=off` compares the fill through the whole mask, and hybrid.rs holds the
+    // GPU's caster masks to their own whole mask's picture).
+    let caster_masks = spec.name == "hybrid" && !spec.values.iter().any(|(k, v)| k == "caster_masks" && v == "off");
+    let cpu_fragments = if caster_masks { None } else { c.volume_fragments };
+    for (name, a, b, tolerance) in [
+        ("covered_pixels", c.covered_pixels, w.covered_pixels, 0.001),
+        ("volume_fragments", cpu_fragments, w.volume_fragments, volume_tolerance),
+        ("cap_triangles", extra(c, "cap_triangles"), extra(w, "cap_triangles"), 0.0),
+        ("silhouette_edges", c.silhouette_edges, w.silhouette_edges, 0.0),
+        ("silhouette_pixels", c.silhouette_pixels, w.silhouette_pixels, 0.01),
+        ("silhouette_texels", extra(c, "silhouette_texels"), extra(w, "silhouette_texels"), 0.001),
+        (
+            "unmasked_volume_fragments",
+            extra(c, "unmasked_volume_fragments"),
+            extra(w, "unmasked_volume_fragments"),
+            0.001,
+        ),
+    ] {
+        if let (Some(a), Some(b)) = (a, b) {
+            if (a as f64 - b as f64).abs() > tolerance * a.max(b) as f64 + 2.0 {
+                why.push(format!("{name}: cpu {a}, wgpu {b}"));
+            }
+        } else if a.is_some() != b.is_some() && name == "covered_pixels" {
+            why.push(format!("{name} reported by one backend only"));
+        }
+    }
+}
+
+/// Writes a failing case's pictures (both backends' shaded images, the reference visibility, and the
+/// differences) under [`out_dir`], named from `stem`; returns the folder.
+fn save_failure_pictures(
+    stem: &str,
+    cpu: &RunOutput,
+    gpu: &RunOutput,
+    ref_vis: &Image<f32>,
+    mask: &Image<bool>,
+) -> PathBuf {
+    let dir = out_dir();
+    let _ = std::fs::create_dir_all(&dir);
+    let _ = gpu.color.save_png(dir.join(format!("{stem}-wgpu.png")));
+    let _ = cpu.color.save_png(dir.join(format!("{stem}-cpu.png")));
+    let _ = visibility_to_rgb(ref_vis, mask).save_png(dir.join(format!("{stem}-reference.vis.png")));
+    let _ = error_map(&gpu.visibility[0], &cpu.visibility[0], mask, mask)
+        .save_png(dir.join(format!("{stem}-wgpu-vs-cpu.diff.png")));
+    let _ = error_map(&gpu.visibility[0], ref_vis, mask, mask)
+        .save_png(dir.join(format!("{stem}-wgpu-vs-reference.diff.png")));
+    dir
+}
+
 #[test]
 fn every_technique_agrees_across_backends_and_with_the_reference() {
     let mut registry = TechniqueRegistry::builtin();
@@ -101,14 +241,7 @@ fn every_technique_agrees_across_backends_and_with_the_reference() {
         eprintln!("conformance skipped: no wgpu adapter ({e}); install mesa-vulkan-drivers for lavapipe");
         return;
     }
-    let mut specs: Vec<TechniqueSpec> = registry
-        .entries()
-        .iter()
-        .filter(|e| e.cpu.is_some() && e.wgpu.is_some())
-        .map(|e| TechniqueSpec::named(e.name))
-        .collect();
-    assert!(!specs.is_empty(), "no technique on both backends");
-    specs.extend(VARIANTS.iter().map(|v| TechniqueSpec::parse(v).expect("a variant's spec")));
+    let specs = specs(&registry);
     let mut failures = Vec::new();
     let mut rows = Vec::new();
     for (scene_name, scene) in scenes() {
@@ -140,14 +273,8 @@ fn every_technique_agrees_across_backends_and_with_the_reference() {
             let ref_vis = if soft {
                 // The area light needs a position: a soft technique under a directional light is held to
                 // the other backend only.
-                let area = soft_reference.get_or_insert_with(|| {
-                    let spec = TechniqueSpec::named("area-light-reference");
-                    match renderer.run_cpu_frame(&frame, SIZE, SIZE, &spec) {
-                        Ok((f, _)) => Some(f),
-                        Err(e) if matches!(e.technique(), Some(TechniqueError::UnsupportedLight { .. })) => None,
-                        Err(e) => panic!("{scene_name}: area-light reference: {e}"),
-                    }
-                });
+                let area =
+                    soft_reference.get_or_insert_with(|| area_light_reference(&mut renderer, &frame, &scene_name));
                 area.as_ref().map(|a| &a.visibility[0])
             } else {
                 Some(&reference.visibility[0])
@@ -164,84 +291,11 @@ fn every_technique_agrees_across_backends_and_with_the_reference() {
                 cpu_err * 100.0,
                 gpu_err * 100.0
             ));
-            let mut why = Vec::new();
-            if cross.mismatch > MAX_CROSS_MISMATCH {
-                why.push(format!(
-                    "cross-backend mismatch {:.3}% > {:.3}%",
-                    cross.mismatch * 100.0,
-                    MAX_CROSS_MISMATCH * 100.0
-                ));
-            }
-            if flip > MAX_CROSS_FLIP {
-                why.push(format!("cross-backend FLIP {flip:.4} > {MAX_CROSS_FLIP}"));
-            }
-            if soft && cross.rmse > MAX_CROSS_RMSE_SOFT {
-                why.push(format!("cross-backend visibility RMSE {:.4} > {MAX_CROSS_RMSE_SOFT}", cross.rmse));
-            }
-            // The counters both backends report must agree (occlusion queries and atomics against CPU counts).
-            let (c, w) = (&cpu.stats.counters, &gpu.stats.counters);
-            let extra = |c: &shadow_core::stats::Counters, k: &str| c.extra.get(k).map(|v| *v as u64);
-            // Relative tolerances: rasterized counts agree to rounding; silhouette_pixels counts per-pixel
-            // depth comparisons, which flip where a corner sample ties the receiver to an ulp.
-            // Hybrid counts its volume fragments under a mask made of silhouette pixels: a pixel that ties
-            // one way on one backend brings its whole overdraw along, so twice theirs.
-            let volume_tolerance = if spec.name == "hybrid" { 0.02 } else { 0.001 };
-            // Both backends' caster masks (on unless turned off) count each small caster only where its
-            // shadow can be, but they choose the pieces counted that way differently (the CPU by triangles
-            // times pixels, the GPU by triangles alone: primitives' sphere is listed on one and drawn through
-            // the whole mask on the other), so that fill is not compared here (the pictures still are;
-            // `hybrid:caster_masks=off` compares the fill through the whole mask, and hybrid.rs holds the
-            // GPU's caster masks to their own whole mask's picture).
-            let caster_masks =
-                spec.name == "hybrid" && !spec.values.iter().any(|(k, v)| k == "caster_masks" && v == "off");
-            let cpu_fragments = if caster_masks { None } else { c.volume_fragments };
-            for (name, a, b, tolerance) in [
-                ("covered_pixels", c.covered_pixels, w.covered_pixels, 0.001),
-                ("volume_fragments", cpu_fragments, w.volume_fragments, volume_tolerance),
-                ("cap_triangles", extra(c, "cap_triangles"), extra(w, "cap_triangles"), 0.0),
-                ("silhouette_edges", c.silhouette_edges, w.silhouette_edges, 0.0),
-                ("silhouette_pixels", c.silhouette_pixels, w.silhouette_pixels, 0.01),
-                ("silhouette_texels", extra(c, "silhouette_texels"), extra(w, "silhouette_texels"), 0.001),
-                (
-                    "unmasked_volume_fragments",
-                    extra(c, "unmasked_volume_fragments"),
-                    extra(w, "unmasked_volume_fragments"),
-                    0.001,
-                ),
-            ] {
-                if let (Some(a), Some(b)) = (a, b) {
-                    if (a as f64 - b as f64).abs() > tolerance * a.max(b) as f64 + 2.0 {
-                        why.push(format!("{name}: cpu {a}, wgpu {b}"));
-                    }
-                } else if a.is_some() != b.is_some() && name == "covered_pixels" {
-                    why.push(format!("{name} reported by one backend only"));
-                }
-            }
-            if (gpu_err - cpu_err).abs() > MAX_ERROR_GAP {
-                why.push(format!("wgpu error {:.3}% vs cpu {:.3}%", gpu_err * 100.0, cpu_err * 100.0));
-            }
-            if let Some(ceiling) = reference_ceiling(&spec.name, &scene_name) {
-                for (backend, err) in [("cpu", cpu_err), ("wgpu", gpu_err)] {
-                    if err > ceiling {
-                        why.push(format!(
-                            "{backend} mismatch vs reference {:.3}% > ceiling {:.3}%",
-                            err * 100.0,
-                            ceiling * 100.0
-                        ));
-                    }
-                }
-            }
+            let case = Case { scene: &scene_name, spec, soft, cross, flip, cpu_err, gpu_err };
+            let why = case.failures(&cpu.stats.counters, &gpu.stats.counters);
             if !why.is_empty() {
-                let dir = out_dir();
-                let _ = std::fs::create_dir_all(&dir);
                 let stem = format!("{scene_name}-{}", t.replace([':', ',', '='], "-"));
-                let _ = gpu.color.save_png(dir.join(format!("{stem}-wgpu.png")));
-                let _ = cpu.color.save_png(dir.join(format!("{stem}-cpu.png")));
-                let _ = visibility_to_rgb(ref_vis, &mask).save_png(dir.join(format!("{stem}-reference.vis.png")));
-                let _ = error_map(&gpu.visibility[0], &cpu.visibility[0], &mask, &mask)
-                    .save_png(dir.join(format!("{stem}-wgpu-vs-cpu.diff.png")));
-                let _ = error_map(&gpu.visibility[0], ref_vis, &mask, &mask)
-                    .save_png(dir.join(format!("{stem}-wgpu-vs-reference.diff.png")));
+                let dir = save_failure_pictures(&stem, &cpu, &gpu, ref_vis, &mask);
                 failures.push(format!("{scene_name} / {t}: {} (pictures in {})", why.join("; "), dir.display()));
             }
         }

@@ -9,7 +9,8 @@ use std::path::Path;
 use glam::{Mat4, Quat, Vec3};
 use serde_json::{Value, json};
 
-use crate::scene::{Light, LightKind, MeshKey, Scene};
+use crate::mesh::Mesh;
+use crate::scene::{Light, LightKind, Material, MeshKey, Scene};
 use crate::shading;
 
 /// Why a scene could not be written.
@@ -46,43 +47,12 @@ fn pad4(v: &mut Vec<u8>, byte: u8) {
 /// The GLB bytes of a scene.
 #[must_use]
 pub fn glb_bytes(scene: &Scene) -> Vec<u8> {
-    let mut bin: Vec<u8> = Vec::new();
-    let (mut views, mut accessors, mut meshes, mut materials, mut nodes) = (vec![], vec![], vec![], vec![], vec![]);
+    let mut parts = MeshParts::default();
+    let mut nodes = vec![];
     let mut mesh_index: HashMap<(MeshKey, String), usize> = HashMap::new();
-    let mut push_view = |bin: &mut Vec<u8>, data: &[u8], target: u32| -> usize {
-        pad4(bin, 0);
-        views.push(json!({"buffer": 0, "byteOffset": bin.len(), "byteLength": data.len(), "target": target}));
-        bin.extend_from_slice(data);
-        views.len() - 1
-    };
     for (_, node, mesh_key, material) in scene.drawables() {
         let Some(mesh) = scene.mesh(mesh_key) else { continue };
-        let key = (mesh_key, material.name.clone());
-        let mi = match mesh_index.get(&key) {
-            Some(&i) => i,
-            None => {
-                let b = mesh.bounds();
-                let pos: Vec<u8> = bytemuck::cast_slice(mesh.positions()).to_vec();
-                let nrm: Vec<u8> = bytemuck::cast_slice(mesh.normals()).to_vec();
-                let idx: Vec<u32> = mesh.triangles().iter().flatten().copied().collect();
-                let pv = push_view(&mut bin, &pos, 34962);
-                let nv = push_view(&mut bin, &nrm, 34962);
-                let iv = push_view(&mut bin, bytemuck::cast_slice(&idx), 34963);
-                let n = mesh.positions().len();
-                accessors.push(json!({"bufferView": pv, "componentType": 5126, "count": n, "type": "VEC3", "min": b.min.to_array(), "max": b.max.to_array()}));
-                accessors.push(json!({"bufferView": nv, "componentType": 5126, "count": n, "type": "VEC3"}));
-                accessors.push(json!({"bufferView": iv, "componentType": 5125, "count": idx.len(), "type": "SCALAR"}));
-                materials.push(json!({
-                    "name": material.name,
-                    "pbrMetallicRoughness": {"baseColorFactor": [material.base_color.x, material.base_color.y, material.base_color.z, 1.0], "metallicFactor": 0.0},
-                    "doubleSided": material.two_sided,
-                }));
-                let a = accessors.len();
-                meshes.push(json!({"primitives": [{"attributes": {"POSITION": a - 3, "NORMAL": a - 2}, "indices": a - 1, "material": materials.len() - 1}]}));
-                mesh_index.insert(key, meshes.len() - 1);
-                meshes.len() - 1
-            }
-        };
+        let mi = *mesh_index.entry((mesh_key, material.name.clone())).or_insert_with(|| parts.mesh(mesh, material));
         let m: Mat4 = node.world_transform();
         nodes.push(json!({"name": node.name(), "mesh": mi, "matrix": m.to_cols_array()}));
     }
@@ -107,6 +77,7 @@ pub fn glb_bytes(scene: &Scene) -> Vec<u8> {
         }
         nodes.push(n);
     }
+    let MeshParts { mut bin, views, accessors, meshes, materials } = parts;
     pad4(&mut bin, 0);
     let mut doc = json!({
         "asset": {"version": "2.0", "generator": "shadowlab"},
@@ -129,6 +100,47 @@ pub fn glb_bytes(scene: &Scene) -> Vec<u8> {
         }
     }
     glb_container(doc.to_string().into_bytes(), &bin)
+}
+
+/// The binary buffer and the glTF arrays describing the meshes written into it.
+#[derive(Default)]
+struct MeshParts {
+    bin: Vec<u8>,
+    views: Vec<Value>,
+    accessors: Vec<Value>,
+    meshes: Vec<Value>,
+    materials: Vec<Value>,
+}
+
+impl MeshParts {
+    /// Appends `data` as a buffer view (4-byte aligned) for `target`; returns the view's index.
+    fn view(&mut self, data: &[u8], target: u32) -> usize {
+        pad4(&mut self.bin, 0);
+        self.views.push(json!({"buffer": 0, "byteOffset": self.bin.len(), "byteLength": data.len(), "target": target}));
+        self.bin.extend_from_slice(data);
+        self.views.len() - 1
+    }
+
+    /// Writes a mesh with its material (positions, normals, indices, one primitive); returns its index.
+    fn mesh(&mut self, mesh: &Mesh, material: &Material) -> usize {
+        let b = mesh.bounds();
+        let idx: Vec<u32> = mesh.triangles().iter().flatten().copied().collect();
+        let pv = self.view(bytemuck::cast_slice(mesh.positions()), 34962);
+        let nv = self.view(bytemuck::cast_slice(mesh.normals()), 34962);
+        let iv = self.view(bytemuck::cast_slice(&idx), 34963);
+        let n = mesh.positions().len();
+        self.accessors.push(json!({"bufferView": pv, "componentType": 5126, "count": n, "type": "VEC3", "min": b.min.to_array(), "max": b.max.to_array()}));
+        self.accessors.push(json!({"bufferView": nv, "componentType": 5126, "count": n, "type": "VEC3"}));
+        self.accessors.push(json!({"bufferView": iv, "componentType": 5125, "count": idx.len(), "type": "SCALAR"}));
+        self.materials.push(json!({
+            "name": material.name,
+            "pbrMetallicRoughness": {"baseColorFactor": [material.base_color.x, material.base_color.y, material.base_color.z, 1.0], "metallicFactor": 0.0},
+            "doubleSided": material.two_sided,
+        }));
+        let a = self.accessors.len();
+        self.meshes.push(json!({"primitives": [{"attributes": {"POSITION": a - 3, "NORMAL": a - 2}, "indices": a - 1, "material": self.materials.len() - 1}]}));
+        self.meshes.len() - 1
+    }
 }
 
 /// A light as KHR_lights_punctual has it, with the position and direction of its node.

@@ -11,8 +11,9 @@
 //!   A query needs the light's projection (shadow maps) or position (volumes), and passing it is simpler
 //!   than every state keeping a copy; the stats let techniques report counters and sub-phase times (a
 //!   readback, say) through one channel instead of a return value the frame driver has to merge.
-//! - `Backend::Error: From<TechniqueError>`, so the shared checks (unsupported light, bad settings) give
-//!   the same error on every backend.
+//! - `Backend::Error: From<TechniqueError> + From<LightViewError>`, so the shared checks (unsupported
+//!   light, bad settings, a light no view can be fitted to) give the same error on every backend, and the
+//!   one frame script ([`crate::script`]) can report them.
 
 pub mod maps;
 pub mod registry;
@@ -20,7 +21,8 @@ pub mod settings;
 
 use crate::frame::FrameInputs;
 use crate::image::{Image, Rgb8};
-use crate::light::LightView;
+use crate::light::{LightView, LightViewError};
+use crate::scene::Light;
 use crate::stats::{Counters, Timings};
 
 pub use registry::LightKinds;
@@ -35,7 +37,7 @@ pub trait Backend: Sized + 'static {
     /// One light's visibility over the view, f32 in [0, 1].
     type Visibility;
     /// What can go wrong that a caller cannot foresee.
-    type Error: std::error::Error + Send + Sync + 'static + From<TechniqueError>;
+    type Error: std::error::Error + Send + Sync + 'static + From<TechniqueError> + From<LightViewError>;
     /// Short name for reports ("cpu", "wgpu").
     const NAME: &'static str;
 }
@@ -64,6 +66,14 @@ pub enum TechniqueError {
     NotBuilt(String),
 }
 
+impl TechniqueError {
+    /// `technique` refuses `light`'s kind.
+    #[must_use]
+    pub fn unsupported_light(technique: &str, light: &Light) -> Self {
+        Self::UnsupportedLight { technique: technique.into(), light: light.type_name() }
+    }
+}
+
 /// Counters and timings a technique reports for one light in one frame.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct FrameStats {
@@ -71,6 +81,16 @@ pub struct FrameStats {
     pub counters: Counters,
     /// Phase times, filled by the frame driver; techniques add sub-phases to `timings.extra`.
     pub timings: Timings,
+}
+
+impl FrameStats {
+    /// Adds one light's stats into the frame's: counters and sub-phase times are summed over lights.
+    pub fn add_light(&mut self, light: FrameStats) {
+        self.counters.merge(&light.counters);
+        for (key, v) in light.timings.extra {
+            *self.timings.extra.entry(key).or_insert(0.0) += v;
+        }
+    }
 }
 
 /// What a technique's build and query see of one light in one frame: the frame's inputs, the light's
@@ -205,11 +225,7 @@ impl<B: Backend, T: ShadowTechnique<B>> DynShadowTechnique<B> for Stateful<B, T>
 
     fn build(&mut self, cx: &mut B::Context, pass: LightPass<'_>) -> Result<(), B::Error> {
         if !self.lights.takes(&pass.light.light) {
-            return Err(TechniqueError::UnsupportedLight {
-                technique: self.technique.name().into(),
-                light: pass.light.light.type_name(),
-            }
-            .into());
+            return Err(TechniqueError::unsupported_light(self.technique.name(), &pass.light.light).into());
         }
         let state = match &mut self.state {
             Some(s) => s,

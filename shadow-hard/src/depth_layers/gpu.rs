@@ -215,7 +215,7 @@ fn render_projection(
         pass.set_bind_group(1, &both, &[]);
         pass.draw(0..3, 0..1);
     }
-    cx.queue.submit([enc.finish()]);
+    cx.submit(enc.finish());
 }
 
 impl ShadowTechnique<WgpuBackend> for DepthLayers {

@@ -175,7 +175,7 @@ impl ShadowTechnique<CpuBackend> for Hybrid {
         let t = Instant::now();
         let map_class = classify_receivers(&state.maps, &state.edge_maps, light, g, self.depth.receiver_offset());
         let silhouette = |x, y| *map_class.get(x, y) == MapClass::Silhouette;
-        let mask = ComputationMask::from_fn(w, h, self.mask_tile, silhouette);
+        let mask = ComputationMask::from_fn(w, h, self.cpu.mask_tile, silhouette);
         stats.timings.extra.insert("classify".into(), ms(t.elapsed()));
         let t = Instant::now();
         let mut ds = DepthStencil::from_depth(&g.depth, 0);

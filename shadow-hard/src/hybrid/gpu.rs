@@ -295,6 +295,26 @@ fn full_screen_draws(
     enc.finish()
 }
 
+impl Hybrid {
+    /// The bindings the query shader has beside the map's: the triangle attributes, and those of the
+    /// variants that are on (edge cells, scissor tiles, listed counts).
+    fn extra_bindings(&self) -> Vec<wgpu::BindGroupLayoutEntry> {
+        let mut extras = vec![attribute_entry(4)];
+        if self.edge_texels.is_on() {
+            extras.push(float_array_entry(6));
+        }
+        let writable = wgpu::BufferBindingType::Storage { read_only: false };
+        if self.gpu.scissor_tile > 0 {
+            extras.push(buffer_entry(7, writable, wgpu::ShaderStages::FRAGMENT));
+        }
+        if self.caster_masks.is_on() {
+            extras.push(buffer_entry(8, writable, wgpu::ShaderStages::FRAGMENT));
+            extras.push(buffer_entry(9, writable, wgpu::ShaderStages::FRAGMENT));
+        }
+        extras
+    }
+}
+
 impl ShadowTechnique<WgpuBackend> for Hybrid {
     type State = State;
 
@@ -306,24 +326,12 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
         let map = DepthMaps::new(cx, &self.depth);
         cx.scoped("creating the hybrid pipelines", |cx| {
             let caster_masks = self.caster_masks.is_on();
-            let source = shaders::query(self.edge_texels, self.scissor_tile > 0, caster_masks);
+            let source = shaders::query(self.edge_texels, self.gpu.scissor_tile > 0, caster_masks);
             let module = shadow_wgpu::shaders::module(&cx.device, "hybrid", source);
             let volume_module =
                 shadow_wgpu::shaders::module(&cx.device, "shadow_volume", shadow_wgpu::shaders::shadow_volume());
-            let gpu_mask = self.gpu_mask;
-            let mut extras = vec![attribute_entry(4)];
-            if self.edge_texels.is_on() {
-                extras.push(float_array_entry(6));
-            }
-            let storage = |read_only| wgpu::BufferBindingType::Storage { read_only };
-            if self.scissor_tile > 0 {
-                extras.push(buffer_entry(7, storage(false), wgpu::ShaderStages::FRAGMENT));
-            }
-            if caster_masks {
-                extras.push(buffer_entry(8, storage(false), wgpu::ShaderStages::FRAGMENT));
-                extras.push(buffer_entry(9, storage(false), wgpu::ShaderStages::FRAGMENT));
-            }
-            let bindings = MapBindings::new(cx, &extras);
+            let gpu_mask = self.gpu.mask;
+            let bindings = MapBindings::new(cx, &self.extra_bindings());
             let groups = [&cx.shared.frame_layout, bindings.layout()];
             let mask = full_screen_pipeline(
                 &cx.device,
@@ -428,13 +436,13 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
         // The views' resources first, made anew for a new view size: the depth-stencil the passes run
         // over (the G-buffer's, or for the depth mask a copy the mask pass sets to depth 1 outside the
         // mask), the tile marks and the caster masks' listed pixels.
-        let target = match self.gpu_mask {
+        let target = match self.gpu.mask {
             GpuMask::Stencil => g.depth.clone(),
             GpuMask::Depth => query::scratch_depth(cx, &mut state.scratch, g),
         };
-        query::fit_tiles(cx, &mut state.tiles, self.scissor_tile, g);
+        query::fit_tiles(cx, &mut state.tiles, self.gpu.scissor_tile, g);
         if let Some(c) = &mut state.casters {
-            query::fit_listed(cx, c, g, self.pair_room)?;
+            query::fit_listed(cx, c, g, self.gpu.pair_room)?;
         }
         let (map_group, target) = {
             let state = &*state;
@@ -506,6 +514,6 @@ fn classes(cx: &WgpuContext, state: &State, last: &LastQuery) -> Result<Image<u3
         &draws,
         None,
     );
-    cx.queue.submit([pass]);
+    cx.submit(pass);
     readback::read_u32(cx, &target, 0)
 }

@@ -30,15 +30,6 @@ shadow_core::technique_settings! {
         /// classification reads the four nearest texels). Chan uses a lower resolution than a plain map needs,
         /// the volumes drawing the edges.
         pub depth: DepthMap = DepthMap::keys(resolution_key("512", "classifying map side in texels (16 to 16384)")),
-        /// Side in pixels of the CPU computation mask's tiles, which the rasterizer skips whole where no pixel
-        /// is masked in.
-        pub mask_tile: u32 = SettingKey::int(
-            "mask_tile",
-            "8",
-            1,
-            64,
-            "CPU computation-mask tile side in pixels (1 to 64): tiles with no silhouette pixel are skipped whole",
-        ),
         /// On, each connected component's volume is counted only at the silhouette pixels within the
         /// light-space bounds of its shadow ([`shafts`]; its count is zero everywhere else): on the CPU
         /// by listed draws, on the GPU by compute passes over the pixels the mask pass lists (pieces of more
@@ -51,25 +42,6 @@ shadow_core::technique_settings! {
             OnOff::NAMES,
             "on, each caster's volume is counted only at the silhouette pixels its shadow's bounds hold (GPU: by compute passes); off, through the whole mask",
         ),
-        /// Where the GPU keeps the computation mask (the CPU always uses its tiles).
-        pub gpu_mask: GpuMask = SettingKey::choice(
-            "gpu_mask",
-            "stencil",
-            GpuMask::NAMES,
-            "GPU computation mask: stencil (a stencil bit) or depth (a scratch depth of 1 outside the mask)",
-        ),
-        /// GPU: 0, the volumes are drawn over the whole view and the mask rejects fragments; N, the mask pass
-        /// also marks the N x N pixel tiles holding a silhouette pixel, the CPU reads the marks back and the
-        /// volumes are drawn only inside scissor rectangles around those tiles, so the rasterizer never makes
-        /// the fragments elsewhere (the draws are repeated per rectangle).
-        pub scissor_tile: u32 = SettingKey::int(
-            "scissor_tile",
-            "0",
-            8,
-            512,
-            "GPU: 0, or draw the volumes only in scissor rectangles around the masked NxN tiles (8 to 512)",
-        )
-        .or("0"),
         /// Which receivers facing the light are also silhouette pixels because of the casters' silhouette
         /// edges (drawn into a map of edge depths), so casters and gaps thinner than a texel, which the map
         /// misses (Chan's Fig. 3-8), still get volumes; off: Chan's rule alone. `paired` by default (ours):
@@ -91,6 +63,50 @@ shadow_core::technique_settings! {
             OnOff::NAMES,
             "on: also count the volumes' fill without the mask (unmasked_volume_fragments), in an extra pass",
         ),
+        /// What the CPU backend alone reads.
+        pub cpu: CpuOptions = CpuOptions::KEYS,
+        /// What the GPU backend alone reads.
+        pub gpu: GpuOptions = GpuOptions::KEYS,
+    }
+}
+
+shadow_core::setting_group! {
+    /// `hybrid`'s settings for the CPU backend alone.
+    pub struct CpuOptions {
+        /// Side in pixels of the CPU computation mask's tiles, which the rasterizer skips whole where no pixel
+        /// is masked in.
+        pub mask_tile: u32 = SettingKey::int(
+            "mask_tile",
+            "8",
+            1,
+            64,
+            "CPU computation-mask tile side in pixels (1 to 64): tiles with no silhouette pixel are skipped whole",
+        ),
+    }
+}
+
+shadow_core::setting_group! {
+    /// `hybrid`'s settings for the GPU backend alone.
+    pub struct GpuOptions {
+        /// Where the computation mask is kept (the CPU always uses its tiles).
+        pub mask: GpuMask = SettingKey::choice(
+            "gpu_mask",
+            "stencil",
+            GpuMask::NAMES,
+            "GPU computation mask: stencil (a stencil bit) or depth (a scratch depth of 1 outside the mask)",
+        ),
+        /// GPU: 0, the volumes are drawn over the whole view and the mask rejects fragments; N, the mask pass
+        /// also marks the N x N pixel tiles holding a silhouette pixel, the CPU reads the marks back and the
+        /// volumes are drawn only inside scissor rectangles around those tiles, so the rasterizer never makes
+        /// the fragments elsewhere (the draws are repeated per rectangle).
+        pub scissor_tile: u32 = SettingKey::int(
+            "scissor_tile",
+            "0",
+            8,
+            512,
+            "GPU: 0, or draw the volumes only in scissor rectangles around the masked NxN tiles (8 to 512)",
+        )
+        .or("0"),
         /// GPU caster masks: how many pairs of a silhouette pixel and a piece whose shaft holds it the compute
         /// passes have room for; `None`, eight per pixel of the view. A pixel whose pairs do not all fit counts
         /// every one of its pieces by itself, in one invocation (slower, same count), so a small room changes

@@ -297,7 +297,7 @@ fn draw_points(
             }
         }
     }
-    cx.queue.submit([enc.finish()]);
+    cx.submit(enc.finish());
 }
 
 /// Counts the non-empty texels of every layer into the first counter, then reads both counters:
@@ -330,7 +330,7 @@ fn count(cx: &WgpuContext, state: &State, maps: &Maps) -> Result<(u64, u64), Wgp
         pass.set_bind_group(0, &group, &[]);
         pass.dispatch_workgroups(side.div_ceil(8), side.div_ceil(8), 1);
     }
-    cx.queue.submit([enc.finish()]);
+    cx.submit(enc.finish());
     read_counters(cx, &state.counters)
 }
 
@@ -344,7 +344,7 @@ fn read_counters(cx: &WgpuContext, counters: &wgpu::Buffer) -> Result<(u64, u64)
     });
     let mut enc = cx.device.create_command_encoder(&Default::default());
     enc.copy_buffer_to_buffer(counters, 0, &staging, 0, COUNTER_STRIDE + 4);
-    cx.queue.submit([enc.finish()]);
+    cx.submit(enc.finish());
     let d = readback::map_read(cx, &staging, "reading the silhouette counters")?;
     let word = |at: usize| u64::from(u32::from_le_bytes([d[at], d[at + 1], d[at + 2], d[at + 3]]));
     Ok((word(0), word(COUNTER_STRIDE as usize)))

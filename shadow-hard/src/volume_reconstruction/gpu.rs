@@ -287,7 +287,7 @@ fn coverage_counts(cx: &WgpuContext, state: &State, last: &LastView) -> Result<s
             }
         }
     }
-    cx.queue.submit([enc.finish()]);
+    cx.submit(enc.finish());
     readback::read_stencil(cx, &target)
 }
 
@@ -332,7 +332,7 @@ fn parity_pass(
         pass.end_occlusion_query();
     }
     enc.resolve_query_set(&set, 0..1, &resolve, 0);
-    cx.queue.submit([enc.finish()]);
+    cx.submit(enc.finish());
     (set, resolve)
 }
 

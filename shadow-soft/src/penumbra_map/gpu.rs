@@ -80,7 +80,7 @@ impl State {
         let vertices = min_target::vertex_buffer(cx, "cones and sheets", &data);
         let mut enc = cx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("penumbra map") });
         min_target::draw(&mut enc, penumbra, &self.build, &group, vertices.as_ref());
-        cx.queue.submit([enc.finish()]);
+        cx.submit(enc.finish());
     }
 }
 

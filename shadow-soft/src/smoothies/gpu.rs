@@ -91,7 +91,7 @@ impl State {
         for (target, pipeline) in buffer.iter().zip([&self.depth_pass, &self.alpha_pass]) {
             min_target::draw(&mut enc, target, pipeline, &group, vertices.as_ref());
         }
-        cx.queue.submit([enc.finish()]);
+        cx.submit(enc.finish());
     }
 }
 

@@ -152,7 +152,7 @@ impl Smoothies {
     pub fn projection(light: &LightView) -> Result<&LightProjection, TechniqueError> {
         match (light.light.kind, light.projections.as_slice()) {
             (LightKind::Spot { .. } | LightKind::Directional { .. }, [p]) => Ok(p),
-            _ => Err(TechniqueError::UnsupportedLight { technique: Self::NAME.into(), light: light.light.type_name() }),
+            _ => Err(TechniqueError::unsupported_light(Self::NAME, &light.light)),
         }
     }
 

@@ -331,7 +331,7 @@ pub fn render_maps(
         pass.set_bind_group(0, &group, &[]);
         draw_instances(cx, &mut pass, frame, |i| i.casts_shadow, false);
     }
-    cx.queue.submit([enc.finish()]);
+    cx.submit(enc.finish());
 }
 
 /// A depth array of `layers` square maps.

@@ -50,5 +50,5 @@ pub fn full_screen(
         pass.draw(0..3, 0..1);
         pass.pop_debug_group();
     }
-    cx.queue.submit([enc.finish()]);
+    cx.submit(enc.finish());
 }

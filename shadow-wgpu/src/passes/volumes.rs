@@ -348,7 +348,7 @@ impl<'a> VolumePass<'a> {
             pass.pop_debug_group();
         }
         enc.resolve_query_set(&set, 0..1, &resolve, 0);
-        cx.queue.submit([enc.finish()]);
+        cx.submit(enc.finish());
         (set, resolve)
     }
 }
@@ -363,7 +363,7 @@ pub fn read_query(cx: &WgpuContext, q: &(wgpu::QuerySet, wgpu::Buffer)) -> Resul
     });
     let mut enc = cx.device.create_command_encoder(&Default::default());
     enc.copy_buffer_to_buffer(&q.1, 0, &staging, 0, 8);
-    cx.queue.submit([enc.finish()]);
+    cx.submit(enc.finish());
     let d = crate::readback::map_read(cx, &staging, "reading an occlusion query")?;
     Ok(u64::from_le_bytes([d[0], d[1], d[2], d[3], d[4], d[5], d[6], d[7]]))
 }

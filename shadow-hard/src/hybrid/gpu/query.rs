@@ -102,7 +102,7 @@ impl<'a> Inputs<'a> {
             depth: target.create_view(&Default::default()),
             target,
             edge_cells,
-            tiles: state.tiles.as_ref().filter(|_| hybrid.scissor_tile > 0),
+            tiles: state.tiles.as_ref().filter(|_| hybrid.gpu.scissor_tile > 0),
             casters,
         })
     }
@@ -129,7 +129,7 @@ impl<'a> Inputs<'a> {
             extras.push(wgpu::BindGroupEntry { binding: 8, resource: l.listed.as_entire_binding() });
             extras.push(wgpu::BindGroupEntry { binding: 9, resource: l.counts.as_entire_binding() });
         }
-        let tile = self.hybrid.scissor_tile;
+        let tile = self.hybrid.gpu.scissor_tile;
         let settings = [tile as f32, self.tiles.map_or(0.0, |t| t.columns as f32), 0.0, 0.0];
         let lookup = LookupParams { radius: 0.0, receiver_offset };
         state.bindings.group(cx, self.maps, light, self.g, lookup, &QueryExtras { settings, entries: &extras })
@@ -165,22 +165,22 @@ impl<'a> Inputs<'a> {
         if let Some((.., l)) = self.casters {
             l.clear(&mut enc);
         }
-        cx.queue.submit([enc.finish()]);
+        cx.submit(enc.finish());
         cx.step("setup");
         let mut mask_draws = vec![(&state.mask, MASK)];
         if let Some(far) = &state.far {
             mask_draws.push((far, 0));
         }
         let stencil = (&self.depth, wgpu::LoadOp::Load, wgpu::LoadOp::Clear(0));
-        cx.queue.submit([full_screen_draws(cx, "hybrid mask", None, stencil, groups, &mask_draws, Some(&silhouettes))]);
+        cx.submit(full_screen_draws(cx, "hybrid mask", None, stencil, groups, &mask_draws, Some(&silhouettes)));
         cx.step("mask");
         if let Some((passes, _, pieces, l)) = self.casters {
             let mut enc = cx.device.create_command_encoder(&Default::default());
             passes.record(cx, &mut enc, pieces, l, g);
-            cx.queue.submit([enc.finish()]);
+            cx.submit(enc.finish());
             cx.step("casters");
         }
-        let tile = self.hybrid.scissor_tile;
+        let tile = self.hybrid.gpu.scissor_tile;
         let rects = self.tiles.map(|t| t.rectangles(cx, tile, (g.width, g.height))).transpose()?;
         let counting = VolumePass {
             label: "hybrid volumes",
@@ -198,7 +198,7 @@ impl<'a> Inputs<'a> {
         }
         let target = Some((&out.view, wgpu::Color::WHITE));
         let stencil = (&self.depth, wgpu::LoadOp::Load, wgpu::LoadOp::Load);
-        cx.queue.submit([full_screen_draws(cx, "hybrid answer", target, stencil, groups, &answers, None)]);
+        cx.submit(full_screen_draws(cx, "hybrid answer", target, stencil, groups, &answers, None));
         cx.step("answer");
         Ok(Counts { silhouettes, passed, rects: rects.map(|r| r.len()) })
     }

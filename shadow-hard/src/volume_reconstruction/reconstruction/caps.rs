@@ -145,85 +145,116 @@ pub fn near_plane_cap(
     }
     let within = square.len() == facet.len()
         && facet.iter().all(|p| p.x >= 0.0 && p.y >= 0.0 && p.x <= (n - 1) as f32 && p.y <= (n - 1) as f32);
-    let facet = square;
-    // The near plane's NDC depth over map space, an affine function.
-    let to_ndc = |s: Vec2| grid.ndc_xy(s);
-    let zn = {
-        let p = [Vec2::ZERO, Vec2::X, Vec2::Y];
-        Affine::through(
-            p,
-            p.map(|s| {
-                let q = to_ndc(s);
-                -(c.x * q.x + c.y * q.y + c.w) / c.z
-            }),
-        )
-    };
-    let (lo, hi) = facet.iter().fold((Vec2::INFINITY, Vec2::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+    let near = NearPlane::new(eye_clip_from_world, c, grid, ndc);
+    let (lo, hi) = square.iter().fold((Vec2::INFINITY, Vec2::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
     let last = (n - 2) as f32;
     let (x0, y0) = (lo.x.floor().clamp(0.0, last) as u32, lo.y.floor().clamp(0.0, last) as u32);
     let (x1, y1) = (hi.x.floor().clamp(0.0, last) as u32, hi.y.floor().clamp(0.0, last) as u32);
 
-    let sample = |x: u32, y: u32| (y * n + x) as usize;
-    let inside = |x: u32, y: u32| {
-        let z = zn.at(Vec2::new(x as f32, y as f32));
-        (0.0..=1.0).contains(&z) && z > ndc[sample(x, y)]
-    };
-    // A cap vertex is where the light ray through `s` meets the near plane. Lifting `(s, zn(s))` through
-    // the inverse projection would put it there too, but a perspective map's NDC depth is nearly 1 a few
-    // near distances out, so f32 loses the point along the ray; the line through the ray's light-near and
-    // light-far points meets the plane exactly: `p = (L.b) a - (L.a) b` has `L.p = 0`.
-    let near_plane = eye_clip_from_world.row(2);
-    let lift = |s: Vec2| {
-        let (a, b) = (grid.world(s, 0.0), grid.world(s, 1.0));
-        let p = a * near_plane.dot(b) - b * near_plane.dot(a);
-        if p.w < 0.0 { -p } else { p }
-    };
     let mut cap = Cap { samples: ((x1 - x0 + 2) * (y1 - y0 + 2)) as usize, ..Cap::default() };
     let mut all_inside = true;
     for y in y0..=y1 {
+        // A run of whole inside cells, from its first column.
         let mut run: Option<u32> = None;
-        let flush = |run: &mut Option<u32>, x_end: u32, cap: &mut Cap| {
-            if let Some(start) = run.take() {
-                let q = [(start, y), (x_end, y), (x_end, y + 1), (start, y + 1)]
-                    .map(|(x, y)| lift(Vec2::new(x as f32, y as f32)));
-                cap.triangles.push([q[0], q[1], q[2]]);
-                cap.triangles.push([q[0], q[2], q[3]]);
-            }
-        };
         for x in x0..=x1 {
             let corners = CELL_CORNERS.map(|(dx, dy)| (x + dx, y + dy));
-            let classes = corners.map(|(cx, cy)| inside(cx, cy));
-            if classes.iter().all(|&i| i) {
+            if corners.iter().all(|&(cx, cy)| near.inside(cx, cy)) {
                 run.get_or_insert(x);
                 continue;
             }
             all_inside = false;
-            flush(&mut run, x, &mut cap);
-            let split = Split::of(corners.map(|(cx, cy)| split_depth[sample(cx, cy)]));
-            let pos = corners.map(|(cx, cy)| Vec2::new(cx as f32, cy as f32));
-            for (tri, _) in split.triangles() {
-                let p = tri.map(|k| pos[k]);
-                let surface = Affine::through(p, tri.map(|k| ndc[sample(corners[k].0, corners[k].1)]));
-                // Inside: behind the surface, and within the light's depth range.
-                let behind = Affine { a: zn.a - surface.a, b: zn.b - surface.b };
-                let past_near = zn;
-                let before_far = Affine { a: -zn.a, b: 1.0 - zn.b };
-                let mut poly = p.to_vec();
-                for f in [behind, past_near, before_far] {
-                    if poly.len() < 3 {
-                        break;
-                    }
-                    poly = clip(&poly, f);
-                }
-                for k in 1..poly.len().saturating_sub(1) {
-                    cap.triangles.push([lift(poly[0]), lift(poly[k]), lift(poly[k + 1])]);
-                }
+            if let Some(start) = run.take() {
+                near.rectangle(start, x, y, &mut cap.triangles);
             }
+            near.partial_cell(corners, split_depth, &mut cap.triangles);
         }
-        flush(&mut run, x1 + 1, &mut cap);
+        if let Some(start) = run {
+            near.rectangle(start, x1 + 1, y, &mut cap.triangles);
+        }
     }
     if all_inside && within && !clipped {
         return Cap { invert_all: true, triangles: Vec::new(), samples: cap.samples };
     }
     cap
+}
+
+/// The eye's near plane seen from one light projection: its NDC depth over map space, and the map's
+/// samples to test against it.
+struct NearPlane<'a> {
+    /// The near plane in world space (the eye's clip-space `z = 0`).
+    plane: Vec4,
+    /// Its NDC depth over map space, an affine function.
+    zn: Affine,
+    grid: &'a SampleGrid,
+    ndc: &'a [f32],
+}
+
+impl<'a> NearPlane<'a> {
+    /// `c`: the near plane in the light's NDC, `c.x x + c.y y + c.z z + c.w = 0`, with `c.z` not zero.
+    fn new(eye_clip_from_world: Mat4, c: Vec4, grid: &'a SampleGrid, ndc: &'a [f32]) -> Self {
+        let p = [Vec2::ZERO, Vec2::X, Vec2::Y];
+        let zn = Affine::through(
+            p,
+            p.map(|s| {
+                let q = grid.ndc_xy(s);
+                -(c.x * q.x + c.y * q.y + c.w) / c.z
+            }),
+        );
+        Self { plane: eye_clip_from_world.row(2), zn, grid, ndc }
+    }
+
+    fn sample(&self, x: u32, y: u32) -> usize {
+        (y * self.grid.n + x) as usize
+    }
+
+    /// Whether the near-plane point on sample `(x, y)`'s ray is inside the volume: within the light's
+    /// depth range and behind the sample.
+    fn inside(&self, x: u32, y: u32) -> bool {
+        let z = self.zn.at(Vec2::new(x as f32, y as f32));
+        (0.0..=1.0).contains(&z) && z > self.ndc[self.sample(x, y)]
+    }
+
+    /// The cap vertex over map point `s`: where the light ray through `s` meets the near plane. Lifting
+    /// `(s, zn(s))` through the inverse projection would put it there too, but a perspective map's NDC
+    /// depth is nearly 1 a few near distances out, so f32 loses the point along the ray; the line through
+    /// the ray's light-near and light-far points meets the plane exactly: `p = (L.b) a - (L.a) b` has
+    /// `L.p = 0`.
+    fn lift(&self, s: Vec2) -> Vec4 {
+        let (a, b) = (self.grid.world(s, 0.0), self.grid.world(s, 1.0));
+        let p = a * self.plane.dot(b) - b * self.plane.dot(a);
+        if p.w < 0.0 { -p } else { p }
+    }
+
+    /// Two triangles over the whole cells of row `y` from column `start` up to `end`.
+    fn rectangle(&self, start: u32, end: u32, y: u32, out: &mut Vec<HomTriangle>) {
+        let q =
+            [(start, y), (end, y), (end, y + 1), (start, y + 1)].map(|(x, y)| self.lift(Vec2::new(x as f32, y as f32)));
+        out.push([q[0], q[1], q[2]]);
+        out.push([q[0], q[2], q[3]]);
+    }
+
+    /// The inside part of a cell whose corners are not all inside: each triangle of the cell's split,
+    /// clipped to behind the reconstructed surface and within the light's depth range.
+    fn partial_cell(&self, corners: [(u32, u32); 4], split_depth: &[f32], out: &mut Vec<HomTriangle>) {
+        let split = Split::of(corners.map(|(cx, cy)| split_depth[self.sample(cx, cy)]));
+        let pos = corners.map(|(cx, cy)| Vec2::new(cx as f32, cy as f32));
+        for (tri, _) in split.triangles() {
+            let p = tri.map(|k| pos[k]);
+            let surface = Affine::through(p, tri.map(|k| self.ndc[self.sample(corners[k].0, corners[k].1)]));
+            let zn = self.zn;
+            let behind = Affine { a: zn.a - surface.a, b: zn.b - surface.b };
+            let past_near = zn;
+            let before_far = Affine { a: -zn.a, b: 1.0 - zn.b };
+            let mut poly = p.to_vec();
+            for f in [behind, past_near, before_far] {
+                if poly.len() < 3 {
+                    break;
+                }
+                poly = clip(&poly, f);
+            }
+            for k in 1..poly.len().saturating_sub(1) {
+                out.push([self.lift(poly[0]), self.lift(poly[k]), self.lift(poly[k + 1])]);
+            }
+        }
+    }
 }

@@ -7,7 +7,7 @@ use shadow_core::geometry::volume::Caps;
 use shadow_core::glam::{Vec2, Vec4};
 use shadow_core::scenes::{self, SceneParams};
 
-use super::{Split, flattened, grids};
+use super::pieces::{Split, flattened, grids};
 
 /// The cell a light-space point looks in (casters.wgsl's `candidates`).
 fn cell_of(frame: (Vec2, Vec2, usize), first: usize, xy: Vec2) -> usize {

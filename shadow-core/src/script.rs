@@ -1,0 +1,146 @@
+//! The frame script (DESIGN 5), written once for every backend: the camera's G-buffer, then per light a
+//! build and a query into that light's visibility, then shading.
+//!
+//! A backend supplies the steps ([`FrameSteps`]) and [`run_frame`] puts them in order, times each phase
+//! and gathers the lights' stats. How the steps run is theirs to decide: the instrumented frame of each
+//! backend waits after every phase (so a phase's wall-clock time is the device's) and reads its targets
+//! back; steps that only record work into a host's frame and never wait run under the same script.
+
+use std::time::Instant;
+
+use crate::frame::FrameInputs;
+use crate::light::LightView;
+use crate::stats::{Phase, ms};
+use crate::technique::{Backend, DynShadowTechnique, FrameStats, LightPass};
+
+/// The steps of one frame on backend `B`, in the order [`run_frame`] calls them.
+pub trait FrameSteps<B: Backend> {
+    /// What shading leaves for [`FrameSteps::finish`] (the shaded image, or the target it was drawn into).
+    type Shaded;
+    /// What the frame leaves its caller (images read back, say).
+    type Output;
+
+    /// Renders the camera's G-buffer.
+    ///
+    /// # Errors
+    /// Backend failures, or a view size the backend cannot render.
+    fn gbuffer(&mut self, cx: &mut B::Context, frame: &FrameInputs) -> Result<B::GBuffer, B::Error>;
+
+    /// The target light `k`'s visibility is queried into.
+    ///
+    /// # Errors
+    /// Backend failures.
+    fn visibility(&mut self, cx: &mut B::Context, k: usize) -> Result<B::Visibility, B::Error>;
+
+    /// Takes light `k`'s visibility once its query is issued.
+    fn keep(&mut self, k: usize, visibility: B::Visibility);
+
+    /// Shades the G-buffer with every light's visibility.
+    ///
+    /// # Errors
+    /// Backend failures.
+    fn shade(
+        &mut self,
+        cx: &mut B::Context,
+        frame: &FrameInputs,
+        gbuffer: &B::GBuffer,
+    ) -> Result<Self::Shaded, B::Error>;
+
+    /// The frame's output, after the last phase; `stats` holds every phase's time, and counters the steps
+    /// read (covered pixels, device times) are added to it here.
+    ///
+    /// # Errors
+    /// Backend failures (a read-back).
+    fn finish(
+        self,
+        cx: &mut B::Context,
+        gbuffer: B::GBuffer,
+        shaded: Self::Shaded,
+        stats: &mut FrameStats,
+    ) -> Result<Self::Output, B::Error>;
+
+    /// Called before each phase's work (a device clock marks the phase's start here).
+    fn begin(&mut self, _cx: &mut B::Context, _phase: Phase) {}
+
+    /// Called once a phase's work is issued. Instrumented steps wait here for the device to finish it.
+    ///
+    /// # Errors
+    /// A device failure while waiting.
+    fn end(&mut self, _cx: &mut B::Context, _phase: Phase) -> Result<(), B::Error> {
+        Ok(())
+    }
+}
+
+/// What [`run_frame`] returns: the steps' output, the fitted view of each light, and the stats.
+pub struct FrameRun<O> {
+    /// The steps' output.
+    pub output: O,
+    /// The fitted view of each light, in the frame's light order.
+    pub light_views: Vec<LightView>,
+    /// Counters summed over the lights, and phase times.
+    pub stats: FrameStats,
+}
+
+/// Runs one frame: `steps` supply the backend's passes and `technique` shadows every light.
+///
+/// # Errors
+/// A light whose view cannot be fitted, a light the technique does not take, or a failure of a step or
+/// of the technique.
+pub fn run_frame<B: Backend, S: FrameSteps<B>>(
+    cx: &mut B::Context,
+    frame: &FrameInputs,
+    mut steps: S,
+    technique: &mut dyn DynShadowTechnique<B>,
+) -> Result<FrameRun<S::Output>, B::Error> {
+    let start = Instant::now();
+    let mut stats = FrameStats::default();
+    let mut phases = Phases { steps: &mut steps, stats: &mut stats };
+
+    let gbuffer = phases.run(cx, Phase::GBuffer, |cx, steps| steps.gbuffer(cx, frame))?;
+    let mut light_views = Vec::with_capacity(frame.lights.len());
+    for (k, light) in frame.lights.iter().enumerate() {
+        let view = frame.light_view(light)?;
+        let mut light_stats = FrameStats::default();
+        phases.run(cx, Phase::Build, |cx, _| {
+            technique.build(cx, LightPass { frame, light: &view, stats: &mut light_stats })
+        })?;
+        let mut vis = phases.steps.visibility(cx, k)?;
+        phases.run(cx, Phase::Query, |cx, _| {
+            technique.query(cx, LightPass { frame, light: &view, stats: &mut light_stats }, &gbuffer, &mut vis)
+        })?;
+        phases.steps.keep(k, vis);
+        phases.stats.add_light(light_stats);
+        light_views.push(view);
+    }
+    let shaded = phases.run(cx, Phase::Shade, |cx, steps| steps.shade(cx, frame, &gbuffer))?;
+
+    stats.timings.total = ms(start.elapsed());
+    let output = steps.finish(cx, gbuffer, shaded, &mut stats)?;
+    Ok(FrameRun { output, light_views, stats })
+}
+
+/// The steps and the stats their phases are timed into.
+struct Phases<'a, S> {
+    steps: &'a mut S,
+    stats: &'a mut FrameStats,
+}
+
+impl<S> Phases<'_, S> {
+    /// Runs one phase between the steps' `begin` and `end`, adding its wall-clock time to the stats.
+    fn run<B: Backend, R>(
+        &mut self,
+        cx: &mut B::Context,
+        phase: Phase,
+        work: impl FnOnce(&mut B::Context, &mut S) -> Result<R, B::Error>,
+    ) -> Result<R, B::Error>
+    where
+        S: FrameSteps<B>,
+    {
+        let t = Instant::now();
+        self.steps.begin(cx, phase);
+        let result = work(cx, self.steps)?;
+        self.steps.end(cx, phase)?;
+        self.stats.timings.add(phase, ms(t.elapsed()));
+        Ok(result)
+    }
+}
