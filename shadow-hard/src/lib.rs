@@ -31,16 +31,3 @@ pub use shadow_map::ShadowMap;
 pub use shadow_volume::ShadowVolume;
 pub use silhouette_map::SilhouetteMap;
 pub use volume_reconstruction::VolumeReconstruction;
-
-/// Every technique's WGSL as it is compiled (each file after the backend shader it extends), by name: for
-/// validation.
-#[must_use]
-pub fn shaders() -> Vec<(&'static str, String)> {
-    let mut all = vec![
-        ("depth layers", depth_layers::gpu::shader()),
-        ("volume reconstruction", volume_reconstruction::gpu::shader()),
-    ];
-    all.extend(silhouette_map::gpu::shaders());
-    all.extend(hybrid::gpu::shaders::all());
-    all
-}

@@ -37,16 +37,3 @@ pub fn spot_projection<'a>(light: &'a LightView, technique: &str) -> Result<&'a 
         _ => Err(TechniqueError::unsupported_light(technique, &light.light)),
     }
 }
-
-/// Every technique's WGSL as it is compiled (each file after the shadow-map shader it extends), by name:
-/// for validation.
-#[must_use]
-pub fn shaders() -> Vec<(&'static str, String)> {
-    vec![
-        ("pcss query", pcss::gpu::query_shader()),
-        ("smoothie buffer", smoothies::gpu::buffer_shader()),
-        ("smoothie query", smoothies::gpu::query_shader()),
-        ("penumbra map", penumbra_map::gpu::build_shader()),
-        ("penumbra query", penumbra_map::gpu::query_shader()),
-    ]
-}

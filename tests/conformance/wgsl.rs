@@ -1,13 +1,20 @@
 //! Every WGSL file in the workspace is parsed and validated with naga as it is compiled (appended to the
 //! backend shader it extends), so a shader error fails `cargo test`, not a user. The files are found on
-//! disk, and each must appear in some validated shader: a new file no shader list names fails here.
+//! disk, and each must appear in some validated shader: a file no registry entry's WGSL (nor the backend's)
+//! holds fails here.
 
 use std::path::{Path, PathBuf};
 
+use shadowlab::TechniqueRegistry;
+
+/// The backend's shaders, then each registered technique's (its entry's WGSL).
 fn every_shader() -> Vec<(&'static str, String)> {
+    let mut registry = TechniqueRegistry::builtin();
+    crate::planar::register(&mut registry);
     let mut all = shadow_wgpu::shaders::all();
-    all.extend(shadow_hard::shaders());
-    all.extend(shadow_soft::shaders());
+    for entry in registry.entries() {
+        all.extend((entry.wgsl)());
+    }
     all
 }
 

@@ -78,6 +78,14 @@ pub struct Entry<C: Backend, G: Backend> {
     pub cpu: Option<Constructor<C>>,
     /// The GPU implementation, if any.
     pub wgpu: Option<Constructor<G>>,
+    /// The WGSL its GPU implementation compiles beyond the backend's own, each shader whole and named:
+    /// every one is validated by the conformance suite.
+    pub wgsl: fn() -> Vec<(&'static str, String)>,
+}
+
+/// No WGSL of its own.
+fn no_wgsl() -> Vec<(&'static str, String)> {
+    Vec::new()
 }
 
 impl<C: Backend, G: Backend> Clone for Entry<C, G> {
@@ -108,6 +116,7 @@ impl<C: Backend, G: Backend> Entry<C, G> {
             canonical: canonical::<S>,
             cpu,
             wgpu,
+            wgsl: no_wgsl,
         }
     }
 
@@ -134,6 +143,12 @@ impl<C: Backend, G: Backend> Entry<C, G> {
     #[must_use]
     pub fn soft(self) -> Self {
         Self { soft: true, ..self }
+    }
+
+    /// The same entry, with the WGSL its GPU implementation compiles.
+    #[must_use]
+    pub fn wgsl(self, shaders: fn() -> Vec<(&'static str, String)>) -> Self {
+        Self { wgsl: shaders, ..self }
     }
 
     /// The same entry, for a reference.

@@ -266,6 +266,12 @@ impl ShadowTechnique<WgpuBackend> for DepthLayers {
     }
 }
 
+/// The technique's shaders as compiled, by name (its registry entry's WGSL).
+#[must_use]
+pub fn shaders() -> Vec<(&'static str, String)> {
+    vec![("depth layers", shader())]
+}
+
 /// The peeling and combination passes.
 #[must_use]
 pub fn shader() -> String {

@@ -211,6 +211,7 @@ where
     S: TechniqueSettings + Into<DepthLayers>,
 {
     Entry::new::<S>(name, description, paper, Some(layers::<CpuBackend, S>), Some(layers::<WgpuBackend, S>))
+        .wgsl(gpu::shaders)
 }
 
 /// The registry entry of Woo's midpoint map.

@@ -174,4 +174,5 @@ pub fn entry() -> Entry {
         "a shadow map, with z-fail shadow volumes at its silhouette pixels only (a computation mask)",
         "Chan 2004 (thesis, chapter 3)",
     )
+    .wgsl(gpu::shaders::all)
 }

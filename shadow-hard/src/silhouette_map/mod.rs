@@ -70,6 +70,7 @@ pub fn entry() -> Entry {
         "a shadow map plus silhouette points half a texel off: piecewise-linear shadow edges",
         "Sen, Cammarano, Hanrahan 2003",
     )
+    .wgsl(gpu::shaders)
 }
 
 #[cfg(test)]

@@ -336,6 +336,12 @@ fn parity_pass(
     (set, resolve)
 }
 
+/// The technique's shaders as compiled, by name (its registry entry's WGSL).
+#[must_use]
+pub fn shaders() -> Vec<(&'static str, String)> {
+    vec![("volume reconstruction", shader())]
+}
+
 /// The boundary and cap passes, after the shadow-volume shader (its resolve).
 #[must_use]
 pub fn shader() -> String {

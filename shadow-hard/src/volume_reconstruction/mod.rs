@@ -181,4 +181,5 @@ pub fn entry() -> Entry {
         "a shadow volume rebuilt from the light's depth map, resolved with one stencil bit",
         "McCool 2000",
     )
+    .wgsl(gpu::shaders)
 }

@@ -63,6 +63,12 @@ impl ShadowTechnique<WgpuBackend> for Pcss {
     }
 }
 
+/// The technique's shaders as compiled, by name (its registry entry's WGSL).
+#[must_use]
+pub fn shaders() -> Vec<(&'static str, String)> {
+    vec![("pcss query", query_shader())]
+}
+
 /// The WGSL of the pcss query: the shadow-map shader, then the query.
 #[must_use]
 pub fn query_shader() -> String {

@@ -93,5 +93,6 @@ pub fn entry() -> Entry {
         "percentage-closer soft shadows: a blocker search sizes a PCF kernel to the penumbra",
         "Fernando 2005",
     )
+    .wgsl(gpu::shaders)
     .soft()
 }

@@ -143,6 +143,12 @@ impl ShadowTechnique<WgpuBackend> for PenumbraMap {
     }
 }
 
+/// The technique's shaders as compiled, by name (its registry entry's WGSL).
+#[must_use]
+pub fn shaders() -> Vec<(&'static str, String)> {
+    vec![("penumbra map", build_shader()), ("penumbra query", query_shader())]
+}
+
 /// The WGSL of the penumbra map's pass.
 #[must_use]
 pub fn build_shader() -> String {

@@ -94,6 +94,7 @@ pub fn entry() -> Entry {
         "fake soft shadows: a shadow map plus cones and sheets at the silhouettes drawn into a penumbra map",
         "Wyman-Hansen 2003 (compared in Chan 2004, thesis 4.5.1)",
     )
+    .wgsl(gpu::shaders)
     .soft()
 }
 

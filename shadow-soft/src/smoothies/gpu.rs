@@ -171,6 +171,12 @@ impl ShadowTechnique<WgpuBackend> for Smoothies {
     }
 }
 
+/// The technique's shaders as compiled, by name (its registry entry's WGSL).
+#[must_use]
+pub fn shaders() -> Vec<(&'static str, String)> {
+    vec![("smoothie buffer", buffer_shader()), ("smoothie query", query_shader())]
+}
+
 /// The WGSL of the smoothie buffer passes.
 #[must_use]
 pub fn buffer_shader() -> String {

@@ -212,6 +212,7 @@ pub fn entry() -> Entry {
         "fake soft shadows: a shadow map plus alpha ramps hung outward from the silhouettes (smoothies)",
         "Chan-Durand 2003; Chan 2004 (thesis, chapter 4)",
     )
+    .wgsl(gpu::shaders)
     .soft()
 }
 
