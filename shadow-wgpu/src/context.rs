@@ -272,20 +272,14 @@ impl WgpuContext {
     pub fn new(choice: &AdapterChoice) -> Result<Self, WgpuError> {
         let adapter = choose_adapter(choice)?;
         let info = adapter.get_info();
-        let summary = AdapterSummary::of(&info);
-        let features = adapter.features();
-        let needed = wgpu::Features::DEPTH32FLOAT_STENCIL8;
         if let Some(what) = missing(&adapter) {
             return Err(WgpuError::MissingFeature { adapter: info.name, what });
         }
-        let timestamps = features.contains(wgpu::Features::TIMESTAMP_QUERY);
-        let required_features =
-            needed | if timestamps { wgpu::Features::TIMESTAMP_QUERY } else { wgpu::Features::empty() };
-        let limits = adapter.limits();
         let desc = wgpu::DeviceDescriptor {
             label: Some("shadowlab"),
-            required_features,
-            required_limits: limits,
+            required_features: Self::REQUIRED_FEATURES | (Self::OPTIONAL_FEATURES & adapter.features()),
+            // Its own device may as well have everything the adapter offers: larger maps, more lights.
+            required_limits: adapter.limits(),
             ..Default::default()
         };
         let (device, queue) = pollster::block_on(adapter.request_device(&desc))
@@ -297,17 +291,67 @@ impl WgpuContext {
                 *l = Some(format!("{reason:?}: {msg}"));
             }
         });
+        Ok(Self::on_device(&adapter, device, queue, lost))
+    }
+
+    /// The features a device must have: shadow volumes and maps share one depth-stencil format,
+    /// Depth32FloatStencil8 (the stencil counts, the depth is the G-buffer's own f32 depth).
+    pub const REQUIRED_FEATURES: wgpu::Features = wgpu::Features::DEPTH32FLOAT_STENCIL8;
+
+    /// The features used where the device has them: timestamp queries, for GPU phase times.
+    pub const OPTIONAL_FEATURES: wgpu::Features = wgpu::Features::TIMESTAMP_QUERY;
+
+    /// The limits a device must meet: WebGPU's defaults, but for 64 bytes of colour attachments per
+    /// sample (the G-buffer pass writes four 16-byte targets at once). Larger maps and views, more lights
+    /// and longer pixel lists are taken where the device's own limits allow them, and refused by name
+    /// past them.
+    #[must_use]
+    pub fn required_limits() -> wgpu::Limits {
+        wgpu::Limits { max_color_attachment_bytes_per_sample: 64, ..wgpu::Limits::default() }
+    }
+
+    /// A context on the host application's own device and queue (clones of them: wgpu's handles are
+    /// shared), made from `adapter`. Everything shadowlab creates lives on that device, so its textures
+    /// can be drawn into the host's surface and sampled by the host's passes.
+    ///
+    /// # Errors
+    /// [`WgpuError::MissingFeature`] naming each thing the device lacks: a feature of
+    /// [`Self::REQUIRED_FEATURES`], a limit under [`Self::required_limits`], or a target format the
+    /// adapter cannot render to.
+    pub fn from_host(adapter: &wgpu::Adapter, device: wgpu::Device, queue: wgpu::Queue) -> Result<Self, WgpuError> {
+        let info = adapter.get_info();
+        let mut lacks = Vec::new();
+        if !device.features().contains(Self::REQUIRED_FEATURES) {
+            lacks.push("the device feature DEPTH32FLOAT_STENCIL8".to_string());
+        }
+        Self::required_limits().check_limits_with_fail_fn(&device.limits(), false, |name, needed, has| {
+            lacks.push(format!("the device limit {name} of {needed} (it has {has})"));
+        });
+        lacks.extend(missing(adapter));
+        if !lacks.is_empty() {
+            return Err(WgpuError::MissingFeature { adapter: info.name, what: lacks.join(", ") });
+        }
+        // The host keeps its own device-lost callback: wgpu holds one per device.
+        Ok(Self::on_device(adapter, device, queue, Arc::new(Mutex::new(None))))
+    }
+
+    fn on_device(
+        adapter: &wgpu::Adapter,
+        device: wgpu::Device,
+        queue: wgpu::Queue,
+        lost: Arc<Mutex<Option<String>>>,
+    ) -> Self {
         let shared = crate::pipelines::Shared::new(&device);
-        Ok(Self {
-            adapter: summary,
+        Self {
+            adapter: AdapterSummary::of(&adapter.get_info()),
+            timestamps: device.features().contains(wgpu::Features::TIMESTAMP_QUERY),
             device,
             queue,
-            timestamps,
             clock: None,
             lost,
             cache: crate::upload::SceneCache::default(),
             shared,
-        })
+        }
     }
 
     /// Fails if the device was lost.

@@ -4,6 +4,7 @@
 mod cli;
 mod depth_layers;
 mod gpu_clock;
+mod host;
 mod hybrid;
 mod settings;
 mod silhouette_map;

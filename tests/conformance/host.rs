@@ -1,0 +1,80 @@
+//! shadowlab on the host application's own device: a device and queue the application made, with
+//! WebGPU's default limits and only the feature shadowlab requires, render every technique as shadowlab's
+//! own device does; a device without that feature is refused with what it lacks. Without a wgpu adapter
+//! these print one line and pass, unless SHADOWLAB_REQUIRE_GPU=1.
+
+use shadow_core::FrameInputs;
+use shadow_core::scenes::{self, SceneParams};
+use shadow_core::technique::TechniqueSpec;
+use shadow_wgpu::WgpuContext;
+use shadowlab::{BackendChoice, BackendKind, Renderer, TechniqueRegistry};
+
+/// A renderer on shadowlab's own device, or `None` (and a line) without an adapter.
+fn own_renderer(what: &str) -> Option<Renderer> {
+    let mut renderer = Renderer::new(TechniqueRegistry::builtin());
+    if let Err(e) = renderer.resolve(BackendChoice::Wgpu) {
+        let require = std::env::var("SHADOWLAB_REQUIRE_GPU").is_ok_and(|v| v == "1");
+        assert!(!require, "SHADOWLAB_REQUIRE_GPU=1 but no wgpu adapter: {e}");
+        eprintln!("{what} skipped: no wgpu adapter ({e})");
+        return None;
+    }
+    Some(renderer)
+}
+
+/// The adapter named `name`, on an instance of the host's, with a device as a host would ask for one:
+/// `features`, WebGPU's default limits.
+fn host_device(name: &str, features: wgpu::Features) -> (wgpu::Adapter, wgpu::Device, wgpu::Queue) {
+    let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle());
+    let adapter = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::all()))
+        .into_iter()
+        .find(|a| a.get_info().name == name && a.features().contains(WgpuContext::REQUIRED_FEATURES))
+        .unwrap_or_else(|| panic!("the host's instance has no adapter '{name}'"));
+    let desc = wgpu::DeviceDescriptor {
+        label: Some("host"),
+        required_features: features,
+        required_limits: WgpuContext::required_limits(),
+        ..Default::default()
+    };
+    let (device, queue) = pollster::block_on(adapter.request_device(&desc)).expect("a host device");
+    (adapter, device, queue)
+}
+
+#[test]
+fn a_host_device_renders_every_technique_as_shadowlabs_own() {
+    let Some(mut renderer) = own_renderer("host device") else { return };
+    let name = renderer.adapter().expect("an adapter").name.clone();
+    let (adapter, device, queue) = host_device(&name, WgpuContext::REQUIRED_FEATURES);
+    let mut host = WgpuContext::from_host(&adapter, device, queue).expect("the host's device is enough");
+    let registry = TechniqueRegistry::builtin();
+    let mut compared = 0;
+    for scene in ["cubes", "room"] {
+        let s = scenes::build(scene, &SceneParams::default()).expect("scene");
+        let frame = FrameInputs::from_first_camera(&s).expect("frame");
+        for entry in registry.entries().iter().filter(|e| e.wgpu.is_some()) {
+            let spec = TechniqueSpec::named(entry.name);
+            let own = renderer.run(BackendKind::Wgpu, &frame, 160, 120, &spec).expect("own device");
+            let mut technique = registry.wgpu(&spec).expect("technique");
+            let hosted =
+                shadow_wgpu::render_frame(&mut host, &frame, 160, 120, technique.as_mut()).expect("host device");
+            assert!(own.visibility[0].data().contains(&0.0), "{scene} / {}: nothing in shadow", entry.name);
+            assert!(
+                own.visibility[0].data() == hosted.visibility[0].data(),
+                "{scene} / {}: the host's device renders another visibility",
+                entry.name
+            );
+            assert_eq!(own.color.data(), hosted.color.data(), "{scene} / {}", entry.name);
+            compared += 1;
+        }
+    }
+    assert!(compared >= 20, "only {compared} techniques compared");
+}
+
+#[test]
+fn a_host_device_without_the_depth_stencil_format_is_refused_by_name() {
+    let Some(renderer) = own_renderer("host device refusal") else { return };
+    let name = renderer.adapter().expect("an adapter").name.clone();
+    let (adapter, device, queue) = host_device(&name, wgpu::Features::empty());
+    let err = WgpuContext::from_host(&adapter, device, queue).err().expect("refused");
+    let msg = err.to_string();
+    assert!(msg.contains(&name) && msg.contains("DEPTH32FLOAT_STENCIL8"), "{msg}");
+}
