@@ -410,12 +410,17 @@ impl WgpuContext {
         }
     }
 
-    /// Submits recorded work to the queue. The backend's passes and the techniques hand their work to
-    /// the GPU only through here (the clock's markers aside), in the order the frame script runs them, so
-    /// where a frame's work goes is decided in one place: a frame recorded into a host's own submission
-    /// would collect it here instead of submitting.
-    pub fn submit(&self, work: wgpu::CommandBuffer) {
-        self.queue.submit([work]);
+    /// An encoder to record a pass's work into; hand it back with [`Self::submit`]. The backend's passes
+    /// and the techniques record only into these (the clock's markers aside), in the order the frame
+    /// script runs them, so where a frame's work goes is decided here and in `submit` alone.
+    #[must_use]
+    pub fn encoder(&self, label: &str) -> wgpu::CommandEncoder {
+        self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) })
+    }
+
+    /// Submits the work recorded into an encoder from [`Self::encoder`] to the queue.
+    pub fn submit(&self, encoder: wgpu::CommandEncoder) {
+        self.queue.submit([encoder.finish()]);
     }
 
     /// Waits for all submitted work.

@@ -235,9 +235,9 @@ fn read_count(cx: &WgpuContext, q: &wgpu::Buffer) -> Result<u64, WgpuError> {
         usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
         mapped_at_creation: false,
     });
-    let mut enc = cx.device.create_command_encoder(&Default::default());
+    let mut enc = cx.encoder("readback");
     enc.copy_buffer_to_buffer(q, 0, &staging, 0, 8);
-    cx.submit(enc.finish());
+    cx.submit(enc);
     let d = readback::map_read(cx, &staging, "counting receivers")?;
     Ok(u64::from_le_bytes([d[0], d[1], d[2], d[3], d[4], d[5], d[6], d[7]]))
 }
@@ -289,7 +289,7 @@ fn shade(
             usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
-        let mut enc = cx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("shade") });
+        let mut enc = cx.encoder("shade");
         for counting in [true, false] {
             let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some(if counting { "count receivers" } else { "shade" }),
@@ -319,7 +319,7 @@ fn shade(
             }
         }
         enc.resolve_query_set(&query, 0..1, &resolved, 0);
-        cx.submit(enc.finish());
+        cx.submit(enc);
         (color, resolved)
     })
 }

@@ -90,7 +90,7 @@ pub fn render(cx: &mut WgpuContext, frame: &FrameInputs, width: u32, height: u32
         let [position, normal, albedo, geometric_normal] = ["position", "normal", "albedo", "geometric normal"]
             .map(|l| target(cx, l, width, height, ATTRIBUTE).create_view(&Default::default()));
         let depth_view = depth.create_view(&Default::default());
-        let mut enc = cx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("gbuffer") });
+        let mut enc = cx.encoder("gbuffer");
         {
             let clear = |v| {
                 Some(wgpu::RenderPassColorAttachment {
@@ -121,7 +121,7 @@ pub fn render(cx: &mut WgpuContext, frame: &FrameInputs, width: u32, height: u32
             draw_instances(cx, &mut pass, frame, |_| true, true);
             pass.pop_debug_group();
         }
-        cx.submit(enc.finish());
+        cx.submit(enc);
         GpuGBuffer {
             width,
             height,

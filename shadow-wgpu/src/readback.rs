@@ -23,7 +23,7 @@ fn read_layer(
         usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
         mapped_at_creation: false,
     });
-    let mut enc = cx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("readback") });
+    let mut enc = cx.encoder("readback");
     enc.copy_texture_to_buffer(
         wgpu::TexelCopyTextureInfo {
             texture: tex,
@@ -37,7 +37,7 @@ fn read_layer(
         },
         wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
     );
-    cx.submit(enc.finish());
+    cx.submit(enc);
     let data = map_read(cx, &buffer, "readback")?;
     let mut out = Vec::with_capacity((row * h) as usize);
     for y in 0..h as usize {

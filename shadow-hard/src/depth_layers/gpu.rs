@@ -192,7 +192,7 @@ fn render_projection(
     };
     // Pass 1 cannot bind z1 while writing it: it gets z2's texture as a stand-in it never reads.
     let (first, peel) = (group1(&v2, &v2), group1(&v1, &v1));
-    let mut enc = cx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("depth layers") });
+    let mut enc = cx.encoder("depth layers");
     for (peeling, target, group) in [(false, &v1, &first), (true, &v2, &peel)] {
         let mut pass = depth_pass(&mut enc, target, if peeling { "second layer" } else { "first layer" });
         pass.set_bind_group(0, &group0, &[]);
@@ -215,7 +215,7 @@ fn render_projection(
         pass.set_bind_group(1, &both, &[]);
         pass.draw(0..3, 0..1);
     }
-    cx.submit(enc.finish());
+    cx.submit(enc);
 }
 
 impl ShadowTechnique<WgpuBackend> for DepthLayers {

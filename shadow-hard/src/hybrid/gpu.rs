@@ -250,8 +250,8 @@ fn full_screen_draws(
     groups: [&wgpu::BindGroup; 2],
     draws: &[(&wgpu::RenderPipeline, u32)],
     query: Option<&(wgpu::QuerySet, wgpu::Buffer)>,
-) -> wgpu::CommandBuffer {
-    let mut enc = cx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
+) -> wgpu::CommandEncoder {
+    let mut enc = cx.encoder(label);
     {
         let colour = target.map(|(view, clear)| wgpu::RenderPassColorAttachment {
             view,
@@ -292,7 +292,7 @@ fn full_screen_draws(
     if let Some((set, resolve)) = query {
         enc.resolve_query_set(set, 0..1, resolve, 0);
     }
-    enc.finish()
+    enc
 }
 
 impl Hybrid {

@@ -250,7 +250,7 @@ fn draw_points(
         ..Default::default()
     });
     let point_depth = maps.point_depth.create_view(&Default::default());
-    let mut enc = cx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("silhouette map") });
+    let mut enc = cx.encoder("silhouette map");
     enc.clear_buffer(&state.counters, 0, None);
     for (k, range) in ranges.iter().enumerate() {
         let params = BuildParams { settings: [res as f32, side as f32, margin, k as f32] };
@@ -297,14 +297,14 @@ fn draw_points(
             }
         }
     }
-    cx.submit(enc.finish());
+    cx.submit(enc);
 }
 
 /// Counts the non-empty texels of every layer into the first counter, then reads both counters:
 /// (non-empty texels, silhouette pixels).
 fn count(cx: &WgpuContext, state: &State, maps: &Maps) -> Result<(u64, u64), WgpuError> {
     let side = maps.points.width();
-    let mut enc = cx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("count texels") });
+    let mut enc = cx.encoder("count texels");
     for k in 0..maps.points.depth_or_array_layers() {
         let layer = layer_view(&maps.points, k);
         let group = cx.device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -330,7 +330,7 @@ fn count(cx: &WgpuContext, state: &State, maps: &Maps) -> Result<(u64, u64), Wgp
         pass.set_bind_group(0, &group, &[]);
         pass.dispatch_workgroups(side.div_ceil(8), side.div_ceil(8), 1);
     }
-    cx.submit(enc.finish());
+    cx.submit(enc);
     read_counters(cx, &state.counters)
 }
 
@@ -342,9 +342,9 @@ fn read_counters(cx: &WgpuContext, counters: &wgpu::Buffer) -> Result<(u64, u64)
         usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
         mapped_at_creation: false,
     });
-    let mut enc = cx.device.create_command_encoder(&Default::default());
+    let mut enc = cx.encoder("readback");
     enc.copy_buffer_to_buffer(counters, 0, &staging, 0, COUNTER_STRIDE + 4);
-    cx.submit(enc.finish());
+    cx.submit(enc);
     let d = readback::map_read(cx, &staging, "reading the silhouette counters")?;
     let word = |at: usize| u64::from(u32::from_le_bytes([d[at], d[at + 1], d[at + 2], d[at + 3]]));
     Ok((word(0), word(COUNTER_STRIDE as usize)))

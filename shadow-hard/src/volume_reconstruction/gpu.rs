@@ -262,7 +262,7 @@ fn coverage_counts(cx: &WgpuContext, state: &State, last: &LastView) -> Result<s
         view_formats: &[],
     });
     let view = target.create_view(&wgpu::TextureViewDescriptor::default());
-    let mut enc = cx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("volume view") });
+    let mut enc = cx.encoder("volume view");
     {
         let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("volume view"),
@@ -287,7 +287,7 @@ fn coverage_counts(cx: &WgpuContext, state: &State, last: &LastView) -> Result<s
             }
         }
     }
-    cx.submit(enc.finish());
+    cx.submit(enc);
     readback::read_stencil(cx, &target)
 }
 
@@ -303,7 +303,7 @@ fn parity_pass(
     clear: Option<u32>,
 ) -> (wgpu::QuerySet, wgpu::Buffer) {
     let (set, resolve) = occlusion_query(cx);
-    let mut enc = cx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("parity") });
+    let mut enc = cx.encoder("parity");
     {
         let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("parity"),
@@ -332,7 +332,7 @@ fn parity_pass(
         pass.end_occlusion_query();
     }
     enc.resolve_query_set(&set, 0..1, &resolve, 0);
-    cx.submit(enc.finish());
+    cx.submit(enc);
     (set, resolve)
 }
 

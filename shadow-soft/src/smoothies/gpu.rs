@@ -87,11 +87,11 @@ impl State {
         let group = min_target::bind(cx, &self.buffer_layout, "smoothie buffer", &params, maps);
         let data = vertices(triangles);
         let vertices = min_target::vertex_buffer(cx, "smoothies", &data);
-        let mut enc = cx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("smoothies") });
+        let mut enc = cx.encoder("smoothies");
         for (target, pipeline) in buffer.iter().zip([&self.depth_pass, &self.alpha_pass]) {
             min_target::draw(&mut enc, target, pipeline, &group, vertices.as_ref());
         }
-        cx.submit(enc.finish());
+        cx.submit(enc);
     }
 }
 

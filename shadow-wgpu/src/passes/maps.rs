@@ -302,7 +302,7 @@ pub fn render_maps(
     instances: &wgpu::Buffer,
 ) {
     let res = maps.width();
-    let mut enc = cx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("light pass") });
+    let mut enc = cx.encoder("light pass");
     for (k, p) in light.projections.iter().enumerate() {
         let group =
             cx.shared.frame_group(&cx.device, &ViewRaw::new(p.clip_from_world, glam::Vec3::ZERO, res, res), instances);
@@ -331,7 +331,7 @@ pub fn render_maps(
         pass.set_bind_group(0, &group, &[]);
         draw_instances(cx, &mut pass, frame, |i| i.casts_shadow, false);
     }
-    cx.submit(enc.finish());
+    cx.submit(enc);
 }
 
 /// A depth array of `layers` square maps.

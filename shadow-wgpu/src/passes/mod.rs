@@ -20,7 +20,7 @@ pub fn full_screen(
     groups: &[&wgpu::BindGroup],
     depth_stencil: Option<(&wgpu::TextureView, u32)>,
 ) {
-    let mut enc = cx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
+    let mut enc = cx.encoder(label);
     {
         let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some(label),
@@ -50,5 +50,5 @@ pub fn full_screen(
         pass.draw(0..3, 0..1);
         pass.pop_debug_group();
     }
-    cx.submit(enc.finish());
+    cx.submit(enc);
 }

@@ -306,7 +306,7 @@ impl<'a> VolumePass<'a> {
         depth: &wgpu::TextureView,
     ) -> (wgpu::QuerySet, wgpu::Buffer) {
         let (set, resolve) = occlusion_query(cx);
-        let mut enc = cx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(self.label) });
+        let mut enc = cx.encoder(self.label);
         {
             let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some(self.label),
@@ -348,7 +348,7 @@ impl<'a> VolumePass<'a> {
             pass.pop_debug_group();
         }
         enc.resolve_query_set(&set, 0..1, &resolve, 0);
-        cx.submit(enc.finish());
+        cx.submit(enc);
         (set, resolve)
     }
 }
@@ -361,9 +361,9 @@ pub fn read_query(cx: &WgpuContext, q: &(wgpu::QuerySet, wgpu::Buffer)) -> Resul
         usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
         mapped_at_creation: false,
     });
-    let mut enc = cx.device.create_command_encoder(&Default::default());
+    let mut enc = cx.encoder("readback");
     enc.copy_buffer_to_buffer(&q.1, 0, &staging, 0, 8);
-    cx.submit(enc.finish());
+    cx.submit(enc);
     let d = crate::readback::map_read(cx, &staging, "reading an occlusion query")?;
     Ok(u64::from_le_bytes([d[0], d[1], d[2], d[3], d[4], d[5], d[6], d[7]]))
 }

@@ -180,9 +180,9 @@ impl ListedPixels {
     /// Reads back the pixels listed, the fragments the compute pass's triangles made at them, its stencil
     /// updates, its pixel-triangle tests and the pixels counted alone.
     pub(super) fn counters(&self, cx: &WgpuContext) -> Result<[u64; 5], WgpuError> {
-        let mut enc = cx.device.create_command_encoder(&Default::default());
+        let mut enc = cx.encoder("readback");
         enc.copy_buffer_to_buffer(&self.listed, 0, &self.staging, 0, HEADER);
-        cx.submit(enc.finish());
+        cx.submit(enc);
         let d = readback::map_read(cx, &self.staging, "reading the hybrid caster counters")?;
         let word = |i: usize| u64::from(u32::from_le_bytes([d[4 * i], d[4 * i + 1], d[4 * i + 2], d[4 * i + 3]]));
         Ok([word(0), word(1), word(2), word(3), word(4)])

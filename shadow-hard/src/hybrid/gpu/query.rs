@@ -151,7 +151,7 @@ impl<'a> Inputs<'a> {
         let g = self.g;
         let groups = [&g.frame_group, map_group];
         let silhouettes = occlusion_query(cx);
-        let mut enc = cx.device.create_command_encoder(&Default::default());
+        let mut enc = cx.encoder("hybrid mask depth");
         if self.target != g.depth {
             enc.copy_texture_to_texture(
                 g.depth.as_image_copy(),
@@ -165,7 +165,7 @@ impl<'a> Inputs<'a> {
         if let Some((.., l)) = self.casters {
             l.clear(&mut enc);
         }
-        cx.submit(enc.finish());
+        cx.submit(enc);
         cx.step("setup");
         let mut mask_draws = vec![(&state.mask, MASK)];
         if let Some(far) = &state.far {
@@ -175,9 +175,9 @@ impl<'a> Inputs<'a> {
         cx.submit(full_screen_draws(cx, "hybrid mask", None, stencil, groups, &mask_draws, Some(&silhouettes)));
         cx.step("mask");
         if let Some((passes, _, pieces, l)) = self.casters {
-            let mut enc = cx.device.create_command_encoder(&Default::default());
+            let mut enc = cx.encoder("hybrid caster masks");
             passes.record(cx, &mut enc, pieces, l, g);
-            cx.submit(enc.finish());
+            cx.submit(enc);
             cx.step("casters");
         }
         let tile = self.hybrid.gpu.scissor_tile;

@@ -35,9 +35,9 @@ impl TileMarks {
 
     /// The marked tiles (read back) as scissor rectangles within a `width x height` view.
     pub(super) fn rectangles(&self, cx: &WgpuContext, tile: u32, size: (u32, u32)) -> Result<Vec<[u32; 4]>, WgpuError> {
-        let mut enc = cx.device.create_command_encoder(&Default::default());
+        let mut enc = cx.encoder("readback");
         enc.copy_buffer_to_buffer(&self.marks, 0, &self.staging, 0, self.marks.size());
-        cx.submit(enc.finish());
+        cx.submit(enc);
         let bytes = readback::map_read(cx, &self.staging, "reading the hybrid tile marks")?;
         let marked: Vec<bool> = bytes.chunks_exact(4).map(|m| m != [0; 4]).collect();
         Ok(scissor_rectangles(&marked, self.columns, tile, size))
