@@ -6,6 +6,7 @@
 //! integrated, then virtual). Software adapters (lavapipe) are used only when asked for by name or when
 //! [`AdapterChoice::allow_software`] is set.
 
+use std::cell::{Cell, RefCell};
 use std::sync::{Arc, Mutex};
 
 use shadow_core::frame::FrameError;
@@ -56,6 +57,13 @@ pub enum WgpuError {
         height: u64,
         /// Why not.
         why: String,
+    },
+    /// A wait for the GPU or a read-back inside a frame recorded into a host's encoder, which is only
+    /// submitted once the recording is done.
+    #[error("{what} needs the GPU's results, which a frame recorded into a host's encoder does not wait for")]
+    NotRecordable {
+        /// What needed them.
+        what: String,
     },
     /// More lights than one frame can shade: one visibility layer and one uniform slot each.
     #[error("the frame has {lights} lights; the wgpu backend shades at most {most}")]
@@ -155,6 +163,10 @@ pub struct WgpuContext {
     pub cache: crate::upload::SceneCache,
     /// The pipelines and layouts every pass shares (the frame bind group's layout among them).
     pub shared: crate::pipelines::Shared,
+    /// While a frame is recorded into a host's encoder ([`WgpuContext::record_into`]): that encoder,
+    /// lent to each pass in turn.
+    lent: RefCell<Option<wgpu::CommandEncoder>>,
+    recording: Cell<bool>,
 }
 
 /// The instance. Set `XDG_RUNTIME_DIR` (CI does) to keep the Vulkan loader quiet on headless machines.
@@ -351,6 +363,8 @@ impl WgpuContext {
             lost,
             cache: crate::upload::SceneCache::default(),
             shared,
+            lent: RefCell::new(None),
+            recording: Cell::new(false),
         }
     }
 
@@ -415,12 +429,64 @@ impl WgpuContext {
     /// script runs them, so where a frame's work goes is decided here and in `submit` alone.
     #[must_use]
     pub fn encoder(&self, label: &str) -> wgpu::CommandEncoder {
+        if let Some(lent) = self.lent.borrow_mut().take() {
+            return lent;
+        }
         self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) })
     }
 
-    /// Submits the work recorded into an encoder from [`Self::encoder`] to the queue.
+    /// Submits the work recorded into an encoder from [`Self::encoder`] to the queue; while a frame is
+    /// recorded into a host's encoder, hands that encoder back for the next pass instead.
     pub fn submit(&self, encoder: wgpu::CommandEncoder) {
-        self.queue.submit([encoder.finish()]);
+        if self.recording.get() {
+            *self.lent.borrow_mut() = Some(encoder);
+        } else {
+            self.queue.submit([encoder.finish()]);
+        }
+    }
+
+    /// Runs `record` with every pass recording into `host`, the host application's own encoder, which
+    /// the host submits: nothing is submitted, waited for or read back meanwhile (a pass that would wait
+    /// or read back fails with [`WgpuError::NotRecordable`]), and the instrumentation (counters, clock)
+    /// is off ([`Self::instrumented`]). On an error the host's encoder may have lost what was recorded
+    /// into it, its own earlier commands included.
+    ///
+    /// # Errors
+    /// What `record` returns.
+    pub fn record_into<R>(
+        &mut self,
+        host: &mut wgpu::CommandEncoder,
+        record: impl FnOnce(&mut Self) -> Result<R, WgpuError>,
+    ) -> Result<R, WgpuError> {
+        let stand_in = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("stand-in") });
+        *self.lent.get_mut() = Some(std::mem::replace(host, stand_in));
+        self.recording.set(true);
+        let clock = self.clock.take();
+        let result = record(self);
+        self.clock = clock;
+        self.recording.set(false);
+        if let Some(lent) = self.lent.get_mut().take() {
+            *host = lent;
+        }
+        result
+    }
+
+    /// Whether passes count what they do (counters read back after each pass) and the clock marks the
+    /// phases: in every frame but one recorded into a host's encoder.
+    #[must_use]
+    pub fn instrumented(&self) -> bool {
+        !self.recording.get()
+    }
+
+    /// Refuses a wait or read-back for `what` while a frame is recorded into a host's encoder.
+    ///
+    /// # Errors
+    /// [`WgpuError::NotRecordable`] while recording.
+    pub fn may_wait(&self, what: &str) -> Result<(), WgpuError> {
+        if self.recording.get() {
+            return Err(WgpuError::NotRecordable { what: what.into() });
+        }
+        Ok(())
     }
 
     /// Waits for all submitted work.
@@ -428,6 +494,7 @@ impl WgpuContext {
     /// # Errors
     /// A lost device or a poll failure.
     pub fn wait(&self) -> Result<(), WgpuError> {
+        self.may_wait("a wait for the GPU")?;
         self.device
             .poll(wgpu::PollType::wait_indefinitely())
             .map_err(|e| WgpuError::Gpu { during: "wait".into(), message: e.to_string() })?;

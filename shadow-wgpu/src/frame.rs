@@ -242,6 +242,76 @@ fn read_count(cx: &WgpuContext, q: &wgpu::Buffer) -> Result<u64, WgpuError> {
     Ok(u64::from_le_bytes([d[0], d[1], d[2], d[3], d[4], d[5], d[6], d[7]]))
 }
 
+/// The shading pass's inputs: the G-buffer's position, normal and albedo, every light's visibility (a
+/// layer each of `vis`) and the frame's lights.
+pub(crate) fn shade_group(
+    cx: &WgpuContext,
+    frame: &FrameInputs,
+    g: &GpuGBuffer,
+    vis: &wgpu::Texture,
+) -> wgpu::BindGroup {
+    let mut lights: LightTable = bytemuck::Zeroable::zeroed();
+    lights.count[0] = frame.lights.len() as u32;
+    for (slot, l) in lights.lights.iter_mut().zip(&frame.lights) {
+        *slot = LightRaw::from(l);
+    }
+    let lbuf = cx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("lights"),
+        contents: bytemuck::bytes_of(&lights),
+        usage: wgpu::BufferUsages::UNIFORM,
+    });
+    let vis_view = vis.create_view(&wgpu::TextureViewDescriptor {
+        dimension: Some(wgpu::TextureViewDimension::D2Array),
+        ..Default::default()
+    });
+    cx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("shade"),
+        layout: &cx.shared.shade_layout,
+        entries: &[
+            wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&g.position) },
+            wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&g.normal) },
+            wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&g.albedo) },
+            wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&vis_view) },
+            wgpu::BindGroupEntry { binding: 4, resource: lbuf.as_entire_binding() },
+        ],
+    })
+}
+
+/// One full-screen pass of `pipeline` over the G-buffer into `view` (cleared to black first), with the
+/// shading inputs `group`; with a `query`, counting the samples that pass in its one occlusion query.
+pub(crate) fn full_screen_shade(
+    enc: &mut wgpu::CommandEncoder,
+    view: &wgpu::TextureView,
+    pipeline: &wgpu::RenderPipeline,
+    g: &GpuGBuffer,
+    group: &wgpu::BindGroup,
+    query: Option<&wgpu::QuerySet>,
+) {
+    let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some(if query.is_some() { "count receivers" } else { "shade" }),
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::BLACK), store: wgpu::StoreOp::Store },
+        })],
+        depth_stencil_attachment: None,
+        timestamp_writes: None,
+        occlusion_query_set: query,
+        multiview_mask: None,
+    });
+    pass.set_pipeline(pipeline);
+    pass.set_bind_group(0, &g.frame_group, &[]);
+    pass.set_bind_group(1, group, &[]);
+    if query.is_some() {
+        pass.begin_occlusion_query(0);
+    }
+    pass.draw(0..3, 0..1);
+    if query.is_some() {
+        pass.end_occlusion_query();
+    }
+}
+
 /// Counts the receiver pixels (an occlusion query over a pass that discards everything else), then
 /// shades. Returns the shaded texture and the query's resolve buffer.
 fn shade(
@@ -252,31 +322,7 @@ fn shade(
 ) -> Result<(wgpu::Texture, wgpu::Buffer), WgpuError> {
     cx.scoped("the shading pass", |cx| {
         let color = layered(cx, "color", g.width, g.height, 1, COLOR);
-        let mut lights: LightTable = bytemuck::Zeroable::zeroed();
-        lights.count[0] = frame.lights.len() as u32;
-        for (slot, l) in lights.lights.iter_mut().zip(&frame.lights) {
-            *slot = LightRaw::from(l);
-        }
-        let lbuf = cx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("lights"),
-            contents: bytemuck::bytes_of(&lights),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
-        let vis_view = vis.create_view(&wgpu::TextureViewDescriptor {
-            dimension: Some(wgpu::TextureViewDimension::D2Array),
-            ..Default::default()
-        });
-        let group = cx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("shade"),
-            layout: &cx.shared.shade_layout,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&g.position) },
-                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&g.normal) },
-                wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&g.albedo) },
-                wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&vis_view) },
-                wgpu::BindGroupEntry { binding: 4, resource: lbuf.as_entire_binding() },
-            ],
-        });
+        let group = shade_group(cx, frame, g, vis);
         let view = color.create_view(&Default::default());
         let query = cx.device.create_query_set(&wgpu::QuerySetDescriptor {
             label: Some("receivers"),
@@ -290,34 +336,8 @@ fn shade(
             mapped_at_creation: false,
         });
         let mut enc = cx.encoder("shade");
-        for counting in [true, false] {
-            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some(if counting { "count receivers" } else { "shade" }),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                depth_stencil_attachment: None,
-                timestamp_writes: None,
-                occlusion_query_set: counting.then_some(&query),
-                multiview_mask: None,
-            });
-            pass.set_pipeline(if counting { &cx.shared.receivers } else { &cx.shared.shade });
-            pass.set_bind_group(0, &g.frame_group, &[]);
-            pass.set_bind_group(1, &group, &[]);
-            if counting {
-                pass.begin_occlusion_query(0);
-            }
-            pass.draw(0..3, 0..1);
-            if counting {
-                pass.end_occlusion_query();
-            }
-        }
+        full_screen_shade(&mut enc, &view, &cx.shared.receivers, g, &group, Some(&query));
+        full_screen_shade(&mut enc, &view, &cx.shared.shade, g, &group, None);
         enc.resolve_query_set(&query, 0..1, &resolved, 0);
         cx.submit(enc);
         (color, resolved)

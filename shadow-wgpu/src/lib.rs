@@ -1,8 +1,9 @@
 //! shadow-wgpu: the GPU backend, through wgpu.
 //!
-//! A headless context ([`context`]), scene upload cached per mesh ([`upload`]), the G-buffer
-//! ([`gbuffer`]), the frame driver with shading and readback ([`frame`]), pipelines and WGSL every
-//! technique uses ([`pipelines`], [`shaders`]), and the passes techniques are built from ([`passes`]).
+//! A context on its own device or the host application's ([`context`]), scene upload cached per mesh
+//! ([`upload`]), the G-buffer ([`gbuffer`]), the instrumented frame with shading and read-backs
+//! ([`frame`]), the frame recorded into a host's encoder ([`record`]), pipelines and WGSL every technique
+//! uses ([`pipelines`], [`shaders`]), and the passes techniques are built from ([`passes`]).
 
 pub mod clock;
 pub mod context;
@@ -11,9 +12,11 @@ pub mod gbuffer;
 pub mod passes;
 pub mod pipelines;
 pub mod readback;
+pub mod record;
 pub mod shaders;
 pub mod upload;
 
 pub use context::{AdapterChoice, AdapterSummary, WgpuBackend, WgpuContext, WgpuError, list_adapters};
 pub use frame::{GpuVisibility, WgpuFrame, render_frame};
 pub use gbuffer::GpuGBuffer;
+pub use record::{ColorTarget, FrameRecorder};

@@ -49,8 +49,9 @@ fn read_layer(
 /// Maps a MAP_READ buffer (its copies already submitted) and returns its bytes.
 ///
 /// # Errors
-/// A GPU failure.
+/// A GPU failure, or [`WgpuError::NotRecordable`] inside a frame recorded into a host's encoder.
 pub fn map_read(cx: &WgpuContext, buffer: &wgpu::Buffer, during: &str) -> Result<Vec<u8>, WgpuError> {
+    cx.may_wait(during)?;
     let slice = buffer.slice(..);
     let (tx, rx) = std::sync::mpsc::channel();
     slice.map_async(wgpu::MapMode::Read, move |r| {

@@ -7,19 +7,7 @@ use shadow_core::FrameInputs;
 use shadow_core::scenes::{self, SceneParams};
 use shadow_core::technique::TechniqueSpec;
 use shadow_wgpu::WgpuContext;
-use shadowlab::{BackendChoice, BackendKind, Renderer, TechniqueRegistry};
-
-/// A renderer on shadowlab's own device, or `None` (and a line) without an adapter.
-fn own_renderer(what: &str) -> Option<Renderer> {
-    let mut renderer = Renderer::new(TechniqueRegistry::builtin());
-    if let Err(e) = renderer.resolve(BackendChoice::Wgpu) {
-        let require = std::env::var("SHADOWLAB_REQUIRE_GPU").is_ok_and(|v| v == "1");
-        assert!(!require, "SHADOWLAB_REQUIRE_GPU=1 but no wgpu adapter: {e}");
-        eprintln!("{what} skipped: no wgpu adapter ({e})");
-        return None;
-    }
-    Some(renderer)
-}
+use shadowlab::{BackendKind, TechniqueRegistry};
 
 /// The adapter named `name`, on an instance of the host's, with a device as a host would ask for one:
 /// `features`, WebGPU's default limits.
@@ -41,7 +29,7 @@ fn host_device(name: &str, features: wgpu::Features) -> (wgpu::Adapter, wgpu::De
 
 #[test]
 fn a_host_device_renders_every_technique_as_shadowlabs_own() {
-    let Some(mut renderer) = own_renderer("host device") else { return };
+    let Some(mut renderer) = crate::with_wgpu("host device") else { return };
     let name = renderer.adapter().expect("an adapter").name.clone();
     let (adapter, device, queue) = host_device(&name, WgpuContext::REQUIRED_FEATURES);
     let mut host = WgpuContext::from_host(&adapter, device, queue).expect("the host's device is enough");
@@ -71,7 +59,7 @@ fn a_host_device_renders_every_technique_as_shadowlabs_own() {
 
 #[test]
 fn a_host_device_without_the_depth_stencil_format_is_refused_by_name() {
-    let Some(renderer) = own_renderer("host device refusal") else { return };
+    let Some(renderer) = crate::with_wgpu("host device refusal") else { return };
     let name = renderer.adapter().expect("an adapter").name.clone();
     let (adapter, device, queue) = host_device(&name, wgpu::Features::empty());
     let err = WgpuContext::from_host(&adapter, device, queue).err().expect("refused");

@@ -13,6 +13,7 @@ mod smoothies;
 #[path = "../../examples/planar/mod.rs"]
 #[allow(dead_code)]
 mod planar;
+mod recorded;
 mod scale;
 mod suite;
 mod volume_reconstruction;

@@ -15,9 +15,21 @@ struct Lights {
 const AMBIENT: f32 = 0.15;
 const BACKGROUND: vec3<f32> = vec3<f32>(0.02, 0.025, 0.04);
 
+// Into a target that stores sRGB-encoded values as they are (a Unorm format).
 @fragment
 fn fs_shade(in: FullScreen) -> @location(0) vec4<f32> {
-    let px = vec2<i32>(in.pos.xy);
+    let c = shaded(vec2<i32>(in.pos.xy));
+    return vec4<f32>(linear_to_srgb(c.x), linear_to_srgb(c.y), linear_to_srgb(c.z), 1.0);
+}
+
+// Into an sRGB format, whose stores encode: linear values.
+@fragment
+fn fs_shade_linear(in: FullScreen) -> @location(0) vec4<f32> {
+    return vec4<f32>(shaded(vec2<i32>(in.pos.xy)), 1.0);
+}
+
+// The linear colour at pixel `px`: every light's term times its visibility, over the ambient.
+fn shaded(px: vec2<i32>) -> vec3<f32> {
     let albedo = textureLoad(g_albedo, px, 0);
     var c = BACKGROUND;
     if (albedo.w > 0.0) {
@@ -30,7 +42,7 @@ fn fs_shade(in: FullScreen) -> @location(0) vec4<f32> {
         }
         c = albedo.xyz * (vec3<f32>(AMBIENT) + direct);
     }
-    return vec4<f32>(linear_to_srgb(c.x), linear_to_srgb(c.y), linear_to_srgb(c.z), 1.0);
+    return c;
 }
 
 // Counts receiver pixels (covered_pixels) through an occlusion query: only receivers survive.

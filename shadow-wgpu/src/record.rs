@@ -1,0 +1,165 @@
+//! A frame recorded into the host application's own command encoder: the frame script of shadow-core
+//! with steps that only record. Nothing is submitted, waited for or read back; the host submits its
+//! encoder when it likes, and the shaded image lands in the host's colour target (any renderable format,
+//! sRGB or not, RGBA or BGRA). The techniques' counters and the phase clock are off
+//! ([`WgpuContext::instrumented`]).
+//!
+//! A technique that needs the GPU's results within the frame (one reconstructing on the CPU from a map
+//! it reads back, or drawing in rectangles read back from the GPU) fails here with
+//! [`WgpuError::NotRecordable`].
+
+use std::collections::HashMap;
+
+use shadow_core::script::{FrameRun, FrameSteps, run_frame};
+use shadow_core::technique::{DynShadowTechnique, FrameStats};
+use shadow_core::{FrameInputs, LightView};
+
+use crate::context::{WgpuBackend, WgpuContext, WgpuError};
+use crate::frame::{GpuVisibility, MAX_LIGHTS, full_screen_shade, layer_view, layered, shade_group};
+use crate::gbuffer::{self, GpuGBuffer};
+use crate::pipelines::{VISIBILITY, full_screen_pipeline};
+
+/// Records frames into a host's encoder, keeping what it made for them: the visibility targets (remade
+/// when the view's size or the number of lights changes) and a shading pipeline per colour format.
+#[derive(Default)]
+pub struct FrameRecorder {
+    visibility: Option<Visibility>,
+    shade: HashMap<wgpu::TextureFormat, wgpu::RenderPipeline>,
+}
+
+/// Every light's visibility, a layer each of one R32Float array texture (1 lit, 0 shadowed).
+struct Visibility {
+    texture: wgpu::Texture,
+    width: u32,
+    height: u32,
+    layers: u32,
+}
+
+/// Where a recorded frame's shading goes: a view of the host's texture, its format and size.
+pub struct ColorTarget<'a> {
+    /// The view to shade into (cleared first).
+    pub view: &'a wgpu::TextureView,
+    /// Its texture's format (an sRGB format gets linear values, which its stores encode; any other
+    /// gets sRGB-encoded values).
+    pub format: wgpu::TextureFormat,
+    /// Its width in pixels: the frame's view width.
+    pub width: u32,
+    /// Its height in pixels.
+    pub height: u32,
+}
+
+impl FrameRecorder {
+    /// A recorder with nothing made yet.
+    #[must_use]
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Records one frame of `frame` with `technique` into `encoder`: the G-buffer, every light's build
+    /// and query, and shading into `target`. Returns the fitted view of each light.
+    ///
+    /// # Errors
+    /// Too many lights, a light the technique does not take, a technique that needs the GPU's results
+    /// within the frame ([`WgpuError::NotRecordable`]), or a GPU failure. On an error, what `encoder`
+    /// held may be lost.
+    pub fn record(
+        &mut self,
+        cx: &mut WgpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        frame: &FrameInputs,
+        technique: &mut dyn DynShadowTechnique<WgpuBackend>,
+        target: &ColorTarget<'_>,
+    ) -> Result<Vec<LightView>, WgpuError> {
+        let most = MAX_LIGHTS.min(cx.device.limits().max_texture_array_layers as usize);
+        if frame.lights.len() > most {
+            return Err(WgpuError::TooManyLights { lights: frame.lights.len(), most });
+        }
+        let visibility =
+            visibility_for(&mut self.visibility, cx, target.width, target.height, frame.lights.len() as u32);
+        let shade = self.shade.entry(target.format).or_insert_with(|| shade_pipeline(cx, target.format));
+        let steps = RecordSteps { width: target.width, height: target.height, visibility, shade, target: target.view };
+        let FrameRun { light_views, .. } = cx.record_into(encoder, |cx| run_frame(cx, frame, steps, technique))?;
+        Ok(light_views)
+    }
+
+    /// The last recorded frame's visibility, a layer per light (R32Float: 1 lit, 0 shadowed), for engines
+    /// that shade themselves; `None` before the first frame.
+    #[must_use]
+    pub fn visibility(&self) -> Option<&wgpu::Texture> {
+        self.visibility.as_ref().map(|v| &v.texture)
+    }
+}
+
+/// The visibility targets in `slot` for a `width x height` view of `lights` lights, made again only when
+/// either changed.
+fn visibility_for<'a>(
+    slot: &'a mut Option<Visibility>,
+    cx: &WgpuContext,
+    width: u32,
+    height: u32,
+    lights: u32,
+) -> &'a wgpu::Texture {
+    let layers = lights.max(1);
+    let fits = |v: &Visibility| v.width == width && v.height == height && v.layers == layers;
+    if !slot.as_ref().is_some_and(fits) {
+        *slot = None;
+    }
+    let made = slot.get_or_insert_with(|| Visibility {
+        texture: layered(cx, "recorded visibility", width, height, layers, VISIBILITY),
+        width,
+        height,
+        layers,
+    });
+    &made.texture
+}
+
+/// The shading pipeline for a target of `format`.
+fn shade_pipeline(cx: &WgpuContext, format: wgpu::TextureFormat) -> wgpu::RenderPipeline {
+    let module = crate::shaders::module(&cx.device, "shade", crate::shaders::shade());
+    let entry = if format.is_srgb() { "fs_shade_linear" } else { "fs_shade" };
+    let groups = [&cx.shared.frame_layout, &cx.shared.shade_layout];
+    full_screen_pipeline(&cx.device, "recorded shade", &module, entry, &groups, Some(format), None)
+}
+
+/// The recording steps: the frame's targets and the host's.
+struct RecordSteps<'a> {
+    width: u32,
+    height: u32,
+    visibility: &'a wgpu::Texture,
+    shade: &'a wgpu::RenderPipeline,
+    target: &'a wgpu::TextureView,
+}
+
+impl FrameSteps<WgpuBackend> for RecordSteps<'_> {
+    type Shaded = ();
+    type Output = ();
+
+    fn gbuffer(&mut self, cx: &mut WgpuContext, frame: &FrameInputs) -> Result<GpuGBuffer, WgpuError> {
+        gbuffer::render(cx, frame, self.width, self.height)
+    }
+
+    fn visibility(&mut self, _cx: &mut WgpuContext, k: usize) -> Result<GpuVisibility, WgpuError> {
+        Ok(GpuVisibility { view: layer_view(self.visibility, k as u32), width: self.width, height: self.height })
+    }
+
+    fn keep(&mut self, _k: usize, _visibility: GpuVisibility) {}
+
+    fn shade(&mut self, cx: &mut WgpuContext, frame: &FrameInputs, g: &GpuGBuffer) -> Result<(), WgpuError> {
+        cx.scoped("the recorded shading pass", |cx| {
+            let group = shade_group(cx, frame, g, self.visibility);
+            let mut enc = cx.encoder("shade");
+            full_screen_shade(&mut enc, self.target, self.shade, g, &group, None);
+            cx.submit(enc);
+        })
+    }
+
+    fn finish(
+        self,
+        _cx: &mut WgpuContext,
+        _gbuffer: GpuGBuffer,
+        _shaded: (),
+        _stats: &mut FrameStats,
+    ) -> Result<(), WgpuError> {
+        Ok(())
+    }
+}
