@@ -102,6 +102,15 @@ impl Renderer {
         self.gpu.as_ref().map(|g| &g.adapter)
     }
 
+    /// The GPU context, made on first use (a software adapter allowed), for driving the wgpu backend
+    /// directly: recording frames into an encoder of the caller's, say.
+    ///
+    /// # Errors
+    /// No adapter, or a device that cannot be created.
+    pub fn wgpu_context(&mut self) -> Result<&mut WgpuContext, Error> {
+        self.gpu(true)
+    }
+
     /// The registry.
     #[must_use]
     pub fn registry(&self) -> &TechniqueRegistry {

@@ -98,6 +98,8 @@ fn bad_inputs_give_one_line_and_the_right_status() {
         (&["bench", "--frames", "0", "--backend", "cpu"], 2, "--frames must be at least 1"),
         (&["bench", "--sweep", "speed=1,2", "--backend", "cpu"], 2, "must be res or tris"),
         (&["bench", "--sweep", "res=256,-3", "--backend", "cpu"], 2, "positive whole numbers"),
+        (&["bench", "--realtime", "--backend", "cpu"], 2, "--realtime runs on the wgpu backend, not 'cpu'"),
+        (&["bench", "--realtime", "--sweep", "res=256"], 2, "--realtime does not sweep"),
         // A sphere of 2 billion vertices, refused before it is allocated.
         (
             &["bench", "--sweep", "tris=4000000000", "--backend", "cpu"],

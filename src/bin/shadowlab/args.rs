@@ -190,6 +190,10 @@ pub(crate) enum Command {
         /// Print JSON.
         #[arg(long)]
         json: bool,
+        /// Measure the real-time path on the GPU (frames recorded into the bench's own encoder, two in
+        /// flight, no waits or read-backs inside a frame) beside the instrumented frames, with their ratio.
+        #[arg(long)]
+        realtime: bool,
         /// Repeat over a parameter: res=256,512,... (map side) or tris=10000,100000,... (a sphere of that
         /// many triangles on the ground); writes sweep.csv and sweep.png.
         #[arg(long)]

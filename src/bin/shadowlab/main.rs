@@ -116,8 +116,21 @@ fn run(cli: Cli) -> Result<(), Error> {
         Command::Compare { scene, view, technique, techniques, backend, reference, out_dir } => {
             compare(&scene, &view, technique, techniques, &backend, reference.as_deref(), out_dir)
         }
-        Command::Bench { scene, view, technique, techniques, backend, frames, warmup, json, sweep, out_dir } => {
-            bench(&scene, &view, BenchArgs { technique, techniques, backend, frames, warmup, json, sweep, out_dir })
+        Command::Bench {
+            scene,
+            view,
+            technique,
+            techniques,
+            backend,
+            frames,
+            warmup,
+            json,
+            realtime,
+            sweep,
+            out_dir,
+        } => {
+            let b = BenchArgs { technique, techniques, backend, frames, warmup, json, realtime, sweep, out_dir };
+            bench(&scene, &view, b)
         }
         Command::Export { scene, out } => export(&scene, &out),
         Command::Results { out, size, backend, bench_scene, bench_size, bench_frames } => {
@@ -468,6 +481,7 @@ struct BenchArgs {
     frames: u32,
     warmup: u32,
     json: bool,
+    realtime: bool,
     sweep: Option<String>,
     out_dir: Option<PathBuf>,
 }
@@ -493,6 +507,12 @@ fn bench(args: &SceneArgs, view: &ViewArgs, b: BenchArgs) -> Result<(), Error> {
         return Err(Error::Usage("--frames must be at least 1".into()));
     }
     let sweep = b.sweep.as_deref().map(parse_sweep).transpose()?;
+    if b.realtime && sweep.is_some() {
+        return Err(Error::Usage("--realtime does not sweep: leave out --sweep".into()));
+    }
+    if b.realtime && !["auto", "wgpu"].contains(&b.backend.as_str()) {
+        return Err(Error::Usage(format!("--realtime runs on the wgpu backend, not '{}'", b.backend)));
+    }
     view.check_adapter(&b.backend)?;
     let mut renderer = Renderer::new(TechniqueRegistry::builtin()).with_adapter(view.adapter.clone());
     // The scene and its view are checked before the backend says which it is.
@@ -506,7 +526,7 @@ fn bench(args: &SceneArgs, view: &ViewArgs, b: BenchArgs) -> Result<(), Error> {
             sweep_scenes.push(sweep_scene(v).map_err(|e| Error::Usage(format!("--sweep tris={v}: {e}")))?);
         }
     }
-    let kinds = backends(&mut renderer, &b.backend)?;
+    let kinds = backends(&mut renderer, if b.realtime { "wgpu" } else { &b.backend })?;
     match sweep {
         None => bench_once(&mut renderer, (args, first), specs, kinds, &b),
         Some((key, values)) => {
@@ -516,7 +536,8 @@ fn bench(args: &SceneArgs, view: &ViewArgs, b: BenchArgs) -> Result<(), Error> {
     }
 }
 
-/// One bench run of the scene's own frame: the table, or JSON.
+/// One bench run of the scene's own frame (with `--realtime`, the real-time path beside the instrumented
+/// frames): the table, or JSON.
 fn bench_once(
     renderer: &mut Renderer,
     (args, (frame, w, h)): (&SceneArgs, (FrameInputs, u32, u32)),
@@ -524,6 +545,7 @@ fn bench_once(
     kinds: Vec<shadowlab::BackendKind>,
     b: &BenchArgs,
 ) -> Result<(), Error> {
+    use shadowlab::bench::realtime::{realtime_steps, realtime_table, run_realtime_bench};
     use shadowlab::bench::{BenchJob, bench_table, run_bench};
     let job = BenchJob {
         scene: args.name(),
@@ -535,15 +557,21 @@ fn bench_once(
         techniques: specs,
         backends: kinds,
     };
-    let bar = progress_bar(job.steps());
-    let r = run_bench(renderer, &job, |m| report_progress(&bar, m))?;
+    let bar = progress_bar(if b.realtime { realtime_steps(&job) } else { job.steps() });
+    let (json, table) = if b.realtime {
+        let r = run_realtime_bench(renderer, &job, |m| report_progress(&bar, m))?;
+        (serde_json::to_value(&r), realtime_table(&r))
+    } else {
+        let r = run_bench(renderer, &job, |m| report_progress(&bar, m))?;
+        (serde_json::to_value(&r), bench_table(&r))
+    };
     if let Some(bar) = bar {
         bar.finish_and_clear();
     }
     if b.json {
-        return print_json(&serde_json::to_value(&r).map_err(|e| Error::Usage(e.to_string()))?);
+        return print_json(&json.map_err(|e| Error::Usage(e.to_string()))?);
     }
-    out_raw!("{}", bench_table(&r));
+    out_raw!("{table}");
     Ok(())
 }
 

@@ -8,6 +8,8 @@
 //! measured. The backends do not take turns: between CPU frames, which share the machine's cores with it,
 //! lavapipe ran `smoothies` 1.52 times its shadow map's frame on cylinder, against 1.28 to 1.32 on its own.
 
+pub mod realtime;
+
 use std::collections::BTreeMap;
 
 use glam::{Mat3, Vec3};
@@ -98,6 +100,15 @@ pub fn moved_light(light: &Light, center: Vec3, k: u32, n: u32) -> Light {
 }
 
 impl BenchJob<'_> {
+    /// The frame of run frame `k` of `total`: the lights turned a `k / total` part of a quarter turn.
+    #[must_use]
+    pub fn frame_at(&self, k: u32, total: u32) -> FrameInputs {
+        let center = self.frame.bounds.center();
+        let mut frame = self.frame.clone();
+        frame.lights = self.frame.lights.iter().map(|l| moved_light(l, center, k, total)).collect();
+        frame
+    }
+
     /// How many times [`run_bench`] reports progress: per backend, once per technique as it is prepared,
     /// then once per frame round (warm-up included).
     #[must_use]
@@ -125,7 +136,6 @@ pub fn run_bench(
     job: &BenchJob<'_>,
     mut progress: impl FnMut(&str),
 ) -> Result<BenchReport, Error> {
-    let center = job.frame.bounds.center();
     let total = job.warmup + job.frames;
     let mut lanes = Vec::new();
     for &backend in &job.backends {
@@ -138,8 +148,7 @@ pub fn run_bench(
         for k in 0..total {
             let warm = if k < job.warmup { " (warm-up)" } else { "" };
             progress(&format!("{}: frame {} of {total}{warm}", backend.name(), k + 1));
-            let mut frame = job.frame.clone();
-            frame.lights = job.frame.lights.iter().map(|l| moved_light(l, center, k, total)).collect();
+            let frame = job.frame_at(k, total);
             for lane in &mut lanes[first..] {
                 let run = renderer.run_prepared(&mut lane.prepared, &frame, job.width, job.height)?;
                 if k >= job.warmup {
