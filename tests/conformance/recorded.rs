@@ -1,8 +1,8 @@
 //! The frame recorded into a host's encoder against the instrumented frame: every technique that can be
 //! recorded gives the same visibility, byte for byte, and the same shaded image in an Rgba8Unorm target
 //! (and within one level of it in a Bgra8UnormSrgb one, whose stores encode); a technique that needs the
-//! GPU's results within the frame is refused by name. Without a wgpu adapter this prints one line and
-//! passes, unless SHADOWLAB_REQUIRE_GPU=1.
+//! GPU's results within the frame (or a variant that reads tiles back) is refused by name. Without a wgpu
+//! adapter this prints one line and passes, unless SHADOWLAB_REQUIRE_GPU=1.
 
 use shadow_core::FrameInputs;
 use shadow_core::scenes::{self, SceneParams};
@@ -83,4 +83,10 @@ fn recorded_frames_match_the_instrumented_ones() {
         }
     }
     assert!(recorded >= 18, "only {recorded} techniques recorded");
+    // The scissor rectangles come from tile marks read back within the frame.
+    let s = scenes::build("cubes", &SceneParams::default()).expect("scene");
+    let frame = FrameInputs::from_first_camera(&s).expect("frame");
+    let spec = TechniqueSpec::parse("hybrid:scissor_tile=32").expect("spec");
+    let err = record(&mut cx, &mut recorder, &frame, &spec, &unorm).err().expect("refused");
+    assert!(matches!(err, WgpuError::NotRecordable { .. }), "{err}");
 }
