@@ -322,6 +322,25 @@ impl WgpuContext {
         wgpu::Limits { max_color_attachment_bytes_per_sample: 64, ..wgpu::Limits::default() }
     }
 
+    /// Whether shadowlab can work on `adapter`: it has [`Self::REQUIRED_FEATURES`] and renders to every
+    /// target format shadowlab uses.
+    #[must_use]
+    pub fn can_use(adapter: &wgpu::Adapter) -> bool {
+        missing(adapter).is_none()
+    }
+
+    /// The device a host application asks for to lend it to shadowlab: [`Self::REQUIRED_FEATURES`] and
+    /// [`Self::required_limits`] (a host may ask for more).
+    #[must_use]
+    pub fn device_descriptor() -> wgpu::DeviceDescriptor<'static> {
+        wgpu::DeviceDescriptor {
+            label: Some("shadowlab host"),
+            required_features: Self::REQUIRED_FEATURES,
+            required_limits: Self::required_limits(),
+            ..Default::default()
+        }
+    }
+
     /// A context on the host application's own device and queue (clones of them: wgpu's handles are
     /// shared), made from `adapter`. Everything shadowlab creates lives on that device, so its textures
     /// can be drawn into the host's surface and sampled by the host's passes.

@@ -15,14 +15,9 @@ fn host_device(name: &str, features: wgpu::Features) -> (wgpu::Adapter, wgpu::De
     let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle());
     let adapter = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::all()))
         .into_iter()
-        .find(|a| a.get_info().name == name && a.features().contains(WgpuContext::REQUIRED_FEATURES))
+        .find(|a| a.get_info().name == name && WgpuContext::can_use(a))
         .unwrap_or_else(|| panic!("the host's instance has no adapter '{name}'"));
-    let desc = wgpu::DeviceDescriptor {
-        label: Some("host"),
-        required_features: features,
-        required_limits: WgpuContext::required_limits(),
-        ..Default::default()
-    };
+    let desc = wgpu::DeviceDescriptor { required_features: features, ..WgpuContext::device_descriptor() };
     let (device, queue) = pollster::block_on(adapter.request_device(&desc)).expect("a host device");
     (adapter, device, queue)
 }

@@ -87,6 +87,6 @@ fn recorded_frames_match_the_instrumented_ones() {
     let s = scenes::build("cubes", &SceneParams::default()).expect("scene");
     let frame = FrameInputs::from_first_camera(&s).expect("frame");
     let spec = TechniqueSpec::parse("hybrid:scissor_tile=32").expect("spec");
-    let err = record(&mut cx, &mut recorder, &frame, &spec, &unorm).err().expect("refused");
+    let err = record(&mut cx, &mut recorder, &frame, &spec, &unorm).expect_err("refused");
     assert!(matches!(err, WgpuError::NotRecordable { .. }), "{err}");
 }
