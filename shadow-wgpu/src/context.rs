@@ -167,6 +167,8 @@ pub struct WgpuContext {
     /// lent to each pass in turn.
     lent: RefCell<Option<wgpu::CommandEncoder>>,
     recording: Cell<bool>,
+    /// The G-buffer's targets of the last frame, reused while the view's size stays.
+    pub(crate) gbuffer_targets: Option<crate::gbuffer::GBufferTargets>,
 }
 
 /// The instance. Set `XDG_RUNTIME_DIR` (CI does) to keep the Vulkan loader quiet on headless machines.
@@ -384,6 +386,7 @@ impl WgpuContext {
             shared,
             lent: RefCell::new(None),
             recording: Cell::new(false),
+            gbuffer_targets: None,
         }
     }
 

@@ -71,7 +71,37 @@ fn target(cx: &WgpuContext, label: &str, w: u32, h: u32, format: wgpu::TextureFo
     })
 }
 
-/// Renders the G-buffer of a frame.
+/// The G-buffer's targets and its camera's uniform buffer, kept from frame to frame while the view's size
+/// stays: a frame then allocates none of them.
+#[derive(Clone)]
+pub(crate) struct GBufferTargets {
+    width: u32,
+    height: u32,
+    depth: wgpu::Texture,
+    /// Position, normal, albedo, geometric normal.
+    attributes: [wgpu::TextureView; 4],
+    view: wgpu::Buffer,
+}
+
+impl GBufferTargets {
+    fn new(cx: &WgpuContext, width: u32, height: u32) -> Self {
+        Self {
+            width,
+            height,
+            depth: target(cx, "depth", width, height, DEPTH_STENCIL),
+            attributes: ["position", "normal", "albedo", "geometric normal"]
+                .map(|l| target(cx, l, width, height, ATTRIBUTE).create_view(&Default::default())),
+            view: cx.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("camera view"),
+                size: std::mem::size_of::<ViewRaw>() as u64,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+        }
+    }
+}
+
+/// Renders the G-buffer of a frame, into the targets of the frame before when its view had this size.
 ///
 /// # Errors
 /// A bad size or a GPU failure.
@@ -79,16 +109,17 @@ pub fn render(cx: &mut WgpuContext, frame: &FrameInputs, width: u32, height: u32
     check_size(cx, "view", width, height)?;
     cx.cache.upload_meshes(&cx.device, frame);
     let instances = cx.cache.instances(&cx.device, frame).clone();
+    let targets = match cx.gbuffer_targets.take() {
+        Some(t) if (t.width, t.height) == (width, height) => t,
+        _ => GBufferTargets::new(cx, width, height),
+    };
+    cx.gbuffer_targets = Some(targets.clone());
     cx.scoped("the G-buffer pass", |cx| {
         let clip_from_world = frame.camera.clip_from_world(width as f32 / height as f32);
-        let frame_group = cx.shared.frame_group(
-            &cx.device,
-            &ViewRaw::new(clip_from_world, frame.camera.eye, width, height),
-            &instances,
-        );
-        let depth = target(cx, "depth", width, height, DEPTH_STENCIL);
-        let [position, normal, albedo, geometric_normal] = ["position", "normal", "albedo", "geometric normal"]
-            .map(|l| target(cx, l, width, height, ATTRIBUTE).create_view(&Default::default()));
+        let view = ViewRaw::new(clip_from_world, frame.camera.eye, width, height);
+        cx.queue.write_buffer(&targets.view, 0, bytemuck::bytes_of(&view));
+        let frame_group = cx.shared.frame_group_with(&cx.device, &targets.view, &instances);
+        let GBufferTargets { depth, attributes: [position, normal, albedo, geometric_normal], .. } = targets;
         let depth_view = depth.create_view(&Default::default());
         let mut enc = cx.encoder("gbuffer");
         {

@@ -246,11 +246,22 @@ impl Shared {
             contents: bytemuck::bytes_of(view),
             usage: wgpu::BufferUsages::UNIFORM,
         });
+        self.frame_group_with(device, &ubuf, instances)
+    }
+
+    /// The same group over a uniform buffer of the caller's holding the view.
+    #[must_use]
+    pub fn frame_group_with(
+        &self,
+        device: &wgpu::Device,
+        view: &wgpu::Buffer,
+        instances: &wgpu::Buffer,
+    ) -> wgpu::BindGroup {
         device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("frame"),
             layout: &self.frame_layout,
             entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: ubuf.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 0, resource: view.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 1, resource: instances.as_entire_binding() },
             ],
         })
