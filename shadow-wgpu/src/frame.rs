@@ -242,24 +242,42 @@ fn read_count(cx: &WgpuContext, q: &wgpu::Buffer) -> Result<u64, WgpuError> {
     Ok(u64::from_le_bytes([d[0], d[1], d[2], d[3], d[4], d[5], d[6], d[7]]))
 }
 
+/// A uniform buffer for the shading pass's lights, to be written frame after frame.
+pub(crate) fn lights_buffer(cx: &WgpuContext) -> wgpu::Buffer {
+    cx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("lights"),
+        size: std::mem::size_of::<LightTable>() as u64,
+        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    })
+}
+
 /// The shading pass's inputs: the G-buffer's position, normal and albedo, every light's visibility (a
-/// layer each of `vis`) and the frame's lights.
+/// layer each of `vis`) and the frame's lights, written into `lights` when given (a buffer of
+/// [`lights_buffer`]'s) or into a new buffer.
 pub(crate) fn shade_group(
     cx: &WgpuContext,
     frame: &FrameInputs,
     g: &GpuGBuffer,
     vis: &wgpu::Texture,
+    lights: Option<&wgpu::Buffer>,
 ) -> wgpu::BindGroup {
-    let mut lights: LightTable = bytemuck::Zeroable::zeroed();
-    lights.count[0] = frame.lights.len() as u32;
-    for (slot, l) in lights.lights.iter_mut().zip(&frame.lights) {
+    let mut table: LightTable = bytemuck::Zeroable::zeroed();
+    table.count[0] = frame.lights.len() as u32;
+    for (slot, l) in table.lights.iter_mut().zip(&frame.lights) {
         *slot = LightRaw::from(l);
     }
-    let lbuf = cx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("lights"),
-        contents: bytemuck::bytes_of(&lights),
-        usage: wgpu::BufferUsages::UNIFORM,
-    });
+    let lbuf = match lights {
+        Some(b) => {
+            cx.queue.write_buffer(b, 0, bytemuck::bytes_of(&table));
+            b.clone()
+        }
+        None => cx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("lights"),
+            contents: bytemuck::bytes_of(&table),
+            usage: wgpu::BufferUsages::UNIFORM,
+        }),
+    };
     let vis_view = vis.create_view(&wgpu::TextureViewDescriptor {
         dimension: Some(wgpu::TextureViewDimension::D2Array),
         ..Default::default()
@@ -322,7 +340,7 @@ fn shade(
 ) -> Result<(wgpu::Texture, wgpu::Buffer), WgpuError> {
     cx.scoped("the shading pass", |cx| {
         let color = layered(cx, "color", g.width, g.height, 1, COLOR);
-        let group = shade_group(cx, frame, g, vis);
+        let group = shade_group(cx, frame, g, vis, None);
         let view = color.create_view(&Default::default());
         let query = cx.device.create_query_set(&wgpu::QuerySetDescriptor {
             label: Some("receivers"),
