@@ -112,6 +112,24 @@ fn gltf_hierarchy_strips_fans_camera_and_light() {
 }
 
 #[test]
+fn a_lamp_under_a_turned_scaled_parent_is_placed_by_the_whole_hierarchy() {
+    let s = assets::load(data("good/lamp_under_turned_parent.gltf")).unwrap();
+    let light = s.lights().next().unwrap().1;
+    // Parent: at (1, 2, 0), a quarter turn about +y (+z goes to +x), scale 2; lamp 3 along the parent's
+    // +z: 6 along world +x from the parent. It shines down its -z, world -x.
+    match light.kind {
+        LightKind::Spot { position, direction, cone_angle } => {
+            assert!((position - Vec3::new(7.0, 2.0, 0.0)).length() < 1e-5, "{position}");
+            assert!((direction - Vec3::NEG_X).length() < 1e-5, "{direction}");
+            assert!((cone_angle - 0.8).abs() < 1e-6, "{cone_angle}");
+        }
+        other => panic!("{other:?}"),
+    }
+    assert!(light.inner_cone_angle.is_some_and(|a| (a - 0.4).abs() < 1e-6), "{:?}", light.inner_cone_angle);
+    assert_eq!((light.intensity, light.range, light.color), (5.0, Some(10.0), Vec3::new(1.0, 0.5, 0.25)));
+}
+
+#[test]
 fn glb_with_binary_chunk_loads() {
     let s = assets::load(data("good/triangle.glb")).unwrap();
     assert_eq!(s.triangle_count(), 1);
