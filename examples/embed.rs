@@ -1,7 +1,7 @@
 //! An application that owns its window and GPU and draws shadowlab's shadows in its own frame: it makes
-//! the wgpu instance, adapter, device and surface, lends the device to shadowlab
-//! (`WgpuContext::from_host`), and every frame records the shadowed scene into its own command encoder
-//! (`FrameRecorder::record`) before it presents. Space switches the technique; Escape quits.
+//! the wgpu instance, adapter, device and surface, lends the device to shadowlab (`RealtimeShadows`), and
+//! every frame records the shadowed scene into its own command encoder before it presents. Space switches
+//! the technique; Escape quits.
 //!
 //! `cargo run --release --example embed` opens a window. Without a display, or with `--frames N`, it
 //! renders N frames (30 by default) into a texture of its own and writes the last to `out/embed.png`.
@@ -9,10 +9,9 @@
 use std::sync::Arc;
 
 use shadow_core::scenes::{self, SceneParams};
-use shadow_core::technique::{DynShadowTechnique, TechniqueSpec};
 use shadow_core::{FrameInputs, Image};
-use shadow_wgpu::{ColorTarget, FrameRecorder, WgpuBackend, WgpuContext};
-use shadowlab::{TechniqueRegistry, bench::moved_light};
+use shadow_wgpu::{ColorTarget, WgpuContext};
+use shadowlab::{TechniqueRegistry, bench::moved_light, realtime::RealtimeShadows};
 use winit::event::WindowEvent;
 use winit::event_loop::{ActiveEventLoop, EventLoop};
 use winit::keyboard::{Key, NamedKey};
@@ -21,24 +20,27 @@ use winit::window::{Window, WindowId};
 type Failure = Box<dyn std::error::Error>;
 const TECHNIQUES: [&str; 4] = ["shadow-map", "shadow-volume-zfail", "hybrid", "pcss"];
 
-/// shadowlab's part: its context on the application's device, the scene, the techniques to switch between.
+/// shadowlab's part: the shadows on the application's device, the scene, the technique's place in the list.
 struct Shadows {
-    cx: WgpuContext,
-    recorder: FrameRecorder,
+    shadows: RealtimeShadows,
     frame: FrameInputs,
-    techniques: Vec<Box<dyn DynShadowTechnique<WgpuBackend>>>,
     which: usize,
     tick: u32,
 }
 
 impl Shadows {
-    fn new(adapter: &wgpu::Adapter, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<Self, Failure> {
-        let cx = WgpuContext::from_host(adapter, device.clone(), queue.clone())?;
-        let frame = FrameInputs::from_first_camera(&scenes::build("cubes", &SceneParams::default())?)?;
+    fn new((adapter, device, queue): &Gpu) -> Result<Self, Failure> {
         let registry = TechniqueRegistry::builtin();
-        let techniques =
-            TECHNIQUES.iter().map(|t| registry.wgpu(&TechniqueSpec::named(t))).collect::<Result<_, _>>()?;
-        Ok(Self { cx, recorder: FrameRecorder::new(), frame, techniques, which: 0, tick: 0 })
+        let shadows = RealtimeShadows::new(adapter, device.clone(), queue.clone(), registry, TECHNIQUES[0])?;
+        let frame = FrameInputs::from_first_camera(&scenes::build("cubes", &SceneParams::default())?)?;
+        Ok(Self { shadows, frame, which: 0, tick: 0 })
+    }
+
+    fn next_technique(&mut self) -> Result<(), Failure> {
+        self.which = (self.which + 1) % TECHNIQUES.len();
+        self.shadows.set_technique(TECHNIQUES[self.which])?;
+        println!("technique: {}", self.shadows.technique());
+        Ok(())
     }
 
     /// Records one frame into the application's encoder, the light turned a little further.
@@ -46,8 +48,7 @@ impl Shadows {
         let (mut frame, center) = (self.frame.clone(), self.frame.bounds.center());
         frame.lights = self.frame.lights.iter().map(|l| moved_light(l, center, self.tick % 240, 60)).collect();
         self.tick += 1;
-        let technique = self.techniques[self.which].as_mut();
-        self.recorder.record(&mut self.cx, encoder, &frame, technique, target)?;
+        self.shadows.record(encoder, &frame, target)?;
         Ok(())
     }
 }
@@ -81,7 +82,7 @@ impl Windowed {
         let (gpu, size) = (gpu(&instance, Some(&surface))?, window.inner_size());
         let config = surface.get_default_config(&gpu.0, size.width, size.height).ok_or("cannot present")?;
         surface.configure(&gpu.1, &config);
-        Ok(Self { window, surface, config, shadows: Shadows::new(&gpu.0, &gpu.1, &gpu.2)?, gpu })
+        Ok(Self { window, surface, config, shadows: Shadows::new(&gpu)?, gpu })
     }
 
     fn redraw(&mut self) -> Result<(), Failure> {
@@ -120,10 +121,7 @@ impl winit::application::ApplicationHandler for App {
         match event {
             WindowEvent::KeyboardInput { event, .. } if event.state.is_pressed() => match event.logical_key {
                 Key::Named(NamedKey::Escape) => event_loop.exit(),
-                Key::Named(NamedKey::Space) => {
-                    app.shadows.which = (app.shadows.which + 1) % TECHNIQUES.len();
-                    println!("technique: {}", TECHNIQUES[app.shadows.which]);
-                }
+                Key::Named(NamedKey::Space) => self.1 = app.shadows.next_technique().err(),
                 _ => {}
             },
             WindowEvent::Resized(size) => {
@@ -142,18 +140,17 @@ impl winit::application::ApplicationHandler for App {
 
 /// `frames` frames into a texture of the application's own, the last written to `out/embed.png`.
 fn offscreen(frames: u32) -> Result<(), Failure> {
-    let (adapter, device, queue) =
-        gpu(&wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle()), None)?;
-    let mut shadows = Shadows::new(&adapter, &device, &queue)?;
+    let gpu = gpu(&wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle()), None)?;
+    let (mut shadows, (_, device, queue)) = (Shadows::new(&gpu)?, &gpu);
     let (width, height, format) = (640, 480, wgpu::TextureFormat::Rgba8UnormSrgb);
-    let texture = shadow_wgpu::frame::layered(&shadows.cx, "offscreen", width, height, 1, format);
+    let texture = shadow_wgpu::frame::layered(shadows.shadows.context(), "offscreen", width, height, 1, format);
     let view = texture.create_view(&Default::default());
     for _ in 0..frames {
         let mut encoder = device.create_command_encoder(&Default::default());
         shadows.draw(&mut encoder, &ColorTarget { view: &view, format, width, height })?;
         queue.submit([encoder.finish()]);
     }
-    let image: Image<_> = shadow_wgpu::readback::read_rgb8(&shadows.cx, &texture)?;
+    let image: Image<_> = shadow_wgpu::readback::read_rgb8(shadows.shadows.context(), &texture)?;
     std::fs::create_dir_all("out")?;
     image.save_png("out/embed.png")?;
     println!("{frames} frames of {}; the last in out/embed.png", TECHNIQUES[shadows.which]);

@@ -8,6 +8,7 @@ pub mod bench;
 pub mod compare;
 mod error;
 pub mod plot;
+pub mod realtime;
 pub mod registry;
 pub mod renderer;
 pub mod results;
@@ -24,6 +25,8 @@ use shadow_core::Scene;
 use shadow_core::assets::{self, AssetError};
 use shadow_core::scenes::{self, SceneParams, UnknownScene};
 pub use shadow_cpu as cpu;
+pub use shadow_wgpu as gpu;
+pub use wgpu;
 
 /// Why a scene could not be had.
 #[derive(Debug, thiserror::Error)]

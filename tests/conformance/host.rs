@@ -61,3 +61,31 @@ fn a_host_device_without_the_depth_stencil_format_is_refused_by_name() {
     let msg = err.to_string();
     assert!(msg.contains(&name) && msg.contains("DEPTH32FLOAT_STENCIL8"), "{msg}");
 }
+
+#[test]
+fn realtime_shadows_switch_techniques_and_keep_theirs_on_a_refusal() {
+    use shadowlab::realtime::RealtimeShadows;
+    let Some(renderer) = crate::with_wgpu("realtime shadows") else { return };
+    let name = renderer.adapter().expect("an adapter").name.clone();
+    let (adapter, device, queue) = host_device(&name, WgpuContext::REQUIRED_FEATURES);
+    let registry = TechniqueRegistry::builtin();
+    let mut shadows = RealtimeShadows::new(&adapter, device.clone(), queue.clone(), registry, "shadow-map")
+        .unwrap_or_else(|e| panic!("{e}"));
+    let err = shadows.set_technique("ray-traced").expect_err("the reference has no GPU side");
+    assert!(err.to_string().contains("not implemented on the wgpu backend"), "{err}");
+    assert!(shadows.set_technique("shadow-map:res=3").is_err(), "a map of side 3 taken");
+    assert_eq!(shadows.technique().to_string(), "shadow-map");
+    shadows.set_technique("shadow-volume-zfail").unwrap_or_else(|e| panic!("{e}"));
+    let s = scenes::build("cubes", &SceneParams::default()).expect("scene");
+    let frame = FrameInputs::from_first_camera(&s).expect("frame");
+    let texture = shadow_wgpu::frame::layered(shadows.context(), "target", 64, 48, 1, wgpu::TextureFormat::Rgba8Unorm);
+    let view = texture.create_view(&Default::default());
+    let target = shadow_wgpu::ColorTarget { view: &view, format: texture.format(), width: 64, height: 48 };
+    let mut encoder = device.create_command_encoder(&Default::default());
+    let views = shadows.record(&mut encoder, &frame, &target).unwrap_or_else(|e| panic!("{e}"));
+    queue.submit([encoder.finish()]);
+    assert_eq!(views.len(), frame.lights.len());
+    let vis = shadows.visibility().expect("a visibility target");
+    let vis = shadow_wgpu::readback::read_f32(shadows.context(), vis, 0, wgpu::TextureAspect::All).expect("read back");
+    assert!(vis.data().contains(&0.0) && vis.data().contains(&1.0), "no shadow edge in the recorded frame");
+}

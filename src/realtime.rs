@@ -1,0 +1,96 @@
+//! Shadows inside a host application's own wgpu frame: shadowlab's context on the host's device, a frame
+//! recorder, and a technique chosen by its spec at runtime and switched between frames.
+//!
+//! ```no_run
+//! # fn frame(adapter: &wgpu::Adapter, device: &wgpu::Device, queue: &wgpu::Queue,
+//! #          frame: &shadowlab::core::FrameInputs, view: &wgpu::TextureView) -> Result<(), shadowlab::Error> {
+//! use shadowlab::realtime::RealtimeShadows;
+//! use shadowlab::TechniqueRegistry;
+//!
+//! let mut shadows =
+//!     RealtimeShadows::new(adapter, device.clone(), queue.clone(), TechniqueRegistry::builtin(), "shadow-map")?;
+//! let target = shadow_wgpu::ColorTarget { view, format: wgpu::TextureFormat::Bgra8UnormSrgb, width: 800, height: 600 };
+//! let mut encoder = device.create_command_encoder(&Default::default());
+//! shadows.record(&mut encoder, frame, &target)?;
+//! queue.submit([encoder.finish()]);
+//! shadows.set_technique("shadow-volume-zfail")?;
+//! # Ok(()) }
+//! ```
+
+use shadow_core::technique::{DynShadowTechnique, TechniqueSpec};
+use shadow_core::{FrameInputs, LightView};
+use shadow_wgpu::{ColorTarget, FrameRecorder, WgpuBackend, WgpuContext};
+
+use crate::{Error, TechniqueRegistry};
+
+/// Shadows recorded into a host's frames (see the module docs).
+pub struct RealtimeShadows {
+    cx: WgpuContext,
+    recorder: FrameRecorder,
+    registry: TechniqueRegistry,
+    spec: TechniqueSpec,
+    technique: Box<dyn DynShadowTechnique<WgpuBackend>>,
+}
+
+impl RealtimeShadows {
+    /// Shadows on the host's device and queue (made from `adapter`), with the technique of `spec`
+    /// (`NAME[:key=value,...]`) from `registry`.
+    ///
+    /// # Errors
+    /// A device short of what shadowlab requires, or a spec the registry refuses or has no GPU side for.
+    pub fn new(
+        adapter: &wgpu::Adapter,
+        device: wgpu::Device,
+        queue: wgpu::Queue,
+        registry: TechniqueRegistry,
+        spec: &str,
+    ) -> Result<Self, Error> {
+        let cx = WgpuContext::from_host(adapter, device, queue)?;
+        let spec = TechniqueSpec::parse(spec)?;
+        let technique = registry.wgpu(&spec)?;
+        Ok(Self { cx, recorder: FrameRecorder::new(), registry, spec, technique })
+    }
+
+    /// Switches to the technique of `spec` from the next frame on; on an error the current one stays.
+    ///
+    /// # Errors
+    /// A spec the registry refuses or has no GPU side for.
+    pub fn set_technique(&mut self, spec: &str) -> Result<(), Error> {
+        let spec = TechniqueSpec::parse(spec)?;
+        self.technique = self.registry.wgpu(&spec)?;
+        self.spec = spec;
+        Ok(())
+    }
+
+    /// The technique's spec.
+    #[must_use]
+    pub fn technique(&self) -> &TechniqueSpec {
+        &self.spec
+    }
+
+    /// Records one frame into the host's `encoder`, shading into `target` (see [`FrameRecorder::record`]).
+    /// Returns the fitted view of each light.
+    ///
+    /// # Errors
+    /// As [`FrameRecorder::record`].
+    pub fn record(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        frame: &FrameInputs,
+        target: &ColorTarget<'_>,
+    ) -> Result<Vec<LightView>, Error> {
+        Ok(self.recorder.record(&mut self.cx, encoder, frame, self.technique.as_mut(), target)?)
+    }
+
+    /// The last frame's visibility, a layer per light (see [`FrameRecorder::visibility`]).
+    #[must_use]
+    pub fn visibility(&self) -> Option<&wgpu::Texture> {
+        self.recorder.visibility()
+    }
+
+    /// shadowlab's context on the host's device.
+    #[must_use]
+    pub fn context(&self) -> &WgpuContext {
+        &self.cx
+    }
+}
