@@ -5,7 +5,7 @@
 //! and reads its own timestamps after the run.
 //!
 //! Beside each technique's real-time frames, its instrumented frames (`bench`'s: a wait after each phase,
-//! counters, read-backs) run in the same session, so their ratio holds on a machine whose speed drifts.
+//! counters, read-backs) run in the same process, so their ratio holds on a machine whose speed drifts.
 
 use std::collections::VecDeque;
 use std::time::Instant;
