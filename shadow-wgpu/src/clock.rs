@@ -76,14 +76,7 @@ impl PhaseClock {
         }
         let index = self.count.get();
         let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("phase marker") });
-        drop(enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("phase marker"),
-            timestamp_writes: Some(wgpu::ComputePassTimestampWrites {
-                query_set: &self.set,
-                beginning_of_pass_write_index: Some(index),
-                end_of_pass_write_index: None,
-            }),
-        }));
+        write_mark(&mut enc, &self.set, index);
         queue.submit([enc.finish()]);
         self.count.set(index + 1);
         Some(index)
@@ -98,29 +91,41 @@ impl PhaseClock {
         if count == 0 {
             return Ok(Vec::new());
         }
-        let size = u64::from(count) * 8;
-        let resolve = cx.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("timestamps"),
-            size,
-            usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
-        });
-        let staging = cx.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("timestamps readback"),
-            size,
-            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-            mapped_at_creation: false,
-        });
-        let mut enc = cx.device.create_command_encoder(&Default::default());
-        enc.resolve_query_set(&self.set, 0..count, &resolve, 0);
-        enc.copy_buffer_to_buffer(&resolve, 0, &staging, 0, size);
-        cx.queue.submit([enc.finish()]);
-        let ticks = crate::readback::map_read(cx, &staging, "reading timestamps")?;
+        let ticks = read_ticks(cx, &self.set, count)?;
         let period = f64::from(cx.queue.get_timestamp_period());
-        let ticks: Vec<u64> = ticks
-            .chunks_exact(8)
-            .map(|c| u64::from_le_bytes([c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7]]))
-            .collect();
         Ok(ticks.iter().map(|&t| t.saturating_sub(ticks[0]) as f64 * period * 1e-6).collect())
     }
+}
+
+/// Writes timestamp `index` of `set` where `encoder` stands: an empty compute pass that writes it as it
+/// begins.
+pub fn write_mark(encoder: &mut wgpu::CommandEncoder, set: &wgpu::QuerySet, index: u32) {
+    drop(encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+        label: Some("timestamp"),
+        timestamp_writes: Some(wgpu::ComputePassTimestampWrites {
+            query_set: set,
+            beginning_of_pass_write_index: Some(index),
+            end_of_pass_write_index: None,
+        }),
+    }));
+}
+
+/// The first `count` timestamps of `set`, in ticks of the queue's timestamp period, read back once the
+/// work that wrote them is done.
+///
+/// # Errors
+/// A GPU failure while reading them back, or a read-back inside a recorded frame.
+pub fn read_ticks(cx: &WgpuContext, set: &wgpu::QuerySet, count: u32) -> Result<Vec<u64>, WgpuError> {
+    let size = u64::from(count) * 8;
+    let buffer = |label, usage| {
+        cx.device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size, usage, mapped_at_creation: false })
+    };
+    let resolve = buffer("timestamps", wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC);
+    let staging = buffer("timestamps readback", wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ);
+    let mut enc = cx.encoder("timestamps");
+    enc.resolve_query_set(set, 0..count, &resolve, 0);
+    enc.copy_buffer_to_buffer(&resolve, 0, &staging, 0, size);
+    cx.submit(enc);
+    let bytes = crate::readback::map_read(cx, &staging, "reading timestamps")?;
+    Ok(bytes.chunks_exact(8).map(|c| u64::from_le_bytes([c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7]])).collect())
 }

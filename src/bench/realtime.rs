@@ -233,33 +233,15 @@ impl FrameClock {
         Self { set, count }
     }
 
-    /// Writes timestamp `index` where `encoder` stands (an empty compute pass that writes it).
+    /// Writes timestamp `index` where `encoder` stands.
     fn mark(&self, encoder: &mut wgpu::CommandEncoder, index: u32) {
-        drop(encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("frame mark"),
-            timestamp_writes: Some(wgpu::ComputePassTimestampWrites {
-                query_set: &self.set,
-                beginning_of_pass_write_index: Some(index),
-                end_of_pass_write_index: None,
-            }),
-        }));
+        shadow_wgpu::clock::write_mark(encoder, &self.set, index);
     }
 
     /// Each frame's GPU time in ms.
     fn read(&self, cx: &WgpuContext) -> Result<Vec<f64>, WgpuError> {
-        let size = u64::from(self.count) * 8;
-        let usage =
-            |u| wgpu::BufferDescriptor { label: Some("frame clock"), size, usage: u, mapped_at_creation: false };
-        let resolve = cx.device.create_buffer(&usage(wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC));
-        let staging = cx.device.create_buffer(&usage(wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ));
-        let mut enc = cx.encoder("frame clock");
-        enc.resolve_query_set(&self.set, 0..self.count, &resolve, 0);
-        enc.copy_buffer_to_buffer(&resolve, 0, &staging, 0, size);
-        cx.submit(enc);
-        let bytes = shadow_wgpu::readback::map_read(cx, &staging, "reading the frame clock")?;
+        let ticks = shadow_wgpu::clock::read_ticks(cx, &self.set, self.count)?;
         let period = f64::from(cx.queue.get_timestamp_period());
-        let ticks: Vec<u64> =
-            bytes.chunks_exact(8).map(|c| u64::from_le_bytes(c.try_into().unwrap_or([0; 8]))).collect();
         Ok(ticks.chunks_exact(2).map(|p| p[1].saturating_sub(p[0]) as f64 * period / 1e6).collect())
     }
 }

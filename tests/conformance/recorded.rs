@@ -16,16 +16,7 @@ const NOT_RECORDABLE: [&str; 1] = ["volume-reconstruction"];
 
 /// A colour target of `format`, `w x h`, that can be read back.
 fn color_target(cx: &WgpuContext, format: wgpu::TextureFormat, w: u32, h: u32) -> wgpu::Texture {
-    cx.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("host colour"),
-        size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-        view_formats: &[],
-    })
+    shadow_wgpu::frame::layered(cx, "host colour", w, h, 1, format)
 }
 
 /// Records one frame into a fresh encoder, as a host would, and submits it.

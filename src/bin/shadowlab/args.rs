@@ -50,6 +50,21 @@ pub(crate) struct SceneArgs {
     pub(crate) allow_outside_files: bool,
 }
 
+/// Which techniques, on which backend: what `compare` and `bench` measure.
+#[derive(Args, Clone)]
+pub(crate) struct TechniqueArgs {
+    /// NAME[:key=value,...], repeatable (default: every technique but the references, with default
+    /// settings).
+    #[arg(long)]
+    pub(crate) technique: Vec<String>,
+    /// all, or NAME,NAME with default settings.
+    #[arg(long)]
+    pub(crate) techniques: Option<String>,
+    /// Backend: auto, cpu, wgpu or both.
+    #[arg(long, default_value = "auto")]
+    pub(crate) backend: String,
+}
+
 /// How big the view is and where it is rendered.
 #[derive(Args, Clone)]
 pub(crate) struct ViewArgs {
@@ -171,16 +186,8 @@ pub(crate) enum Command {
         scene: SceneArgs,
         #[command(flatten)]
         view: ViewArgs,
-        /// NAME[:key=value,...], repeatable (default: every technique but the references, with default
-        /// settings).
-        #[arg(long)]
-        technique: Vec<String>,
-        /// all, or NAME,NAME with default settings.
-        #[arg(long)]
-        techniques: Option<String>,
-        /// Backend: auto, cpu, wgpu or both.
-        #[arg(long, default_value = "auto")]
-        backend: String,
+        #[command(flatten)]
+        choice: TechniqueArgs,
         /// Measured frames.
         #[arg(long, default_value_t = 20)]
         frames: u32,
@@ -240,16 +247,8 @@ pub(crate) enum Command {
         scene: SceneArgs,
         #[command(flatten)]
         view: ViewArgs,
-        /// NAME[:key=value,...], repeatable (default: every technique but the references, with default
-        /// settings).
-        #[arg(long)]
-        technique: Vec<String>,
-        /// all, or NAME,NAME with default settings.
-        #[arg(long)]
-        techniques: Option<String>,
-        /// Backend: auto, cpu, wgpu or both.
-        #[arg(long, default_value = "auto")]
-        backend: String,
+        #[command(flatten)]
+        choice: TechniqueArgs,
         /// The reference for every technique, NAME[:key=value,...]: ray-traced or area-light-reference
         /// (default: each technique's own kind's).
         #[arg(long)]

@@ -19,7 +19,7 @@ use shadowlab::{BackendChoice, Error, Renderer, TechniqueRegistry};
 
 mod args;
 
-use args::{Cli, Command, SceneArgs, ViewArgs};
+use args::{Cli, Command, SceneArgs, TechniqueArgs, ViewArgs};
 
 /// Writes a line to standard output. A closed pipe (`shadowlab techniques | head -1`) ends the program
 /// quietly: whoever read the output has what they wanted.
@@ -113,24 +113,11 @@ fn run(cli: Cli) -> Result<(), Error> {
         Command::Techniques { json } => list_techniques(json),
         Command::Inspect { target, json, allow_outside_files } => inspect(&target, json, allow_outside_files),
         Command::Render { scene, view, technique, backend, out } => render(&scene, &view, &technique, &backend, &out),
-        Command::Compare { scene, view, technique, techniques, backend, reference, out_dir } => {
-            compare(&scene, &view, technique, techniques, &backend, reference.as_deref(), out_dir)
+        Command::Compare { scene, view, choice, reference, out_dir } => {
+            compare(&scene, &view, &choice, reference.as_deref(), out_dir)
         }
-        Command::Bench {
-            scene,
-            view,
-            technique,
-            techniques,
-            backend,
-            frames,
-            warmup,
-            json,
-            realtime,
-            sweep,
-            out_dir,
-        } => {
-            let b = BenchArgs { technique, techniques, backend, frames, warmup, json, realtime, sweep, out_dir };
-            bench(&scene, &view, b)
+        Command::Bench { scene, view, choice, frames, warmup, json, realtime, sweep, out_dir } => {
+            bench(&scene, &view, BenchArgs { choice, frames, warmup, json, realtime, sweep, out_dir })
         }
         Command::Export { scene, out } => export(&scene, &out),
         Command::Results { out, size, backend, bench_scene, bench_size, bench_frames } => {
@@ -347,16 +334,15 @@ fn render(args: &SceneArgs, view: &ViewArgs, technique: &str, backend: &str, out
 fn compare(
     args: &SceneArgs,
     view: &ViewArgs,
-    technique: Vec<String>,
-    techniques: Option<String>,
-    backend: &str,
+    choice: &TechniqueArgs,
     reference: Option<&str>,
     out_dir: Option<PathBuf>,
 ) -> Result<(), Error> {
+    let backend = choice.backend.as_str();
     view.check_adapter(backend)?;
     let mut renderer = Renderer::new(TechniqueRegistry::builtin()).with_adapter(view.adapter.clone());
     let (frame, w, h) = args.frame(view)?;
-    let specs = technique_specs(&renderer, &technique, techniques.as_deref(), &frame)?;
+    let specs = technique_specs(&renderer, &choice.technique, choice.techniques.as_deref(), &frame)?;
     let (reference, soft_reference) = match reference {
         Some(text) => {
             let spec = TechniqueSpec::parse(text)?;
@@ -475,9 +461,7 @@ fn report_progress(bar: &Option<indicatif::ProgressBar>, msg: &str) {
 }
 
 struct BenchArgs {
-    technique: Vec<String>,
-    techniques: Option<String>,
-    backend: String,
+    choice: TechniqueArgs,
     frames: u32,
     warmup: u32,
     json: bool,
@@ -510,15 +494,15 @@ fn bench(args: &SceneArgs, view: &ViewArgs, b: BenchArgs) -> Result<(), Error> {
     if b.realtime && sweep.is_some() {
         return Err(Error::Usage("--realtime does not sweep: leave out --sweep".into()));
     }
-    if b.realtime && !["auto", "wgpu"].contains(&b.backend.as_str()) {
-        return Err(Error::Usage(format!("--realtime runs on the wgpu backend, not '{}'", b.backend)));
+    if b.realtime && !["auto", "wgpu"].contains(&b.choice.backend.as_str()) {
+        return Err(Error::Usage(format!("--realtime runs on the wgpu backend, not '{}'", b.choice.backend)));
     }
-    view.check_adapter(&b.backend)?;
+    view.check_adapter(&b.choice.backend)?;
     let mut renderer = Renderer::new(TechniqueRegistry::builtin()).with_adapter(view.adapter.clone());
     // The scene and its view are checked before the backend says which it is.
     let first = args.frame(view)?;
-    let specs = technique_specs(&renderer, &b.technique, b.techniques.as_deref(), &first.0)?;
-    check_availability(&renderer, &specs, &b.backend)?;
+    let specs = technique_specs(&renderer, &b.choice.technique, b.choice.techniques.as_deref(), &first.0)?;
+    check_availability(&renderer, &specs, &b.choice.backend)?;
     // A triangle sweep's scenes are built up front too: a count too large is refused before anything runs.
     let mut sweep_scenes = Vec::new();
     if let Some(("tris", values)) = &sweep {
@@ -526,7 +510,7 @@ fn bench(args: &SceneArgs, view: &ViewArgs, b: BenchArgs) -> Result<(), Error> {
             sweep_scenes.push(sweep_scene(v).map_err(|e| Error::Usage(format!("--sweep tris={v}: {e}")))?);
         }
     }
-    let kinds = backends(&mut renderer, if b.realtime { "wgpu" } else { &b.backend })?;
+    let kinds = backends(&mut renderer, if b.realtime { "wgpu" } else { &b.choice.backend })?;
     match sweep {
         None => bench_once(&mut renderer, (args, first), specs, kinds, &b),
         Some((key, values)) => {
