@@ -102,11 +102,11 @@ pub fn run_frame<B: Backend, S: FrameSteps<B>>(
         let view = frame.light_view(light)?;
         let mut light_stats = FrameStats::default();
         phases.run(cx, Phase::Build, |cx, _| {
-            technique.build(cx, LightPass { frame, light: &view, stats: &mut light_stats })
+            technique.build(cx, LightPass { frame, light: &view, slot: k, stats: &mut light_stats })
         })?;
         let mut vis = phases.steps.visibility(cx, k)?;
         phases.run(cx, Phase::Query, |cx, _| {
-            technique.query(cx, LightPass { frame, light: &view, stats: &mut light_stats }, &gbuffer, &mut vis)
+            technique.query(cx, LightPass { frame, light: &view, slot: k, stats: &mut light_stats }, &gbuffer, &mut vis)
         })?;
         phases.steps.keep(k, vis);
         phases.stats.add_light(light_stats);

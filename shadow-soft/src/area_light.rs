@@ -140,7 +140,7 @@ impl ShadowTechnique<CpuBackend> for AreaLightReference {
         g: &GBuffer,
         out: &mut Image<f32>,
     ) -> Result<(), CpuError> {
-        let LightPass { frame, light, stats } = pass;
+        let LightPass { frame, light, stats, .. } = pass;
         let bvh = state.bvh(self.name())?;
         let Some(centre) = light.light.position() else {
             return Err(TechniqueError::NotBuilt(self.name().into()).into());

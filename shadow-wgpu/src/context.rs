@@ -58,6 +58,16 @@ pub enum WgpuError {
         /// Why not.
         why: String,
     },
+    /// A buffer larger than the device allows.
+    #[error("{what} would take {bytes} bytes, over the device's limit of {most} for one buffer")]
+    TooLarge {
+        /// What the buffer holds.
+        what: String,
+        /// Its size.
+        bytes: u64,
+        /// The device's limit.
+        most: u64,
+    },
     /// A wait for the GPU or a read-back inside a frame recorded into a host's encoder, which is only
     /// submitted once the recording is done.
     #[error("{what} needs the GPU's results, which a frame recorded into a host's encoder does not wait for")]

@@ -108,7 +108,7 @@ impl GBufferTargets {
 pub fn render(cx: &mut WgpuContext, frame: &FrameInputs, width: u32, height: u32) -> Result<GpuGBuffer, WgpuError> {
     check_size(cx, "view", width, height)?;
     cx.cache.upload_meshes(&cx.device, frame);
-    let instances = cx.cache.instances(&cx.device, frame).clone();
+    let instances = cx.cache.instances(&cx.device, &cx.queue, frame).clone();
     let targets = match cx.gbuffer_targets.take() {
         Some(t) if (t.width, t.height) == (width, height) => t,
         _ => GBufferTargets::new(cx, width, height),

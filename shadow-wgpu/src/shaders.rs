@@ -55,10 +55,23 @@ pub fn shadow_volume() -> String {
     with_common(include_str!("shaders/shadow_volume.wgsl"))
 }
 
+/// The shadow-volume shader followed by the GPU extrusion's compute passes and the vertex shaders that
+/// draw what they find (`passes::extrusion`).
+#[must_use]
+pub fn extrusion() -> String {
+    format!("{}\n{}", shadow_volume(), include_str!("shaders/extrude.wgsl"))
+}
+
 /// Every shader of the backend, by name, for validation.
 #[must_use]
 pub fn all() -> Vec<(&'static str, String)> {
-    vec![("gbuffer", gbuffer()), ("shade", shade()), ("shadow_map", shadow_map()), ("shadow_volume", shadow_volume())]
+    vec![
+        ("gbuffer", gbuffer()),
+        ("shade", shade()),
+        ("shadow_map", shadow_map()),
+        ("shadow_volume", shadow_volume()),
+        ("extrusion", extrusion()),
+    ]
 }
 
 /// A shader module from WGSL text.

@@ -1,10 +1,13 @@
 //! Scene upload, cached: vertex and index buffers per [`MeshKey`] (refreshed when the mesh's version
-//! changes), and the per-instance data of a frame (refreshed when any instance changes).
+//! changes), the adjacency the GPU's shadow-volume extrusion reads (per mesh, on first use), and the
+//! per-instance data of a frame (rewritten in place when an instance changes, made anew only when their
+//! number does).
 
 use std::collections::HashMap;
 
 use bytemuck::{Pod, Zeroable};
 use glam::Mat4;
+use shadow_core::geometry::adjacency::{Adjacency, FaceUse};
 use shadow_core::{FrameInputs, MeshKey};
 use wgpu::util::DeviceExt;
 
@@ -15,7 +18,8 @@ pub struct MeshGpu {
     pub positions: wgpu::Buffer,
     /// Normals, one `vec4<f32>` per vertex.
     pub normals: wgpu::Buffer,
-    /// Triangle indices.
+    /// Triangle indices (also bound as storage: the extrusion copies casting faces' indices into its cap
+    /// lists).
     pub indices: wgpu::Buffer,
     /// Number of indices.
     pub index_count: u32,
@@ -43,10 +47,79 @@ impl InstanceRaw {
     }
 }
 
+/// A mesh's adjacency on the GPU, as the shadow-volume extrusion reads it (twin: shadow-core's
+/// `Adjacency`).
+pub struct AdjacencyGpu {
+    version: u64,
+    /// Welded positions, `vec4<f32>` with w = 1.
+    pub welded: wgpu::Buffer,
+    /// Per face, its plane `(n, d)` as the adjacency scaled it (`vec4<f32>`).
+    pub planes: wgpu::Buffer,
+    /// Per edge `(a, b, first use, uses)`, `vec4<u32>`: its welded vertices (a < b) and its run of
+    /// [`Self::uses`]. Manifold edges first, then boundary edges, then the rest, as the CPU's silhouette
+    /// reads them.
+    pub edges: wgpu::Buffer,
+    /// The faces' uses of the edges, `face << 1 | reversed` (shadow-core's `FaceUse`).
+    pub uses: wgpu::Buffer,
+    /// Number of faces.
+    pub faces: u32,
+    /// Number of edges.
+    pub edge_count: u32,
+    /// Number of uses: the most side quads one light can make of the mesh (an edge's weight is at most
+    /// its number of uses).
+    pub use_count: u32,
+    /// Whether the mesh is closed: only lit faces cast, or else every face turned to the light (Bergeron).
+    pub closed: bool,
+}
+
+impl AdjacencyGpu {
+    fn upload(device: &wgpu::Device, adj: &Adjacency, version: u64) -> Self {
+        let welded: Vec<[f32; 4]> = adj.positions().iter().map(|p| p.extend(1.0).to_array()).collect();
+        let planes: Vec<[f32; 4]> = adj.planes().iter().map(|p| p.to_array()).collect();
+        let mut edges: Vec<[u32; 4]> = Vec::with_capacity(adj.edge_count());
+        let mut uses: Vec<u32> = Vec::with_capacity(2 * adj.edge_count());
+        let mut push = |v: [u32; 2], faces: &mut dyn Iterator<Item = FaceUse>| {
+            let first = uses.len() as u32;
+            uses.extend(faces.map(|u| u.face() << 1 | u32::from(u.reversed())));
+            edges.push([v[0], v[1], first, uses.len() as u32 - first]);
+        };
+        for (e, &[fwd, rev]) in adj.manifold_edges().iter().zip(adj.manifold_faces()) {
+            push(e.v, &mut [FaceUse::new(fwd, false), FaceUse::new(rev, true)].into_iter());
+        }
+        for (e, &u) in adj.boundary_edges().iter().zip(adj.boundary_faces()) {
+            push(e.v, &mut std::iter::once(u));
+        }
+        for e in adj.complex_edges() {
+            push(e.v, &mut e.uses.iter().copied());
+        }
+        // Storage bindings may not be empty: a mesh without edges still binds one word.
+        let storage = |label, contents: &[u8]| {
+            let padded = [0u8; 16];
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents: if contents.is_empty() { &padded } else { contents },
+                usage: wgpu::BufferUsages::STORAGE,
+            })
+        };
+        Self {
+            version,
+            welded: storage("welded positions", bytemuck::cast_slice(&welded)),
+            planes: storage("face planes", bytemuck::cast_slice(&planes)),
+            edges: storage("edges", bytemuck::cast_slice(&edges)),
+            uses: storage("face uses", bytemuck::cast_slice(&uses)),
+            faces: planes.len() as u32,
+            edge_count: edges.len() as u32,
+            use_count: uses.len() as u32,
+            closed: adj.closed(),
+        }
+    }
+}
+
 /// What the backend keeps uploaded between frames.
 #[derive(Default)]
 pub struct SceneCache {
     meshes: HashMap<MeshKey, MeshGpu>,
+    adjacency: HashMap<MeshKey, AdjacencyGpu>,
     instances: Option<(Vec<InstanceRaw>, wgpu::Buffer)>,
 }
 
@@ -70,7 +143,11 @@ impl SceneCache {
                     version: inst.mesh_version,
                     positions: make("positions", bytemuck::cast_slice(&positions), wgpu::BufferUsages::VERTEX),
                     normals: make("normals", bytemuck::cast_slice(&normals), wgpu::BufferUsages::VERTEX),
-                    indices: make("indices", bytemuck::cast_slice(&indices), wgpu::BufferUsages::INDEX),
+                    indices: make(
+                        "indices",
+                        bytemuck::cast_slice(&indices),
+                        wgpu::BufferUsages::INDEX | wgpu::BufferUsages::STORAGE,
+                    ),
                     index_count: indices.len() as u32,
                 },
             );
@@ -83,20 +160,44 @@ impl SceneCache {
         self.meshes.get(&key)
     }
 
-    /// The frame's instance data, uploaded when it changed.
-    pub fn instances(&mut self, device: &wgpu::Device, frame: &FrameInputs) -> &wgpu::Buffer {
+    /// Uploads the adjacency of every casting instance's mesh that is missing or stale.
+    pub fn upload_adjacency(&mut self, device: &wgpu::Device, frame: &FrameInputs) {
+        for inst in frame.instances.iter().filter(|i| i.casts_shadow) {
+            if self.adjacency.get(&inst.mesh_key).is_some_and(|a| a.version == inst.mesh_version) {
+                continue;
+            }
+            self.adjacency.insert(inst.mesh_key, AdjacencyGpu::upload(device, &inst.adjacency, inst.mesh_version));
+        }
+    }
+
+    /// The adjacency of an instance's mesh (after [`SceneCache::upload_adjacency`]).
+    #[must_use]
+    pub fn adjacency(&self, key: MeshKey) -> Option<&AdjacencyGpu> {
+        self.adjacency.get(&key)
+    }
+
+    /// The frame's instance data: the instances that changed are written into the buffer in place, which
+    /// is made anew only when the number of instances changes.
+    pub fn instances(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, frame: &FrameInputs) -> &wgpu::Buffer {
         let raw: Vec<InstanceRaw> = frame.instances.iter().map(InstanceRaw::of).collect();
-        let stale = self
-            .instances
-            .as_ref()
-            .is_none_or(|(old, _)| bytemuck::cast_slice::<_, u8>(old) != bytemuck::cast_slice::<_, u8>(&raw));
-        if stale {
-            let buf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("instances"),
-                contents: bytemuck::cast_slice(&raw),
-                usage: wgpu::BufferUsages::STORAGE,
-            });
-            self.instances = Some((raw, buf));
+        match &mut self.instances {
+            Some((old, buf)) if old.len() == raw.len() => {
+                let size = std::mem::size_of::<InstanceRaw>();
+                for (i, (was, now)) in old.iter_mut().zip(&raw).enumerate() {
+                    if bytemuck::bytes_of(was) != bytemuck::bytes_of(now) {
+                        queue.write_buffer(buf, (i * size) as u64, bytemuck::bytes_of(now));
+                        *was = *now;
+                    }
+                }
+            }
+            slot => {
+                let buf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("instances"),
+                    contents: bytemuck::cast_slice(&raw),
+                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                });
+                *slot = Some((raw, buf));
+            }
         }
         match &self.instances {
             Some((_, b)) => b,

@@ -258,20 +258,21 @@ pub fn realtime_table(r: &RealtimeReport) -> String {
         "technique", "instrumented", "real-time", "ratio", "record (CPU)", "GPU"
     ));
     let cell = |st: &Stat| format!("{:.2} [{:.2}..{:.2}]", st.median, st.min, st.max);
+    // A technique run with more than one set of settings is told apart by them.
+    let label = |e: &RealtimeEntry| {
+        let twice = r.results.iter().filter(|o| o.technique == e.technique).count() > 1;
+        if twice { format!("{}:{}", e.technique, e.settings) } else { e.technique.clone() }
+    };
     for e in &r.results {
         let inst = cell(&e.instrumented_ms);
         match (&e.refused, e.frame_ms, e.ratio, &e.record_ms) {
             (None, Some(f), Some(ratio), Some(rec)) => s.push_str(&format!(
                 "{:<24} {inst:>20} {f:>10.2} {ratio:>8.2} {:>20} {:>20}\n",
-                e.technique,
+                label(e),
                 cell(rec),
                 e.gpu_ms.as_ref().map_or_else(|| "-".into(), cell)
             )),
-            _ => s.push_str(&format!(
-                "{:<24} {inst:>20} refused: {}\n",
-                e.technique,
-                e.refused.as_deref().unwrap_or("?")
-            )),
+            _ => s.push_str(&format!("{:<24} {inst:>20} refused: {}\n", label(e), e.refused.as_deref().unwrap_or("?"))),
         }
     }
     s

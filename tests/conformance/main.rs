@@ -3,6 +3,7 @@
 
 mod cli;
 mod depth_layers;
+mod extrusion;
 mod gpu_clock;
 mod host;
 mod hybrid;

@@ -100,6 +100,10 @@ pub struct LightPass<'a> {
     pub frame: &'a FrameInputs,
     /// The light and its fitted projections.
     pub light: &'a LightView,
+    /// The light's place among the frame's lights. A device whose buffer writes all land before the
+    /// frame's commands run (a frame recorded into one command buffer) needs the data of each light in
+    /// a place of its own: techniques index it by this.
+    pub slot: usize,
     /// Counters and sub-phase times for this light.
     pub stats: &'a mut FrameStats,
 }

@@ -243,7 +243,7 @@ impl ShadowTechnique<WgpuBackend> for DepthLayers {
                 Some(cx.scoped("allocating depth layers", |cx| (map_texture(cx, res, 1), map_texture(cx, res, 1)))?);
         }
         cx.cache.upload_meshes(&cx.device, frame);
-        let instances = cx.cache.instances(&cx.device, frame).clone();
+        let instances = cx.cache.instances(&cx.device, &cx.queue, frame).clone();
         let maps = state.maps.clone().ok_or_else(|| TechniqueError::NotBuilt(self.kind.name().into()))?;
         cx.scoped("the depth-layer passes", |cx| {
             for (k, proj) in light.projections.iter().enumerate() {

@@ -140,7 +140,7 @@ impl ShadowTechnique<CpuBackend> for Hybrid {
     }
 
     fn build(&self, _: &mut CpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), CpuError> {
-        let LightPass { frame, light, stats } = pass;
+        let LightPass { frame, light, stats, .. } = pass;
         render_depth_maps(frame, light, self.depth.resolution, self.depth.depth_bias(), &mut state.maps)?;
         // The edge maps' segments come from the volumes' own silhouette pass (unused with
         // `edge_texels=off`, where they cost two transforms per silhouette edge).
@@ -166,7 +166,7 @@ impl ShadowTechnique<CpuBackend> for Hybrid {
         g: &GBuffer,
         out: &mut Image<f32>,
     ) -> Result<(), CpuError> {
-        let LightPass { frame, light, stats } = pass;
+        let LightPass { frame, light, stats, .. } = pass;
         let volumes = state.volumes.as_ref().ok_or_else(|| TechniqueError::NotBuilt(Self::NAME.into()))?;
         if state.maps.len() != light.projections.len() {
             return Err(TechniqueError::NotBuilt(Self::NAME.into()).into());

@@ -393,7 +393,7 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
     }
 
     fn build(&self, cx: &mut WgpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), WgpuError> {
-        let LightPass { frame, light, stats } = pass;
+        let LightPass { frame, light, stats, .. } = pass;
         state.map.render(cx, frame, light, self.depth.resolution)?;
         cx.step("map");
         let res = self.depth.resolution;
@@ -428,7 +428,7 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
         g: &GpuGBuffer,
         out: &mut GpuVisibility,
     ) -> Result<(), WgpuError> {
-        let LightPass { frame, light, stats } = pass;
+        let LightPass { frame, light, stats, .. } = pass;
         let not_built = || WgpuError::from(TechniqueError::NotBuilt(Self::NAME.into()));
         if self.edge_texels.is_on() && state.edge_maps.is_none() {
             return Err(not_built());

@@ -35,7 +35,7 @@ impl ShadowTechnique<CpuBackend> for RayTraced {
         g: &GBuffer,
         out: &mut Image<f32>,
     ) -> Result<(), CpuError> {
-        let LightPass { frame, light, stats } = pass;
+        let LightPass { frame, light, stats, .. } = pass;
         let bvh = state.bvh(Self::NAME)?;
         let origins = RayOrigins::new(g, frame, self.epsilon);
         per_receiver(g, out, |_, _, i| {

@@ -31,7 +31,7 @@ impl ShadowTechnique<CpuBackend> for ShadowVolume {
     }
 
     fn build(&self, _: &mut CpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), CpuError> {
-        let LightPass { frame, light, stats } = pass;
+        let LightPass { frame, light, stats, .. } = pass;
         let caps = if self.counting == VolumeCounting::ZFail { Caps::Both } else { Caps::None };
         state.volumes = Some(build_volumes(frame, light, caps, stats));
         Ok(())

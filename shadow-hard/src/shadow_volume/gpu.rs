@@ -1,28 +1,45 @@
-//! Stencil shadow volumes on the GPU (twin: [`super::cpu`]): the shared extrusion, uploaded and counted by
-//! `passes::volumes` with the technique's counting, then resolved.
+//! Stencil shadow volumes on the GPU (twin: [`super::cpu`]): found, extruded and counted by
+//! `passes::extrusion` with the technique's counting (or, with `extrusion=cpu`, the shared extrusion
+//! uploaded and counted by `passes::volumes`), then resolved.
 //!
-//! Counters come from occlusion queries: samples passing the volume pass, and, in a separate pass with
+//! In instrumented frames the build reads back the extrusion's edge and triangle counts, and the other
+//! counters come from occlusion queries: samples passing the volume pass, and, in a separate pass with
 //! the depth test off, every rasterized volume fragment (inside the query phase, timed as its sub-phase
 //! `count_fragments` so it can be taken out).
 
 use shadow_core::geometry::volume::{Caps, VolumeCounting};
 use shadow_core::technique::LightPass;
 use shadow_core::technique::{ShadowTechnique, TechniqueError};
+use shadow_wgpu::passes::extrusion::GpuExtrusion;
 use shadow_wgpu::passes::volumes::{
     StencilResolve, VolumeDraw, VolumePass, build_draws, count_all_pipeline, counting_state, read_query,
     volume_pipeline,
 };
 use shadow_wgpu::{GpuGBuffer, GpuVisibility, WgpuBackend, WgpuContext, WgpuError, shaders};
 
-use super::ShadowVolume;
+use super::{Extrusion, ShadowVolume};
 
-/// Pipelines and the uploaded volumes of the last build.
+/// The resolve, and the volumes as the `extrusion` setting makes them.
 pub struct State {
-    ccw: wgpu::RenderPipeline,
-    cw: wgpu::RenderPipeline,
-    count_all: wgpu::RenderPipeline,
     resolve: StencilResolve,
-    draws: Vec<VolumeDraw>,
+    volumes: Volumes,
+    /// Whether a light was built since the state was made.
+    built: bool,
+}
+
+/// Where the volumes come from.
+enum Volumes {
+    /// Found and extruded on the GPU.
+    Gpu(Box<GpuExtrusion>),
+    /// shadow-core's extrusion, uploaded: the pipelines for either winding, the fragment counter's, and
+    /// the last build's draws.
+    Cpu { ccw: wgpu::RenderPipeline, cw: wgpu::RenderPipeline, count_all: wgpu::RenderPipeline, draws: Vec<VolumeDraw> },
+}
+
+impl ShadowVolume {
+    fn caps(&self) -> Caps {
+        if self.counting == VolumeCounting::ZFail { Caps::Both } else { Caps::None }
+    }
 }
 
 impl ShadowTechnique<WgpuBackend> for ShadowVolume {
@@ -33,22 +50,40 @@ impl ShadowTechnique<WgpuBackend> for ShadowVolume {
     }
 
     fn create_state(&self, cx: &mut WgpuContext) -> Result<State, WgpuError> {
-        let counting = self.counting;
+        let (counting, extrusion) = (self.counting, self.gpu.extrusion);
         cx.scoped("creating the shadow-volume pipelines", |cx| {
             let module = shaders::module(&cx.device, "shadow_volume", shaders::shadow_volume());
-            let state = counting_state(counting, wgpu::CompareFunction::Always, 0xff, 0xff);
-            let ccw = volume_pipeline(cx, &module, "vs_volume", wgpu::FrontFace::Ccw, state.clone());
-            let cw = volume_pipeline(cx, &module, "vs_volume", wgpu::FrontFace::Cw, state);
-            let count_all = count_all_pipeline(cx, &module);
             let resolve = StencilResolve::new(cx, &module, 0xff);
-            State { ccw, cw, count_all, resolve, draws: Vec::new() }
+            let volumes = match extrusion {
+                Extrusion::Gpu => Volumes::Gpu(Box::new(GpuExtrusion::new(cx, counting))),
+                Extrusion::Cpu => {
+                    let state = counting_state(counting, wgpu::CompareFunction::Always, 0xff, 0xff);
+                    Volumes::Cpu {
+                        ccw: volume_pipeline(cx, &module, "vs_volume", wgpu::FrontFace::Ccw, state.clone()),
+                        cw: volume_pipeline(cx, &module, "vs_volume", wgpu::FrontFace::Cw, state),
+                        count_all: count_all_pipeline(cx, &module),
+                        draws: Vec::new(),
+                    }
+                }
+            };
+            State { resolve, volumes, built: false }
         })
     }
 
     fn build(&self, cx: &mut WgpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), WgpuError> {
-        let LightPass { frame, light, stats } = pass;
-        let caps = if self.counting == VolumeCounting::ZFail { Caps::Both } else { Caps::None };
-        state.draws = build_draws(cx, frame, light, caps, stats)?;
+        let LightPass { frame, light, slot, stats } = pass;
+        match &mut state.volumes {
+            Volumes::Gpu(extrusion) => {
+                extrusion.build(cx, frame, light, slot, self.caps())?;
+                if cx.instrumented() {
+                    let c = extrusion.counts(cx)?;
+                    stats.counters.silhouette_edges = Some(c.silhouette_edges);
+                    stats.counters.volume_triangles = Some(c.triangles);
+                }
+            }
+            Volumes::Cpu { draws, .. } => *draws = build_draws(cx, frame, light, self.caps(), stats)?,
+        }
+        state.built = true;
         Ok(())
     }
 
@@ -60,35 +95,46 @@ impl ShadowTechnique<WgpuBackend> for ShadowVolume {
         g: &GpuGBuffer,
         out: &mut GpuVisibility,
     ) -> Result<(), WgpuError> {
-        let LightPass { frame, stats, .. } = pass;
-        if state.draws.is_empty() && stats.counters.volume_triangles.is_none() {
+        let LightPass { frame, slot, stats, .. } = pass;
+        if !state.built {
             return Err(TechniqueError::NotBuilt(self.name().into()).into());
         }
         let depth = g.depth_view();
-        let counting = VolumePass {
-            label: "shadow volumes",
-            ccw: &state.ccw,
-            cw: &state.cw,
-            stencil: wgpu::LoadOp::Clear(0),
-            reference: 0,
-            scissors: None,
-        };
+        let volumes = &state.volumes;
         let passed = cx.scoped("the shadow-volume pass", |cx| {
-            let q = counting.run(cx, &state.draws, frame, g, &depth);
+            let q = match volumes {
+                Volumes::Gpu(extrusion) => extrusion.draw(cx, frame, g, &depth, slot, false),
+                Volumes::Cpu { ccw, cw, draws, .. } => {
+                    let counting = VolumePass {
+                        label: "shadow volumes",
+                        ccw,
+                        cw,
+                        stencil: wgpu::LoadOp::Clear(0),
+                        reference: 0,
+                        scissors: None,
+                    };
+                    Some(counting.run(cx, draws, frame, g, &depth))
+                }
+            };
             state.resolve.run(cx, g, out, &depth);
             q
         })?;
-        if !cx.instrumented() {
-            return Ok(());
-        }
+        let Some(passed) = passed.filter(|_| cx.instrumented()) else { return Ok(()) };
         cx.end_of_work();
         let passed = read_query(cx, &passed)?;
         // Every rasterized fragment, for Sen's overdraw: a second pass with the depth test off. It runs
         // after the resolve, so it does not disturb the result; its time lands in a separate sub-phase.
         let t = std::time::Instant::now();
-        let every = VolumePass::count(&state.count_all, "count volume fragments");
-        let all = cx.scoped("the volume fragment count", |cx| every.run(cx, &state.draws, frame, g, &depth))?;
-        let all = read_query(cx, &all)?;
+        let all = cx.scoped("the volume fragment count", |cx| match volumes {
+            Volumes::Gpu(extrusion) => extrusion.draw(cx, frame, g, &depth, slot, true),
+            Volumes::Cpu { count_all, draws, .. } => {
+                Some(VolumePass::count(count_all, "count volume fragments").run(cx, draws, frame, g, &depth))
+            }
+        })?;
+        let all = match all {
+            Some(q) => read_query(cx, &q)?,
+            None => 0,
+        };
         stats.timings.extra.insert("count_fragments".into(), shadow_core::stats::ms(t.elapsed()));
         let c = &mut stats.counters;
         c.volume_fragments = Some(all);

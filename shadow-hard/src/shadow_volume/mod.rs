@@ -7,14 +7,18 @@
 //! faces behind it (back faces +1, front faces -1 where the depth test fails) and closes every volume with
 //! a near and a far cap; with the camera's infinite far plane nothing is clipped behind, so it is right
 //! with the eye in shadow too. Open meshes cast with Bergeron's weights (shared geometry), so the counts
-//! stay right for the teapot and the Cornell box. The extrusion is shadow-core's, the counting each
-//! backend's `passes::volumes`.
+//! stay right for the teapot and the Cornell box. The CPU extrudes with shadow-core's geometry and counts
+//! with its `passes::volumes`; the GPU finds and extrudes the volumes itself in a compute pass
+//! (`passes::extrusion`, the cost Sen, Chan and Nealen each name for volumes), or, with `extrusion=cpu`,
+//! draws shadow-core's extrusion uploaded each frame, the reference the compute pass is held to.
 
 pub mod cpu;
 pub mod gpu;
 
 use shadow_core::geometry::volume::VolumeCounting;
-use shadow_core::technique::settings::{SettingKey, SettingsError, TechniqueSettings, TechniqueSpec, Values};
+use shadow_core::technique::settings::{
+    SettingField, SettingKey, SettingsError, TechniqueSettings, TechniqueSpec, Values,
+};
 use shadow_core::technique::{Backend, DynShadowTechnique, ShadowTechnique, Stateful};
 use shadow_cpu::CpuBackend;
 use shadow_wgpu::WgpuBackend;
@@ -24,26 +28,54 @@ use crate::Entry;
 /// `shadow-volume-zpass` and `shadow-volume-zfail`: stencil shadow volumes from silhouette edges.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ShadowVolume {
-    /// Which counting.
+    /// Which counting (from the technique's name).
     pub counting: VolumeCounting,
+    /// What the GPU backend alone reads.
+    pub gpu: GpuOptions,
 }
 
 impl ShadowVolume {
     /// Z-pass volumes.
-    pub const ZPASS: Self = Self { counting: VolumeCounting::ZPass };
+    pub const ZPASS: Self = Self { counting: VolumeCounting::ZPass, gpu: GpuOptions { extrusion: Extrusion::Gpu } };
     /// Z-fail volumes.
-    pub const ZFAIL: Self = Self { counting: VolumeCounting::ZFail };
+    pub const ZFAIL: Self = Self { counting: VolumeCounting::ZFail, ..Self::ZPASS };
+}
+
+shadow_core::setting_group! {
+    /// The shadow volumes' settings for the GPU backend alone.
+    pub struct GpuOptions {
+        /// Where the GPU's volumes are found and extruded.
+        pub extrusion: Extrusion = SettingKey::choice(
+            "extrusion",
+            "gpu",
+            Extrusion::NAMES,
+            "GPU: gpu (silhouettes found and extruded in a compute pass) or cpu (shadow-core's extrusion, uploaded each frame: the reference)",
+        ),
+    }
+}
+
+shadow_core::named_enum! {
+    /// Where the GPU backend's shadow volumes are found and extruded.
+    pub enum Extrusion {
+        /// In a compute pass over each mesh's adjacency, uploaded once: the host records a few commands
+        /// per light and never sees a vertex.
+        Gpu = "gpu",
+        /// On the host with shadow-core's geometry, uploaded every frame (what the CPU backend draws).
+        Cpu = "cpu",
+    }
 }
 
 impl TechniqueSettings for ShadowVolume {
     fn keys() -> &'static [SettingKey] {
-        &[]
+        GpuOptions::KEYS
     }
-    fn from_values(_: &Values<'_>) -> Result<Self, SettingsError> {
-        Ok(Self::ZFAIL)
+    fn from_values(v: &Values<'_>) -> Result<Self, SettingsError> {
+        Ok(Self { gpu: GpuOptions::read(v, GpuOptions::KEYS)?, ..Self::ZFAIL })
     }
     fn to_values(&self) -> Vec<String> {
-        Vec::new()
+        let mut out = Vec::new();
+        self.gpu.write(&mut out);
+        out
     }
 }
 
@@ -78,8 +110,9 @@ fn named<B: Backend>(spec: &TechniqueSpec) -> Result<Box<dyn DynShadowTechnique<
 where
     ShadowVolume: ShadowTechnique<B>,
 {
-    ShadowVolume::parse(&spec.name, &spec.values)?;
-    Ok(Stateful::boxed(ShadowVolume::named(&spec.name).unwrap_or(ShadowVolume::ZFAIL), String::new()))
+    let settings = ShadowVolume::parse(&spec.name, &spec.values)?;
+    let counting = ShadowVolume::named(&spec.name).unwrap_or(ShadowVolume::ZFAIL).counting;
+    Ok(Stateful::boxed(ShadowVolume { counting, ..settings }, settings.settings_string()))
 }
 
 fn entry(name: &'static str, description: &'static str, paper: &'static str) -> Entry {
@@ -111,10 +144,12 @@ mod tests {
     use super::*;
 
     #[test]
-    fn takes_no_settings() {
-        assert_eq!(ShadowVolume::defaults().settings_string(), "");
+    fn takes_only_the_extrusion() {
+        assert_eq!(ShadowVolume::defaults().settings_string(), "extrusion=gpu");
+        let cpu = vec![("extrusion".to_string(), "cpu".to_string())];
+        assert_eq!(ShadowVolume::parse("shadow-volume-zpass", &cpu).expect("valid").gpu.extrusion, Extrusion::Cpu);
         let given = vec![("res".to_string(), "1".to_string())];
         let e = ShadowVolume::parse("shadow-volume-zfail", &given).unwrap_err();
-        assert!(e.to_string().contains("settings: none"), "{e}");
+        assert!(e.to_string().contains("extrusion"), "{e}");
     }
 }

@@ -46,7 +46,7 @@ impl ShadowTechnique<CpuBackend> for SilhouetteMap {
     }
 
     fn build(&self, _: &mut CpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), CpuError> {
-        let LightPass { frame, light, stats } = pass;
+        let LightPass { frame, light, stats, .. } = pass;
         let res = self.depth.resolution;
         render_depth_maps(frame, light, res, self.depth.depth_bias(), &mut state.maps)?;
         let edges = frame.silhouette_segments(light);

@@ -362,13 +362,13 @@ impl ShadowTechnique<WgpuBackend> for SilhouetteMap {
     }
 
     fn build(&self, cx: &mut WgpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), WgpuError> {
-        let LightPass { frame, light, stats } = pass;
+        let LightPass { frame, light, stats, .. } = pass;
         let res = self.depth.resolution;
         check_size(cx, "shadow map", res, res)?;
         state.allocate(cx, res, light.projections.len() as u32)?;
         let Some(maps) = &state.maps else { return Err(TechniqueError::NotBuilt(Self::NAME.into()).into()) };
         cx.cache.upload_meshes(&cx.device, frame);
-        let instances = cx.cache.instances(&cx.device, frame).clone();
+        let instances = cx.cache.instances(&cx.device, &cx.queue, frame).clone();
         let edges = frame.silhouette_segments(light);
         cx.scoped("the silhouette-map passes", |cx| {
             render_maps(cx, &state.light_pass, frame, light, &maps.depth, None, &instances);

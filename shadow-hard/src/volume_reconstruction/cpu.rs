@@ -74,7 +74,7 @@ impl ShadowTechnique<CpuBackend> for VolumeReconstruction {
     }
 
     fn build(&self, _: &mut CpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), CpuError> {
-        let LightPass { frame, light, stats } = pass;
+        let LightPass { frame, light, stats, .. } = pass;
         let res = self.depth.resolution;
         let view = light.with_seamless_faces(res);
         let bias = self.depth.depth_bias();

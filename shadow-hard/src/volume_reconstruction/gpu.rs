@@ -142,7 +142,7 @@ impl ShadowTechnique<WgpuBackend> for VolumeReconstruction {
     }
 
     fn build(&self, cx: &mut WgpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), WgpuError> {
-        let LightPass { frame, light, stats } = pass;
+        let LightPass { frame, light, stats, .. } = pass;
         let res = self.depth.resolution;
         check_size(cx, "depth map", res, res)?;
         let view = light.with_seamless_faces(res);
@@ -159,7 +159,7 @@ impl ShadowTechnique<WgpuBackend> for VolumeReconstruction {
         let maps = state.maps.clone().ok_or_else(|| TechniqueError::NotBuilt(Self::NAME.into()))?;
         let id_maps = state.ids.clone();
         cx.cache.upload_meshes(&cx.device, frame);
-        let instances = cx.cache.instances(&cx.device, frame).clone();
+        let instances = cx.cache.instances(&cx.device, &cx.queue, frame).clone();
         cx.scoped("the light pass", |cx| {
             render_maps(cx, &state.light_pass, frame, &view, &maps, id_maps.as_ref(), &instances);
         })?;

@@ -87,7 +87,7 @@ impl ShadowTechnique<CpuBackend> for PenumbraMap {
     }
 
     fn build(&self, _: &mut CpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), CpuError> {
-        let LightPass { frame, light, stats } = pass;
+        let LightPass { frame, light, stats, .. } = pass;
         // The sub-phase `penumbra_map`: the cones and sheets built and drawn (the depth map is shadow-map's).
         let t0 = Instant::now();
         let (proj, built) = Self::construct(frame, light, stats)?;

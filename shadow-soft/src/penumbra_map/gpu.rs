@@ -107,7 +107,7 @@ impl ShadowTechnique<WgpuBackend> for PenumbraMap {
     }
 
     fn build(&self, cx: &mut WgpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), WgpuError> {
-        let LightPass { frame, light, stats } = pass;
+        let LightPass { frame, light, stats, .. } = pass;
         let t0 = std::time::Instant::now();
         let (proj, built) = Self::construct(frame, light, stats)?;
         let construct = t0.elapsed();

@@ -124,7 +124,7 @@ impl ShadowTechnique<CpuBackend> for Smoothies {
     }
 
     fn build(&self, _: &mut CpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), CpuError> {
-        let LightPass { frame, light, stats } = pass;
+        let LightPass { frame, light, stats, .. } = pass;
         let proj = Self::projection(light)?;
         render_depth_maps(frame, light, self.depth.resolution, self.depth.depth_bias(), &mut state.maps)?;
         let t0 = Instant::now();

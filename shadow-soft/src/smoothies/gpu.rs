@@ -129,7 +129,7 @@ impl ShadowTechnique<WgpuBackend> for Smoothies {
     }
 
     fn build(&self, cx: &mut WgpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), WgpuError> {
-        let LightPass { frame, light, stats } = pass;
+        let LightPass { frame, light, stats, .. } = pass;
         let proj = Self::projection(light)?;
         state.map.render(cx, frame, light, self.depth.resolution)?;
         let t0 = std::time::Instant::now();

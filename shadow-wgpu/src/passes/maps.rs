@@ -394,7 +394,7 @@ impl DepthMaps {
             }
         };
         cx.cache.upload_meshes(&cx.device, frame);
-        let instances = cx.cache.instances(&cx.device, frame).clone();
+        let instances = cx.cache.instances(&cx.device, &cx.queue, frame).clone();
         cx.scoped("the shadow-map light pass", |cx| {
             render_maps(cx, &self.pipeline, frame, light, &maps, None, &instances)
         })

@@ -3,10 +3,12 @@
 //! - [`maps`]: render light depth maps (and object-ID maps), look them up over the G-buffer with each
 //!   filter, or with a technique's own fragment entry;
 //! - [`volumes`]: upload shadow volumes, count them in the stencil either way, resolve the stencil,
-//!   count what a pass rasterizes.
+//!   count what a pass rasterizes;
+//! - [`extrusion`]: find and extrude shadow volumes on the GPU and count them in the stencil.
 //!
 //! [`full_screen`] runs a technique's full-screen pass into a visibility target.
 
+pub mod extrusion;
 pub mod maps;
 pub mod volumes;
 

@@ -78,19 +78,45 @@ pub fn volume_pipeline(
     front_face: wgpu::FrontFace,
     depth_stencil: wgpu::DepthStencilState,
 ) -> wgpu::RenderPipeline {
+    let vertex = StencilVertex { module, entry, groups: &[&cx.shared.frame_layout], buffers: &[Some(POSITION_LAYOUT)] };
+    stencil_pipeline(cx, &vertex, front_face, depth_stencil)
+}
+
+/// The vertex stage of a stencil-only pipeline: its entry, the bind groups its layout holds and its
+/// vertex buffers.
+pub struct StencilVertex<'a> {
+    /// The module.
+    pub module: &'a wgpu::ShaderModule,
+    /// The vertex entry point.
+    pub entry: &'a str,
+    /// The layouts of bind groups 0, 1, ...
+    pub groups: &'a [&'a wgpu::BindGroupLayout],
+    /// The vertex buffers.
+    pub buffers: &'a [Option<wgpu::VertexBufferLayout<'a>>],
+}
+
+/// A pipeline with no fragment stage drawing both faces through `vertex`, `front_face` deciding which
+/// face the stencil's front ops apply to.
+pub fn stencil_pipeline(
+    cx: &WgpuContext,
+    vertex: &StencilVertex<'_>,
+    front_face: wgpu::FrontFace,
+    depth_stencil: wgpu::DepthStencilState,
+) -> wgpu::RenderPipeline {
+    let groups: Vec<Option<&wgpu::BindGroupLayout>> = vertex.groups.iter().copied().map(Some).collect();
     let layout = cx.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some("volume"),
-        bind_group_layouts: &[Some(&cx.shared.frame_layout)],
+        label: Some(vertex.entry),
+        bind_group_layouts: &groups,
         immediate_size: 0,
     });
     cx.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some("volume"),
+        label: Some(vertex.entry),
         layout: Some(&layout),
         vertex: wgpu::VertexState {
-            module,
-            entry_point: Some(entry),
+            module: vertex.module,
+            entry_point: Some(vertex.entry),
             compilation_options: Default::default(),
-            buffers: &[Some(POSITION_LAYOUT)],
+            buffers: vertex.buffers,
         },
         primitive: wgpu::PrimitiveState { front_face, cull_mode: None, ..Default::default() },
         depth_stencil: Some(depth_stencil),
