@@ -3,10 +3,9 @@
 //! float colour target is an optional feature. Smoothies keep their buffer's depth and alpha this way,
 //! the penumbra map its values.
 
-use shadow_wgpu::WgpuContext;
 use shadow_wgpu::frame::layer_view;
 use shadow_wgpu::pipelines::{buffer_entry, depth_array_entry, depth_pass, min_depth_pipeline};
-use wgpu::util::DeviceExt;
+use shadow_wgpu::{Transient, WgpuContext};
 
 /// A pipeline drawing `vertices` through `vertex` and `fragment` of `module`, whose fragment depth is the
 /// value kept (shadow-wgpu's `min_depth_pipeline` with a fragment stage).
@@ -29,14 +28,14 @@ pub fn draw(
     target: &wgpu::Texture,
     pipeline: &wgpu::RenderPipeline,
     group: &wgpu::BindGroup,
-    vertices: Option<&(wgpu::Buffer, u32)>,
+    vertices: Option<&(Transient, u32)>,
 ) {
     let view = layer_view(target, 0);
     let mut pass = depth_pass(enc, &view, "minimum target");
     if let Some((buffer, count)) = vertices {
         pass.set_pipeline(pipeline);
         pass.set_bind_group(0, group, &[]);
-        pass.set_vertex_buffer(0, buffer.slice(..));
+        pass.set_vertex_buffer(0, buffer.slice());
         pass.draw(0..*count, 0..1);
     }
 }
@@ -53,7 +52,7 @@ pub fn layout(cx: &WgpuContext, label: &str) -> wgpu::BindGroupLayout {
     })
 }
 
-/// A group of [`layout`]: `params` uploaded as the uniform, and `maps`.
+/// A group of [`layout`]: `params` as the uniform (in the frame's transient buffer), and `maps`.
 #[must_use]
 pub fn bind(
     cx: &WgpuContext,
@@ -62,11 +61,7 @@ pub fn bind(
     params: &impl bytemuck::Pod,
     maps: &wgpu::Texture,
 ) -> wgpu::BindGroup {
-    let uniform = cx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some(label),
-        contents: bytemuck::bytes_of(params),
-        usage: wgpu::BufferUsages::UNIFORM,
-    });
+    let uniform = cx.transient(bytemuck::bytes_of(params));
     let maps_view = maps.create_view(&wgpu::TextureViewDescriptor {
         dimension: Some(wgpu::TextureViewDimension::D2Array),
         ..Default::default()
@@ -75,21 +70,15 @@ pub fn bind(
         label: Some(label),
         layout,
         entries: &[
-            wgpu::BindGroupEntry { binding: 0, resource: uniform.as_entire_binding() },
+            wgpu::BindGroupEntry { binding: 0, resource: uniform.binding() },
             wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&maps_view) },
         ],
     })
 }
 
-/// `vertices` uploaded, with their count; `None` when there are none (a pass then only clears).
+/// `vertices` in the frame's transient buffer, with their count; `None` when there are none (a pass
+/// then only clears).
 #[must_use]
-pub fn vertex_buffer<V: bytemuck::Pod>(cx: &WgpuContext, label: &str, vertices: &[V]) -> Option<(wgpu::Buffer, u32)> {
-    (!vertices.is_empty()).then(|| {
-        let buffer = cx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some(label),
-            contents: bytemuck::cast_slice(vertices),
-            usage: wgpu::BufferUsages::VERTEX,
-        });
-        (buffer, vertices.len() as u32)
-    })
+pub fn vertex_buffer<V: bytemuck::Pod>(cx: &WgpuContext, vertices: &[V]) -> Option<(Transient, u32)> {
+    (!vertices.is_empty()).then(|| (cx.transient(bytemuck::cast_slice(vertices)), vertices.len() as u32))
 }

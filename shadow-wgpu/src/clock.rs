@@ -118,7 +118,7 @@ pub fn write_mark(encoder: &mut wgpu::CommandEncoder, set: &wgpu::QuerySet, inde
 pub fn read_ticks(cx: &WgpuContext, set: &wgpu::QuerySet, count: u32) -> Result<Vec<u64>, WgpuError> {
     let size = u64::from(count) * 8;
     let buffer = |label, usage| {
-        cx.device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size, usage, mapped_at_creation: false })
+        cx.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size, usage, mapped_at_creation: false })
     };
     let resolve = buffer("timestamps", wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC);
     let staging = buffer("timestamps readback", wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ);

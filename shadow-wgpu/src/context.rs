@@ -179,6 +179,8 @@ pub struct WgpuContext {
     recording: Cell<bool>,
     /// The G-buffer's targets of the last frame, reused while the view's size stays.
     pub(crate) gbuffer_targets: Option<crate::gbuffer::GBufferTargets>,
+    /// What it has made, and the frame's transient buffer.
+    pub(crate) resources: crate::resources::Resources,
 }
 
 /// The instance. Set `XDG_RUNTIME_DIR` (CI does) to keep the Vulkan loader quiet on headless machines.
@@ -397,6 +399,7 @@ impl WgpuContext {
             lent: RefCell::new(None),
             recording: Cell::new(false),
             gbuffer_targets: None,
+            resources: Default::default(),
         }
     }
 

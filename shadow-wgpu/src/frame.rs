@@ -9,7 +9,6 @@ use shadow_core::script::{FrameRun, FrameSteps, run_frame};
 use shadow_core::stats::Phase;
 use shadow_core::technique::{DynShadowTechnique, FrameStats};
 use shadow_core::{FrameInputs, Image};
-use wgpu::util::DeviceExt;
 
 use crate::clock::PhaseClock;
 use crate::context::{WgpuBackend, WgpuContext, WgpuError};
@@ -63,7 +62,7 @@ pub fn layered(
     layers: u32,
     format: wgpu::TextureFormat,
 ) -> wgpu::Texture {
-    cx.device.create_texture(&wgpu::TextureDescriptor {
+    cx.create_texture(&wgpu::TextureDescriptor {
         label: Some(label),
         size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: layers },
         mip_level_count: 1,
@@ -229,7 +228,7 @@ fn add_gpu_times(at: &[f64], spans: Vec<Span>, stats: &mut FrameStats) {
 
 /// The receiver count of [`shade`]'s occlusion query.
 fn read_count(cx: &WgpuContext, q: &wgpu::Buffer) -> Result<u64, WgpuError> {
-    let staging = cx.device.create_buffer(&wgpu::BufferDescriptor {
+    let staging = cx.create_buffer(&wgpu::BufferDescriptor {
         label: Some("receivers readback"),
         size: 8,
         usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
@@ -242,42 +241,20 @@ fn read_count(cx: &WgpuContext, q: &wgpu::Buffer) -> Result<u64, WgpuError> {
     Ok(u64::from_le_bytes([d[0], d[1], d[2], d[3], d[4], d[5], d[6], d[7]]))
 }
 
-/// A uniform buffer for the shading pass's lights, to be written frame after frame.
-pub(crate) fn lights_buffer(cx: &WgpuContext) -> wgpu::Buffer {
-    cx.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("lights"),
-        size: std::mem::size_of::<LightTable>() as u64,
-        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    })
-}
-
 /// The shading pass's inputs: the G-buffer's position, normal and albedo, every light's visibility (a
-/// layer each of `vis`) and the frame's lights, written into `lights` when given (a buffer of
-/// [`lights_buffer`]'s) or into a new buffer.
+/// layer each of `vis`) and the frame's lights (in the frame's transient buffer).
 pub(crate) fn shade_group(
     cx: &WgpuContext,
     frame: &FrameInputs,
     g: &GpuGBuffer,
     vis: &wgpu::Texture,
-    lights: Option<&wgpu::Buffer>,
 ) -> wgpu::BindGroup {
     let mut table: LightTable = bytemuck::Zeroable::zeroed();
     table.count[0] = frame.lights.len() as u32;
     for (slot, l) in table.lights.iter_mut().zip(&frame.lights) {
         *slot = LightRaw::from(l);
     }
-    let lbuf = match lights {
-        Some(b) => {
-            cx.queue.write_buffer(b, 0, bytemuck::bytes_of(&table));
-            b.clone()
-        }
-        None => cx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("lights"),
-            contents: bytemuck::bytes_of(&table),
-            usage: wgpu::BufferUsages::UNIFORM,
-        }),
-    };
+    let lights = cx.transient(bytemuck::bytes_of(&table));
     let vis_view = vis.create_view(&wgpu::TextureViewDescriptor {
         dimension: Some(wgpu::TextureViewDimension::D2Array),
         ..Default::default()
@@ -290,7 +267,7 @@ pub(crate) fn shade_group(
             wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&g.normal) },
             wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&g.albedo) },
             wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&vis_view) },
-            wgpu::BindGroupEntry { binding: 4, resource: lbuf.as_entire_binding() },
+            wgpu::BindGroupEntry { binding: 4, resource: lights.binding() },
         ],
     })
 }
@@ -340,14 +317,14 @@ fn shade(
 ) -> Result<(wgpu::Texture, wgpu::Buffer), WgpuError> {
     cx.scoped("the shading pass", |cx| {
         let color = layered(cx, "color", g.width, g.height, 1, COLOR);
-        let group = shade_group(cx, frame, g, vis, None);
+        let group = shade_group(cx, frame, g, vis);
         let view = color.create_view(&Default::default());
         let query = cx.device.create_query_set(&wgpu::QuerySetDescriptor {
             label: Some("receivers"),
             ty: wgpu::QueryType::Occlusion,
             count: 1,
         });
-        let resolved = cx.device.create_buffer(&wgpu::BufferDescriptor {
+        let resolved = cx.create_buffer(&wgpu::BufferDescriptor {
             label: Some("receivers"),
             size: 8,
             usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,

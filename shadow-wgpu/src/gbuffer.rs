@@ -57,7 +57,7 @@ pub fn check_size(cx: &WgpuContext, what: &'static str, width: u32, height: u32)
 }
 
 fn target(cx: &WgpuContext, label: &str, w: u32, h: u32, format: wgpu::TextureFormat) -> wgpu::Texture {
-    cx.device.create_texture(&wgpu::TextureDescriptor {
+    cx.create_texture(&wgpu::TextureDescriptor {
         label: Some(label),
         size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
         mip_level_count: 1,
@@ -91,7 +91,7 @@ impl GBufferTargets {
             depth: target(cx, "depth", width, height, DEPTH_STENCIL),
             attributes: ["position", "normal", "albedo", "geometric normal"]
                 .map(|l| target(cx, l, width, height, ATTRIBUTE).create_view(&Default::default())),
-            view: cx.device.create_buffer(&wgpu::BufferDescriptor {
+            view: cx.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("camera view"),
                 size: std::mem::size_of::<ViewRaw>() as u64,
                 usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
@@ -107,8 +107,10 @@ impl GBufferTargets {
 /// A bad size or a GPU failure.
 pub fn render(cx: &mut WgpuContext, frame: &FrameInputs, width: u32, height: u32) -> Result<GpuGBuffer, WgpuError> {
     check_size(cx, "view", width, height)?;
-    cx.cache.upload_meshes(&cx.device, frame);
-    let instances = cx.cache.instances(&cx.device, &cx.queue, frame).clone();
+    // A frame begins with its G-buffer: its transient data starts over.
+    cx.begin_transient();
+    cx.upload_meshes(frame);
+    let instances = cx.instances(frame);
     let targets = match cx.gbuffer_targets.take() {
         Some(t) if (t.width, t.height) == (width, height) => t,
         _ => GBufferTargets::new(cx, width, height),

@@ -3,7 +3,8 @@
 //! A context on its own device or the host application's ([`context`]), scene upload cached per mesh
 //! ([`upload`]), the G-buffer ([`gbuffer`]), the instrumented frame with shading and read-backs
 //! ([`frame`]), the frame recorded into a host's encoder ([`record`]), pipelines and WGSL every technique
-//! uses ([`pipelines`], [`shaders`]), and the passes techniques are built from ([`passes`]).
+//! uses ([`pipelines`], [`shaders`]), the passes techniques are built from ([`passes`]), and where
+//! buffers and textures come from ([`resources`]).
 
 pub mod clock;
 pub mod context;
@@ -13,6 +14,7 @@ pub mod passes;
 pub mod pipelines;
 pub mod readback;
 pub mod record;
+pub mod resources;
 pub mod shaders;
 pub mod upload;
 
@@ -20,3 +22,4 @@ pub use context::{AdapterChoice, AdapterSummary, WgpuBackend, WgpuContext, WgpuE
 pub use frame::{GpuVisibility, WgpuFrame, render_frame};
 pub use gbuffer::GpuGBuffer;
 pub use record::{ColorTarget, FrameRecorder};
+pub use resources::{Created, Transient};

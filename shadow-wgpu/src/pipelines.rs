@@ -4,7 +4,6 @@
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
 use shadow_core::scene::{Light, LightKind};
-use wgpu::util::DeviceExt;
 
 use crate::shaders;
 
@@ -238,15 +237,12 @@ impl Shared {
         Self { frame_layout, gbuffer, shade_layout, shade, receivers }
     }
 
-    /// A group-0 bind group for a view (camera or light) over a frame's instances.
+    /// A group-0 bind group for a view (camera or light) over a frame's instances, the view in this frame's
+    /// transient buffer.
     #[must_use]
-    pub fn frame_group(&self, device: &wgpu::Device, view: &ViewRaw, instances: &wgpu::Buffer) -> wgpu::BindGroup {
-        let ubuf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("view"),
-            contents: bytemuck::bytes_of(view),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
-        self.frame_group_with(device, &ubuf, instances)
+    pub fn frame_group(&self, cx: &crate::WgpuContext, view: &ViewRaw, instances: &wgpu::Buffer) -> wgpu::BindGroup {
+        let view = cx.transient(bytemuck::bytes_of(view));
+        self.frame_group_over(&cx.device, view.binding(), instances)
     }
 
     /// The same group over a uniform buffer of the caller's holding the view.
@@ -257,11 +253,20 @@ impl Shared {
         view: &wgpu::Buffer,
         instances: &wgpu::Buffer,
     ) -> wgpu::BindGroup {
+        self.frame_group_over(device, view.as_entire_binding(), instances)
+    }
+
+    fn frame_group_over(
+        &self,
+        device: &wgpu::Device,
+        view: wgpu::BindingResource<'_>,
+        instances: &wgpu::Buffer,
+    ) -> wgpu::BindGroup {
         device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("frame"),
             layout: &self.frame_layout,
             entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: view.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 0, resource: view },
                 wgpu::BindGroupEntry { binding: 1, resource: instances.as_entire_binding() },
             ],
         })

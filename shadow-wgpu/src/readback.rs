@@ -17,7 +17,7 @@ fn read_layer(
     let (w, h) = (tex.width(), tex.height());
     let row = w * texel_bytes;
     let padded = row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-    let buffer = cx.device.create_buffer(&wgpu::BufferDescriptor {
+    let buffer = cx.create_buffer(&wgpu::BufferDescriptor {
         label: Some("readback"),
         size: u64::from(padded) * u64::from(h),
         usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,

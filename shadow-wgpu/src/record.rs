@@ -15,18 +15,17 @@ use shadow_core::technique::{DynShadowTechnique, FrameStats};
 use shadow_core::{FrameInputs, LightView};
 
 use crate::context::{WgpuBackend, WgpuContext, WgpuError};
-use crate::frame::{GpuVisibility, MAX_LIGHTS, full_screen_shade, layer_view, layered, lights_buffer, shade_group};
+use crate::frame::{GpuVisibility, MAX_LIGHTS, full_screen_shade, layer_view, layered, shade_group};
 use crate::gbuffer::{self, GpuGBuffer};
 use crate::pipelines::{VISIBILITY, full_screen_pipeline};
 
 /// Records frames into a host's encoder, keeping what it made for them: the visibility targets (remade
-/// when the view's size or the number of lights changes), the lights' buffer and a shading pipeline per
+/// when the view's size or the number of lights changes) and a shading pipeline per
 /// colour format.
 #[derive(Default)]
 pub struct FrameRecorder {
     visibility: Option<Visibility>,
     shade: HashMap<wgpu::TextureFormat, wgpu::RenderPipeline>,
-    lights: Option<wgpu::Buffer>,
 }
 
 /// Every light's visibility, a layer each of one R32Float array texture (1 lit, 0 shadowed).
@@ -79,9 +78,8 @@ impl FrameRecorder {
         let visibility =
             visibility_for(&mut self.visibility, cx, target.width, target.height, frame.lights.len() as u32);
         let shade = self.shade.entry(target.format).or_insert_with(|| shade_pipeline(cx, target.format));
-        let lights = self.lights.get_or_insert_with(|| lights_buffer(cx));
         let (width, height) = (target.width, target.height);
-        let steps = RecordSteps { width, height, visibility, shade, lights, target: target.view };
+        let steps = RecordSteps { width, height, visibility, shade, target: target.view };
         let FrameRun { light_views, .. } = cx.record_into(encoder, |cx| run_frame(cx, frame, steps, technique))?;
         Ok(light_views)
     }
@@ -131,7 +129,6 @@ struct RecordSteps<'a> {
     height: u32,
     visibility: &'a wgpu::Texture,
     shade: &'a wgpu::RenderPipeline,
-    lights: &'a wgpu::Buffer,
     target: &'a wgpu::TextureView,
 }
 
@@ -151,7 +148,7 @@ impl FrameSteps<WgpuBackend> for RecordSteps<'_> {
 
     fn shade(&mut self, cx: &mut WgpuContext, frame: &FrameInputs, g: &GpuGBuffer) -> Result<(), WgpuError> {
         cx.scoped("the recorded shading pass", |cx| {
-            let group = shade_group(cx, frame, g, self.visibility, Some(self.lights));
+            let group = shade_group(cx, frame, g, self.visibility);
             let mut enc = cx.encoder("shade");
             full_screen_shade(&mut enc, self.target, self.shade, g, &group, None);
             cx.submit(enc);

@@ -9,7 +9,8 @@ use bytemuck::{Pod, Zeroable};
 use glam::Mat4;
 use shadow_core::geometry::adjacency::{Adjacency, FaceUse};
 use shadow_core::{FrameInputs, MeshKey};
-use wgpu::util::DeviceExt;
+
+use crate::context::WgpuContext;
 
 /// A mesh on the GPU.
 pub struct MeshGpu {
@@ -73,7 +74,7 @@ pub struct AdjacencyGpu {
 }
 
 impl AdjacencyGpu {
-    fn upload(device: &wgpu::Device, adj: &Adjacency, version: u64) -> Self {
+    fn upload(cx: &WgpuContext, adj: &Adjacency, version: u64) -> Self {
         let welded: Vec<[f32; 4]> = adj.positions().iter().map(|p| p.extend(1.0).to_array()).collect();
         let planes: Vec<[f32; 4]> = adj.planes().iter().map(|p| p.to_array()).collect();
         let mut edges: Vec<[u32; 4]> = Vec::with_capacity(adj.edge_count());
@@ -95,7 +96,7 @@ impl AdjacencyGpu {
         // Storage bindings may not be empty: a mesh without edges still binds one word.
         let storage = |label, contents: &[u8]| {
             let padded = [0u8; 16];
-            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            cx.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some(label),
                 contents: if contents.is_empty() { &padded } else { contents },
                 usage: wgpu::BufferUsages::STORAGE,
@@ -125,7 +126,7 @@ pub struct SceneCache {
 
 impl SceneCache {
     /// Uploads every instance's mesh that is missing or stale.
-    pub fn upload_meshes(&mut self, device: &wgpu::Device, frame: &FrameInputs) {
+    pub fn upload_meshes(&mut self, cx: &WgpuContext, frame: &FrameInputs) {
         for inst in &frame.instances {
             if self.meshes.get(&inst.mesh_key).is_some_and(|m| m.version == inst.mesh_version) {
                 continue;
@@ -135,7 +136,7 @@ impl SceneCache {
             let normals: Vec<[f32; 4]> = m.normals().iter().map(|n| n.extend(0.0).to_array()).collect();
             let indices: Vec<u32> = m.triangles().iter().flatten().copied().collect();
             let make = |label, contents: &[u8], usage| {
-                device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
+                cx.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
             };
             self.meshes.insert(
                 inst.mesh_key,
@@ -161,12 +162,12 @@ impl SceneCache {
     }
 
     /// Uploads the adjacency of every casting instance's mesh that is missing or stale.
-    pub fn upload_adjacency(&mut self, device: &wgpu::Device, frame: &FrameInputs) {
+    pub fn upload_adjacency(&mut self, cx: &WgpuContext, frame: &FrameInputs) {
         for inst in frame.instances.iter().filter(|i| i.casts_shadow) {
             if self.adjacency.get(&inst.mesh_key).is_some_and(|a| a.version == inst.mesh_version) {
                 continue;
             }
-            self.adjacency.insert(inst.mesh_key, AdjacencyGpu::upload(device, &inst.adjacency, inst.mesh_version));
+            self.adjacency.insert(inst.mesh_key, AdjacencyGpu::upload(cx, &inst.adjacency, inst.mesh_version));
         }
     }
 
@@ -178,20 +179,20 @@ impl SceneCache {
 
     /// The frame's instance data: the instances that changed are written into the buffer in place, which
     /// is made anew only when the number of instances changes.
-    pub fn instances(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, frame: &FrameInputs) -> &wgpu::Buffer {
+    pub fn instances(&mut self, cx: &WgpuContext, frame: &FrameInputs) -> &wgpu::Buffer {
         let raw: Vec<InstanceRaw> = frame.instances.iter().map(InstanceRaw::of).collect();
         match &mut self.instances {
             Some((old, buf)) if old.len() == raw.len() => {
                 let size = std::mem::size_of::<InstanceRaw>();
                 for (i, (was, now)) in old.iter_mut().zip(&raw).enumerate() {
                     if bytemuck::bytes_of(was) != bytemuck::bytes_of(now) {
-                        queue.write_buffer(buf, (i * size) as u64, bytemuck::bytes_of(now));
+                        cx.queue.write_buffer(buf, (i * size) as u64, bytemuck::bytes_of(now));
                         *was = *now;
                     }
                 }
             }
             slot => {
-                let buf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                let buf = cx.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                     label: Some("instances"),
                     contents: bytemuck::cast_slice(&raw),
                     usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
@@ -203,5 +204,30 @@ impl SceneCache {
             Some((_, b)) => b,
             None => unreachable!("just uploaded"),
         }
+    }
+}
+
+impl WgpuContext {
+    /// Uploads every instance's mesh of `frame` that is missing or stale ([`SceneCache::upload_meshes`]).
+    pub fn upload_meshes(&mut self, frame: &FrameInputs) {
+        let mut cache = std::mem::take(&mut self.cache);
+        cache.upload_meshes(self, frame);
+        self.cache = cache;
+    }
+
+    /// Uploads the adjacency of every casting instance's mesh that is missing or stale
+    /// ([`SceneCache::upload_adjacency`]).
+    pub fn upload_adjacency(&mut self, frame: &FrameInputs) {
+        let mut cache = std::mem::take(&mut self.cache);
+        cache.upload_adjacency(self, frame);
+        self.cache = cache;
+    }
+
+    /// The frame's instance data, written where it changed ([`SceneCache::instances`]).
+    pub fn instances(&mut self, frame: &FrameInputs) -> wgpu::Buffer {
+        let mut cache = std::mem::take(&mut self.cache);
+        let buffer = cache.instances(self, frame).clone();
+        self.cache = cache;
+        buffer
     }
 }

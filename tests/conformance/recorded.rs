@@ -81,3 +81,87 @@ fn recorded_frames_match_the_instrumented_ones() {
     let err = record(&mut cx, &mut recorder, &frame, &spec, &unorm).expect_err("refused");
     assert!(matches!(err, WgpuError::NotRecordable { .. }), "{err}");
 }
+
+/// Recorded frames of `technique` on `scene` with its first light circling the vertical axis and its
+/// first drawn node moving, `frames` of them, each submitted: what the context made after the first frame, the last
+/// frame, and its visibility.
+fn made_after_the_first_frame(
+    cx: &mut WgpuContext,
+    scene: &mut shadow_core::Scene,
+    technique: &mut dyn shadow_core::technique::DynShadowTechnique<shadow_wgpu::WgpuBackend>,
+    target: &wgpu::Texture,
+    frames: u32,
+) -> Result<(shadow_wgpu::Created, FrameInputs, shadow_core::Image<f32>), WgpuError> {
+    use shadow_core::LightKind;
+    use shadow_core::glam::{Mat4, Vec3};
+    let light = scene.lights().next().map(|(k, _)| k).expect("a light");
+    let node = scene.drawables().next().map(|(k, ..)| k).expect("a drawn node");
+    let start = scene.node(node).expect("node").local_transform();
+    let mut recorder = FrameRecorder::new();
+    let view = target.create_view(&Default::default());
+    let color = ColorTarget { view: &view, format: target.format(), width: target.width(), height: target.height() };
+    let (mut first, mut last) = (None, None);
+    for i in 0..frames {
+        // The light circles the scene's vertical axis, turned with it, so it keeps lighting the scene.
+        let turn = Mat4::from_rotation_y(0.02);
+        if let Some(l) = scene.light_mut(light) {
+            match &mut l.kind {
+                LightKind::Spot { position, direction, .. } => {
+                    *position = turn.transform_point3(*position);
+                    *direction = turn.transform_vector3(*direction);
+                }
+                LightKind::Point { position } => *position = turn.transform_point3(*position),
+                LightKind::Directional { direction } => *direction = turn.transform_vector3(*direction),
+            }
+        }
+        let nudge = Mat4::from_translation(Vec3::new(0.002 * i as f32, 0.0, 0.0));
+        scene.set_local_transform(node, nudge * start).expect("node");
+        let frame = FrameInputs::from_first_camera(scene).expect("frame");
+        let mut encoder = cx.device.create_command_encoder(&Default::default());
+        recorder.record(cx, &mut encoder, &frame, technique, &color)?;
+        cx.queue.submit([encoder.finish()]);
+        first.get_or_insert(cx.created());
+        last = Some(frame);
+    }
+    let (now, first) = (cx.created(), first.unwrap_or_default());
+    let made = shadow_wgpu::Created { buffers: now.buffers - first.buffers, textures: now.textures - first.textures };
+    let visibility = recorder.visibility().expect("a recorded frame");
+    let visibility = readback::read_f32(cx, visibility, 0, wgpu::TextureAspect::All)?;
+    Ok((made, last.expect("a frame"), visibility))
+}
+
+#[test]
+fn a_moving_light_and_node_allocate_nothing_after_the_first_frame() {
+    const FRAMES: u32 = 100;
+    let Some(mut renderer) = crate::with_wgpu("recorded allocations") else { return };
+    let mut cx = WgpuContext::new(&shadow_wgpu::AdapterChoice { name: None, allow_software: true }).expect("context");
+    let target = color_target(&cx, wgpu::TextureFormat::Rgba8UnormSrgb, 128, 96);
+    let mut failures = Vec::new();
+    let mut checked = 0;
+    for entry in
+        renderer.registry().clone().entries().iter().filter(|e| e.wgpu.is_some() && !NOT_RECORDABLE.contains(&e.name))
+    {
+        let mut scene = scenes::build("primitives", &SceneParams::default()).expect("scene");
+        let mut technique = renderer.registry().wgpu(&TechniqueSpec::named(entry.name)).expect("technique");
+        let (made, last, visibility) =
+            made_after_the_first_frame(&mut cx, &mut scene, technique.as_mut(), &target, FRAMES)
+                .unwrap_or_else(|e| panic!("{}: {e}", entry.name));
+        if made != shadow_wgpu::Created::default() {
+            failures.push(format!("{}: {} buffers, {} textures", entry.name, made.buffers, made.textures));
+        }
+        // What was reused holds this frame's data, not a stale one's: the last frame as a fresh render.
+        let (w, h) = (target.width(), target.height());
+        let fresh = renderer.run(BackendKind::Wgpu, &last, w, h, &TechniqueSpec::named(entry.name)).expect("a frame");
+        let differ = visibility.data().iter().zip(fresh.visibility[0].data()).filter(|(a, b)| a != b).count();
+        let shadowed = visibility.data().iter().filter(|&&v| v == 0.0).count();
+        if differ > 0 || shadowed == 0 {
+            failures.push(format!(
+                "{}: the last of {FRAMES} frames has {shadowed} shadowed pixels, {differ} unlike a fresh render's",
+                entry.name
+            ));
+        }
+        checked += 1;
+    }
+    assert!(failures.is_empty(), "made after the first frame:\n{}", failures.join("\n"));
+    assert!(checked >= 10, "only {checked} techniques checked");
+}

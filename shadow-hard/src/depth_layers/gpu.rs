@@ -11,7 +11,6 @@ use shadow_core::light::LightProjection;
 use shadow_core::technique::LightPass;
 use shadow_core::technique::settings::Filter;
 use shadow_core::technique::{ShadowTechnique, TechniqueError};
-use wgpu::util::DeviceExt;
 
 use shadow_wgpu::frame::{GpuVisibility, layer_view};
 use shadow_wgpu::gbuffer::{GpuGBuffer, check_size};
@@ -167,17 +166,12 @@ fn render_projection(
 ) {
     let Some((z1, z2)) = &state.scratch else { return };
     let res = maps.width();
-    let group0 =
-        cx.shared.frame_group(&cx.device, &ViewRaw::new(proj.clip_from_world, glam::Vec3::ZERO, res, res), instances);
+    let group0 = cx.shared.frame_group(cx, &ViewRaw::new(proj.clip_from_world, glam::Vec3::ZERO, res, res), instances);
     let params = LayerParams {
         view: [proj.near, proj.far, if proj.orthographic { 1.0 } else { 0.0 }, kind_code(s.kind)],
         settings: [s.z_offset, s.peel_epsilon, 0.0, 0.0],
     };
-    let ubuf = cx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("layer params"),
-        contents: bytemuck::bytes_of(&params),
-        usage: wgpu::BufferUsages::UNIFORM,
-    });
+    let params = cx.transient(bytemuck::bytes_of(&params));
     let (v1, v2) = (z1.create_view(&Default::default()), z2.create_view(&Default::default()));
     let group1 = |a: &wgpu::TextureView, b: &wgpu::TextureView| {
         cx.device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -186,7 +180,7 @@ fn render_projection(
             entries: &[
                 wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(a) },
                 wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(b) },
-                wgpu::BindGroupEntry { binding: 2, resource: ubuf.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 2, resource: params.binding() },
             ],
         })
     };
@@ -242,8 +236,8 @@ impl ShadowTechnique<WgpuBackend> for DepthLayers {
             state.scratch =
                 Some(cx.scoped("allocating depth layers", |cx| (map_texture(cx, res, 1), map_texture(cx, res, 1)))?);
         }
-        cx.cache.upload_meshes(&cx.device, frame);
-        let instances = cx.cache.instances(&cx.device, &cx.queue, frame).clone();
+        cx.upload_meshes(frame);
+        let instances = cx.instances(frame);
         let maps = state.maps.clone().ok_or_else(|| TechniqueError::NotBuilt(self.kind.name().into()))?;
         cx.scoped("the depth-layer passes", |cx| {
             for (k, proj) in light.projections.iter().enumerate() {

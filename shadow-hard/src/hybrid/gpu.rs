@@ -119,7 +119,17 @@ pub struct State {
     tiles: Option<TileMarks>,
     /// With `edge_texels=paired`: the edge cells of the last build, a layer per projection.
     edge_maps: Option<wgpu::Texture>,
+    /// Per light of the frame, what its last build uploaded data into, for its next build to reuse: data
+    /// written for one light must not land where another light of the same recorded frame reads.
+    kept: Vec<Kept>,
     last: Option<LastQuery>,
+}
+
+/// What a light's last build uploaded its data into.
+#[derive(Default)]
+struct Kept {
+    pieces: Option<CasterPieces>,
+    edge_maps: Option<wgpu::Texture>,
 }
 
 /// What the caster masks keep: the compute passes, the answer's draw for the listed pixels, the last
@@ -200,7 +210,7 @@ fn far_pass(cx: &WgpuContext, module: &wgpu::ShaderModule, groups: &[&wgpu::Bind
 
 /// A depth-stencil target of the G-buffer's size and format, for the depth mask.
 fn scratch_target(cx: &WgpuContext, width: u32, height: u32) -> wgpu::Texture {
-    cx.device.create_texture(&wgpu::TextureDescriptor {
+    cx.create_texture(&wgpu::TextureDescriptor {
         label: Some("hybrid mask depth"),
         size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
         mip_level_count: 1,
@@ -387,21 +397,28 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
                 far,
                 tiles: None,
                 edge_maps: None,
+                kept: Vec::new(),
                 last: None,
             }
         })
     }
 
     fn build(&self, cx: &mut WgpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), WgpuError> {
-        let LightPass { frame, light, stats, .. } = pass;
+        let LightPass { frame, light, slot, stats } = pass;
         state.map.render(cx, frame, light, self.depth.resolution)?;
         cx.step("map");
+        if state.kept.len() <= slot {
+            state.kept.resize_with(slot + 1, Kept::default);
+        }
+        let kept = std::mem::take(&mut state.kept[slot]);
         let res = self.depth.resolution;
         // The edge maps' segments come from the volumes' own silhouette pass (unused with
         // `edge_texels=off`, where they cost two transforms per silhouette edge).
         let (volumes, segments) = frame.shadow_volumes_and_segments(light, Caps::Both);
         if self.edge_texels.is_on() {
-            state.edge_maps = Some(cx.scoped("the edge cells", |cx| edge_cell_maps(cx, &segments, light, res))?);
+            let maps = cx.scoped("the edge cells", |cx| edge_cell_maps(cx, &segments, light, res, kept.edge_maps))?;
+            state.kept[slot].edge_maps = Some(maps.clone());
+            state.edge_maps = Some(maps);
         }
         cx.step("edges");
         if let Some(casters) = &mut state.casters {
@@ -410,7 +427,9 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
             InstanceVolume::count(&volumes, &mut stats.counters);
             let shafts = CasterShafts::new(frame, light, &volumes);
             let split = Split::new(frame, &volumes, &shafts, LISTED_TRIANGLES, setup_room(cx));
-            casters.pieces = Some(CasterPasses::upload(cx, frame, light, &split, &shafts)?);
+            let pieces = CasterPasses::upload(cx, (frame, light), &split, &shafts, kept.pieces)?;
+            state.kept[slot].pieces = Some(pieces.clone());
+            casters.pieces = Some(pieces);
             state.draws = Some(upload_volumes(cx, frame, &split.raster)?);
             casters.all_draws = self.unmasked_fill.is_on().then(|| upload_volumes(cx, frame, &volumes)).transpose()?;
         } else {
@@ -476,7 +495,7 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
 /// outside the mask, volume-shadowed and volume-lit inside it; 0 (no receiver) where nothing draws.
 fn classes(cx: &WgpuContext, state: &State, last: &LastQuery) -> Result<Image<u32>, WgpuError> {
     let (w, h) = (last.depth.width(), last.depth.height());
-    let target = cx.device.create_texture(&wgpu::TextureDescriptor {
+    let target = cx.create_texture(&wgpu::TextureDescriptor {
         label: Some("hybrid classes"),
         size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
         mip_level_count: 1,

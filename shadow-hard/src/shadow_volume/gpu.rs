@@ -113,7 +113,7 @@ impl ShadowTechnique<WgpuBackend> for ShadowVolume {
                         reference: 0,
                         scissors: None,
                     };
-                    Some(counting.run(cx, draws, frame, g, &depth))
+                    counting.run(cx, draws, frame, g, &depth)
                 }
             };
             state.resolve.run(cx, g, out, &depth);
@@ -121,18 +121,18 @@ impl ShadowTechnique<WgpuBackend> for ShadowVolume {
         })?;
         let Some(passed) = passed.filter(|_| cx.instrumented()) else { return Ok(()) };
         cx.end_of_work();
-        let passed = read_query(cx, &passed)?;
+        let passed = read_query(cx, Some(&passed))?;
         // Every rasterized fragment, for Sen's overdraw: a second pass with the depth test off. It runs
         // after the resolve, so it does not disturb the result; its time lands in a separate sub-phase.
         let t = std::time::Instant::now();
         let all = cx.scoped("the volume fragment count", |cx| match volumes {
             Volumes::Gpu(extrusion) => extrusion.draw(cx, frame, g, &depth, slot, true),
             Volumes::Cpu { count_all, draws, .. } => {
-                Some(VolumePass::count(count_all, "count volume fragments").run(cx, draws, frame, g, &depth))
+                VolumePass::count(count_all, "count volume fragments").run(cx, draws, frame, g, &depth)
             }
         })?;
         let all = match all {
-            Some(q) => read_query(cx, &q)?,
+            Some(q) => read_query(cx, Some(&q))?,
             None => 0,
         };
         stats.timings.extra.insert("count_fragments".into(), shadow_core::stats::ms(t.elapsed()));

@@ -16,7 +16,6 @@ use bytemuck::{Pod, Zeroable};
 use shadow_core::light::LightView;
 use shadow_core::technique::LightPass;
 use shadow_core::technique::{DebugView, ShadowTechnique, TechniqueError};
-use wgpu::util::DeviceExt;
 
 use shadow_wgpu::frame::{GpuVisibility, layer_view, layered};
 use shadow_wgpu::gbuffer::{GpuGBuffer, check_size};
@@ -24,7 +23,7 @@ use shadow_wgpu::passes::maps::{
     LookupParams, MapQuery, QueryExtras, depth_bias, light_pass_pipeline, map_texture, render_maps,
 };
 use shadow_wgpu::pipelines::{MAP_DEPTH, attribute_entry, buffer_entry, depth_array_entry};
-use shadow_wgpu::{WgpuBackend, WgpuContext, WgpuError};
+use shadow_wgpu::{Transient, WgpuBackend, WgpuContext, WgpuError};
 use shadow_wgpu::{readback, shaders};
 
 /// The silhouette points' format: two offsets in texel space.
@@ -169,7 +168,7 @@ impl State {
         });
         let lookup = LookupParams { radius: 0.0, receiver_offset: s.depth.receiver_offset() };
         let query = query_pipeline(cx, &map_module).with_lookup(lookup);
-        let counters = cx.device.create_buffer(&wgpu::BufferDescriptor {
+        let counters = cx.create_buffer(&wgpu::BufferDescriptor {
             label: Some("silhouette counters"),
             size: COUNTER_STRIDE + 4,
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
@@ -208,13 +207,13 @@ impl State {
     }
 }
 
-/// The segments of every projection in one buffer, and each projection's range in it.
+/// The segments of every projection in one slice of the transient buffer, and each projection's range in it.
 fn upload_segments(
     cx: &WgpuContext,
     edges: &[[glam::Vec3; 2]],
     light: &LightView,
     res: u32,
-) -> (wgpu::Buffer, Vec<std::ops::Range<u32>>) {
+) -> (Transient, Vec<std::ops::Range<u32>>) {
     let mut all: Vec<MapSegment> = Vec::new();
     let mut ranges = Vec::new();
     for p in &light.projections {
@@ -226,12 +225,7 @@ fn upload_segments(
         // A storage binding cannot be empty; nothing is drawn from it.
         all.push(MapSegment::default());
     }
-    let buffer = cx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("silhouette segments"),
-        contents: bytemuck::cast_slice(&all),
-        usage: wgpu::BufferUsages::STORAGE,
-    });
-    (buffer, ranges)
+    (cx.transient(bytemuck::cast_slice(&all)), ranges)
 }
 
 /// Pass 2 for every projection, after zeroing both counters.
@@ -239,7 +233,7 @@ fn draw_points(
     cx: &WgpuContext,
     state: &State,
     maps: &Maps,
-    segments: &wgpu::Buffer,
+    segments: &Transient,
     ranges: &[std::ops::Range<u32>],
     margin: f32,
 ) {
@@ -254,18 +248,14 @@ fn draw_points(
     enc.clear_buffer(&state.counters, 0, None);
     for (k, range) in ranges.iter().enumerate() {
         let params = BuildParams { settings: [res as f32, side as f32, margin, k as f32] };
-        let ubuf = cx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("silhouette build params"),
-            contents: bytemuck::bytes_of(&params),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
+        let params = cx.transient(bytemuck::bytes_of(&params));
         let group = cx.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("silhouette points"),
             layout: &state.points_layout,
             entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: segments.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 0, resource: segments.binding() },
                 wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&depth_view) },
-                wgpu::BindGroupEntry { binding: 2, resource: ubuf.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 2, resource: params.binding() },
             ],
         });
         let layer = layer_view(&maps.points, k as u32);
@@ -336,7 +326,7 @@ fn count(cx: &WgpuContext, state: &State, maps: &Maps) -> Result<(u64, u64), Wgp
 
 /// Reads both counters: (non-empty texels, silhouette pixels).
 fn read_counters(cx: &WgpuContext, counters: &wgpu::Buffer) -> Result<(u64, u64), WgpuError> {
-    let staging = cx.device.create_buffer(&wgpu::BufferDescriptor {
+    let staging = cx.create_buffer(&wgpu::BufferDescriptor {
         label: Some("silhouette counters readback"),
         size: COUNTER_STRIDE + 4,
         usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
@@ -367,8 +357,8 @@ impl ShadowTechnique<WgpuBackend> for SilhouetteMap {
         check_size(cx, "shadow map", res, res)?;
         state.allocate(cx, res, light.projections.len() as u32)?;
         let Some(maps) = &state.maps else { return Err(TechniqueError::NotBuilt(Self::NAME.into()).into()) };
-        cx.cache.upload_meshes(&cx.device, frame);
-        let instances = cx.cache.instances(&cx.device, &cx.queue, frame).clone();
+        cx.upload_meshes(frame);
+        let instances = cx.instances(frame);
         let edges = frame.silhouette_segments(light);
         cx.scoped("the silhouette-map passes", |cx| {
             render_maps(cx, &state.light_pass, frame, light, &maps.depth, None, &instances);

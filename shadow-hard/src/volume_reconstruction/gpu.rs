@@ -20,7 +20,6 @@ use super::{ObjectIds, VolumeReconstruction};
 use shadow_core::glam::Vec4;
 use shadow_core::technique::LightPass;
 use shadow_core::technique::{DebugView, ShadowTechnique, TechniqueError};
-use wgpu::util::DeviceExt;
 
 use shadow_wgpu::frame::{GpuVisibility, layered};
 use shadow_wgpu::gbuffer::{GpuGBuffer, check_size};
@@ -99,7 +98,7 @@ fn vertex_buffer(cx: &WgpuContext, label: &str, triangles: &[HomTriangle]) -> Op
         return None;
     }
     let vertices: Vec<Vec4> = triangles.iter().flatten().copied().collect();
-    let buffer = cx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+    let buffer = cx.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some(label),
         contents: bytemuck::cast_slice(&vertices),
         usage: wgpu::BufferUsages::VERTEX,
@@ -158,8 +157,8 @@ impl ShadowTechnique<WgpuBackend> for VolumeReconstruction {
         }
         let maps = state.maps.clone().ok_or_else(|| TechniqueError::NotBuilt(Self::NAME.into()))?;
         let id_maps = state.ids.clone();
-        cx.cache.upload_meshes(&cx.device, frame);
-        let instances = cx.cache.instances(&cx.device, &cx.queue, frame).clone();
+        cx.upload_meshes(frame);
+        let instances = cx.instances(frame);
         cx.scoped("the light pass", |cx| {
             render_maps(cx, &state.light_pass, frame, &view, &maps, id_maps.as_ref(), &instances);
         })?;
@@ -217,12 +216,12 @@ impl ShadowTechnique<WgpuBackend> for VolumeReconstruction {
             return Ok(());
         }
         cx.end_of_work();
-        let passed = read_query(cx, &passed)?;
+        let passed = read_query(cx, Some(&passed))?;
         // Every rasterized fragment, after the resolve so it cannot disturb it, timed on its own.
         let t = std::time::Instant::now();
         let counting = [(&state.boundary_vertices, &state.count_boundary), (&cap_vertices, &state.count_caps)];
         let all = cx.scoped("the fragment count", |cx| parity_pass(cx, g, &depth, &counting, None))?;
-        let all = read_query(cx, &all)?;
+        let all = read_query(cx, Some(&all))?;
         stats.timings.extra.insert("count_fragments".into(), shadow_core::stats::ms(t.elapsed()));
         let boundary = state.projections.iter().map(|p| p.triangles.len()).sum::<usize>();
         let c = &mut stats.counters;
@@ -254,7 +253,7 @@ impl ShadowTechnique<WgpuBackend> for VolumeReconstruction {
 /// How many boundary and cap triangles cover each pixel of the last query's view (twin: cpu.rs's
 /// `volume_view`), counted in the stencil of a scratch depth-stencil target and read back.
 fn coverage_counts(cx: &WgpuContext, state: &State, last: &LastView) -> Result<shadow_core::Image<u8>, WgpuError> {
-    let target = cx.device.create_texture(&wgpu::TextureDescriptor {
+    let target = cx.create_texture(&wgpu::TextureDescriptor {
         label: Some("volume view"),
         size: wgpu::Extent3d { width: last.width, height: last.height, depth_or_array_layers: 1 },
         mip_level_count: 1,

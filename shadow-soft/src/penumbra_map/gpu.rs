@@ -77,7 +77,7 @@ impl State {
         };
         let group = min_target::bind(cx, &self.build_layout, "penumbra map", &params, maps);
         let data = vertices(triangles);
-        let vertices = min_target::vertex_buffer(cx, "cones and sheets", &data);
+        let vertices = min_target::vertex_buffer(cx, &data);
         let mut enc = cx.encoder("penumbra map");
         min_target::draw(&mut enc, penumbra, &self.build, &group, vertices.as_ref());
         cx.submit(enc);

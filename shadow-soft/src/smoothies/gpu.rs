@@ -11,7 +11,6 @@ use shadow_wgpu::frame::{layer_view, layered};
 use shadow_wgpu::passes::maps::{DepthMaps, LookupParams, MapQuery, QueryExtras};
 use shadow_wgpu::pipelines::{FragmentEntry, MAP_DEPTH, buffer_entry, depth_entry};
 use shadow_wgpu::{GpuGBuffer, GpuVisibility, WgpuBackend, WgpuContext, WgpuError, readback, shaders};
-use wgpu::util::DeviceExt;
 
 use super::geometry::{Ramp, SmoothieTriangle};
 use super::{FalloffTable, Smoothies};
@@ -86,7 +85,7 @@ impl State {
         };
         let group = min_target::bind(cx, &self.buffer_layout, "smoothie buffer", &params, maps);
         let data = vertices(triangles);
-        let vertices = min_target::vertex_buffer(cx, "smoothies", &data);
+        let vertices = min_target::vertex_buffer(cx, &data);
         let mut enc = cx.encoder("smoothies");
         for (target, pipeline) in buffer.iter().zip([&self.depth_pass, &self.alpha_pass]) {
             min_target::draw(&mut enc, target, pipeline, &group, vertices.as_ref());
@@ -119,7 +118,7 @@ impl ShadowTechnique<WgpuBackend> for Smoothies {
             let lookup = LookupParams { radius: 0.0, receiver_offset: self.depth.receiver_offset() };
             let query = MapQuery::with_entry(cx, &query_module, FragmentEntry::from("fs_smoothie_query"), &extra)
                 .with_lookup(lookup);
-            let falloff = cx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            let falloff = cx.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("smoothie falloff"),
                 contents: bytemuck::cast_slice(falloff.samples()),
                 usage: wgpu::BufferUsages::STORAGE,

@@ -14,9 +14,8 @@ use shadow_core::geometry::LightSource;
 use shadow_core::geometry::volume::{Caps, VolumeCounting};
 use shadow_core::light::LightView;
 use shadow_core::{FrameInputs, MeshKey};
-use wgpu::util::DeviceExt;
 
-use super::volumes::{StencilVertex, count_all, counting_state, occlusion_query, stencil_pipeline};
+use super::volumes::{Query, StencilVertex, count_all, counting_state, occlusion_query, stencil_pipeline};
 use crate::context::{WgpuContext, WgpuError};
 use crate::gbuffer::GpuGBuffer;
 use crate::pipelines::POSITION_LAYOUT;
@@ -140,8 +139,8 @@ impl GpuExtrusion {
         slot: usize,
         caps: Caps,
     ) -> Result<(), WgpuError> {
-        cx.cache.upload_meshes(&cx.device, frame);
-        cx.cache.upload_adjacency(&cx.device, frame);
+        cx.upload_meshes(frame);
+        cx.upload_adjacency(frame);
         let slots = frame.lights.len().max(slot + 1);
         let jobs = Jobs::for_frame(&mut self.jobs, cx, [&self.compute_layout, &self.draw_layout], frame, slots)?;
         let world = light.source();
@@ -183,7 +182,7 @@ impl GpuExtrusion {
     pub fn counts(&self, cx: &WgpuContext) -> Result<ExtrusionCounts, WgpuError> {
         let Some(jobs) = &self.jobs else { return Ok(ExtrusionCounts::default()) };
         cx.may_wait("reading the extrusion's counts")?;
-        let staging = cx.device.create_buffer(&wgpu::BufferDescriptor {
+        let staging = cx.create_buffer(&wgpu::BufferDescriptor {
             label: Some("extrusion counts"),
             size: jobs.args.size(),
             usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
@@ -216,7 +215,7 @@ impl GpuExtrusion {
         depth: &wgpu::TextureView,
         slot: usize,
         every_fragment: bool,
-    ) -> Option<(wgpu::QuerySet, wgpu::Buffer)> {
+    ) -> Option<Query> {
         let query = cx.instrumented().then(|| occlusion_query(cx));
         let label = if every_fragment { "count volume fragments" } else { "shadow volumes" };
         let mut enc = cx.encoder(label);
@@ -355,7 +354,7 @@ impl Jobs {
             if bytes > most {
                 return Err(too_large(label, bytes, most));
             }
-            Ok(cx.device.create_buffer(&wgpu::BufferDescriptor {
+            Ok(cx.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
                 size: bytes,
                 usage: wgpu::BufferUsages::STORAGE | extra,
@@ -365,7 +364,7 @@ impl Jobs {
         let template: Vec<u32> = list.iter().flat_map(Job::initial_args).collect();
         let copy = wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC;
         let stride = UNIFORM_BYTES.next_multiple_of(u64::from(limits.min_uniform_buffer_offset_alignment));
-        let uniforms = cx.device.create_buffer(&wgpu::BufferDescriptor {
+        let uniforms = cx.create_buffer(&wgpu::BufferDescriptor {
             label: Some("extrusion uniforms"),
             size: (stride * (slots * list.len()).max(1) as u64),
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
@@ -373,7 +372,7 @@ impl Jobs {
         });
         let mut jobs = Self {
             args: storage("extrusion arguments", template.len() as u64, wgpu::BufferUsages::INDIRECT | copy)?,
-            template: cx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            template: cx.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("extrusion argument template"),
                 contents: bytemuck::cast_slice(&template),
                 usage: wgpu::BufferUsages::COPY_SRC,

@@ -8,7 +8,6 @@ use shadow_core::FrameInputs;
 use shadow_core::light::LightView;
 use shadow_core::technique::maps::DepthMap;
 use shadow_core::technique::settings::{BiasMode, Filter};
-use wgpu::util::DeviceExt;
 
 use crate::context::{WgpuContext, WgpuError};
 use crate::frame::{GpuVisibility, layer_view, layered};
@@ -120,11 +119,7 @@ impl MapBindings {
             planes,
             extra: extras.settings,
         };
-        let ubuf = cx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("map params"),
-            contents: bytemuck::bytes_of(&params),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
+        let params = cx.transient(bytemuck::bytes_of(&params));
         let maps_view = maps.create_view(&wgpu::TextureViewDescriptor {
             dimension: Some(wgpu::TextureViewDimension::D2Array),
             ..Default::default()
@@ -133,7 +128,7 @@ impl MapBindings {
             wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&g.position) },
             wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&maps_view) },
             wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&self.sampler) },
-            wgpu::BindGroupEntry { binding: 3, resource: ubuf.as_entire_binding() },
+            wgpu::BindGroupEntry { binding: 3, resource: params.binding() },
         ];
         entries.extend_from_slice(extras.entries);
         cx.device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -304,8 +299,7 @@ pub fn render_maps(
     let res = maps.width();
     let mut enc = cx.encoder("light pass");
     for (k, p) in light.projections.iter().enumerate() {
-        let group =
-            cx.shared.frame_group(&cx.device, &ViewRaw::new(p.clip_from_world, glam::Vec3::ZERO, res, res), instances);
+        let group = cx.shared.frame_group(cx, &ViewRaw::new(p.clip_from_world, glam::Vec3::ZERO, res, res), instances);
         let view = layer_view(maps, k as u32);
         let id_view = ids.map(|t| layer_view(t, k as u32));
         let id_attachment = id_view.as_ref().map(|view| wgpu::RenderPassColorAttachment {
@@ -393,8 +387,8 @@ impl DepthMaps {
                 self.maps.insert(m).clone()
             }
         };
-        cx.cache.upload_meshes(&cx.device, frame);
-        let instances = cx.cache.instances(&cx.device, &cx.queue, frame).clone();
+        cx.upload_meshes(frame);
+        let instances = cx.instances(frame);
         cx.scoped("the shadow-map light pass", |cx| {
             render_maps(cx, &self.pipeline, frame, light, &maps, None, &instances)
         })

@@ -10,17 +10,17 @@ use shadow_core::geometry::volume::Caps;
 use shadow_core::geometry::volume::VolumeCounting;
 use shadow_core::light::LightView;
 use shadow_core::technique::FrameStats;
-use wgpu::util::DeviceExt;
 
 use crate::context::{WgpuContext, WgpuError};
 use crate::frame::GpuVisibility;
 use crate::gbuffer::GpuGBuffer;
 use crate::pipelines::{DEPTH_STENCIL, POSITION_LAYOUT, VISIBILITY, attribute_entry, full_screen_pipeline};
+use crate::resources::Transient;
 
 /// One draw of volume geometry: vertices, optional indices, instance, winding.
 pub struct VolumeDraw {
-    vertices: Option<wgpu::Buffer>,
-    indices: Option<(wgpu::Buffer, u32)>,
+    vertices: Option<Transient>,
+    indices: Option<(Transient, u32)>,
     count: u32,
     instance: u32,
     /// Front faces wind clockwise (a mirrored instance, or faces cast turned around).
@@ -174,13 +174,13 @@ impl StencilResolve {
 }
 
 /// A one-query occlusion set and the buffer it resolves into.
-pub fn occlusion_query(cx: &WgpuContext) -> (wgpu::QuerySet, wgpu::Buffer) {
+pub fn occlusion_query(cx: &WgpuContext) -> Query {
     let set = cx.device.create_query_set(&wgpu::QuerySetDescriptor {
         label: Some("fragments"),
         ty: wgpu::QueryType::Occlusion,
         count: 1,
     });
-    let resolve = cx.device.create_buffer(&wgpu::BufferDescriptor {
+    let resolve = cx.create_buffer(&wgpu::BufferDescriptor {
         label: Some("occlusion"),
         size: 8,
         usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
@@ -218,30 +218,15 @@ pub fn upload_volumes(
     frame: &FrameInputs,
     volumes: &[InstanceVolume],
 ) -> Result<Vec<VolumeDraw>, WgpuError> {
-    cx.cache.upload_meshes(&cx.device, frame);
+    cx.upload_meshes(frame);
     cx.scoped("uploading shadow volumes", |cx| upload(cx, frame, volumes))
 }
 
-/// Uploads the volumes: sides and far caps as homogeneous vertices, near caps as index lists into the
-/// mesh's own vertex buffer.
+/// Uploads the volumes into the frame's transient buffer: sides and far caps as homogeneous vertices,
+/// near caps as index lists into the mesh's own vertex buffer.
 fn upload(cx: &WgpuContext, frame: &FrameInputs, volumes: &[InstanceVolume]) -> Vec<VolumeDraw> {
-    let vbuf = |data: &[glam::Vec4]| {
-        cx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("volume"),
-            contents: bytemuck::cast_slice(data),
-            usage: wgpu::BufferUsages::VERTEX,
-        })
-    };
-    let ibuf = |data: &[u32]| {
-        (
-            cx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("caps"),
-                contents: bytemuck::cast_slice(data),
-                usage: wgpu::BufferUsages::INDEX,
-            }),
-            data.len() as u32,
-        )
-    };
+    let vbuf = |data: &[glam::Vec4]| cx.transient(bytemuck::cast_slice(data));
+    let ibuf = |data: &[u32]| (cx.transient(bytemuck::cast_slice(data)), data.len() as u32);
     let mut draws = Vec::new();
     for iv in volumes {
         let inst = &frame.instances[iv.instance];
@@ -322,7 +307,8 @@ impl<'a> VolumePass<'a> {
         Self { label, ccw: pipeline, cw: pipeline, stencil: wgpu::LoadOp::Load, reference: 0, scissors: None }
     }
 
-    /// Draws `draws` over the depth-stencil `depth` of `g`; the query counts the samples that pass.
+    /// Draws `draws` over the depth-stencil `depth` of `g`; in an instrumented frame, returns an occlusion
+    /// query of the samples that pass.
     pub fn run(
         &self,
         cx: &WgpuContext,
@@ -330,8 +316,8 @@ impl<'a> VolumePass<'a> {
         frame: &FrameInputs,
         g: &GpuGBuffer,
         depth: &wgpu::TextureView,
-    ) -> (wgpu::QuerySet, wgpu::Buffer) {
-        let (set, resolve) = occlusion_query(cx);
+    ) -> Option<Query> {
+        let query = cx.instrumented().then(|| occlusion_query(cx));
         let mut enc = cx.encoder(self.label);
         {
             let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -343,13 +329,15 @@ impl<'a> VolumePass<'a> {
                     stencil_ops: Some(wgpu::Operations { load: self.stencil, store: wgpu::StoreOp::Store }),
                 }),
                 timestamp_writes: None,
-                occlusion_query_set: Some(&set),
+                occlusion_query_set: query.as_ref().map(|q| &q.0),
                 multiview_mask: None,
             });
             pass.push_debug_group(self.label);
             pass.set_bind_group(0, &g.frame_group, &[]);
             pass.set_stencil_reference(self.reference);
-            pass.begin_occlusion_query(0);
+            if query.is_some() {
+                pass.begin_occlusion_query(0);
+            }
             let whole = [[0, 0, g.width, g.height]];
             for &[x, y, w, h] in self.scissors.unwrap_or(&whole) {
                 pass.set_scissor_rect(x, y, w, h);
@@ -357,31 +345,42 @@ impl<'a> VolumePass<'a> {
                     pass.set_pipeline(if d.cw { self.cw } else { self.ccw });
                     let mesh = frame.instances.get(d.instance as usize).and_then(|i| cx.cache.mesh(i.mesh_key));
                     match (&d.vertices, d.mesh_vertices, mesh) {
-                        (Some(v), _, _) => pass.set_vertex_buffer(0, v.slice(..)),
+                        (Some(v), _, _) => pass.set_vertex_buffer(0, v.slice()),
                         (None, true, Some(m)) => pass.set_vertex_buffer(0, m.positions.slice(..)),
                         _ => continue,
                     }
                     match &d.indices {
                         Some((ib, n)) => {
-                            pass.set_index_buffer(ib.slice(..), wgpu::IndexFormat::Uint32);
+                            pass.set_index_buffer(ib.slice(), wgpu::IndexFormat::Uint32);
                             pass.draw_indexed(0..*n, 0, d.instance..d.instance + 1);
                         }
                         None => pass.draw(0..d.count, d.instance..d.instance + 1),
                     }
                 }
             }
-            pass.end_occlusion_query();
+            if query.is_some() {
+                pass.end_occlusion_query();
+            }
             pass.pop_debug_group();
         }
-        enc.resolve_query_set(&set, 0..1, &resolve, 0);
+        if let Some((set, resolve)) = &query {
+            enc.resolve_query_set(set, 0..1, resolve, 0);
+        }
         cx.submit(enc);
-        (set, resolve)
+        query
     }
 }
 
-/// Reads an occlusion query's resolved count.
-pub fn read_query(cx: &WgpuContext, q: &(wgpu::QuerySet, wgpu::Buffer)) -> Result<u64, WgpuError> {
-    let staging = cx.device.create_buffer(&wgpu::BufferDescriptor {
+/// An occlusion query and the buffer it resolves into.
+pub type Query = (wgpu::QuerySet, wgpu::Buffer);
+
+/// Reads an occlusion query's resolved count; a frame recorded into a host's encoder makes none.
+///
+/// # Errors
+/// [`WgpuError::NotRecordable`] without a query, or a GPU failure.
+pub fn read_query(cx: &WgpuContext, q: Option<&Query>) -> Result<u64, WgpuError> {
+    let Some(q) = q else { return Err(WgpuError::NotRecordable { what: "an occlusion count".into() }) };
+    let staging = cx.create_buffer(&wgpu::BufferDescriptor {
         label: Some("occlusion readback"),
         size: 8,
         usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,

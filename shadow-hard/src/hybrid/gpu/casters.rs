@@ -35,13 +35,12 @@ use pieces::{PieceRun, PieceTables};
 use crate::hybrid::shafts::CasterShafts;
 use shadow_core::FrameInputs;
 use shadow_core::light::LightView;
-use wgpu::util::DeviceExt;
 
 use super::tables::{TABLE_ROW, table};
 use shadow_wgpu::context::{WgpuContext, WgpuError};
 use shadow_wgpu::gbuffer::GpuGBuffer;
 use shadow_wgpu::pipelines::buffer_entry;
-use shadow_wgpu::{readback, shaders};
+use shadow_wgpu::{Transient, readback, shaders};
 
 /// Pieces of at most this many volume triangles are counted by the compute passes at the pixels their
 /// shafts hold; larger ones are rasterized through the whole mask, where a pixel's cost does not grow
@@ -95,12 +94,13 @@ pub(super) struct CasterPasses {
 }
 
 /// One build's small pieces on the GPU.
+#[derive(Clone)]
 pub(super) struct CasterPieces {
-    params: wgpu::Buffer,
+    params: Transient,
     triangles: wgpu::Texture,
     setups: wgpu::Buffer,
     setup_texels: wgpu::Texture,
-    runs: wgpu::Buffer,
+    runs: Transient,
     shaft_texels: wgpu::Texture,
     grid: wgpu::Texture,
     /// Per instance of the frame, its `world_from_local`, a column a texel.
@@ -145,12 +145,7 @@ impl ListedPixels {
         use wgpu::BufferUsages as U;
         let pixels = u64::from(width) * u64::from(height);
         let buffer = |label, size, usage| {
-            cx.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(label),
-                size,
-                usage,
-                mapped_at_creation: false,
-            })
+            cx.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size, usage, mapped_at_creation: false })
         };
         let capacity = pieces.next_power_of_two();
         // The pieces' words, the staged pairs' count and the pixels' flags.
@@ -250,62 +245,73 @@ impl CasterPasses {
         }
     }
 
-    /// Uploads a build's small pieces: their triangles, shafts and grids.
+    /// Uploads a build's small pieces: their triangles, shafts and grids, into the tables of `kept` (this
+    /// light's last build's) where they fit; their parameters and runs go to the frame's transient buffer.
     pub(super) fn upload(
         cx: &WgpuContext,
-        frame: &FrameInputs,
-        light: &LightView,
+        (frame, light): (&FrameInputs, &LightView),
         split: &Split,
         shafts: &CasterShafts,
+        kept: Option<CasterPieces>,
     ) -> Result<CasterPieces, WgpuError> {
         let PieceTables { params, runs, shaft_texels, grid } = PieceTables::new(frame, light, split, shafts);
-        let init = |label, contents: &[u8], usage| {
-            cx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
-        };
-        use wgpu::BufferUsages as U;
         use wgpu::TextureFormat as F;
-        // A build with no small piece still binds its buffers: at least one element each.
-        let nonempty = |bytes: &[u8]| {
-            let mut v = bytes.to_vec();
-            v.resize(v.len().max(std::mem::size_of::<PieceRun>()), 0);
-            v
-        };
-        let shaft_bytes: &[u8] = bytemuck::cast_slice(&shaft_texels);
+        // A build with no small piece still binds its runs: at least one element.
+        let mut runs = bytemuck::cast_slice::<_, u8>(&runs).to_vec();
+        runs.resize(runs.len().max(std::mem::size_of::<PieceRun>()), 0);
         let instance_columns: Vec<[[f32; 4]; 4]> =
             frame.instances.iter().map(|i| i.world_from_local.to_cols_array_2d()).collect();
+        let kept = kept.map(|k| (k.triangles, (k.setups, k.setup_texels), k.shaft_texels, k.grid, k.instance_texels));
+        let (triangles, setups, shafts, grids, instances) = match kept {
+            Some((t, s, sh, g, i)) => (Some(t), Some(s), Some(sh), Some(g), Some(i)),
+            None => (None, None, None, None, None),
+        };
+        let setup_n = u64::from(split.triangle_count()) * SETUP;
         let setup_texels =
-            table(cx, "hybrid caster setups", F::Rgba32Float, u64::from(split.triangle_count()) * SETUP, None)?;
+            table(cx, "hybrid caster setups", F::Rgba32Float, (setup_n, None), setups.as_ref().map(|s| s.1.clone()))?;
+        let setup_bytes = u64::from(setup_texels.height()) * u64::from(TABLE_ROW) * 16;
+        let setups = match setups {
+            Some((buffer, _)) if buffer.size() == setup_bytes => buffer,
+            _ => cx.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("hybrid caster setups"),
+                size: setup_bytes,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            }),
+        };
+        let triangle_bytes = bytemuck::cast_slice(&split.triangles);
         Ok(CasterPieces {
-            params: init("hybrid caster params", bytemuck::bytes_of(&params), U::UNIFORM),
+            params: cx.transient(bytemuck::bytes_of(&params)),
             triangles: table(
                 cx,
                 "hybrid caster triangles",
                 F::Rgba32Uint,
-                split.triangles.len() as u64,
-                Some(bytemuck::cast_slice(&split.triangles)),
+                (split.triangles.len() as u64, Some(triangle_bytes)),
+                triangles,
             )?,
-            setups: cx.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("hybrid caster setups"),
-                size: u64::from(setup_texels.height()) * u64::from(TABLE_ROW) * 16,
-                usage: U::STORAGE | U::COPY_SRC,
-                mapped_at_creation: false,
-            }),
+            setups,
             setup_texels,
-            runs: init("hybrid caster runs", &nonempty(bytemuck::cast_slice(&runs)), U::STORAGE),
+            runs: cx.transient(&runs),
             shaft_texels: table(
                 cx,
                 "hybrid caster shafts",
                 F::Rgba32Float,
-                shaft_texels.len() as u64,
-                Some(shaft_bytes),
+                (shaft_texels.len() as u64, Some(bytemuck::cast_slice(&shaft_texels))),
+                shafts,
             )?,
-            grid: table(cx, "hybrid caster grid", F::R32Uint, grid.len() as u64, Some(bytemuck::cast_slice(&grid)))?,
+            grid: table(
+                cx,
+                "hybrid caster grid",
+                F::R32Uint,
+                (grid.len() as u64, Some(bytemuck::cast_slice(&grid))),
+                grids,
+            )?,
             instance_texels: table(
                 cx,
                 "hybrid caster instances",
                 F::Rgba32Float,
-                4 * frame.instances.len() as u64,
-                Some(bytemuck::cast_slice(&instance_columns)),
+                (4 * frame.instances.len() as u64, Some(bytemuck::cast_slice(&instance_columns))),
+                instances,
             )?,
             triangle_count: split.triangle_count(),
             pieces: split.pieces.len(),
@@ -340,10 +346,10 @@ impl CasterPasses {
                 view(0, &g.position),
                 buffer(8, &listed.listed),
                 buffer(9, &listed.counts),
-                buffer(11, &pieces.params),
+                wgpu::BindGroupEntry { binding: 11, resource: pieces.params.binding() },
                 view(12, &triangles),
                 buffer(13, &pieces.setups),
-                buffer(14, &pieces.runs),
+                wgpu::BindGroupEntry { binding: 14, resource: pieces.runs.binding() },
                 view(15, &grid),
                 buffer(16, &listed.work),
                 view(17, &setups),

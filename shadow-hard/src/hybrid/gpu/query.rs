@@ -6,16 +6,13 @@ use shadow_core::light::LightView;
 use shadow_core::technique::FrameStats;
 use shadow_wgpu::gbuffer::GpuGBuffer;
 use shadow_wgpu::passes::maps::{LookupParams, QueryExtras};
-use shadow_wgpu::passes::volumes::{VolumeDraw, VolumePass, occlusion_query, read_query};
+use shadow_wgpu::passes::volumes::{Query, VolumeDraw, VolumePass, occlusion_query, read_query};
 use shadow_wgpu::{GpuVisibility, WgpuContext, WgpuError};
 
 use super::casters::{CasterPasses, CasterPieces, ListedPixels};
 use super::tiles::TileMarks;
 use super::{Casters, LIT, MASK, OUTSIDE, SHADOWED, State, full_screen_draws, scratch_target};
 use crate::hybrid::Hybrid;
-
-/// An occlusion query and the buffer it resolves into.
-type Query = (wgpu::QuerySet, wgpu::Buffer);
 
 /// What the caster masks bring to one query: their compute passes, the answer's draw for the listed
 /// pixels, the build's small pieces and the listed pixels.
@@ -73,11 +70,11 @@ pub(super) struct Inputs<'a> {
     casters: Option<CasterQuery<'a>>,
 }
 
-/// What the passes leave to count: the mask pass's and the volume pass's occlusion queries, and how many
-/// scissor rectangles the volumes were drawn in.
+/// What the passes leave to count: the mask pass's and the volume pass's occlusion queries (instrumented
+/// frames), and how many scissor rectangles the volumes were drawn in.
 pub(super) struct Counts {
-    silhouettes: Query,
-    passed: Query,
+    silhouettes: Option<Query>,
+    passed: Option<Query>,
     rects: Option<usize>,
 }
 
@@ -150,7 +147,7 @@ impl<'a> Inputs<'a> {
     ) -> Result<Counts, WgpuError> {
         let g = self.g;
         let groups = [&g.frame_group, map_group];
-        let silhouettes = occlusion_query(cx);
+        let silhouettes = cx.instrumented().then(|| occlusion_query(cx));
         let mut enc = cx.encoder("hybrid mask depth");
         if self.target != g.depth {
             enc.copy_texture_to_texture(
@@ -172,7 +169,7 @@ impl<'a> Inputs<'a> {
             mask_draws.push((far, 0));
         }
         let stencil = (&self.depth, wgpu::LoadOp::Load, wgpu::LoadOp::Clear(0));
-        cx.submit(full_screen_draws(cx, "hybrid mask", None, stencil, groups, &mask_draws, Some(&silhouettes)));
+        cx.submit(full_screen_draws(cx, "hybrid mask", None, stencil, groups, &mask_draws, silhouettes.as_ref()));
         cx.step("mask");
         if let Some((passes, _, pieces, l)) = self.casters {
             let mut enc = cx.encoder("hybrid caster masks");
@@ -223,10 +220,10 @@ impl<'a> Inputs<'a> {
         if let Some(n) = counts.rects {
             c.extra.insert("scissor_rects".into(), n as f64);
         }
-        c.silhouette_pixels = Some(read_query(cx, &counts.silhouettes)?);
-        let processed = read_query(cx, &processed)?;
+        c.silhouette_pixels = Some(read_query(cx, counts.silhouettes.as_ref())?);
+        let processed = read_query(cx, processed.as_ref())?;
         // Z-fail updates the count where the depth test fails.
-        let rasterized_updates = processed - read_query(cx, &counts.passed)?.min(processed);
+        let rasterized_updates = processed - read_query(cx, counts.passed.as_ref())?.min(processed);
         // What the compute passes covered and updated at the listed pixels.
         let [computed, computed_updates] = match self.casters {
             Some((_, _, pieces, l)) => {
@@ -245,7 +242,7 @@ impl<'a> Inputs<'a> {
             let every = VolumePass::count(&state.count_all, "count volume fragments");
             let all_draws = state.casters.as_ref().and_then(|c| c.all_draws.as_deref()).unwrap_or(draws);
             let all = cx.scoped("the volume fragment count", |cx| every.run(cx, all_draws, frame, g, &self.depth))?;
-            c.extra.insert("unmasked_volume_fragments".into(), read_query(cx, &all)? as f64);
+            c.extra.insert("unmasked_volume_fragments".into(), read_query(cx, all.as_ref())? as f64);
         }
         Ok(())
     }

@@ -17,12 +17,7 @@ impl TileMarks {
     pub(super) fn new(cx: &WgpuContext, columns: u32, rows: u32) -> Self {
         let size = u64::from(columns * rows) * 4;
         let buffer = |label, usage| {
-            cx.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(label),
-                size,
-                usage,
-                mapped_at_creation: false,
-            })
+            cx.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size, usage, mapped_at_creation: false })
         };
         use wgpu::BufferUsages as U;
         Self {

@@ -1,0 +1,158 @@
+//! Where the backend's buffers and textures come from: every one is made through the context
+//! ([`WgpuContext::create_buffer`] and its siblings), which counts them, so a test can hold a frame loop
+//! to making none after its first frame (the library crates' `clippy.toml` forbids wgpu's own creation
+//! calls outside this module).
+//!
+//! Data the GPU reads in one frame only (a light view's uniform, a map query's parameters, the segments
+//! a pass draws) goes into [`Transient`] slices of one buffer the context keeps, at offsets handed out in
+//! order since the frame began. A frame recorded into one command buffer sees all its writes land before
+//! its first command, so each piece needs a place of its own; the next frame starts over at offset 0
+//! (its writes are queued after the last frame's submission, so they cannot overtake it). The buffer is
+//! made again, twice as large, only when a frame needs more than it holds.
+
+use std::cell::{Cell, RefCell};
+
+use crate::context::WgpuContext;
+
+/// How many buffers and textures a context has made since it was opened.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Created {
+    /// Buffers.
+    pub buffers: u64,
+    /// Textures.
+    pub textures: u64,
+}
+
+/// The counters and the transient buffer a context keeps.
+#[derive(Default)]
+pub(crate) struct Resources {
+    created: Cell<Created>,
+    transient: RefCell<Arena>,
+}
+
+/// The transient buffer and how much of it this frame has used.
+#[derive(Default)]
+struct Arena {
+    buffer: Option<wgpu::Buffer>,
+    used: u64,
+}
+
+/// A slice of the transient buffer holding one piece of this frame's data.
+#[derive(Clone, Debug)]
+pub struct Transient {
+    buffer: wgpu::Buffer,
+    offset: u64,
+    size: u64,
+}
+
+impl Transient {
+    /// The slice as a vertex or index buffer.
+    #[must_use]
+    pub fn slice(&self) -> wgpu::BufferSlice<'_> {
+        self.buffer.slice(self.offset..self.offset + self.size)
+    }
+
+    /// The slice as a binding (uniform or read-only storage).
+    #[must_use]
+    pub fn binding(&self) -> wgpu::BindingResource<'_> {
+        wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+            buffer: &self.buffer,
+            offset: self.offset,
+            size: wgpu::BufferSize::new(self.size),
+        })
+    }
+}
+
+/// The smallest transient buffer: room for every uniform of a frame of a few lights without growing.
+const MIN_TRANSIENT: u64 = 1 << 16;
+
+// The one place wgpu's creation calls are made.
+#[allow(clippy::disallowed_methods)]
+impl WgpuContext {
+    fn count(&self, buffers: u64, textures: u64) {
+        let c = self.resources.created.get();
+        self.resources.created.set(Created { buffers: c.buffers + buffers, textures: c.textures + textures });
+    }
+
+    /// How many buffers and textures this context has made.
+    #[must_use]
+    pub fn created(&self) -> Created {
+        self.resources.created.get()
+    }
+
+    /// Makes a buffer (counted).
+    #[must_use]
+    pub fn create_buffer(&self, desc: &wgpu::BufferDescriptor<'_>) -> wgpu::Buffer {
+        self.count(1, 0);
+        self.device.create_buffer(desc)
+    }
+
+    /// Makes a buffer holding `desc`'s contents (counted).
+    #[must_use]
+    pub fn create_buffer_init(&self, desc: &wgpu::util::BufferInitDescriptor<'_>) -> wgpu::Buffer {
+        use wgpu::util::DeviceExt;
+        self.count(1, 0);
+        self.device.create_buffer_init(desc)
+    }
+
+    /// Makes a texture (counted).
+    #[must_use]
+    pub fn create_texture(&self, desc: &wgpu::TextureDescriptor<'_>) -> wgpu::Texture {
+        self.count(0, 1);
+        self.device.create_texture(desc)
+    }
+
+    /// Makes a texture holding `data` in `order` (counted).
+    #[must_use]
+    pub fn create_texture_with_data(
+        &self,
+        desc: &wgpu::TextureDescriptor<'_>,
+        order: wgpu::util::TextureDataOrder,
+        data: &[u8],
+    ) -> wgpu::Texture {
+        use wgpu::util::DeviceExt;
+        self.count(0, 1);
+        self.device.create_texture_with_data(&self.queue, desc, order, data)
+    }
+
+    /// Starts a frame's transient data over at the start of the buffer.
+    pub(crate) fn begin_transient(&self) {
+        self.resources.transient.borrow_mut().used = 0;
+    }
+
+    /// `bytes` in a slice of the transient buffer of its own for this frame (see the module notes), to
+    /// bind as a uniform or read-only storage, or to draw as vertices or indices.
+    #[must_use]
+    pub fn transient(&self, bytes: &[u8]) -> Transient {
+        let limits = self.device.limits();
+        let align =
+            u64::from(limits.min_uniform_buffer_offset_alignment.max(limits.min_storage_buffer_offset_alignment));
+        // Bindings and writes are whole words; an empty storage binding is not allowed.
+        let size = (bytes.len() as u64).max(4).next_multiple_of(4);
+        let mut arena = self.resources.transient.borrow_mut();
+        let offset = arena.used.next_multiple_of(align);
+        let fits = arena.buffer.as_ref().is_some_and(|b| offset + size <= b.size());
+        let offset = if fits {
+            offset
+        } else {
+            let capacity = (2 * (offset + size)).max(MIN_TRANSIENT).min(limits.max_buffer_size);
+            arena.buffer = Some(self.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("transient"),
+                size: capacity,
+                usage: wgpu::BufferUsages::UNIFORM
+                    | wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::VERTEX
+                    | wgpu::BufferUsages::INDEX
+                    | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }));
+            0
+        };
+        arena.used = offset + size;
+        let Some(buffer) = arena.buffer.clone() else { unreachable!("made above") };
+        let mut padded = bytes.to_vec();
+        padded.resize(size as usize, 0);
+        self.queue.write_buffer(&buffer, offset, &padded);
+        Transient { buffer, offset, size }
+    }
+}
