@@ -207,7 +207,7 @@ impl SceneSetup {
             let default = scene
                 .lights()
                 .next()
-                .map(|(_, l)| *l)
+                .map(|(_, l)| l)
                 .unwrap_or_else(|| Light::spot(Vec3::new(2.0, 4.0, 1.5), Vec3::ZERO, 60.0));
             let light = parse_light(l, &default, scene.bounds().center())?;
             scene.clear_lights();

@@ -157,8 +157,8 @@ impl FrameInputs {
     /// # Errors
     /// As [`FrameInputs::new`], or an unknown camera key.
     pub fn from_scene(scene: &Scene, camera: CameraKey) -> Result<Self, FrameError> {
-        let cam = *scene.camera(camera).ok_or(SceneError::UnknownKey("camera"))?;
-        Self::new(scene, cam, scene.lights().map(|(_, l)| *l).collect())
+        let cam = scene.world_camera(camera).ok_or(SceneError::UnknownKey("camera"))?;
+        Self::new(scene, cam, scene.lights().map(|(_, l)| l).collect())
     }
 
     /// The frame of `scene` seen from its first camera, lit by all its lights.

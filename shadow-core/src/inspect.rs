@@ -52,7 +52,7 @@ impl Inspection {
             out.non_manifold_edges += adj.non_manifold_edge_count();
             out.inconsistent_edges += adj.inconsistent_edge_count();
         }
-        let light = scene.lights().next().map(|(_, l)| *l);
+        let light = scene.lights().next().map(|(_, l)| l);
         let camera = crate::scene::Camera::look_at(glam::Vec3::ONE, glam::Vec3::ZERO, 45.0);
         if let Some(light) = light
             && let Ok(frame) = FrameInputs::new(scene, camera, vec![light])

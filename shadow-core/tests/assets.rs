@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use glam::Vec3;
+use glam::{Mat4, Vec3};
 use shadow_core::assets::{self, AssetFault};
 use shadow_core::scene::LightKind;
 
@@ -127,6 +127,26 @@ fn a_lamp_under_a_turned_scaled_parent_is_placed_by_the_whole_hierarchy() {
     }
     assert!(light.inner_cone_angle.is_some_and(|a| (a - 0.4).abs() < 1e-6), "{:?}", light.inner_cone_angle);
     assert_eq!((light.intensity, light.range, light.color), (5.0, Some(10.0), Vec3::new(1.0, 0.5, 0.25)));
+}
+
+#[test]
+fn a_lamp_follows_its_node_when_the_parent_moves_and_goes_with_it() {
+    let mut s = assets::load(data("good/lamp_under_turned_parent.gltf")).unwrap();
+    let (key, _) = s.lights().next().unwrap();
+    let lamp = s.light_node(key).expect("the lamp follows its node");
+    let parent = s.node(lamp).and_then(|n| n.parent()).expect("the lamp's node has a parent");
+    // The parent moved 4 along world +z and turned back to face +z: the lamp is 6 along +z from it.
+    let moved = Mat4::from_translation(Vec3::new(1.0, 2.0, 4.0)) * Mat4::from_scale(Vec3::splat(2.0));
+    s.set_local_transform(parent, moved).unwrap();
+    match s.world_light(key).unwrap().kind {
+        LightKind::Spot { position, direction, .. } => {
+            assert!((position - Vec3::new(1.0, 2.0, 10.0)).length() < 1e-5, "{position}");
+            assert!((direction - Vec3::NEG_Z).length() < 1e-5, "{direction}");
+        }
+        other => panic!("{other:?}"),
+    }
+    s.remove_node(parent).unwrap();
+    assert!(s.lights().next().is_none(), "the lamp outlived its node");
 }
 
 #[test]

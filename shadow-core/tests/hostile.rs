@@ -364,7 +364,7 @@ fn gltf_spot_lights_keep_their_cones_intensity_and_range() {
     );
     let path = write(&dir.join("spot.gltf"), text);
     let s = assets::load(&path).expect("loads");
-    let light = *s.lights().next().expect("the file's light").1;
+    let light = s.lights().next().expect("the file's light").1;
     assert_eq!(light.intensity, 3.5);
     assert_eq!(light.range, Some(7.0));
     assert_eq!(light.inner_cone_angle, Some(0.6));
@@ -373,7 +373,7 @@ fn gltf_spot_lights_keep_their_cones_intensity_and_range() {
     // Exported and loaded again, the cone is the same.
     let glb = dir.join("again.glb");
     shadow_core::assets::export::export_glb(&s, &glb).expect("exports");
-    let back = *assets::load(&glb).expect("loads again").lights().next().expect("a light").1;
+    let back = assets::load(&glb).expect("loads again").lights().next().expect("a light").1;
     let (o2, i2) = shadow_core::shading::cone_cosines(&back).expect("a spot");
     assert!((o2 - outer).abs() < 1e-5 && (i2 - inner).abs() < 1e-5, "{o2} {i2}");
     assert_eq!(back.intensity, 3.5);

@@ -316,7 +316,7 @@ fn several_lights_shade_alike_on_both_backends() {
     let Some(mut renderer) = crate::with_wgpu("several lights") else { return };
     let scene = scenes::build("primitives", &SceneParams::default()).expect("scene");
     let camera = *scene.camera(scene.cameras().next().expect("camera").0).expect("camera");
-    let spot = *scene.lights().next().expect("a light").1;
+    let spot = scene.lights().next().expect("a light").1;
     let two = vec![spot, Light::point(Vec3::new(-1.5, 2.5, 1.0))];
     let spec = TechniqueSpec::named("shadow-map");
     let (reference, _) = renderer

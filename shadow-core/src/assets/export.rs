@@ -68,7 +68,7 @@ pub fn glb_bytes(scene: &Scene) -> Vec<u8> {
     }
     let mut lights = vec![];
     for (_, l) in scene.lights() {
-        let (light, pos, dir) = light_json(l);
+        let (light, pos, dir) = light_json(&l);
         lights.push(light);
         let mut n = node_trs(pos, look_rotation(dir));
         if let Some(o) = n.as_object_mut() {

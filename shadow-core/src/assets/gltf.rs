@@ -394,21 +394,21 @@ impl Loader<'_> {
                 self.scene.set_mesh(target, Some(p)).map_err(|e| Fault::Malformed(e.to_string()))?;
             }
         }
-        self.camera_and_light(node, world);
+        self.camera_and_light(node, key, world);
         Ok((key, world))
     }
 
-    /// The node's perspective camera and KHR punctual light, placed by its world transform.
-    fn camera_and_light(&mut self, node: &gltf::Node, world: Mat4) {
-        let (_, rot, trans) = world.to_scale_rotation_translation();
-        let forward = (rot * Vec3::NEG_Z).normalize_or(Vec3::NEG_Z);
+    /// The node's perspective camera and KHR punctual light, following the node: both look down the node's
+    /// -Z with +Y up, from its origin. Placed by `world`, they are checked once where the file puts them.
+    fn camera_and_light(&mut self, node: &gltf::Node, key: NodeKey, world: Mat4) {
+        let (origin, forward) = (Vec3::ZERO, Vec3::NEG_Z);
         if let Some(cam) = node.camera()
             && let gltf::camera::Projection::Perspective(p) = cam.projection()
         {
-            let up = (rot * Vec3::Y).normalize_or(Vec3::Y);
-            let camera = Camera { eye: trans, target: trans + forward, up, fov_y: p.yfov(), near: p.znear().max(1e-4) };
-            if camera.validate().is_ok() {
-                self.scene.add_camera(camera);
+            let camera =
+                Camera { eye: origin, target: forward, up: Vec3::Y, fov_y: p.yfov(), near: p.znear().max(1e-4) };
+            if camera.transformed(world).validate().is_ok() {
+                let _ = self.scene.add_camera_to(key, camera);
             }
         }
         if let Some(l) = node.light() {
@@ -416,11 +416,11 @@ impl Loader<'_> {
             // glTF cone angles are half-angles; ours are full apex angles.
             let (kind, inner_cone_angle) = match l.kind() {
                 Kind::Directional => (LightKind::Directional { direction: forward }, None),
-                Kind::Point => (LightKind::Point { position: trans }, None),
+                Kind::Point => (LightKind::Point { position: origin }, None),
                 Kind::Spot { inner_cone_angle, outer_cone_angle } => {
                     let cone_angle = (2.0 * outer_cone_angle).clamp(1e-3, 3.1);
                     let inner = (2.0 * inner_cone_angle).clamp(0.0, cone_angle * 0.999);
-                    (LightKind::Spot { position: trans, direction: forward, cone_angle }, Some(inner))
+                    (LightKind::Spot { position: origin, direction: forward, cone_angle }, Some(inner))
                 }
             };
             // The light's radius is for soft shadows, which glTF does not describe: the default.
@@ -431,10 +431,10 @@ impl Loader<'_> {
                 intensity: l.intensity(),
                 inner_cone_angle,
                 range,
-                ..Light::point(trans)
+                ..Light::point(origin)
             };
-            if light.validate().is_ok() {
-                self.scene.add_light(light);
+            if light.transformed(world).validate().is_ok() {
+                let _ = self.scene.add_light_to(key, light);
             }
         }
     }

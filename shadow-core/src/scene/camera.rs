@@ -26,6 +26,14 @@ impl Camera {
         Self { eye, target, up: Vec3::Y, fov_y: fov_y_deg.to_radians(), near: 0.05 }
     }
 
+    /// The camera moved by the affine transform `m`: its eye, target and up are, its field of view and
+    /// near plane are not.
+    #[must_use]
+    pub fn transformed(&self, m: Mat4) -> Self {
+        let up = m.transform_vector3(self.up).normalize_or(self.up);
+        Self { eye: m.transform_point3(self.eye), target: m.transform_point3(self.target), up, ..*self }
+    }
+
     /// World to view (right-handed, looking down -Z).
     #[must_use]
     pub fn view_from_world(&self) -> Mat4 {

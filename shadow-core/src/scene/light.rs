@@ -1,6 +1,6 @@
 //! Lights: spot, directional and point, in world space, with glTF's colour, intensity, cones and range.
 
-use glam::Vec3;
+use glam::{Mat4, Vec3};
 
 use super::SceneError;
 
@@ -69,6 +69,21 @@ impl Light {
 
     fn white(kind: LightKind) -> Self {
         Self { kind, color: Vec3::ONE, intensity: 1.0, radius: 0.05, inner_cone_angle: None, range: None }
+    }
+
+    /// The light moved by the affine transform `m`: its position and direction are, its cone, radius,
+    /// range and intensity are not (a scaled node does not scale its lamp, as glTF has it).
+    #[must_use]
+    pub fn transformed(&self, m: Mat4) -> Self {
+        let direction = |d: Vec3| m.transform_vector3(d).normalize_or(d);
+        let kind = match self.kind {
+            LightKind::Spot { position, direction: d, cone_angle } => {
+                LightKind::Spot { position: m.transform_point3(position), direction: direction(d), cone_angle }
+            }
+            LightKind::Point { position } => LightKind::Point { position: m.transform_point3(position) },
+            LightKind::Directional { direction: d } => LightKind::Directional { direction: direction(d) },
+        };
+        Self { kind, ..*self }
     }
 
     /// Position for spot and point lights, `None` for directional ones.

@@ -3,7 +3,8 @@
 //!
 //! Every mutation goes through a method that keeps the caches right: moving a node recomputes the world
 //! transforms of its subtree (and nothing else); replacing a mesh drops its cached adjacency and bumps its
-//! version so GPU uploads keyed by [`MeshKey`] know to refresh. Lights and cameras live in world space.
+//! version so GPU uploads keyed by [`MeshKey`] know to refresh. Lights and cameras live in world space,
+//! or in a node's space, following the node as it and its parents move (as a file's lamps do).
 
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, OnceLock};
@@ -163,8 +164,8 @@ pub struct Scene {
     roots: Vec<NodeKey>,
     meshes: SlotMap<MeshKey, MeshEntry>,
     materials: SlotMap<MaterialKey, Material>,
-    lights: SlotMap<LightKey, Light>,
-    cameras: SlotMap<CameraKey, Camera>,
+    lights: SlotMap<LightKey, Placed<Light>>,
+    cameras: SlotMap<CameraKey, Placed<Camera>>,
 }
 
 /// Mesh versions are unique in the process, not per scene: two scenes hand out the same [`MeshKey`]s,
@@ -404,7 +405,7 @@ impl Scene {
         Ok(group)
     }
 
-    /// Removes a node and its whole subtree.
+    /// Removes a node and its whole subtree, with the lights and cameras that follow them.
     ///
     /// # Errors
     /// Unknown node key.
@@ -420,6 +421,10 @@ impl Scene {
                 stack.extend(n.children);
             }
         }
+        // The lights and cameras that followed a removed node go with it.
+        let nodes = &self.nodes;
+        self.lights.retain(|_, l| l.node.is_none_or(|n| nodes.contains_key(n)));
+        self.cameras.retain(|_, c| c.node.is_none_or(|n| nodes.contains_key(n)));
         Ok(())
     }
 
@@ -469,25 +474,47 @@ impl Scene {
 
     // ---- lights and cameras ----
 
-    /// Adds a light.
+    /// Adds a light placed in world space.
     pub fn add_light(&mut self, light: Light) -> LightKey {
-        self.lights.insert(light)
+        self.lights.insert(Placed { value: light, node: None })
     }
 
-    /// A light.
+    /// Adds a light placed in `node`'s space: it follows the node, and moving a parent moves it.
+    ///
+    /// # Errors
+    /// An unknown node key.
+    pub fn add_light_to(&mut self, node: NodeKey, light: Light) -> Result<LightKey, SceneError> {
+        self.nodes.get(node).ok_or(SceneError::UnknownKey("node"))?;
+        Ok(self.lights.insert(Placed { value: light, node: Some(node) }))
+    }
+
+    /// A light as it was given: in world space, or in its node's ([`Scene::light_node`]).
     #[must_use]
     pub fn light(&self, key: LightKey) -> Option<&Light> {
-        self.lights.get(key)
+        self.lights.get(key).map(|p| &p.value)
     }
 
-    /// A light, to edit (lights hold no cached state; nothing depending on the light is cached).
+    /// A light as it was given, to edit (lights hold no cached state; nothing depending on the light is
+    /// cached).
     pub fn light_mut(&mut self, key: LightKey) -> Option<&mut Light> {
-        self.lights.get_mut(key)
+        self.lights.get_mut(key).map(|p| &mut p.value)
     }
 
-    /// Every light.
-    pub fn lights(&self) -> impl Iterator<Item = (LightKey, &Light)> {
-        self.lights.iter()
+    /// The node a light follows, if any.
+    #[must_use]
+    pub fn light_node(&self, key: LightKey) -> Option<NodeKey> {
+        self.lights.get(key)?.node
+    }
+
+    /// A light placed in world space.
+    #[must_use]
+    pub fn world_light(&self, key: LightKey) -> Option<Light> {
+        self.lights.get(key).map(|p| self.placed(p, Light::transformed))
+    }
+
+    /// Every light, placed in world space.
+    pub fn lights(&self) -> impl Iterator<Item = (LightKey, Light)> + '_ {
+        self.lights.iter().map(|(k, p)| (k, self.placed(p, Light::transformed)))
     }
 
     /// Removes every light.
@@ -495,35 +522,73 @@ impl Scene {
         self.lights.clear();
     }
 
-    /// Adds a camera.
+    /// Adds a camera placed in world space.
     pub fn add_camera(&mut self, camera: Camera) -> CameraKey {
-        self.cameras.insert(camera)
+        self.cameras.insert(Placed { value: camera, node: None })
     }
 
-    /// A camera.
+    /// Adds a camera placed in `node`'s space: it follows the node.
+    ///
+    /// # Errors
+    /// An unknown node key.
+    pub fn add_camera_to(&mut self, node: NodeKey, camera: Camera) -> Result<CameraKey, SceneError> {
+        self.nodes.get(node).ok_or(SceneError::UnknownKey("node"))?;
+        Ok(self.cameras.insert(Placed { value: camera, node: Some(node) }))
+    }
+
+    /// A camera as it was given: in world space, or in its node's ([`Scene::camera_node`]).
     #[must_use]
     pub fn camera(&self, key: CameraKey) -> Option<&Camera> {
-        self.cameras.get(key)
+        self.cameras.get(key).map(|p| &p.value)
     }
 
-    /// A camera, to edit.
+    /// A camera as it was given, to edit.
     pub fn camera_mut(&mut self, key: CameraKey) -> Option<&mut Camera> {
-        self.cameras.get_mut(key)
+        self.cameras.get_mut(key).map(|p| &mut p.value)
     }
 
-    /// Every camera.
-    pub fn cameras(&self) -> impl Iterator<Item = (CameraKey, &Camera)> {
-        self.cameras.iter()
+    /// The node a camera follows, if any.
+    #[must_use]
+    pub fn camera_node(&self, key: CameraKey) -> Option<NodeKey> {
+        self.cameras.get(key)?.node
+    }
+
+    /// A camera placed in world space.
+    #[must_use]
+    pub fn world_camera(&self, key: CameraKey) -> Option<Camera> {
+        self.cameras.get(key).map(|p| self.placed(p, Camera::transformed))
+    }
+
+    /// Every camera, placed in world space.
+    pub fn cameras(&self) -> impl Iterator<Item = (CameraKey, Camera)> + '_ {
+        self.cameras.iter().map(|(k, p)| (k, self.placed(p, Camera::transformed)))
     }
 
     /// Removes every camera.
     pub fn clear_cameras(&mut self) {
         self.cameras.clear();
     }
+
+    /// `p` in world space: moved by its node's world transform when it has a node.
+    fn placed<T: Copy>(&self, p: &Placed<T>, transformed: fn(&T, Mat4) -> T) -> T {
+        match p.node.and_then(|n| self.nodes.get(n)) {
+            Some(node) => transformed(&p.value, node.world),
+            None => p.value,
+        }
+    }
+}
+
+/// A light or camera: in world space, or in a node's space, following the node.
+#[derive(Clone, Copy, Debug)]
+struct Placed<T> {
+    value: T,
+    node: Option<NodeKey>,
 }
 
 #[cfg(test)]
 mod tests {
+    use std::f32::consts::FRAC_PI_2;
+
     use super::*;
     use crate::procedural;
 
@@ -559,6 +624,30 @@ mod tests {
         assert_eq!(s.node(c).unwrap().world_transform().w_axis.truncate(), Vec3::new(0.0, 0.0, 2.0));
         assert!(s.group_roots("bad", Mat4::from_scale(Vec3::splat(f32::NAN))).is_err());
         assert_eq!(s.roots(), &[g]);
+    }
+
+    #[test]
+    fn lights_and_cameras_follow_their_nodes() {
+        let mut s = Scene::new();
+        let arm = s.add_node("arm", None, Mat4::from_translation(Vec3::new(1.0, 0.0, 0.0))).unwrap();
+        let hand = s.add_node("hand", Some(arm), Mat4::from_translation(Vec3::new(0.0, 2.0, 0.0))).unwrap();
+        let lamp = s.add_light_to(hand, Light::spot(Vec3::ZERO, Vec3::NEG_Y, 40.0)).unwrap();
+        let eye = s.add_camera_to(hand, Camera::look_at(Vec3::ZERO, Vec3::NEG_Z, 45.0)).unwrap();
+        let fixed = s.add_light(Light::point(Vec3::new(0.0, 5.0, 0.0)));
+        // The arm turns a quarter about +z: the hand, 2 up the arm, ends 2 along -x from (1, 0, 0).
+        s.set_local_transform(arm, Mat4::from_translation(Vec3::X) * Mat4::from_rotation_z(FRAC_PI_2)).unwrap();
+        let lit = s.world_light(lamp).unwrap();
+        assert!((lit.position().unwrap() - Vec3::new(-1.0, 0.0, 0.0)).length() < 1e-6);
+        let LightKind::Spot { direction, .. } = lit.kind else { panic!("a spot") };
+        assert!((direction - Vec3::X).length() < 1e-6, "{direction}");
+        assert!((s.world_camera(eye).unwrap().eye - Vec3::new(-1.0, 0.0, 0.0)).length() < 1e-6);
+        // As given, the lamp is still at its node's origin; the world light stays put.
+        assert_eq!(s.light(lamp).unwrap().position(), Some(Vec3::ZERO));
+        assert_eq!(s.world_light(fixed).unwrap().position(), Some(Vec3::new(0.0, 5.0, 0.0)));
+        s.remove_node(hand).unwrap();
+        assert_eq!(s.lights().map(|(k, _)| k).collect::<Vec<_>>(), vec![fixed]);
+        assert!(s.cameras().next().is_none());
+        assert!(s.add_light_to(hand, Light::point(Vec3::ZERO)).is_err());
     }
 
     #[test]

@@ -10,7 +10,7 @@ use glam::{Mat4, Vec3};
 
 use crate::mesh::Mesh;
 use crate::procedural;
-use crate::scene::{Camera, Light, LightKind, Material, Scene};
+use crate::scene::{Camera, CameraKey, Light, LightKey, LightKind, Material, Scene};
 
 /// Options for building a scene.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -154,7 +154,7 @@ pub fn build(name: &str, params: &SceneParams) -> Result<Scene, UnknownScene> {
 /// Replaces every light with one of type `t` placed and aimed like it.
 pub fn retype_lights(scene: &mut Scene, t: LightType) {
     let target = scene.bounds().center();
-    let lights: Vec<Light> = scene.lights().map(|(_, l)| *l).collect();
+    let lights: Vec<Light> = scene.lights().map(|(_, l)| l).collect();
     scene.clear_lights();
     for l in lights {
         let (position, direction) = match l.kind {
@@ -205,24 +205,24 @@ pub fn stage_model(model: &mut Scene, ground: bool) {
     let place = Mat4::from_scale(Vec3::splat(scale)) * Mat4::from_translation(offset);
     // `place` is finite: the bounds are finite and the scale's divisor is at least 1e-12.
     let _ = model.group_roots("stage", place);
-    let cameras: Vec<Camera> = model.cameras().map(|(_, c)| *c).collect();
-    let lights: Vec<Light> = model.lights().map(|(_, l)| *l).collect();
-    let bare = cameras.is_empty() && lights.is_empty();
-    model.clear_cameras();
-    model.clear_lights();
-    for c in cameras {
-        let (eye, target) = (place.transform_point3(c.eye), place.transform_point3(c.target));
-        model.add_camera(Camera { eye, target, near: c.near * scale, ..c });
+    let bare = model.cameras().next().is_none() && model.lights().next().is_none();
+    // Lights and cameras that follow a node moved with the roots; the others are moved here. The stage's
+    // scale shrinks the model, so a lamp's size and reach and a camera's near plane shrink with it.
+    let lights: Vec<LightKey> = model.lights().map(|(k, _)| k).collect();
+    for k in lights {
+        let follows = model.light_node(k).is_some();
+        if let Some(l) = model.light_mut(k) {
+            let moved = if follows { *l } else { l.transformed(place) };
+            *l = Light { radius: l.radius * scale, range: l.range.map(|r| r * scale), ..moved };
+        }
     }
-    for l in lights {
-        let kind = match l.kind {
-            LightKind::Spot { position, direction, cone_angle } => {
-                LightKind::Spot { position: place.transform_point3(position), direction, cone_angle }
-            }
-            LightKind::Point { position } => LightKind::Point { position: place.transform_point3(position) },
-            directional @ LightKind::Directional { .. } => directional,
-        };
-        model.add_light(Light { kind, radius: l.radius * scale, range: l.range.map(|r| r * scale), ..l });
+    let cameras: Vec<CameraKey> = model.cameras().map(|(k, _)| k).collect();
+    for k in cameras {
+        let follows = model.camera_node(k).is_some();
+        if let Some(c) = model.camera_mut(k) {
+            let moved = if follows { *c } else { c.transformed(place) };
+            *c = Camera { near: c.near * scale, ..moved };
+        }
     }
     if ground && bare {
         let mesh = model.add_mesh(ground_quad());
