@@ -17,10 +17,12 @@
 //! # Ok(()) }
 //! ```
 
+use shadow_core::script::LightTechniques;
 use shadow_core::technique::{DynShadowTechnique, TechniqueSpec};
 use shadow_core::{FrameInputs, LightView};
 use shadow_wgpu::{ColorTarget, FrameRecorder, WgpuBackend, WgpuContext};
 
+use crate::renderer::Named;
 use crate::{Error, TechniqueRegistry};
 
 /// Shadows recorded into a host's frames (see the module docs).
@@ -30,6 +32,8 @@ pub struct RealtimeShadows {
     registry: TechniqueRegistry,
     spec: TechniqueSpec,
     technique: Box<dyn DynShadowTechnique<WgpuBackend>>,
+    /// The techniques lights name for themselves.
+    named: Named<WgpuBackend>,
 }
 
 impl RealtimeShadows {
@@ -48,7 +52,7 @@ impl RealtimeShadows {
         let cx = WgpuContext::from_host(adapter, device, queue)?;
         let spec = TechniqueSpec::parse(spec)?;
         let technique = registry.wgpu(&spec)?;
-        Ok(Self { cx, recorder: FrameRecorder::new(), registry, spec, technique })
+        Ok(Self { cx, recorder: FrameRecorder::new(), registry, spec, technique, named: Vec::new() })
     }
 
     /// Switches to the technique of `spec` from the next frame on; on an error the current one stays.
@@ -68,18 +72,22 @@ impl RealtimeShadows {
         &self.spec
     }
 
-    /// Records one frame into the host's `encoder`, shading into `target` (see [`FrameRecorder::record`]).
-    /// Returns the fitted view of each light.
+    /// Records one frame into the host's `encoder`, shading into `target` (see [`FrameRecorder::record`]):
+    /// each light shadowed as its [`shadow_core::LightShadow`] says, by the technique it names (made from
+    /// the registry on its first frame and kept) or by this one. Returns the fitted view of each light.
     ///
     /// # Errors
-    /// As [`FrameRecorder::record`].
+    /// As [`FrameRecorder::record`], or a light naming a technique the registry refuses.
     pub fn record(
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
         frame: &FrameInputs,
         target: &ColorTarget<'_>,
     ) -> Result<Vec<LightView>, Error> {
-        Ok(self.recorder.record(&mut self.cx, encoder, frame, self.technique.as_mut(), target)?)
+        let registry = &self.registry;
+        crate::renderer::name_techniques(frame, &mut self.named, |s| Ok(registry.wgpu(s)?))?;
+        let techniques = LightTechniques { frame: self.technique.as_mut(), named: &mut self.named };
+        Ok(self.recorder.record(&mut self.cx, encoder, frame, techniques, target)?)
     }
 
     /// The last frame's visibility, a layer per light (see [`FrameRecorder::visibility`]).

@@ -1,10 +1,11 @@
 //! Runtime backend choice: one [`Renderer`] runs any registered technique on any available backend.
 
 use shadow_core::image::Rgb8;
-use shadow_core::technique::{DebugView, FrameStats, TechniqueSpec};
+use shadow_core::script::LightTechniques;
+use shadow_core::technique::{Backend, DebugView, DynShadowTechnique, FrameStats, TechniqueSpec};
 use shadow_core::{FrameInputs, Image};
-use shadow_cpu::{CpuContext, CpuFrame};
-use shadow_wgpu::{AdapterChoice, WgpuContext};
+use shadow_cpu::{CpuBackend, CpuContext, CpuFrame};
+use shadow_wgpu::{AdapterChoice, WgpuBackend, WgpuContext};
 
 use crate::Error;
 use crate::registry::TechniqueRegistry;
@@ -151,7 +152,7 @@ impl Renderer {
         }
     }
 
-    /// A full CPU frame (G-buffer included) of one technique.
+    /// A full CPU frame (G-buffer included) of one technique (and of those the frame's lights name).
     ///
     /// # Errors
     /// Unknown technique, bad settings, or a rendering failure.
@@ -163,7 +164,10 @@ impl Renderer {
         spec: &TechniqueSpec,
     ) -> Result<(CpuFrame, Vec<DebugView>), Error> {
         let mut t = self.registry.cpu(spec)?;
-        let f = shadow_cpu::render_frame(&mut self.cpu, frame, width, height, t.as_mut())?;
+        let mut named = Vec::new();
+        name_techniques(frame, &mut named, |s| Ok(self.registry.cpu(s)?))?;
+        let techniques = LightTechniques { frame: t.as_mut(), named: &mut named };
+        let f = shadow_cpu::render_frame(&mut self.cpu, frame, width, height, techniques)?;
         let views = t.debug_views(&mut self.cpu)?;
         Ok((f, views))
     }
@@ -180,8 +184,8 @@ impl Renderer {
     pub fn prepare(&self, backend: BackendKind, spec: &TechniqueSpec) -> Result<Prepared, Error> {
         let settings = self.registry.canonical(spec)?;
         let technique = match backend {
-            BackendKind::Cpu => PreparedKind::Cpu(self.registry.cpu(spec)?),
-            BackendKind::Wgpu => PreparedKind::Wgpu(self.registry.wgpu(spec)?),
+            BackendKind::Cpu => PreparedKind::Cpu(self.registry.cpu(spec)?, Vec::new()),
+            BackendKind::Wgpu => PreparedKind::Wgpu(self.registry.wgpu(spec)?, Vec::new()),
         };
         Ok(Prepared { name: spec.name.clone(), settings, technique })
     }
@@ -198,15 +202,19 @@ impl Renderer {
         height: u32,
     ) -> Result<RunOutput, Error> {
         let (backend, color, visibility, stats, debug_views) = match &mut p.technique {
-            PreparedKind::Cpu(t) => {
-                let f = shadow_cpu::render_frame(&mut self.cpu, frame, width, height, t.as_mut())?;
+            PreparedKind::Cpu(t, named) => {
+                name_techniques(frame, named, |s| Ok(self.registry.cpu(s)?))?;
+                let techniques = LightTechniques { frame: t.as_mut(), named };
+                let f = shadow_cpu::render_frame(&mut self.cpu, frame, width, height, techniques)?;
                 let views = t.debug_views(&mut self.cpu)?;
                 self.cpu.recycle(f.gbuffer);
                 (BackendKind::Cpu, f.color, f.visibility, f.stats, views)
             }
-            PreparedKind::Wgpu(t) => {
+            PreparedKind::Wgpu(t, named) => {
+                name_techniques(frame, named, |s| Ok(self.registry.wgpu(s)?))?;
                 let g = self.gpu(true)?;
-                let f = shadow_wgpu::render_frame(g, frame, width, height, t.as_mut())?;
+                let techniques = LightTechniques { frame: t.as_mut(), named };
+                let f = shadow_wgpu::render_frame(g, frame, width, height, techniques)?;
                 let views = t.debug_views(g)?;
                 (BackendKind::Wgpu, f.color, f.visibility, f.stats, views)
             }
@@ -240,8 +248,28 @@ impl Renderer {
 }
 
 enum PreparedKind {
-    Cpu(Box<dyn shadow_core::technique::DynShadowTechnique<shadow_cpu::CpuBackend>>),
-    Wgpu(Box<dyn shadow_core::technique::DynShadowTechnique<shadow_wgpu::WgpuBackend>>),
+    Cpu(Box<dyn DynShadowTechnique<CpuBackend>>, Named<CpuBackend>),
+    Wgpu(Box<dyn DynShadowTechnique<WgpuBackend>>, Named<WgpuBackend>),
+}
+
+/// The techniques lights name for themselves, each made once for its spec and kept with its state.
+pub type Named<B> = Vec<(TechniqueSpec, Box<dyn DynShadowTechnique<B>>)>;
+
+/// Makes with `make` each technique a light of `frame` names that `named` lacks.
+///
+/// # Errors
+/// What `make` refuses: an unknown technique, bad settings, one missing on the backend.
+pub fn name_techniques<B: Backend>(
+    frame: &FrameInputs,
+    named: &mut Named<B>,
+    make: impl Fn(&TechniqueSpec) -> Result<Box<dyn DynShadowTechnique<B>>, Error>,
+) -> Result<(), Error> {
+    for shadow in &frame.shadows {
+        if let Some(spec) = shadow.technique.as_ref().filter(|s| !named.iter().any(|(n, _)| n == *s)) {
+            named.push((spec.clone(), make(spec)?));
+        }
+    }
+    Ok(())
 }
 
 /// A technique ready to run on one backend, with its state.
@@ -266,8 +294,8 @@ impl Prepared {
     #[must_use]
     pub fn backend(&self) -> BackendKind {
         match self.technique {
-            PreparedKind::Cpu(_) => BackendKind::Cpu,
-            PreparedKind::Wgpu(_) => BackendKind::Wgpu,
+            PreparedKind::Cpu(..) => BackendKind::Cpu,
+            PreparedKind::Wgpu(..) => BackendKind::Wgpu,
         }
     }
 }

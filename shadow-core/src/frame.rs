@@ -16,7 +16,7 @@ use crate::geometry::silhouette::{CastMode, Silhouette, silhouette};
 use crate::geometry::volume::{Caps, ShadowVolume, extrude};
 use crate::light::{LightView, LightViewError};
 use crate::mesh::Mesh;
-use crate::scene::{Camera, CameraKey, Light, MeshKey, NodeKey, Scene, SceneError};
+use crate::scene::{Camera, CameraKey, Light, LightShadow, MeshKey, NodeKey, Scene, SceneError};
 use crate::stats::Counters;
 
 /// One drawn mesh in world space.
@@ -106,6 +106,9 @@ pub struct FrameInputs {
     pub camera: Camera,
     /// The lights of this frame.
     pub lights: Vec<Light>,
+    /// How each light casts shadows, in the order of `lights`; a light past its end casts with the frame's
+    /// technique.
+    pub shadows: Vec<LightShadow>,
 }
 
 impl FrameInputs {
@@ -144,7 +147,8 @@ impl FrameInputs {
             return Err(FrameError::Empty);
         }
         let bounds = instances.iter().fold(Aabb::EMPTY, |b, i| b.union(i.bounds));
-        let frame = Self { instances, bounds, camera, lights };
+        let shadows = vec![LightShadow::default(); lights.len()];
+        let frame = Self { instances, bounds, camera, lights, shadows };
         let triangles = frame.triangle_count() as u64;
         if triangles > MAX_FRAME_TRIANGLES {
             return Err(FrameError::TooManyTriangles { triangles });
@@ -158,7 +162,9 @@ impl FrameInputs {
     /// As [`FrameInputs::new`], or an unknown camera key.
     pub fn from_scene(scene: &Scene, camera: CameraKey) -> Result<Self, FrameError> {
         let cam = scene.world_camera(camera).ok_or(SceneError::UnknownKey("camera"))?;
-        Self::new(scene, cam, scene.lights().map(|(_, l)| l).collect())
+        let mut frame = Self::new(scene, cam, scene.lights().map(|(_, l)| l).collect())?;
+        frame.shadows = scene.lights().map(|(k, _)| scene.light_shadow(k)).collect();
+        Ok(frame)
     }
 
     /// The frame of `scene` seen from its first camera, lit by all its lights.
@@ -168,6 +174,12 @@ impl FrameInputs {
     pub fn from_first_camera(scene: &Scene) -> Result<Self, FrameError> {
         let (camera, _) = scene.cameras().next().ok_or(FrameError::NoCamera)?;
         Self::from_scene(scene, camera)
+    }
+
+    /// How light `k` casts shadows.
+    #[must_use]
+    pub fn shadow(&self, k: usize) -> LightShadow {
+        self.shadows.get(k).cloned().unwrap_or_default()
     }
 
     /// Total triangles drawn.

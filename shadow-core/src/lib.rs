@@ -33,5 +33,7 @@ pub use glam;
 pub use image::Image;
 pub use light::LightView;
 pub use mesh::{Mesh, MeshError};
-pub use scene::{Camera, CameraKey, Light, LightKey, LightKind, Material, MaterialKey, MeshKey, Node, NodeKey, Scene};
+pub use scene::{
+    Camera, CameraKey, Light, LightKey, LightKind, LightShadow, Material, MaterialKey, MeshKey, Node, NodeKey, Scene,
+};
 pub mod shading;

@@ -1,5 +1,6 @@
 //! The frame script (DESIGN 5), written once for every backend: the camera's G-buffer, then per light a
-//! build and a query into that light's visibility, then shading.
+//! build and a query into that light's visibility, then shading. Each light is shadowed by the frame's
+//! technique or by one of its own ([`LightTechniques`]); a light that casts no shadow is lit everywhere.
 //!
 //! A backend supplies the steps ([`FrameSteps`]) and [`run_frame`] puts them in order, times each phase
 //! and gathers the lights' stats. How the steps run is theirs to decide: the instrumented frame of each
@@ -11,7 +12,8 @@ use std::time::Instant;
 use crate::frame::FrameInputs;
 use crate::light::LightView;
 use crate::stats::{Phase, ms};
-use crate::technique::{Backend, DynShadowTechnique, FrameStats, LightPass};
+use crate::technique::settings::TechniqueSpec;
+use crate::technique::{Backend, DynShadowTechnique, FrameStats, LightPass, TechniqueError};
 
 /// The steps of one frame on backend `B`, in the order [`run_frame`] calls them.
 pub trait FrameSteps<B: Backend> {
@@ -34,6 +36,12 @@ pub trait FrameSteps<B: Backend> {
 
     /// Takes light `k`'s visibility once its query is issued.
     fn keep(&mut self, k: usize, visibility: B::Visibility);
+
+    /// Fills a visibility with 1 (lit everywhere), for a light that casts no shadow.
+    ///
+    /// # Errors
+    /// Backend failures.
+    fn lit(&mut self, cx: &mut B::Context, visibility: &mut B::Visibility) -> Result<(), B::Error>;
 
     /// Shades the G-buffer with every light's visibility.
     ///
@@ -81,17 +89,45 @@ pub struct FrameRun<O> {
     pub stats: FrameStats,
 }
 
-/// Runs one frame: `steps` supply the backend's passes and `technique` shadows every light.
+/// The techniques that shadow a frame's lights: the frame's own, and those lights name for themselves
+/// ([`crate::LightShadow::technique`]), each made once for its spec by the caller (who has the registry).
+pub struct LightTechniques<'a, 'o: 'a, B: Backend> {
+    /// The frame's technique.
+    pub frame: &'a mut (dyn DynShadowTechnique<B> + 'o),
+    /// The techniques lights name, by their specs.
+    pub named: &'a mut [(TechniqueSpec, Box<dyn DynShadowTechnique<B>>)],
+}
+
+impl<'a, 'o: 'a, B: Backend> From<&'a mut (dyn DynShadowTechnique<B> + 'o)> for LightTechniques<'a, 'o, B> {
+    /// The frame's technique alone.
+    fn from(frame: &'a mut (dyn DynShadowTechnique<B> + 'o)) -> Self {
+        Self { frame, named: &mut [] }
+    }
+}
+
+impl<B: Backend> LightTechniques<'_, '_, B> {
+    /// The technique for a light that names `spec`, or the frame's.
+    fn pick(&mut self, spec: Option<&TechniqueSpec>) -> Result<&mut dyn DynShadowTechnique<B>, TechniqueError> {
+        let Some(spec) = spec else { return Ok(&mut *self.frame) };
+        match self.named.iter_mut().find(|(s, _)| s == spec) {
+            Some((_, t)) => Ok(t.as_mut()),
+            None => Err(TechniqueError::Unprepared(spec.to_string())),
+        }
+    }
+}
+
+/// Runs one frame: `steps` supply the backend's passes and `techniques` shadow the lights.
 ///
 /// # Errors
-/// A light whose view cannot be fitted, a light the technique does not take, or a failure of a step or
-/// of the technique.
-pub fn run_frame<B: Backend, S: FrameSteps<B>>(
+/// A light whose view cannot be fitted, a light its technique does not take, a light naming a technique
+/// `techniques` lacks, or a failure of a step or of a technique.
+pub fn run_frame<'t, 'o: 't, B: Backend, S: FrameSteps<B>>(
     cx: &mut B::Context,
     frame: &FrameInputs,
     mut steps: S,
-    technique: &mut dyn DynShadowTechnique<B>,
+    techniques: impl Into<LightTechniques<'t, 'o, B>>,
 ) -> Result<FrameRun<S::Output>, B::Error> {
+    let mut techniques = techniques.into();
     let start = Instant::now();
     let mut stats = FrameStats::default();
     let mut phases = Phases { steps: &mut steps, stats: &mut stats };
@@ -100,11 +136,19 @@ pub fn run_frame<B: Backend, S: FrameSteps<B>>(
     let mut light_views = Vec::with_capacity(frame.lights.len());
     for (k, light) in frame.lights.iter().enumerate() {
         let view = frame.light_view(light)?;
+        let shadow = frame.shadow(k);
+        let mut vis = phases.steps.visibility(cx, k)?;
+        if !shadow.casts {
+            phases.steps.lit(cx, &mut vis)?;
+            phases.steps.keep(k, vis);
+            light_views.push(view);
+            continue;
+        }
+        let technique = techniques.pick(shadow.technique.as_ref())?;
         let mut light_stats = FrameStats::default();
         phases.run(cx, Phase::Build, |cx, _| {
             technique.build(cx, LightPass { frame, light: &view, slot: k, stats: &mut light_stats })
         })?;
-        let mut vis = phases.steps.visibility(cx, k)?;
         phases.run(cx, Phase::Query, |cx, _| {
             technique.query(cx, LightPass { frame, light: &view, slot: k, stats: &mut light_stats }, &gbuffer, &mut vis)
         })?;

@@ -3,8 +3,8 @@
 
 use shadow_core::image::Rgb8;
 use shadow_core::light::LightView;
-use shadow_core::script::{FrameRun, FrameSteps, run_frame};
-use shadow_core::technique::{DynShadowTechnique, FrameStats};
+use shadow_core::script::{FrameRun, FrameSteps, LightTechniques, run_frame};
+use shadow_core::technique::FrameStats;
 use shadow_core::{FrameInputs, Image};
 
 use crate::context::{CpuBackend, CpuContext, CpuError};
@@ -25,19 +25,21 @@ pub struct CpuFrame {
     pub stats: FrameStats,
 }
 
-/// Renders a frame with one technique for every light of the frame.
+/// Renders a frame, each light shadowed by the frame's technique or its own (`techniques`; a single
+/// technique converts into them).
 ///
 /// # Errors
-/// A bad view size, a light the technique does not support, or a technique failure.
-pub fn render_frame(
+/// A bad view size, a light its technique does not support, or a technique failure.
+pub fn render_frame<'t, 'o: 't>(
     cx: &mut CpuContext,
     frame: &FrameInputs,
     width: u32,
     height: u32,
-    technique: &mut dyn DynShadowTechnique<CpuBackend>,
+    techniques: impl Into<LightTechniques<'t, 'o, CpuBackend>>,
 ) -> Result<CpuFrame, CpuError> {
     let steps = CpuSteps { width, height, visibility: Vec::with_capacity(frame.lights.len()) };
-    let FrameRun { output: (gbuffer, visibility, color), light_views, stats } = run_frame(cx, frame, steps, technique)?;
+    let FrameRun { output: (gbuffer, visibility, color), light_views, stats } =
+        run_frame(cx, frame, steps, techniques)?;
     Ok(CpuFrame { gbuffer, light_views, visibility, color, stats })
 }
 
@@ -62,6 +64,11 @@ impl FrameSteps<CpuBackend> for CpuSteps {
 
     fn keep(&mut self, _k: usize, visibility: Image<f32>) {
         self.visibility.push(visibility);
+    }
+
+    fn lit(&mut self, _cx: &mut CpuContext, visibility: &mut Image<f32>) -> Result<(), CpuError> {
+        visibility.data_mut().fill(1.0);
+        Ok(())
     }
 
     fn shade(&mut self, _cx: &mut CpuContext, frame: &FrameInputs, gbuffer: &GBuffer) -> Result<Image<Rgb8>, CpuError> {

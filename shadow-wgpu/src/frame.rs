@@ -5,9 +5,9 @@
 
 use shadow_core::image::Rgb8;
 use shadow_core::light::LightView;
-use shadow_core::script::{FrameRun, FrameSteps, run_frame};
+use shadow_core::script::{FrameRun, FrameSteps, LightTechniques, run_frame};
 use shadow_core::stats::Phase;
-use shadow_core::technique::{DynShadowTechnique, FrameStats};
+use shadow_core::technique::FrameStats;
 use shadow_core::{FrameInputs, Image};
 
 use crate::clock::PhaseClock;
@@ -87,17 +87,17 @@ pub fn layer_view(tex: &wgpu::Texture, layer: u32) -> wgpu::TextureView {
     })
 }
 
-/// Renders a frame with one technique for every light of the frame, waiting after each phase and
-/// reading every target back.
+/// Renders a frame, each light shadowed by the frame's technique or its own (`techniques`; a single
+/// technique converts into them), waiting after each phase and reading every target back.
 ///
 /// # Errors
 /// A bad view size, an unsupported light, or a GPU failure.
-pub fn render_frame(
+pub fn render_frame<'t, 'o: 't>(
     cx: &mut WgpuContext,
     frame: &FrameInputs,
     width: u32,
     height: u32,
-    technique: &mut dyn DynShadowTechnique<WgpuBackend>,
+    techniques: impl Into<LightTechniques<'t, 'o, WgpuBackend>>,
 ) -> Result<WgpuFrame, WgpuError> {
     let most = MAX_LIGHTS.min(cx.device.limits().max_texture_array_layers as usize);
     if frame.lights.len() > most {
@@ -105,7 +105,7 @@ pub fn render_frame(
     }
     cx.clock = PhaseClock::new(cx);
     let steps = MeasuredSteps::new(cx, frame, width, height);
-    let result = run_frame(cx, frame, steps, technique);
+    let result = run_frame(cx, frame, steps, techniques);
     cx.clock = None;
     let FrameRun { output: (visibility, color), light_views, stats } = result?;
     Ok(WgpuFrame { light_views, visibility, color, stats })
@@ -165,6 +165,11 @@ impl FrameSteps<WgpuBackend> for MeasuredSteps {
     }
 
     fn keep(&mut self, _k: usize, _visibility: GpuVisibility) {}
+
+    fn lit(&mut self, cx: &mut WgpuContext, visibility: &mut GpuVisibility) -> Result<(), WgpuError> {
+        clear_lit(cx, visibility);
+        Ok(())
+    }
 
     fn shade(&mut self, cx: &mut WgpuContext, frame: &FrameInputs, g: &GpuGBuffer) -> Result<Self::Shaded, WgpuError> {
         shade(cx, frame, g, &self.visibility)
@@ -239,6 +244,25 @@ fn read_count(cx: &WgpuContext, q: &wgpu::Buffer) -> Result<u64, WgpuError> {
     cx.submit(enc);
     let d = readback::map_read(cx, &staging, "counting receivers")?;
     Ok(u64::from_le_bytes([d[0], d[1], d[2], d[3], d[4], d[5], d[6], d[7]]))
+}
+
+/// Clears a visibility target to 1: lit everywhere (a light that casts no shadow).
+pub(crate) fn clear_lit(cx: &WgpuContext, visibility: &GpuVisibility) {
+    let mut enc = cx.encoder("unshadowed light");
+    enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some("unshadowed light"),
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view: &visibility.view,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::WHITE), store: wgpu::StoreOp::Store },
+        })],
+        depth_stencil_attachment: None,
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    });
+    cx.submit(enc);
 }
 
 /// The shading pass's inputs: the G-buffer's position, normal and albedo, every light's visibility (a

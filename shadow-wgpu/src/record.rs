@@ -10,12 +10,12 @@
 
 use std::collections::HashMap;
 
-use shadow_core::script::{FrameRun, FrameSteps, run_frame};
-use shadow_core::technique::{DynShadowTechnique, FrameStats};
+use shadow_core::script::{FrameRun, FrameSteps, LightTechniques, run_frame};
+use shadow_core::technique::FrameStats;
 use shadow_core::{FrameInputs, LightView};
 
 use crate::context::{WgpuBackend, WgpuContext, WgpuError};
-use crate::frame::{GpuVisibility, MAX_LIGHTS, full_screen_shade, layer_view, layered, shade_group};
+use crate::frame::{GpuVisibility, MAX_LIGHTS, clear_lit, full_screen_shade, layer_view, layered, shade_group};
 use crate::gbuffer::{self, GpuGBuffer};
 use crate::pipelines::{VISIBILITY, full_screen_pipeline};
 
@@ -56,19 +56,20 @@ impl FrameRecorder {
         Self::default()
     }
 
-    /// Records one frame of `frame` with `technique` into `encoder`: the G-buffer, every light's build
-    /// and query, and shading into `target`. Returns the fitted view of each light.
+    /// Records one frame of `frame` into `encoder`: the G-buffer, every light's build and query (with the
+    /// frame's technique or the light's own, from `techniques`; a single technique converts into them),
+    /// and shading into `target`. Returns the fitted view of each light.
     ///
     /// # Errors
     /// Too many lights, a light the technique does not take, a technique that needs the GPU's results
     /// within the frame ([`WgpuError::NotRecordable`]), or a GPU failure. On an error, what `encoder`
     /// held may be lost.
-    pub fn record(
+    pub fn record<'t, 'o: 't>(
         &mut self,
         cx: &mut WgpuContext,
         encoder: &mut wgpu::CommandEncoder,
         frame: &FrameInputs,
-        technique: &mut dyn DynShadowTechnique<WgpuBackend>,
+        techniques: impl Into<LightTechniques<'t, 'o, WgpuBackend>>,
         target: &ColorTarget<'_>,
     ) -> Result<Vec<LightView>, WgpuError> {
         let most = MAX_LIGHTS.min(cx.device.limits().max_texture_array_layers as usize);
@@ -80,7 +81,7 @@ impl FrameRecorder {
         let shade = self.shade.entry(target.format).or_insert_with(|| shade_pipeline(cx, target.format));
         let (width, height) = (target.width, target.height);
         let steps = RecordSteps { width, height, visibility, shade, target: target.view };
-        let FrameRun { light_views, .. } = cx.record_into(encoder, |cx| run_frame(cx, frame, steps, technique))?;
+        let FrameRun { light_views, .. } = cx.record_into(encoder, |cx| run_frame(cx, frame, steps, techniques))?;
         Ok(light_views)
     }
 
@@ -145,6 +146,11 @@ impl FrameSteps<WgpuBackend> for RecordSteps<'_> {
     }
 
     fn keep(&mut self, _k: usize, _visibility: GpuVisibility) {}
+
+    fn lit(&mut self, cx: &mut WgpuContext, visibility: &mut GpuVisibility) -> Result<(), WgpuError> {
+        clear_lit(cx, visibility);
+        Ok(())
+    }
 
     fn shade(&mut self, cx: &mut WgpuContext, frame: &FrameInputs, g: &GpuGBuffer) -> Result<(), WgpuError> {
         cx.scoped("the recorded shading pass", |cx| {

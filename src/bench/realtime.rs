@@ -175,7 +175,7 @@ fn realtime_frames(
         if let Some((c, m)) = marks {
             c.mark(&mut encoder, 2 * m);
         }
-        recorder.record(cx, &mut encoder, &frame, technique, &color)?;
+        recorder.record(cx, &mut encoder, &frame, &mut *technique, &color)?;
         if let Some((c, m)) = marks {
             c.mark(&mut encoder, 2 * m + 1);
         }

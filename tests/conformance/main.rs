@@ -7,6 +7,7 @@ mod extrusion;
 mod gpu_clock;
 mod host;
 mod hybrid;
+mod per_light;
 mod settings;
 mod silhouette_map;
 mod smoothies;

@@ -118,7 +118,7 @@ fn made_after_the_first_frame(
         scene.set_local_transform(node, nudge * start).expect("node");
         let frame = FrameInputs::from_first_camera(scene).expect("frame");
         let mut encoder = cx.device.create_command_encoder(&Default::default());
-        recorder.record(cx, &mut encoder, &frame, technique, &color)?;
+        recorder.record(cx, &mut encoder, &frame, &mut *technique, &color)?;
         cx.queue.submit([encoder.finish()]);
         first.get_or_insert(cx.created());
         last = Some(frame);

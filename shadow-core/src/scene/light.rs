@@ -3,6 +3,7 @@
 use glam::{Mat4, Vec3};
 
 use super::SceneError;
+use crate::technique::settings::TechniqueSpec;
 
 /// What kind of light, with its placement in world space.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -26,6 +27,34 @@ pub enum LightKind {
         /// Position.
         position: Vec3,
     },
+}
+
+/// How a light casts shadows (set per light with [`super::Scene::set_light_shadow`]).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct LightShadow {
+    /// Whether it casts shadows; one that does not lights everything it reaches (its visibility is 1).
+    pub casts: bool,
+    /// The technique that shadows it, with its settings (a map's size and bias where the technique has
+    /// them); `None`: the frame's technique. Lights of one frame may each name another.
+    pub technique: Option<TechniqueSpec>,
+}
+
+impl Default for LightShadow {
+    /// Casting, with the frame's technique.
+    fn default() -> Self {
+        Self { casts: true, technique: None }
+    }
+}
+
+impl LightShadow {
+    /// Casting with `technique` (a spec such as `shadow-map:res=1024`).
+    #[must_use]
+    pub fn with(technique: TechniqueSpec) -> Self {
+        Self { casts: true, technique: Some(technique) }
+    }
+
+    /// Casting no shadow.
+    pub const NONE: Self = Self { casts: false, technique: None };
 }
 
 /// A light source.

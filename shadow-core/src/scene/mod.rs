@@ -10,7 +10,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, OnceLock};
 
 use glam::{Mat4, Vec3};
-use slotmap::SlotMap;
+use slotmap::{SecondaryMap, SlotMap};
 
 use crate::bounds::Aabb;
 use crate::geometry::adjacency::Adjacency;
@@ -20,7 +20,7 @@ mod camera;
 mod light;
 
 pub use camera::Camera;
-pub use light::{Light, LightKind};
+pub use light::{Light, LightKind, LightShadow};
 
 slotmap::new_key_type! {
     /// A node of the hierarchy.
@@ -165,6 +165,7 @@ pub struct Scene {
     meshes: SlotMap<MeshKey, MeshEntry>,
     materials: SlotMap<MaterialKey, Material>,
     lights: SlotMap<LightKey, Placed<Light>>,
+    light_shadows: SecondaryMap<LightKey, LightShadow>,
     cameras: SlotMap<CameraKey, Placed<Camera>>,
 }
 
@@ -424,6 +425,8 @@ impl Scene {
         // The lights and cameras that followed a removed node go with it.
         let nodes = &self.nodes;
         self.lights.retain(|_, l| l.node.is_none_or(|n| nodes.contains_key(n)));
+        let lights = &self.lights;
+        self.light_shadows.retain(|k, _| lights.contains_key(k));
         self.cameras.retain(|_, c| c.node.is_none_or(|n| nodes.contains_key(n)));
         Ok(())
     }
@@ -520,6 +523,23 @@ impl Scene {
     /// Removes every light.
     pub fn clear_lights(&mut self) {
         self.lights.clear();
+        self.light_shadows.clear();
+    }
+
+    /// Sets how a light casts shadows: whether it does, and with which technique and settings.
+    ///
+    /// # Errors
+    /// An unknown light key.
+    pub fn set_light_shadow(&mut self, key: LightKey, shadow: LightShadow) -> Result<(), SceneError> {
+        self.lights.get(key).ok_or(SceneError::UnknownKey("light"))?;
+        self.light_shadows.insert(key, shadow);
+        Ok(())
+    }
+
+    /// How a light casts shadows (by default: it does, with the frame's technique).
+    #[must_use]
+    pub fn light_shadow(&self, key: LightKey) -> LightShadow {
+        self.light_shadows.get(key).cloned().unwrap_or_default()
     }
 
     /// Adds a camera placed in world space.

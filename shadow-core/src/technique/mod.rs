@@ -64,6 +64,9 @@ pub enum TechniqueError {
     /// `build` was not called before `query`.
     #[error("technique '{0}' was queried before it was built")]
     NotBuilt(String),
+    /// A light names a technique the frame was not given.
+    #[error("a light is shadowed by '{0}', which the frame was not given (make it from the registry)")]
+    Unprepared(String),
 }
 
 impl TechniqueError {
