@@ -66,6 +66,13 @@ impl RealtimeShadows {
         Ok(())
     }
 
+    /// Forgets every light's last build, so the next frame builds each light afresh: after a change a
+    /// build cannot see (lights whose view and casters are unchanged are otherwise not built again).
+    pub fn invalidate(&mut self) {
+        self.technique.invalidate();
+        self.named.iter_mut().for_each(|(_, t)| t.invalidate());
+    }
+
     /// The technique's spec.
     #[must_use]
     pub fn technique(&self) -> &TechniqueSpec {

@@ -290,6 +290,21 @@ impl Prepared {
     pub fn settings(&self) -> &str {
         &self.settings
     }
+    /// Forgets every light's last build (its own and the named techniques'), so the next frame builds
+    /// each light afresh.
+    pub fn invalidate(&mut self) {
+        match &mut self.technique {
+            PreparedKind::Cpu(t, named) => {
+                t.invalidate();
+                named.iter_mut().for_each(|(_, t)| t.invalidate());
+            }
+            PreparedKind::Wgpu(t, named) => {
+                t.invalidate();
+                named.iter_mut().for_each(|(_, t)| t.invalidate());
+            }
+        }
+    }
+
     /// The backend it runs on.
     #[must_use]
     pub fn backend(&self) -> BackendKind {

@@ -111,6 +111,31 @@ pub struct LightPass<'a> {
     pub stats: &'a mut FrameStats,
 }
 
+impl LightPass<'_> {
+    /// A digest of what a light's build reads: the light's position (or direction), its radius and its
+    /// fitted projections (which hold its cone), and every
+    /// instance's mesh, version, placement and shadow flags (the camera is not among them: a build that
+    /// reads it is not kept, see [`ShadowTechnique::build_is_reusable`]).
+    #[must_use]
+    pub fn build_key(&self) -> u64 {
+        use std::hash::{Hash, Hasher};
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        let floats = |h: &mut std::collections::hash_map::DefaultHasher, v: &[f32]| {
+            v.iter().for_each(|x| x.to_bits().hash(h));
+        };
+        floats(&mut h, &self.light.source().homogeneous().to_array());
+        floats(&mut h, &[self.light.light.radius]);
+        for p in &self.light.projections {
+            floats(&mut h, &p.clip_from_world.to_cols_array());
+        }
+        for inst in &self.frame.instances {
+            (inst.mesh_key, inst.mesh_version, inst.casts_shadow, inst.receives_shadow).hash(&mut h);
+            floats(&mut h, &inst.world_from_local.to_cols_array());
+        }
+        h.finish()
+    }
+}
+
 /// A named picture of a technique's internals (a depth map, an edge map, a silhouette-point overlay).
 #[derive(Clone, Debug)]
 pub struct DebugView {
@@ -153,6 +178,13 @@ pub trait ShadowTechnique<B: Backend>: Send + Sync {
         out: &mut B::Visibility,
     ) -> Result<(), B::Error>;
 
+    /// Whether a light's build may be kept for later frames while the light's view, the casters and the
+    /// meshes it reads stay the same (default: yes). A technique whose build reads the camera, or leaves
+    /// its query data that lasts one frame only (the frame's transient buffer), says no.
+    fn build_is_reusable(&self) -> bool {
+        true
+    }
+
     /// Pictures of the internals after the last build (default: none).
     ///
     /// # Errors
@@ -189,21 +221,33 @@ pub trait DynShadowTechnique<B: Backend>: Send {
     /// # Errors
     /// As [`ShadowTechnique::debug_views`].
     fn debug_views(&mut self, cx: &mut B::Context) -> Result<Vec<DebugView>, B::Error>;
+    /// Forgets every light's last build, so the next frame builds each light afresh (after a change the
+    /// build cannot see: a mesh edited in place, say).
+    fn invalidate(&mut self);
 }
 
-/// A technique with its lazily created state: the standard [`DynShadowTechnique`].
+/// A technique with its lazily created state, one per light of the frame ([`LightPass::slot`]): the
+/// standard [`DynShadowTechnique`].
+///
+/// A light whose view, casters and meshes are what its last build read (and, for a technique whose build
+/// reads it, the camera) is not built again: its state still holds that build (the three.js
+/// `autoUpdate` idea, made automatic). The frame's counters say how many lights were spared
+/// (`cached_builds`); [`DynShadowTechnique::invalidate`] forgets every build.
 pub struct Stateful<B: Backend, T: ShadowTechnique<B>> {
     technique: T,
     settings: String,
     lights: LightKinds,
-    state: Option<T::State>,
+    /// Per light slot: its state, and what its last build read.
+    slots: Vec<Option<(T::State, Option<u64>)>>,
+    /// The slot last built or queried, for the debug views.
+    last: usize,
 }
 
 impl<B: Backend, T: ShadowTechnique<B>> Stateful<B, T> {
     /// Wraps a technique taking every kind of light; `settings` is its canonical settings string for
     /// reports.
     pub fn new(technique: T, settings: String) -> Self {
-        Self { technique, settings, lights: LightKinds::ALL, state: None }
+        Self { technique, settings, lights: LightKinds::ALL, slots: Vec::new(), last: 0 }
     }
 
     /// The same, refusing lights of kinds outside `lights` before any build.
@@ -234,11 +278,23 @@ impl<B: Backend, T: ShadowTechnique<B>> DynShadowTechnique<B> for Stateful<B, T>
         if !self.lights.takes(&pass.light.light) {
             return Err(TechniqueError::unsupported_light(self.technique.name(), &pass.light.light).into());
         }
-        let state = match &mut self.state {
+        let reads = self.technique.build_is_reusable().then(|| pass.build_key());
+        if self.slots.len() <= pass.slot {
+            self.slots.resize_with(pass.slot + 1, || None);
+        }
+        self.last = pass.slot;
+        let (state, built) = match &mut self.slots[pass.slot] {
             Some(s) => s,
-            slot => slot.insert(self.technique.create_state(cx)?),
+            slot => slot.insert((self.technique.create_state(cx)?, None)),
         };
-        self.technique.build(cx, state, pass)
+        if reads.is_some() && *built == reads {
+            *pass.stats.counters.extra.entry("cached_builds".into()).or_insert(0.0) += 1.0;
+            return Ok(());
+        }
+        *built = None;
+        self.technique.build(cx, state, pass)?;
+        *built = reads;
+        Ok(())
     }
 
     fn query(
@@ -248,14 +304,22 @@ impl<B: Backend, T: ShadowTechnique<B>> DynShadowTechnique<B> for Stateful<B, T>
         gbuffer: &B::GBuffer,
         out: &mut B::Visibility,
     ) -> Result<(), B::Error> {
-        let state = self.state.as_mut().ok_or_else(|| TechniqueError::NotBuilt(self.technique.name().into()))?;
+        let not_built = || TechniqueError::NotBuilt(self.technique.name().into());
+        let (state, _) = self.slots.get_mut(pass.slot).and_then(Option::as_mut).ok_or_else(not_built)?;
+        self.last = pass.slot;
         self.technique.query(cx, state, pass, gbuffer, out)
     }
 
     fn debug_views(&mut self, cx: &mut B::Context) -> Result<Vec<DebugView>, B::Error> {
-        match &self.state {
-            Some(s) => self.technique.debug_views(cx, s),
+        match self.slots.get(self.last).and_then(Option::as_ref) {
+            Some((s, _)) => self.technique.debug_views(cx, s),
             None => Ok(Vec::new()),
+        }
+    }
+
+    fn invalidate(&mut self) {
+        for (_, built) in self.slots.iter_mut().flatten() {
+            *built = None;
         }
     }
 }

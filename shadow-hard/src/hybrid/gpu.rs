@@ -332,6 +332,12 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
         Self::NAME
     }
 
+    /// Its build sizes the caster masks' tolerances by the camera, and leaves the volumes and the small
+    /// pieces' parameters in the frame's transient buffer.
+    fn build_is_reusable(&self) -> bool {
+        false
+    }
+
     fn create_state(&self, cx: &mut WgpuContext) -> Result<State, WgpuError> {
         let map = DepthMaps::new(cx, &self.depth);
         cx.scoped("creating the hybrid pipelines", |cx| {

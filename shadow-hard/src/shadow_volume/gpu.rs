@@ -49,6 +49,12 @@ impl ShadowTechnique<WgpuBackend> for ShadowVolume {
         ShadowVolume::name(self)
     }
 
+    /// The compute pass's lists outlast the frame; volumes extruded on the host are uploaded into the
+    /// frame's transient buffer, which does not.
+    fn build_is_reusable(&self) -> bool {
+        self.gpu.extrusion == Extrusion::Gpu
+    }
+
     fn create_state(&self, cx: &mut WgpuContext) -> Result<State, WgpuError> {
         let (counting, extrusion) = (self.counting, self.gpu.extrusion);
         cx.scoped("creating the shadow-volume pipelines", |cx| {
