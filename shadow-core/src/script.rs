@@ -105,6 +105,13 @@ impl<'a, 'o: 'a, B: Backend> From<&'a mut (dyn DynShadowTechnique<B> + 'o)> for 
     }
 }
 
+impl<'a, B: Backend, T: DynShadowTechnique<B> + 'a> From<&'a mut T> for LightTechniques<'a, 'a, B> {
+    /// The frame's technique alone.
+    fn from(frame: &'a mut T) -> Self {
+        Self { frame, named: &mut [] }
+    }
+}
+
 impl<B: Backend> LightTechniques<'_, '_, B> {
     /// The technique for a light that names `spec`, or the frame's.
     fn pick(&mut self, spec: Option<&TechniqueSpec>) -> Result<&mut dyn DynShadowTechnique<B>, TechniqueError> {

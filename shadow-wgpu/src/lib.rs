@@ -16,6 +16,7 @@ pub mod readback;
 pub mod record;
 pub mod resources;
 pub mod shaders;
+pub mod timer;
 pub mod upload;
 
 pub use context::{AdapterChoice, AdapterSummary, WgpuBackend, WgpuContext, WgpuError, list_adapters};
@@ -23,3 +24,4 @@ pub use frame::{GpuVisibility, WgpuFrame, render_frame};
 pub use gbuffer::GpuGBuffer;
 pub use record::{ColorTarget, FrameRecorder};
 pub use resources::{Created, Transient};
+pub use timer::FrameTimer;

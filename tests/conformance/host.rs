@@ -89,3 +89,33 @@ fn realtime_shadows_switch_techniques_and_keep_theirs_on_a_refusal() {
     let vis = shadow_wgpu::readback::read_f32(shadows.context(), vis, 0, wgpu::TextureAspect::All).expect("read back");
     assert!(vis.data().contains(&0.0) && vis.data().contains(&1.0), "no shadow edge in the recorded frame");
 }
+
+#[test]
+fn timed_realtime_frames_report_their_gpu_time_frames_later() {
+    use shadowlab::realtime::RealtimeShadows;
+    let Some(renderer) = crate::with_wgpu("timed realtime frames") else { return };
+    let name = renderer.adapter().expect("an adapter").name.clone();
+    let (adapter, device, queue) = host_device(&name, WgpuContext::REQUIRED_FEATURES | wgpu::Features::TIMESTAMP_QUERY);
+    let registry = TechniqueRegistry::builtin();
+    let mut shadows = RealtimeShadows::new(&adapter, device.clone(), queue.clone(), registry, "shadow-volume-zfail")
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert!(shadows.time_frames(true), "the device has timestamps, the timer none");
+    let s = scenes::build("cubes", &SceneParams::default()).expect("scene");
+    let frame = FrameInputs::from_first_camera(&s).expect("frame");
+    let texture = shadow_wgpu::frame::layered(shadows.context(), "target", 64, 48, 1, wgpu::TextureFormat::Rgba8Unorm);
+    let view = texture.create_view(&Default::default());
+    let target = shadow_wgpu::ColorTarget { view: &view, format: texture.format(), width: 64, height: 48 };
+    // The host waits for each frame here, so each step of the read-back lands by the next frame: the map
+    // is asked for when frame 2 is recorded, and frame 3 reads frame 1's time.
+    let mut times = Vec::new();
+    for _ in 0..3 {
+        let mut encoder = device.create_command_encoder(&Default::default());
+        shadows.record(&mut encoder, &frame, &target).unwrap_or_else(|e| panic!("{e}"));
+        queue.submit([encoder.finish()]);
+        times.push(shadows.gpu_ms());
+        device.poll(wgpu::PollType::wait_indefinitely()).expect("the frame done");
+    }
+    assert_eq!(&times[..2], &[None, None], "a time before its frame was read back");
+    assert!(times[2].is_some_and(|ms| ms > 0.0 && ms < 60_000.0), "frame 1's GPU time: {:?}", times[2]);
+    assert!(!shadows.time_frames(false) && shadows.gpu_ms().is_none(), "still timing");
+}
