@@ -99,10 +99,7 @@ pub fn render_frame<'t, 'o: 't>(
     height: u32,
     techniques: impl Into<LightTechniques<'t, 'o, WgpuBackend>>,
 ) -> Result<WgpuFrame, WgpuError> {
-    let most = MAX_LIGHTS.min(cx.device.limits().max_texture_array_layers as usize);
-    if frame.lights.len() > most {
-        return Err(WgpuError::TooManyLights { lights: frame.lights.len(), most });
-    }
+    check_lights(cx, frame)?;
     cx.clock = PhaseClock::new(cx);
     let steps = MeasuredSteps::new(cx, frame, width, height);
     let result = run_frame(cx, frame, steps, techniques);
@@ -244,6 +241,18 @@ fn read_count(cx: &WgpuContext, q: &wgpu::Buffer) -> Result<u64, WgpuError> {
     cx.submit(enc);
     let d = readback::map_read(cx, &staging, "counting receivers")?;
     Ok(u64::from_le_bytes([d[0], d[1], d[2], d[3], d[4], d[5], d[6], d[7]]))
+}
+
+/// Refuses a frame of more lights than one frame can shade on `cx`'s device.
+///
+/// # Errors
+/// [`WgpuError::TooManyLights`].
+pub(crate) fn check_lights(cx: &WgpuContext, frame: &FrameInputs) -> Result<(), WgpuError> {
+    let most = MAX_LIGHTS.min(cx.device.limits().max_texture_array_layers as usize);
+    if frame.lights.len() > most {
+        return Err(WgpuError::TooManyLights { lights: frame.lights.len(), most });
+    }
+    Ok(())
 }
 
 /// Clears a visibility target to 1: lit everywhere (a light that casts no shadow).

@@ -106,6 +106,111 @@ impl GBufferTargets {
 /// # Errors
 /// A bad size or a GPU failure.
 pub fn render(cx: &mut WgpuContext, frame: &FrameInputs, width: u32, height: u32) -> Result<GpuGBuffer, WgpuError> {
+    fill(cx, frame, (width, height), "the G-buffer pass", |cx, pass| {
+        pass.set_pipeline(&cx.shared.gbuffer);
+        draw_instances(cx, pass, frame, |_| true, true);
+    })
+}
+
+/// What an engine that renders its own depth and normals lends a recorded frame in place of the G-buffer
+/// pass ([`crate::FrameRecorder::record_visibility`]).
+///
+/// Shadow volumes count against this depth: their near caps lie on the surfaces exactly only where the
+/// engine rasterized with shadowlab's transform (`clip_from_world * world_from_local`, as its G-buffer
+/// does); elsewhere a lit surface facing the light may count its own cap.
+pub struct HostSurfaces<'a> {
+    /// The camera's depth as the frame's camera projects it, 1 where nothing was drawn: a view of a
+    /// `Depth32Float` texture, or the depth aspect of a depth-stencil one.
+    pub depth: &'a wgpu::TextureView,
+    /// Unit world-space normals in rgb: a view of a float texture (`Rgba16Float`, `Rgba32Float`, ...).
+    pub normals: &'a wgpu::TextureView,
+    /// The view's width in pixels, the two textures' too.
+    pub width: u32,
+    /// Its height.
+    pub height: u32,
+}
+
+/// The pass that turns a host's depth and normals into the G-buffer (`import.wgsl`).
+pub struct ImportPass {
+    pipeline: wgpu::RenderPipeline,
+    layout: wgpu::BindGroupLayout,
+}
+
+impl ImportPass {
+    /// The pipeline.
+    #[must_use]
+    pub fn new(cx: &WgpuContext) -> Self {
+        use crate::pipelines::{attribute_entry, buffer_entry, depth_entry};
+        let layout = cx.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("host surfaces"),
+            entries: &[
+                depth_entry(0),
+                attribute_entry(1),
+                buffer_entry(2, wgpu::BufferBindingType::Uniform, wgpu::ShaderStages::FRAGMENT),
+            ],
+        });
+        let module = crate::shaders::module(&cx.device, "import", crate::shaders::import());
+        let target =
+            Some(wgpu::ColorTargetState { format: ATTRIBUTE, blend: None, write_mask: wgpu::ColorWrites::ALL });
+        let depth = wgpu::DepthStencilState {
+            format: DEPTH_STENCIL,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::Always),
+            stencil: Default::default(),
+            bias: Default::default(),
+        };
+        let pipeline = crate::pipelines::full_screen_pipeline_to(
+            &cx.device,
+            ("host surfaces", &module, "fs_import".into()),
+            &[&cx.shared.frame_layout, &layout],
+            &[target.clone(), target.clone(), target.clone(), target],
+            Some(depth),
+        );
+        Self { pipeline, layout }
+    }
+}
+
+/// The G-buffer of a frame from a host's depth and normals (`pass`): world positions from the depth
+/// through the camera, the normals as both the shading and the face normal (turned towards the eye),
+/// a white albedo, every covered pixel a receiver.
+///
+/// # Errors
+/// A bad size or a GPU failure.
+pub fn import(
+    cx: &mut WgpuContext,
+    frame: &FrameInputs,
+    host: &HostSurfaces<'_>,
+    pass: &ImportPass,
+) -> Result<GpuGBuffer, WgpuError> {
+    let (width, height) = (host.width, host.height);
+    fill(cx, frame, (width, height), "the host surfaces' import", |cx, render| {
+        // Made once the frame's transient data has started over, which the fill does first.
+        let clip_from_world = frame.camera.clip_from_world(width as f32 / height as f32);
+        let world_from_clip = cx.transient(bytemuck::bytes_of(&clip_from_world.inverse().to_cols_array()));
+        let group = cx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("host surfaces"),
+            layout: &pass.layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(host.depth) },
+                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(host.normals) },
+                wgpu::BindGroupEntry { binding: 2, resource: world_from_clip.binding() },
+            ],
+        });
+        render.set_pipeline(&pass.pipeline);
+        render.set_bind_group(1, &group, &[]);
+        render.draw(0..3, 0..1);
+    })
+}
+
+/// Fills the G-buffer's targets (those of the frame before when its view had this size, cleared) in one
+/// pass that `draw` records, with the camera's group 0 bound.
+fn fill(
+    cx: &mut WgpuContext,
+    frame: &FrameInputs,
+    (width, height): (u32, u32),
+    during: &str,
+    draw: impl FnOnce(&WgpuContext, &mut wgpu::RenderPass<'_>),
+) -> Result<GpuGBuffer, WgpuError> {
     check_size(cx, "view", width, height)?;
     // A frame begins with its G-buffer: its transient data starts over.
     cx.begin_transient();
@@ -116,7 +221,7 @@ pub fn render(cx: &mut WgpuContext, frame: &FrameInputs, width: u32, height: u32
         _ => GBufferTargets::new(cx, width, height),
     };
     cx.gbuffer_targets = Some(targets.clone());
-    cx.scoped("the G-buffer pass", |cx| {
+    cx.scoped(during, |cx| {
         let clip_from_world = frame.camera.clip_from_world(width as f32 / height as f32);
         let view = ViewRaw::new(clip_from_world, frame.camera.eye, width, height);
         cx.queue.write_buffer(&targets.view, 0, bytemuck::bytes_of(&view));
@@ -149,9 +254,8 @@ pub fn render(cx: &mut WgpuContext, frame: &FrameInputs, width: u32, height: u32
                 multiview_mask: None,
             });
             pass.push_debug_group("gbuffer");
-            pass.set_pipeline(&cx.shared.gbuffer);
             pass.set_bind_group(0, &frame_group, &[]);
-            draw_instances(cx, &mut pass, frame, |_| true, true);
+            draw(cx, &mut pass);
             pass.pop_debug_group();
         }
         cx.submit(enc);

@@ -21,7 +21,7 @@ pub mod upload;
 
 pub use context::{AdapterChoice, AdapterSummary, WgpuBackend, WgpuContext, WgpuError, list_adapters};
 pub use frame::{GpuVisibility, WgpuFrame, render_frame};
-pub use gbuffer::GpuGBuffer;
+pub use gbuffer::{GpuGBuffer, HostSurfaces};
 pub use record::{ColorTarget, FrameRecorder};
 pub use resources::{Created, Transient};
 pub use timer::FrameTimer;

@@ -348,12 +348,22 @@ pub fn full_screen_pipeline<'a>(
     format: Option<wgpu::TextureFormat>,
     depth_stencil: Option<wgpu::DepthStencilState>,
 ) -> wgpu::RenderPipeline {
-    let groups: Vec<Option<&wgpu::BindGroupLayout>> = groups.iter().map(|g| Some(*g)).collect();
-    let fragment = fragment.into();
     let targets: Vec<_> = format
         .map(|format| Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL }))
         .into_iter()
         .collect();
+    full_screen_pipeline_to(device, (label, module, fragment.into()), groups, &targets, depth_stencil)
+}
+
+/// [`full_screen_pipeline`] into any colour targets: `(label, module, fragment entry)`.
+pub fn full_screen_pipeline_to(
+    device: &wgpu::Device,
+    (label, module, fragment): (&str, &wgpu::ShaderModule, FragmentEntry<'_>),
+    groups: &[&wgpu::BindGroupLayout],
+    targets: &[Option<wgpu::ColorTargetState>],
+    depth_stencil: Option<wgpu::DepthStencilState>,
+) -> wgpu::RenderPipeline {
+    let groups: Vec<Option<&wgpu::BindGroupLayout>> = groups.iter().map(|g| Some(*g)).collect();
     let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some(label),
         bind_group_layouts: &groups,
@@ -378,7 +388,7 @@ pub fn full_screen_pipeline<'a>(
                 constants: fragment.constants,
                 ..Default::default()
             },
-            targets: &targets,
+            targets,
         }),
         multiview_mask: None,
         cache: None,

@@ -4,6 +4,9 @@
 //! sRGB or not, RGBA or BGRA). The techniques' counters and the phase clock are off
 //! ([`WgpuContext::instrumented`]).
 //!
+//! An engine that renders its own depth and normals and shades itself lends them in place of the G-buffer
+//! pass ([`FrameRecorder::record_visibility`]) and reads each light's visibility.
+//!
 //! A technique that needs the GPU's results within the frame (one reconstructing on the CPU from a map
 //! it reads back, or drawing in rectangles read back from the GPU) fails here with
 //! [`WgpuError::NotRecordable`].
@@ -15,8 +18,8 @@ use shadow_core::technique::FrameStats;
 use shadow_core::{FrameInputs, LightView};
 
 use crate::context::{WgpuBackend, WgpuContext, WgpuError};
-use crate::frame::{GpuVisibility, MAX_LIGHTS, clear_lit, full_screen_shade, layer_view, layered, shade_group};
-use crate::gbuffer::{self, GpuGBuffer};
+use crate::frame::{GpuVisibility, check_lights, clear_lit, full_screen_shade, layer_view, layered, shade_group};
+use crate::gbuffer::{self, GpuGBuffer, HostSurfaces, ImportPass};
 use crate::pipelines::{VISIBILITY, full_screen_pipeline};
 
 /// Records frames into a host's encoder, keeping what it made for them: the visibility targets (remade
@@ -26,6 +29,8 @@ use crate::pipelines::{VISIBILITY, full_screen_pipeline};
 pub struct FrameRecorder {
     visibility: Option<Visibility>,
     shade: HashMap<wgpu::TextureFormat, wgpu::RenderPipeline>,
+    /// The pass that makes the G-buffer from a host's surfaces, once one lends them.
+    import: Option<ImportPass>,
 }
 
 /// Every light's visibility, a layer each of one R32Float array texture (1 lit, 0 shadowed).
@@ -72,15 +77,36 @@ impl FrameRecorder {
         techniques: impl Into<LightTechniques<'t, 'o, WgpuBackend>>,
         target: &ColorTarget<'_>,
     ) -> Result<Vec<LightView>, WgpuError> {
-        let most = MAX_LIGHTS.min(cx.device.limits().max_texture_array_layers as usize);
-        if frame.lights.len() > most {
-            return Err(WgpuError::TooManyLights { lights: frame.lights.len(), most });
-        }
+        check_lights(cx, frame)?;
         let visibility =
             visibility_for(&mut self.visibility, cx, target.width, target.height, frame.lights.len() as u32);
         let shade = self.shade.entry(target.format).or_insert_with(|| shade_pipeline(cx, target.format));
         let (width, height) = (target.width, target.height);
-        let steps = RecordSteps { width, height, visibility, shade, target: target.view };
+        let steps = RecordSteps { width, height, visibility, host: None, shade: Some((shade, target.view)) };
+        let FrameRun { light_views, .. } = cx.record_into(encoder, |cx| run_frame(cx, frame, steps, techniques))?;
+        Ok(light_views)
+    }
+
+    /// Records one frame's shadows into `encoder` for an engine that renders its own depth and normals
+    /// and shades itself: the G-buffer made from `host`'s surfaces in place of its pass, every light's
+    /// build and query, and no shading; each light's visibility is then in [`Self::visibility`].
+    /// Returns the fitted view of each light.
+    ///
+    /// # Errors
+    /// As [`Self::record`].
+    pub fn record_visibility<'t, 'o: 't>(
+        &mut self,
+        cx: &mut WgpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        frame: &FrameInputs,
+        techniques: impl Into<LightTechniques<'t, 'o, WgpuBackend>>,
+        host: &HostSurfaces<'_>,
+    ) -> Result<Vec<LightView>, WgpuError> {
+        check_lights(cx, frame)?;
+        let visibility = visibility_for(&mut self.visibility, cx, host.width, host.height, frame.lights.len() as u32);
+        let import = self.import.get_or_insert_with(|| ImportPass::new(cx));
+        let (width, height) = (host.width, host.height);
+        let steps = RecordSteps { width, height, visibility, host: Some((host, import)), shade: None };
         let FrameRun { light_views, .. } = cx.record_into(encoder, |cx| run_frame(cx, frame, steps, techniques))?;
         Ok(light_views)
     }
@@ -124,13 +150,14 @@ fn shade_pipeline(cx: &WgpuContext, format: wgpu::TextureFormat) -> wgpu::Render
     full_screen_pipeline(&cx.device, "recorded shade", &module, entry, &groups, Some(format), None)
 }
 
-/// The recording steps: the frame's targets and the host's.
+/// The recording steps: the frame's targets, the host's surfaces in place of the G-buffer pass when it
+/// lends them, and the shading pipeline with the host's colour target when it shades into one.
 struct RecordSteps<'a> {
     width: u32,
     height: u32,
     visibility: &'a wgpu::Texture,
-    shade: &'a wgpu::RenderPipeline,
-    target: &'a wgpu::TextureView,
+    host: Option<(&'a HostSurfaces<'a>, &'a ImportPass)>,
+    shade: Option<(&'a wgpu::RenderPipeline, &'a wgpu::TextureView)>,
 }
 
 impl FrameSteps<WgpuBackend> for RecordSteps<'_> {
@@ -138,7 +165,10 @@ impl FrameSteps<WgpuBackend> for RecordSteps<'_> {
     type Output = ();
 
     fn gbuffer(&mut self, cx: &mut WgpuContext, frame: &FrameInputs) -> Result<GpuGBuffer, WgpuError> {
-        gbuffer::render(cx, frame, self.width, self.height)
+        match self.host {
+            Some((host, import)) => gbuffer::import(cx, frame, host, import),
+            None => gbuffer::render(cx, frame, self.width, self.height),
+        }
     }
 
     fn visibility(&mut self, _cx: &mut WgpuContext, k: usize) -> Result<GpuVisibility, WgpuError> {
@@ -153,10 +183,11 @@ impl FrameSteps<WgpuBackend> for RecordSteps<'_> {
     }
 
     fn shade(&mut self, cx: &mut WgpuContext, frame: &FrameInputs, g: &GpuGBuffer) -> Result<(), WgpuError> {
+        let Some((pipeline, target)) = self.shade else { return Ok(()) };
         cx.scoped("the recorded shading pass", |cx| {
             let group = shade_group(cx, frame, g, self.visibility);
             let mut enc = cx.encoder("shade");
-            full_screen_shade(&mut enc, self.target, self.shade, g, &group, None);
+            full_screen_shade(&mut enc, target, pipeline, g, &group, None);
             cx.submit(enc);
         })
     }

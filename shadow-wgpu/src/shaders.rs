@@ -30,6 +30,12 @@ pub fn gbuffer() -> String {
     with_common(include_str!("shaders/gbuffer.wgsl"))
 }
 
+/// The G-buffer from a host's depth and normals.
+#[must_use]
+pub fn import() -> String {
+    with_common(include_str!("shaders/import.wgsl"))
+}
+
 /// Shading pass.
 #[must_use]
 pub fn shade() -> String {
@@ -67,6 +73,7 @@ pub fn extrusion() -> String {
 pub fn all() -> Vec<(&'static str, String)> {
     vec![
         ("gbuffer", gbuffer()),
+        ("import", import()),
         ("shade", shade()),
         ("shadow_map", shadow_map()),
         ("shadow_volume", shadow_volume()),

@@ -1,7 +1,8 @@
 //! shadowlab on the host application's own device: a device and queue the application made, with
 //! WebGPU's default limits and only the feature shadowlab requires, render every technique as shadowlab's
-//! own device does; a device without that feature is refused with what it lacks. Without a wgpu adapter
-//! these print one line and pass, unless SHADOWLAB_REQUIRE_GPU=1.
+//! own device does; a device without that feature is refused with what it lacks. An engine's own depth
+//! and normals stand in for the G-buffer; timed frames report their GPU time a few frames later. Without
+//! a wgpu adapter these print one line and pass, unless SHADOWLAB_REQUIRE_GPU=1.
 
 use shadow_core::FrameInputs;
 use shadow_core::scenes::{self, SceneParams};
@@ -118,4 +119,42 @@ fn timed_realtime_frames_report_their_gpu_time_frames_later() {
     assert_eq!(&times[..2], &[None, None], "a time before its frame was read back");
     assert!(times[2].is_some_and(|ms| ms > 0.0 && ms < 60_000.0), "frame 1's GPU time: {:?}", times[2]);
     assert!(!shadows.time_frames(false) && shadows.gpu_ms().is_none(), "still timing");
+}
+
+#[test]
+fn an_engines_own_depth_and_normals_stand_in_for_the_gbuffer() {
+    let Some(mut renderer) = crate::with_wgpu("host surfaces") else { return };
+    let name = renderer.adapter().expect("an adapter").name.clone();
+    let (adapter, device, queue) = host_device(&name, WgpuContext::REQUIRED_FEATURES);
+    let s = scenes::build("cubes", &SceneParams::default()).expect("scene");
+    let frame = FrameInputs::from_first_camera(&s).expect("frame");
+    let (w, h) = (160, 120);
+    // The engine's depth and normals: here, a G-buffer drawn on a context of the engine's own.
+    let mut engine = WgpuContext::from_host(&adapter, device.clone(), queue.clone()).expect("a context");
+    let surfaces = shadow_wgpu::gbuffer::render(&mut engine, &frame, w, h).expect("the engine's surfaces");
+    let depth = surfaces
+        .depth
+        .create_view(&wgpu::TextureViewDescriptor { aspect: wgpu::TextureAspect::DepthOnly, ..Default::default() });
+    let host = shadow_wgpu::HostSurfaces { depth: &depth, normals: &surfaces.normal, width: w, height: h };
+    let mut cx = WgpuContext::from_host(&adapter, device.clone(), queue.clone()).expect("a context");
+    let registry = TechniqueRegistry::builtin();
+    let mut recorder = shadow_wgpu::FrameRecorder::new();
+    for (spec, most) in
+        [("shadow-volume-zfail", 0.0), ("silhouette-map", 0.001), ("shadow-map", 0.001), ("pcss", 0.001)]
+    {
+        let spec = TechniqueSpec::parse(spec).expect("spec");
+        let mut technique = registry.wgpu(&spec).expect("technique");
+        let mut encoder = device.create_command_encoder(&Default::default());
+        recorder.record_visibility(&mut cx, &mut encoder, &frame, technique.as_mut(), &host).expect("recorded");
+        queue.submit([encoder.finish()]);
+        let layers = recorder.visibility().expect("visibility");
+        let vis = shadow_wgpu::readback::read_f32(&cx, layers, 0, wgpu::TextureAspect::All).expect("read back");
+        let own = renderer.run(BackendKind::Wgpu, &frame, w, h, &spec).expect("own frame");
+        let differ = vis.data().iter().zip(own.visibility[0].data()).filter(|(a, b)| (*a - *b).abs() > 0.01).count();
+        let share = differ as f64 / vis.data().len() as f64;
+        assert!(own.visibility[0].data().contains(&0.0), "{spec}: nothing in shadow");
+        // Positions found from the depth differ from the rasterized ones by rounding, which moves a map's
+        // depth test at the odd pixel; volumes count against the very same depth.
+        assert!(share <= most, "{spec}: {differ} pixels ({:.3}%) differ from the G-buffer's", share * 100.0);
+    }
 }
