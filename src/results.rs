@@ -1,8 +1,9 @@
 //! `shadowlab results`: measures every technique on every built-in scene and writes `docs/results.md`,
 //! so each number there comes from one command on a named machine and adapter.
 //!
-//! Three parts: the error of each technique against its reference on each scene (both backends), the
-//! largest disagreement between the backends, and the frame time per phase on one scene (`bench`).
+//! Four parts: the error of each technique against its reference on each scene (both backends), the
+//! largest disagreement between the backends, the frame time per phase on one scene (`bench`), and on a
+//! GPU adapter the real-time path on that scene (`bench --realtime`).
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -10,6 +11,7 @@ use std::fmt::Write as _;
 use shadow_core::FrameInputs;
 use shadow_core::scenes::{self, SceneParams};
 
+use crate::bench::realtime::{RealtimeReport, run_realtime_bench};
 use crate::bench::{BenchJob, BenchReport, run_bench};
 use crate::compare::{CompareJob, CompareReport, references_for, run_compare};
 use crate::renderer::{BackendKind, Renderer};
@@ -90,10 +92,22 @@ pub fn run_results(renderer: &mut Renderer, job: &ResultsJob, mut progress: impl
         backends: job.backends.clone(),
     };
     let timing = run_bench(renderer, &bench, |m| progress(&format!("{}: {m}", job.bench_scene)))?;
-    Ok(markdown(renderer, job, &reports, &timing))
+    // The real-time path where there is a GPU adapter: the same frames recorded, two in flight.
+    let realtime = if job.backends.contains(&BackendKind::Wgpu) {
+        let realtime = BenchJob { backends: vec![BackendKind::Wgpu], ..bench };
+        Some(run_realtime_bench(renderer, &realtime, |m| progress(&format!("{} real-time: {m}", job.bench_scene)))?)
+    } else {
+        None
+    };
+    Ok(markdown(renderer, job, &reports, (&timing, realtime.as_ref())))
 }
 
-fn markdown(renderer: &Renderer, job: &ResultsJob, reports: &[CompareReport], timing: &BenchReport) -> String {
+fn markdown(
+    renderer: &Renderer,
+    job: &ResultsJob,
+    reports: &[CompareReport],
+    (timing, realtime): (&BenchReport, Option<&RealtimeReport>),
+) -> String {
     let adapter = renderer.adapter().map_or_else(
         || "none (CPU backend only)".to_string(),
         |a| {
@@ -115,7 +129,42 @@ fn markdown(renderer: &Renderer, job: &ResultsJob, reports: &[CompareReport], ti
     errors_table(&mut s, renderer.registry(), job, reports);
     cross_table(&mut s, reports);
     timing_table(&mut s, timing);
+    if let Some(r) = realtime {
+        realtime_table(&mut s, r);
+    }
     s
+}
+
+/// The real-time path against the instrumented frames of the same run.
+fn realtime_table(s: &mut String, r: &RealtimeReport) {
+    let _ = writeln!(s, "\n## Real-time path\n");
+    let _ = writeln!(
+        s,
+        "`{}` at {}x{}, {} frames with the light turning, recorded into an encoder of the bench's own with {} \
+         in flight, no counters and no read-backs (`shadowlab bench --realtime`). Wall time per frame, its ratio \
+         to the instrumented frame's median above, the host's time to record a frame (median), and the GPU's \
+         own time per frame where the adapter has timestamp queries (median), in ms.\n",
+        r.scene, r.width, r.height, r.frames, r.in_flight
+    );
+    let _ = writeln!(s, "| technique | real-time | ratio | record (CPU) | GPU |\n|---|---:|---:|---:|---:|");
+    for e in &r.results {
+        match (&e.refused, e.frame_ms, e.ratio) {
+            (None, Some(f), Some(ratio)) => {
+                let median = |st: Option<&crate::bench::Stat>| st.map_or("-".into(), |st| format!("{:.2}", st.median));
+                let _ = writeln!(
+                    s,
+                    "| {} | {f:.1} | {ratio:.2} | {} | {} |",
+                    e.technique,
+                    median(e.record_ms.as_ref()),
+                    median(e.gpu_ms.as_ref())
+                );
+            }
+            _ => {
+                let why = e.refused.as_deref().unwrap_or("not measured");
+                let _ = writeln!(s, "| {} | refused: {why} | | | |", e.technique);
+            }
+        }
+    }
 }
 
 /// One row per technique and backend, one column per scene.
