@@ -181,6 +181,9 @@ pub struct WgpuContext {
     pub(crate) gbuffer_targets: Option<crate::gbuffer::GBufferTargets>,
     /// What it has made, and the frame's transient buffer.
     pub(crate) resources: crate::resources::Resources,
+    /// The format of the G-buffer's depth and the volumes' stencil: Depth32FloatStencil8 where the
+    /// device has it, Depth24PlusStencil8 otherwise.
+    pub depth_stencil: wgpu::TextureFormat,
 }
 
 /// The instance. Set `XDG_RUNTIME_DIR` (CI does) to keep the Vulkan loader quiet on headless machines.
@@ -212,9 +215,6 @@ fn rank(info: &wgpu::AdapterInfo) -> u8 {
 /// and the float and integer formats of the G-buffer and the techniques' targets as render attachments
 /// (an OpenGL adapter such as llvmpipe's cannot render to Rgba32Float).
 fn missing(adapter: &wgpu::Adapter) -> Option<String> {
-    if !adapter.features().contains(wgpu::Features::DEPTH32FLOAT_STENCIL8) {
-        return Some("the Depth32FloatStencil8 format".into());
-    }
     use wgpu::TextureFormat as F;
     [F::Rgba32Float, F::Rg32Float, F::R32Float, F::R32Uint, F::Rgba8Unorm]
         .into_iter()
@@ -320,12 +320,14 @@ impl WgpuContext {
         Ok(Self::on_device(&adapter, device, queue, lost))
     }
 
-    /// The features a device must have: shadow volumes and maps share one depth-stencil format,
-    /// Depth32FloatStencil8 (the stencil counts, the depth is the G-buffer's own f32 depth).
-    pub const REQUIRED_FEATURES: wgpu::Features = wgpu::Features::DEPTH32FLOAT_STENCIL8;
+    /// The features a device must have: none beyond WebGPU's core.
+    pub const REQUIRED_FEATURES: wgpu::Features = wgpu::Features::empty();
 
-    /// The features used where the device has them: timestamp queries, for GPU phase times.
-    pub const OPTIONAL_FEATURES: wgpu::Features = wgpu::Features::TIMESTAMP_QUERY;
+    /// The features used where the device has them: Depth32FloatStencil8 for the G-buffer's depth and
+    /// the volumes' stencil (an f32 depth, as the CPU backend's; without it Depth24PlusStencil8, which
+    /// every device has), and timestamp queries, for GPU phase times.
+    pub const OPTIONAL_FEATURES: wgpu::Features =
+        wgpu::Features::DEPTH32FLOAT_STENCIL8.union(wgpu::Features::TIMESTAMP_QUERY);
 
     /// The limits a device must meet: WebGPU's defaults, but for 64 bytes of colour attachments per
     /// sample (the G-buffer pass writes four 16-byte targets at once). Larger maps and views, more lights
@@ -344,7 +346,8 @@ impl WgpuContext {
     }
 
     /// The device a host application asks for to lend it to shadowlab: [`Self::REQUIRED_FEATURES`] and
-    /// [`Self::required_limits`] (a host may ask for more).
+    /// [`Self::required_limits`] (a host may ask for more: those of [`Self::OPTIONAL_FEATURES`] its adapter
+    /// has are used).
     #[must_use]
     pub fn device_descriptor() -> wgpu::DeviceDescriptor<'static> {
         wgpu::DeviceDescriptor {
@@ -366,8 +369,9 @@ impl WgpuContext {
     pub fn from_host(adapter: &wgpu::Adapter, device: wgpu::Device, queue: wgpu::Queue) -> Result<Self, WgpuError> {
         let info = adapter.get_info();
         let mut lacks = Vec::new();
-        if !device.features().contains(Self::REQUIRED_FEATURES) {
-            lacks.push("the device feature DEPTH32FLOAT_STENCIL8".to_string());
+        let features = Self::REQUIRED_FEATURES - device.features();
+        if !features.is_empty() {
+            lacks.push(format!("the device features {features:?}"));
         }
         Self::required_limits().check_limits_with_fail_fn(&device.limits(), false, |name, needed, has| {
             lacks.push(format!("the device limit {name} of {needed} (it has {has})"));
@@ -386,7 +390,13 @@ impl WgpuContext {
         queue: wgpu::Queue,
         lost: Arc<Mutex<Option<String>>>,
     ) -> Self {
-        let shared = crate::pipelines::Shared::new(&device);
+        // The G-buffer's depth and the volumes' stencil: f32 depth where the device has it.
+        let depth_stencil = if device.features().contains(wgpu::Features::DEPTH32FLOAT_STENCIL8) {
+            wgpu::TextureFormat::Depth32FloatStencil8
+        } else {
+            wgpu::TextureFormat::Depth24PlusStencil8
+        };
+        let shared = crate::pipelines::Shared::new(&device, depth_stencil);
         Self {
             adapter: AdapterSummary::of(&adapter.get_info()),
             timestamps: device.features().contains(wgpu::Features::TIMESTAMP_QUERY),
@@ -400,6 +410,7 @@ impl WgpuContext {
             recording: Cell::new(false),
             gbuffer_targets: None,
             resources: Default::default(),
+            depth_stencil,
         }
     }
 

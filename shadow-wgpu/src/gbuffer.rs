@@ -1,11 +1,11 @@
-//! The camera G-buffer on the GPU: Depth32FloatStencil8 plus world position (w: receives shadow),
+//! The camera G-buffer on the GPU: the context's depth-stencil format plus world position (w: receives shadow),
 //! shading normal and albedo (w: covered), all f32 so shading matches the CPU's.
 
 use shadow_core::FrameInputs;
 use shadow_core::scene::Camera;
 
 use crate::context::{WgpuContext, WgpuError};
-use crate::pipelines::{ATTRIBUTE, DEPTH_STENCIL, ViewRaw};
+use crate::pipelines::{ATTRIBUTE, ViewRaw};
 
 /// The camera view of a frame, on the GPU.
 pub struct GpuGBuffer {
@@ -88,7 +88,7 @@ impl GBufferTargets {
         Self {
             width,
             height,
-            depth: target(cx, "depth", width, height, DEPTH_STENCIL),
+            depth: target(cx, "depth", width, height, cx.depth_stencil),
             attributes: ["position", "normal", "albedo", "geometric normal"]
                 .map(|l| target(cx, l, width, height, ATTRIBUTE).create_view(&Default::default())),
             view: cx.create_buffer(&wgpu::BufferDescriptor {
@@ -117,7 +117,9 @@ pub fn render(cx: &mut WgpuContext, frame: &FrameInputs, width: u32, height: u32
 ///
 /// Shadow volumes count against this depth: their near caps lie on the surfaces exactly only where the
 /// engine rasterized with shadowlab's transform (`clip_from_world * world_from_local`, as its G-buffer
-/// does); elsewhere a lit surface facing the light may count its own cap.
+/// does) and the depth is kept as f32 on both sides (Depth32FloatStencil8 on shadowlab's context: a
+/// 24-bit depth read and written again may come back a unit off); elsewhere a lit surface facing the
+/// light may count its own cap.
 pub struct HostSurfaces<'a> {
     /// The camera's depth as the frame's camera projects it, 1 where nothing was drawn: a view of a
     /// `Depth32Float` texture, or the depth aspect of a depth-stencil one.
@@ -153,7 +155,7 @@ impl ImportPass {
         let target =
             Some(wgpu::ColorTargetState { format: ATTRIBUTE, blend: None, write_mask: wgpu::ColorWrites::ALL });
         let depth = wgpu::DepthStencilState {
-            format: DEPTH_STENCIL,
+            format: cx.depth_stencil,
             depth_write_enabled: Some(true),
             depth_compare: Some(wgpu::CompareFunction::Always),
             stencil: Default::default(),

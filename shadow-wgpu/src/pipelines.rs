@@ -7,8 +7,6 @@ use shadow_core::scene::{Light, LightKind};
 
 use crate::shaders;
 
-/// The camera's depth and stencil.
-pub const DEPTH_STENCIL: wgpu::TextureFormat = wgpu::TextureFormat::Depth32FloatStencil8;
 /// Light-space depth maps.
 pub const MAP_DEPTH: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 /// G-buffer attributes.
@@ -157,7 +155,7 @@ pub struct Shared {
 impl Shared {
     /// Creates the shared pipelines.
     #[must_use]
-    pub fn new(device: &wgpu::Device) -> Self {
+    pub fn new(device: &wgpu::Device, depth_stencil: wgpu::TextureFormat) -> Self {
         let all = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
         let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("frame"),
@@ -185,7 +183,7 @@ impl Shared {
             },
             primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
             depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_STENCIL,
+                format: depth_stencil,
                 depth_write_enabled: Some(true),
                 depth_compare: Some(wgpu::CompareFunction::Less),
                 stencil: Default::default(),

@@ -81,7 +81,7 @@ use shadow_wgpu::passes::volumes::{
     VolumeDraw, count_all_pipeline, counting_state, upload_draws, upload_volumes, volume_pipeline,
 };
 use shadow_wgpu::pipelines::{
-    DEPTH_STENCIL, FragmentEntry, VISIBILITY, attribute_entry, buffer_entry, float_array_entry, full_screen_pipeline,
+    FragmentEntry, VISIBILITY, attribute_entry, buffer_entry, float_array_entry, full_screen_pipeline,
 };
 use shadow_wgpu::readback;
 use shadow_wgpu::{WgpuBackend, WgpuContext, WgpuError};
@@ -147,12 +147,12 @@ struct Casters {
 /// test "bit 7 set", the depth test `Less`. The depth mask: no stencil test, the depth test turned around
 /// to a passing `GreaterEqual`; outside the mask only fragments at depth 1 (far caps) pass, and what they
 /// count there stays in the low bits, which the answer does not read outside the mask.
-fn volume_state(mask: GpuMask) -> wgpu::DepthStencilState {
+fn volume_state(format: wgpu::TextureFormat, mask: GpuMask) -> wgpu::DepthStencilState {
     let test = match mask {
         GpuMask::Stencil => wgpu::CompareFunction::Equal,
         GpuMask::Depth => wgpu::CompareFunction::Always,
     };
-    let mut state = counting_state(VolumeCounting::ZFail, test, MASK, COUNT);
+    let mut state = counting_state(format, VolumeCounting::ZFail, test, MASK, COUNT);
     if mask == GpuMask::Depth {
         state.depth_compare = Some(wgpu::CompareFunction::GreaterEqual);
         for face in [&mut state.stencil.front, &mut state.stencil.back] {
@@ -164,7 +164,7 @@ fn volume_state(mask: GpuMask) -> wgpu::DepthStencilState {
 }
 
 /// The mask pass's depth-stencil state: sets bit 7 on the pixels it keeps.
-fn mask_state() -> wgpu::DepthStencilState {
+fn mask_state(format: wgpu::TextureFormat) -> wgpu::DepthStencilState {
     let set_mask = wgpu::StencilFaceState {
         compare: wgpu::CompareFunction::Always,
         pass_op: wgpu::StencilOperation::Replace,
@@ -172,7 +172,7 @@ fn mask_state() -> wgpu::DepthStencilState {
     };
     wgpu::DepthStencilState {
         stencil: wgpu::StencilState { front: set_mask, back: set_mask, read_mask: 0, write_mask: MASK },
-        ..stencil_test(wgpu::CompareFunction::Always, 0)
+        ..stencil_test(format, wgpu::CompareFunction::Always, 0)
     }
 }
 
@@ -199,7 +199,7 @@ fn far_pass(cx: &WgpuContext, module: &wgpu::ShaderModule, groups: &[&wgpu::Bind
         depth_stencil: Some(wgpu::DepthStencilState {
             depth_write_enabled: Some(true),
             stencil: wgpu::StencilState { front: outside, back: outside, read_mask: MASK, write_mask: 0 },
-            ..stencil_test(wgpu::CompareFunction::Always, 0)
+            ..stencil_test(cx.depth_stencil, wgpu::CompareFunction::Always, 0)
         }),
         multisample: Default::default(),
         fragment: None,
@@ -216,7 +216,7 @@ fn scratch_target(cx: &WgpuContext, width: u32, height: u32) -> wgpu::Texture {
         mip_level_count: 1,
         sample_count: 1,
         dimension: wgpu::TextureDimension::D2,
-        format: DEPTH_STENCIL,
+        format: cx.depth_stencil,
         usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_DST,
         view_formats: &[],
     })
@@ -229,12 +229,16 @@ struct LastQuery {
     depth: wgpu::Texture,
 }
 
-/// A depth-stencil state that only tests the stencil: `compare` against the reference under `read_mask`,
-/// the depth test off, nothing written.
-fn stencil_test(compare: wgpu::CompareFunction, read_mask: u32) -> wgpu::DepthStencilState {
+/// A depth-stencil state (in `format`) that only tests the stencil: `compare` against the reference under
+/// `read_mask`, the depth test off, nothing written.
+fn stencil_test(
+    format: wgpu::TextureFormat,
+    compare: wgpu::CompareFunction,
+    read_mask: u32,
+) -> wgpu::DepthStencilState {
     let face = wgpu::StencilFaceState { compare, ..Default::default() };
     wgpu::DepthStencilState {
-        format: DEPTH_STENCIL,
+        format,
         depth_write_enabled: Some(false),
         depth_compare: Some(wgpu::CompareFunction::Always),
         stencil: wgpu::StencilState { front: face, back: face, read_mask, write_mask: 0 },
@@ -339,6 +343,12 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
     }
 
     fn create_state(&self, cx: &mut WgpuContext) -> Result<State, WgpuError> {
+        if self.gpu.mask == GpuMask::Depth && cx.depth_stencil != wgpu::TextureFormat::Depth32FloatStencil8 {
+            let message = "gpu_mask=depth copies the G-buffer's depth, which this device keeps as \
+                           Depth24PlusStencil8 (it lacks DEPTH32FLOAT_STENCIL8), a format no copy takes"
+                .to_string();
+            return Err(TechniqueError::BadSettings { technique: Self::NAME.into(), message }.into());
+        }
         let map = DepthMaps::new(cx, &self.depth);
         cx.scoped("creating the hybrid pipelines", |cx| {
             let caster_masks = self.caster_masks.is_on();
@@ -356,17 +366,17 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
                 "fs_hybrid_mask",
                 &groups,
                 None,
-                Some(mask_state()),
+                Some(mask_state(cx.depth_stencil)),
             );
             let far = (gpu_mask == GpuMask::Depth).then(|| far_pass(cx, &module, &groups));
-            let counting = volume_state(gpu_mask);
+            let counting = volume_state(cx.depth_stencil, gpu_mask);
             let volume = |front| volume_pipeline(cx, &volume_module, "vs_volume", front, counting.clone());
             let (volumes_ccw, volumes_cw) = (volume(wgpu::FrontFace::Ccw), volume(wgpu::FrontFace::Cw));
             let count = |state| volume_pipeline(cx, &volume_module, "vs_volume", wgpu::FrontFace::Ccw, state);
-            let count_masked = count(stencil_test(wgpu::CompareFunction::Equal, MASK));
+            let count_masked = count(stencil_test(cx.depth_stencil, wgpu::CompareFunction::Equal, MASK));
             let count_all = count_all_pipeline(cx, &volume_module);
             let answer = |entry, (compare, read_mask, _): (_, u32, u32)| {
-                let state = stencil_test(compare, read_mask);
+                let state = stencil_test(cx.depth_stencil, compare, read_mask);
                 full_screen_pipeline(
                     &cx.device,
                     "hybrid answer",
@@ -515,7 +525,7 @@ fn classes(cx: &WgpuContext, state: &State, last: &LastQuery) -> Result<Image<u3
         let constants = [("CODE", f64::from(class)), ("SHADOWED_CODE", f64::from(PixelClass::VolumeShadowed as u32))];
         let entry = FragmentEntry { name: "fs_hybrid_code", constants: &constants };
         let groups = [&cx.shared.frame_layout, state.bindings.layout()];
-        let depth_stencil = Some(stencil_test(test.0, test.1));
+        let depth_stencil = Some(stencil_test(cx.depth_stencil, test.0, test.1));
         let pipeline = full_screen_pipeline(
             &cx.device,
             "hybrid classes",

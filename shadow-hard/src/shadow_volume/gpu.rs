@@ -63,7 +63,7 @@ impl ShadowTechnique<WgpuBackend> for ShadowVolume {
             let volumes = match extrusion {
                 Extrusion::Gpu => Volumes::Gpu(Box::new(GpuExtrusion::new(cx, counting))),
                 Extrusion::Cpu => {
-                    let state = counting_state(counting, wgpu::CompareFunction::Always, 0xff, 0xff);
+                    let state = counting_state(cx.depth_stencil, counting, wgpu::CompareFunction::Always, 0xff, 0xff);
                     Volumes::Cpu {
                         ccw: volume_pipeline(cx, &module, "vs_volume", wgpu::FrontFace::Ccw, state.clone()),
                         cw: volume_pipeline(cx, &module, "vs_volume", wgpu::FrontFace::Cw, state),

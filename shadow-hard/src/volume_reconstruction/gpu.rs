@@ -27,7 +27,6 @@ use shadow_wgpu::passes::maps::{
     ID_FORMAT, depth_bias, light_id_pipeline, light_pass_pipeline, map_texture, render_maps,
 };
 use shadow_wgpu::passes::volumes::{StencilResolve, count_all, occlusion_query, read_query, volume_pipeline};
-use shadow_wgpu::pipelines::DEPTH_STENCIL;
 use shadow_wgpu::{WgpuBackend, WgpuContext, WgpuError};
 use shadow_wgpu::{readback, shaders};
 
@@ -62,8 +61,8 @@ struct LastView {
     caps: Option<(wgpu::Buffer, u32)>,
 }
 
-/// Bit 0 inverted on every fragment that passes `depth_compare`, both faces.
-fn parity(depth_compare: wgpu::CompareFunction) -> wgpu::DepthStencilState {
+/// Bit 0 inverted on every fragment that passes `depth_compare`, both faces (in `format`).
+fn parity(format: wgpu::TextureFormat, depth_compare: wgpu::CompareFunction) -> wgpu::DepthStencilState {
     let face = wgpu::StencilFaceState {
         compare: wgpu::CompareFunction::Always,
         fail_op: wgpu::StencilOperation::Keep,
@@ -71,7 +70,7 @@ fn parity(depth_compare: wgpu::CompareFunction) -> wgpu::DepthStencilState {
         pass_op: wgpu::StencilOperation::Invert,
     };
     wgpu::DepthStencilState {
-        format: DEPTH_STENCIL,
+        format,
         depth_write_enabled: Some(false),
         depth_compare: Some(depth_compare),
         stencil: wgpu::StencilState { front: face, back: face, read_mask: 1, write_mask: 1 },
@@ -79,8 +78,8 @@ fn parity(depth_compare: wgpu::CompareFunction) -> wgpu::DepthStencilState {
     }
 }
 
-/// Every fragment counted in the stencil (clamped at 255), both faces, the depth test off.
-fn coverage() -> wgpu::DepthStencilState {
+/// Every fragment counted in the stencil (clamped at 255), both faces, the depth test off (in `format`).
+fn coverage(format: wgpu::TextureFormat) -> wgpu::DepthStencilState {
     let face = wgpu::StencilFaceState {
         compare: wgpu::CompareFunction::Always,
         fail_op: wgpu::StencilOperation::Keep,
@@ -89,7 +88,7 @@ fn coverage() -> wgpu::DepthStencilState {
     };
     wgpu::DepthStencilState {
         stencil: wgpu::StencilState { front: face, back: face, read_mask: 0xff, write_mask: 0xff },
-        ..count_all()
+        ..count_all(format)
     }
 }
 
@@ -117,19 +116,19 @@ impl ShadowTechnique<WgpuBackend> for VolumeReconstruction {
         cx.scoped("creating the volume-reconstruction pipelines", |cx| {
             let maps = shaders::module(&cx.device, "shadow_map", shaders::shadow_map());
             let module = shaders::module(&cx.device, "volume_reconstruction", shader());
-            let ccw = wgpu::FrontFace::Ccw;
+            let (ccw, ds) = (wgpu::FrontFace::Ccw, cx.depth_stencil);
             State {
                 light_pass: if self.ids == ObjectIds::Off {
                     light_pass_pipeline(cx, &maps, depth_bias(&self.depth))
                 } else {
                     light_id_pipeline(cx, &maps, depth_bias(&self.depth))
                 },
-                boundary: volume_pipeline(cx, &module, "vs_boundary", ccw, parity(wgpu::CompareFunction::Less)),
-                caps: volume_pipeline(cx, &module, "vs_cap", ccw, parity(wgpu::CompareFunction::Always)),
-                count_boundary: volume_pipeline(cx, &module, "vs_boundary", ccw, count_all()),
-                count_caps: volume_pipeline(cx, &module, "vs_cap", ccw, count_all()),
-                coverage_boundary: volume_pipeline(cx, &module, "vs_boundary", ccw, coverage()),
-                coverage_caps: volume_pipeline(cx, &module, "vs_cap", ccw, coverage()),
+                boundary: volume_pipeline(cx, &module, "vs_boundary", ccw, parity(ds, wgpu::CompareFunction::Less)),
+                caps: volume_pipeline(cx, &module, "vs_cap", ccw, parity(ds, wgpu::CompareFunction::Always)),
+                count_boundary: volume_pipeline(cx, &module, "vs_boundary", ccw, count_all(ds)),
+                count_caps: volume_pipeline(cx, &module, "vs_cap", ccw, count_all(ds)),
+                coverage_boundary: volume_pipeline(cx, &module, "vs_boundary", ccw, coverage(ds)),
+                coverage_caps: volume_pipeline(cx, &module, "vs_cap", ccw, coverage(ds)),
                 resolve: StencilResolve::new(cx, &module, 1),
                 maps: None,
                 ids: None,
@@ -259,7 +258,7 @@ fn coverage_counts(cx: &WgpuContext, state: &State, last: &LastView) -> Result<s
         mip_level_count: 1,
         sample_count: 1,
         dimension: wgpu::TextureDimension::D2,
-        format: DEPTH_STENCIL,
+        format: cx.depth_stencil,
         usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
         view_formats: &[],
     });

@@ -111,10 +111,10 @@ impl GpuExtrusion {
         let draw_layout = layout(cx, "extruded volumes", wgpu::ShaderStages::VERTEX, &DRAW_BINDINGS);
         let compute = |entry| compute_pipeline(cx, &module, &compute_layout, entry);
         let draw = |entry, front, state| draw_pipeline(cx, &module, &draw_layout, entry, front, state);
-        let state = counting_state(counting, wgpu::CompareFunction::Always, 0xff, 0xff);
+        let state = counting_state(cx.depth_stencil, counting, wgpu::CompareFunction::Always, 0xff, 0xff);
         let counting = STAGES
             .map(|entry| [wgpu::FrontFace::Ccw, wgpu::FrontFace::Cw].map(|front| draw(entry, front, state.clone())));
-        let count_all = STAGES.map(|entry| draw(entry, wgpu::FrontFace::Ccw, count_all()));
+        let count_all = STAGES.map(|entry| draw(entry, wgpu::FrontFace::Ccw, count_all(cx.depth_stencil)));
         Self {
             faces: compute("cs_faces"),
             edges: compute("cs_edges"),

@@ -14,7 +14,7 @@ use shadow_core::technique::FrameStats;
 use crate::context::{WgpuContext, WgpuError};
 use crate::frame::GpuVisibility;
 use crate::gbuffer::GpuGBuffer;
-use crate::pipelines::{DEPTH_STENCIL, POSITION_LAYOUT, VISIBILITY, attribute_entry, full_screen_pipeline};
+use crate::pipelines::{POSITION_LAYOUT, VISIBILITY, attribute_entry, full_screen_pipeline};
 use crate::resources::Transient;
 
 /// One draw of volume geometry: vertices, optional indices, instance, winding.
@@ -29,10 +29,11 @@ pub struct VolumeDraw {
     mesh_vertices: bool,
 }
 
-/// The depth-stencil state of a volume pass counting `counting`'s way with wrapping ops in the bits of
-/// `write_mask`, on the fragments whose stencil passes `test` against the reference under `read_mask`;
-/// the depth test `Less`, no depth writes.
+/// The depth-stencil state (in `format`, the context's `depth_stencil`) of a volume pass counting
+/// `counting`'s way with wrapping ops in the bits of `write_mask`, on the fragments whose stencil passes
+/// `test` against the reference under `read_mask`; the depth test `Less`, no depth writes.
 pub fn counting_state(
+    format: wgpu::TextureFormat,
     counting: VolumeCounting,
     test: wgpu::CompareFunction,
     read_mask: u32,
@@ -46,7 +47,7 @@ pub fn counting_state(
         VolumeCounting::ZFail => (face(Op::Keep, Op::DecrementWrap), face(Op::Keep, Op::IncrementWrap)),
     };
     wgpu::DepthStencilState {
-        format: DEPTH_STENCIL,
+        format,
         depth_write_enabled: Some(false),
         depth_compare: Some(wgpu::CompareFunction::Less),
         stencil: wgpu::StencilState { front, back, read_mask, write_mask },
@@ -54,10 +55,11 @@ pub fn counting_state(
     }
 }
 
-/// Every fragment passes, nothing written: for counting what a pass rasterizes (occlusion queries).
-pub fn count_all() -> wgpu::DepthStencilState {
+/// Every fragment passes, nothing written (in `format`, the context's `depth_stencil`): for counting what
+/// a pass rasterizes (occlusion queries).
+pub fn count_all(format: wgpu::TextureFormat) -> wgpu::DepthStencilState {
     wgpu::DepthStencilState {
-        format: DEPTH_STENCIL,
+        format,
         depth_write_enabled: Some(false),
         depth_compare: Some(wgpu::CompareFunction::Always),
         stencil: Default::default(),
@@ -67,7 +69,7 @@ pub fn count_all() -> wgpu::DepthStencilState {
 
 /// The volumes' whole fill: [`count_all`] over the volume vertices (both faces; it does not cull).
 pub fn count_all_pipeline(cx: &WgpuContext, module: &wgpu::ShaderModule) -> wgpu::RenderPipeline {
-    volume_pipeline(cx, module, "vs_volume", wgpu::FrontFace::Ccw, count_all())
+    volume_pipeline(cx, module, "vs_volume", wgpu::FrontFace::Ccw, count_all(cx.depth_stencil))
 }
 
 /// A stencil-only pipeline drawing homogeneous points through `entry` (both faces).
@@ -143,7 +145,7 @@ impl StencilResolve {
         });
         let test = wgpu::StencilFaceState { compare: wgpu::CompareFunction::NotEqual, ..Default::default() };
         let state = wgpu::DepthStencilState {
-            format: DEPTH_STENCIL,
+            format: cx.depth_stencil,
             depth_write_enabled: Some(false),
             depth_compare: Some(wgpu::CompareFunction::Always),
             stencil: wgpu::StencilState { front: test, back: test, read_mask, write_mask: 0 },
