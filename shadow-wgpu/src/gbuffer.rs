@@ -71,8 +71,8 @@ fn target(cx: &WgpuContext, label: &str, w: u32, h: u32, format: wgpu::TextureFo
     })
 }
 
-/// The G-buffer's targets and its camera's uniform buffer, kept from frame to frame while the view's size
-/// stays: a frame then allocates none of them.
+/// The G-buffer's targets, kept from frame to frame while the view's size stays: a frame then allocates
+/// none of them.
 #[derive(Clone)]
 pub(crate) struct GBufferTargets {
     width: u32,
@@ -80,7 +80,6 @@ pub(crate) struct GBufferTargets {
     depth: wgpu::Texture,
     /// Position, normal, albedo, geometric normal.
     attributes: [wgpu::TextureView; 4],
-    view: wgpu::Buffer,
 }
 
 impl GBufferTargets {
@@ -91,12 +90,6 @@ impl GBufferTargets {
             depth: target(cx, "depth", width, height, cx.depth_stencil),
             attributes: ["position", "normal", "albedo", "geometric normal"]
                 .map(|l| target(cx, l, width, height, ATTRIBUTE).create_view(&Default::default())),
-            view: cx.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("camera view"),
-                size: std::mem::size_of::<ViewRaw>() as u64,
-                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            }),
         }
     }
 }
@@ -226,8 +219,7 @@ fn fill(
     cx.scoped(during, |cx| {
         let clip_from_world = frame.camera.clip_from_world(width as f32 / height as f32);
         let view = ViewRaw::new(clip_from_world, frame.camera.eye, width, height);
-        cx.queue.write_buffer(&targets.view, 0, bytemuck::bytes_of(&view));
-        let frame_group = cx.shared.frame_group_with(&cx.device, &targets.view, &instances);
+        let frame_group = cx.shared.frame_group(cx, &view, &instances);
         let GBufferTargets { depth, attributes: [position, normal, albedo, geometric_normal], .. } = targets;
         let depth_view = depth.create_view(&Default::default());
         let mut enc = cx.encoder("gbuffer");

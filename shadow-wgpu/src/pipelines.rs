@@ -243,17 +243,6 @@ impl Shared {
         self.frame_group_over(&cx.device, view.binding(), instances)
     }
 
-    /// The same group over a uniform buffer of the caller's holding the view.
-    #[must_use]
-    pub fn frame_group_with(
-        &self,
-        device: &wgpu::Device,
-        view: &wgpu::Buffer,
-        instances: &wgpu::Buffer,
-    ) -> wgpu::BindGroup {
-        self.frame_group_over(device, view.as_entire_binding(), instances)
-    }
-
     fn frame_group_over(
         &self,
         device: &wgpu::Device,

@@ -6,9 +6,9 @@
 //! Data the GPU reads in one frame only (a light view's uniform, a map query's parameters, the segments
 //! a pass draws) goes into [`Transient`] slices of one buffer the context keeps, at offsets handed out in
 //! order since the frame began. A frame recorded into one command buffer sees all its writes land before
-//! its first command, so each piece needs a place of its own; the next frame starts over at offset 0
-//! (its writes are queued after the last frame's submission, so they cannot overtake it). The buffer is
-//! made again, twice as large, only when a frame needs more than it holds.
+//! its first command, so each piece needs a place of its own. Consecutive frames write different buffers,
+//! a few in turn, so a frame's writes do not wait for the frames still in flight to finish reading. The
+//! buffers are made again, twice as large, only when a frame needs more than one holds.
 
 use std::cell::{Cell, RefCell};
 
@@ -30,10 +30,13 @@ pub(crate) struct Resources {
     transient: RefCell<Arena>,
 }
 
-/// The transient buffer and how much of it this frame has used.
+/// The transient buffers, [`FRAMES`] of `size` bytes used in turn, the frame under way and how much of
+/// its buffer it has used.
 #[derive(Default)]
 struct Arena {
-    buffer: Option<wgpu::Buffer>,
+    buffers: Vec<wgpu::Buffer>,
+    size: u64,
+    frame: u64,
     used: u64,
 }
 
@@ -65,6 +68,11 @@ impl Transient {
 
 /// The smallest transient buffer: room for every uniform of a frame of a few lights without growing.
 const MIN_TRANSIENT: u64 = 1 << 16;
+
+/// Frames whose transient data may be in use at once: each writes a buffer of its own, so a frame's
+/// writes never land in a buffer a frame still on the GPU reads (the copy would wait for that frame to
+/// finish: the GPU tracks a buffer's use whole, not by range).
+const FRAMES: usize = 3;
 
 // The one place wgpu's creation calls are made.
 #[allow(clippy::disallowed_methods)]
@@ -117,7 +125,9 @@ impl WgpuContext {
 
     /// Starts a frame's transient data over at the start of the buffer.
     pub(crate) fn begin_transient(&self) {
-        self.resources.transient.borrow_mut().used = 0;
+        let mut arena = self.resources.transient.borrow_mut();
+        arena.frame += 1;
+        arena.used = 0;
     }
 
     /// `bytes` in a slice of the transient buffer of its own for this frame (see the module notes), to
@@ -130,26 +140,23 @@ impl WgpuContext {
         // Bindings and writes are whole words; an empty storage binding is not allowed.
         let size = (bytes.len() as u64).max(4).next_multiple_of(4);
         let mut arena = self.resources.transient.borrow_mut();
-        let offset = arena.used.next_multiple_of(align);
-        let fits = arena.buffer.as_ref().is_some_and(|b| offset + size <= b.size());
-        let offset = if fits {
-            offset
+        let local = arena.used.next_multiple_of(align);
+        let offset = if !arena.buffers.is_empty() && local + size <= arena.size {
+            local
         } else {
-            let capacity = (2 * (offset + size)).max(MIN_TRANSIENT).min(limits.max_buffer_size);
-            arena.buffer = Some(self.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("transient"),
-                size: capacity,
-                usage: wgpu::BufferUsages::UNIFORM
-                    | wgpu::BufferUsages::STORAGE
-                    | wgpu::BufferUsages::VERTEX
-                    | wgpu::BufferUsages::INDEX
-                    | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            }));
+            arena.size = (2 * (local + size)).max(MIN_TRANSIENT).min(limits.max_buffer_size);
+            let usage = wgpu::BufferUsages::UNIFORM
+                | wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::VERTEX
+                | wgpu::BufferUsages::INDEX
+                | wgpu::BufferUsages::COPY_DST;
+            let desc =
+                wgpu::BufferDescriptor { label: Some("transient"), size: arena.size, usage, mapped_at_creation: false };
+            arena.buffers = (0..FRAMES).map(|_| self.create_buffer(&desc)).collect();
             0
         };
         arena.used = offset + size;
-        let Some(buffer) = arena.buffer.clone() else { unreachable!("made above") };
+        let buffer = arena.buffers[arena.frame as usize % FRAMES].clone();
         let mut padded = bytes.to_vec();
         padded.resize(size as usize, 0);
         self.queue.write_buffer(&buffer, offset, &padded);

@@ -92,8 +92,11 @@ pub fn run_realtime_bench(
         let instrumented = stat(&totals);
         progress(&format!("{spec}: real-time frames"));
         let mut technique = renderer.registry().wgpu(spec)?;
+        let mut named = Vec::new();
+        let registry = renderer.registry();
+        crate::renderer::name_techniques(job.frame, &mut named, |s| Ok(registry.wgpu(s)?))?;
         let cx = renderer.wgpu_context()?;
-        let entry = match realtime_frames(cx, job, technique.as_mut()) {
+        let entry = match realtime_frames(cx, job, technique.as_mut(), &mut named) {
             Ok(times) => {
                 let frame_ms = times.wall_ms / f64::from(job.frames.max(1));
                 RealtimeEntry {
@@ -145,12 +148,13 @@ struct Times {
     gpu_ms: Vec<f64>,
 }
 
-/// The job's frames of one technique through the real-time path: warm-up frames each waited for, then
-/// the measured frames with at most [`IN_FLIGHT`] in flight.
+/// The job's frames of one technique (and of those its lights name, `named`) through the real-time path:
+/// warm-up frames each waited for, then the measured frames with at most [`IN_FLIGHT`] in flight.
 fn realtime_frames(
     cx: &mut WgpuContext,
     job: &BenchJob<'_>,
     technique: &mut dyn shadow_core::technique::DynShadowTechnique<shadow_wgpu::WgpuBackend>,
+    named: &mut crate::renderer::Named<shadow_wgpu::WgpuBackend>,
 ) -> Result<Times, WgpuError> {
     let target = surface_like(cx, job.width, job.height);
     let view = target.create_view(&Default::default());
@@ -175,7 +179,8 @@ fn realtime_frames(
         if let Some((c, m)) = marks {
             c.mark(&mut encoder, 2 * m);
         }
-        recorder.record(cx, &mut encoder, &frame, &mut *technique, &color)?;
+        let techniques = shadow_core::script::LightTechniques { frame: &mut *technique, named: &mut *named };
+        recorder.record(cx, &mut encoder, &frame, techniques, &color)?;
         if let Some((c, m)) = marks {
             c.mark(&mut encoder, 2 * m + 1);
         }
