@@ -72,7 +72,7 @@ const MIN_TRANSIENT: u64 = 1 << 16;
 /// Frames whose transient data may be in use at once: each writes a buffer of its own, so a frame's
 /// writes never land in a buffer a frame still on the GPU reads (the copy would wait for that frame to
 /// finish: the GPU tracks a buffer's use whole, not by range).
-const FRAMES: usize = 3;
+pub(crate) const FRAMES: usize = 3;
 
 // The one place wgpu's creation calls are made.
 #[allow(clippy::disallowed_methods)]
@@ -124,6 +124,11 @@ impl WgpuContext {
     }
 
     /// Starts a frame's transient data over at the start of the buffer.
+    /// Which of the [`FRAMES`] buffers kept in turn this frame uses.
+    pub(crate) fn frame_turn(&self) -> usize {
+        self.resources.transient.borrow().frame as usize % FRAMES
+    }
+
     pub(crate) fn begin_transient(&self) {
         let mut arena = self.resources.transient.borrow_mut();
         arena.frame += 1;

@@ -121,7 +121,8 @@ impl AdjacencyGpu {
 pub struct SceneCache {
     meshes: HashMap<MeshKey, MeshGpu>,
     adjacency: HashMap<MeshKey, AdjacencyGpu>,
-    instances: Option<(Vec<InstanceRaw>, wgpu::Buffer)>,
+    /// The instance buffers, one per frame that may be in flight, each with what it holds.
+    instances: Vec<(Vec<InstanceRaw>, wgpu::Buffer)>,
 }
 
 impl SceneCache {
@@ -177,33 +178,30 @@ impl SceneCache {
         self.adjacency.get(&key)
     }
 
-    /// The frame's instance data: the instances that changed are written into the buffer in place, which
-    /// is made anew only when the number of instances changes.
+    /// The frame's instance data, in the buffer of this frame's turn (a few are used in turn, as the
+    /// transient buffers are, so a frame's writes never wait for a frame in flight that reads): the
+    /// instances that changed since that buffer's last frame are written in place. The buffers are made
+    /// anew only when the number of instances changes.
     pub fn instances(&mut self, cx: &WgpuContext, frame: &FrameInputs) -> &wgpu::Buffer {
         let raw: Vec<InstanceRaw> = frame.instances.iter().map(InstanceRaw::of).collect();
-        match &mut self.instances {
-            Some((old, buf)) if old.len() == raw.len() => {
-                let size = std::mem::size_of::<InstanceRaw>();
-                for (i, (was, now)) in old.iter_mut().zip(&raw).enumerate() {
-                    if bytemuck::bytes_of(was) != bytemuck::bytes_of(now) {
-                        cx.queue.write_buffer(buf, (i * size) as u64, bytemuck::bytes_of(now));
-                        *was = *now;
-                    }
-                }
-            }
-            slot => {
-                let buf = cx.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some("instances"),
-                    contents: bytemuck::cast_slice(&raw),
-                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-                });
-                *slot = Some((raw, buf));
+        if self.instances.first().is_none_or(|(old, _)| old.len() != raw.len()) {
+            let desc = wgpu::util::BufferInitDescriptor {
+                label: Some("instances"),
+                contents: bytemuck::cast_slice(&raw),
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            };
+            self.instances =
+                (0..crate::resources::FRAMES).map(|_| (raw.clone(), cx.create_buffer_init(&desc))).collect();
+        }
+        let (old, buf) = &mut self.instances[cx.frame_turn()];
+        let size = std::mem::size_of::<InstanceRaw>();
+        for (i, (was, now)) in old.iter_mut().zip(&raw).enumerate() {
+            if bytemuck::bytes_of(was) != bytemuck::bytes_of(now) {
+                cx.queue.write_buffer(buf, (i * size) as u64, bytemuck::bytes_of(now));
+                *was = *now;
             }
         }
-        match &self.instances {
-            Some((_, b)) => b,
-            None => unreachable!("just uploaded"),
-        }
+        buf
     }
 }
 
