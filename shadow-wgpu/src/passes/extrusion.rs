@@ -8,7 +8,9 @@
 //! 64-byte uniform per instance and a handful of commands. Every buffer is made once per set of casting
 //! instances and reused: the lists by every light in turn (the GPU runs them in order), the uniforms in
 //! a place per light ([`LightPass::slot`](shadow_core::technique::LightPass)), since a frame recorded
-//! into one command buffer sees every write before its first command.
+//! into one command buffer sees every write before its first command, and in a buffer per frame that
+//! may be in flight, used in turn as the transient buffers are, so a frame's writes never wait for one
+//! still reading.
 
 use shadow_core::geometry::LightSource;
 use shadow_core::geometry::volume::{Caps, VolumeCounting};
@@ -44,6 +46,9 @@ pub struct GpuExtrusion {
     /// Every fragment counted, nothing written (instrumented frames), by vertex stage.
     count_all: [wgpu::RenderPipeline; 3],
     jobs: Option<Jobs>,
+    /// The frame turn whose uniforms the last build wrote, which its draws read (a build kept for later
+    /// frames keeps its turn).
+    built_turn: usize,
 }
 
 /// The extrusion of every casting instance of a frame, in the buffers they share.
@@ -54,15 +59,16 @@ struct Jobs {
     args: wgpu::Buffer,
     /// The arguments every light starts from: no triangles, each list's first index.
     template: wgpu::Buffer,
-    /// Each job's [`Uniform`] for each light slot (slot-major), `stride` bytes apart.
-    uniforms: wgpu::Buffer,
+    /// Per frame turn, each job's [`Uniform`] for each light slot (slot-major), `stride` bytes apart.
+    uniforms: Vec<wgpu::Buffer>,
     stride: u64,
     slots: usize,
     weights: wgpu::Buffer,
     records: wgpu::Buffer,
     caps: wgpu::Buffer,
-    compute_groups: Vec<wgpu::BindGroup>,
-    draw_groups: Vec<wgpu::BindGroup>,
+    /// Per frame turn, each job's groups.
+    compute_groups: Vec<Vec<wgpu::BindGroup>>,
+    draw_groups: Vec<Vec<wgpu::BindGroup>>,
 }
 
 /// One casting instance's place in the shared buffers.
@@ -123,6 +129,7 @@ impl GpuExtrusion {
             counting,
             count_all,
             jobs: None,
+            built_turn: 0,
         }
     }
 
@@ -154,7 +161,9 @@ impl GpuExtrusion {
                 bytes
             })
             .collect();
-        cx.queue.write_buffer(&jobs.uniforms, jobs.offset(slot, 0), &uniforms);
+        let turn = cx.frame_turn();
+        cx.queue.write_buffer(&jobs.uniforms[turn], jobs.offset(slot, 0), &uniforms);
+        self.built_turn = turn;
         let most = cx.device.limits().max_compute_workgroups_per_dimension;
         let mut enc = cx.encoder("shadow-volume extrusion");
         enc.copy_buffer_to_buffer(&jobs.template, 0, &jobs.args, 0, jobs.args.size());
@@ -162,7 +171,7 @@ impl GpuExtrusion {
             let mut pass = enc
                 .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("extrusion"), timestamp_writes: None });
             for (j, job) in jobs.list.iter().enumerate() {
-                pass.set_bind_group(2, &jobs.compute_groups[j], &[jobs.offset(slot, j) as u32]);
+                pass.set_bind_group(2, &jobs.compute_groups[turn][j], &[jobs.offset(slot, j) as u32]);
                 pass.set_pipeline(&self.faces);
                 let (x, y) = groups(job.faces, most);
                 pass.dispatch_workgroups(x, y, 1);
@@ -248,7 +257,7 @@ impl GpuExtrusion {
                 };
                 let m = inst.mirrored;
                 let args = |word: u32| u64::from(4 * (job.args + word));
-                pass.set_bind_group(1, &jobs.draw_groups[j], &[jobs.offset(slot, j) as u32]);
+                pass.set_bind_group(1, &jobs.draw_groups[self.built_turn][j], &[jobs.offset(slot, j) as u32]);
                 pass.set_pipeline(pick(0, m));
                 pass.draw_indirect(&jobs.args, args(0));
                 pass.set_vertex_buffer(0, mesh.positions.slice(..));
@@ -364,12 +373,16 @@ impl Jobs {
         let template: Vec<u32> = list.iter().flat_map(Job::initial_args).collect();
         let copy = wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC;
         let stride = UNIFORM_BYTES.next_multiple_of(u64::from(limits.min_uniform_buffer_offset_alignment));
-        let uniforms = cx.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("extrusion uniforms"),
-            size: (stride * (slots * list.len()).max(1) as u64),
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let uniforms = (0..crate::resources::FRAMES)
+            .map(|_| {
+                cx.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("extrusion uniforms"),
+                    size: (stride * (slots * list.len()).max(1) as u64),
+                    usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                    mapped_at_creation: false,
+                })
+            })
+            .collect();
         let mut jobs = Self {
             args: storage("extrusion arguments", template.len() as u64, wgpu::BufferUsages::INDIRECT | copy)?,
             template: cx.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -388,8 +401,13 @@ impl Jobs {
             key,
             list,
         };
-        jobs.compute_groups = jobs.list.iter().map(|job| jobs.compute_group(cx, compute_layout, job)).collect();
-        jobs.draw_groups = jobs.list.iter().map(|job| jobs.draw_group(cx, draw_layout, job)).collect();
+        let turns = 0..jobs.uniforms.len();
+        jobs.compute_groups = turns
+            .clone()
+            .map(|t| jobs.list.iter().map(|job| jobs.compute_group(cx, compute_layout, job, t)).collect())
+            .collect();
+        jobs.draw_groups =
+            turns.map(|t| jobs.list.iter().map(|job| jobs.draw_group(cx, draw_layout, job, t)).collect()).collect();
         Ok(jobs)
     }
 
@@ -398,21 +416,28 @@ impl Jobs {
         (slot * self.list.len() + j) as u64 * self.stride
     }
 
-    fn uniform_binding(&self) -> wgpu::BindingResource<'_> {
+    /// The uniforms of frame turn `turn`, bound at a job's offset.
+    fn uniform_binding(&self, turn: usize) -> wgpu::BindingResource<'_> {
         wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-            buffer: &self.uniforms,
+            buffer: &self.uniforms[turn],
             offset: 0,
             size: wgpu::BufferSize::new(UNIFORM_BYTES),
         })
     }
 
-    fn compute_group(&self, cx: &WgpuContext, layout: &wgpu::BindGroupLayout, job: &Job) -> wgpu::BindGroup {
+    fn compute_group(
+        &self,
+        cx: &WgpuContext,
+        layout: &wgpu::BindGroupLayout,
+        job: &Job,
+        turn: usize,
+    ) -> wgpu::BindGroup {
         let (Some(adj), Some(mesh)) = (cx.cache.adjacency(job.mesh), cx.cache.mesh(job.mesh)) else {
             unreachable!("a job is made only for an uploaded mesh")
         };
         let buffers =
             [&adj.planes, &adj.edges, &adj.uses, &mesh.indices, &self.weights, &self.records, &self.caps, &self.args];
-        let mut entries = vec![wgpu::BindGroupEntry { binding: 0, resource: self.uniform_binding() }];
+        let mut entries = vec![wgpu::BindGroupEntry { binding: 0, resource: self.uniform_binding(turn) }];
         entries.extend(
             buffers
                 .iter()
@@ -422,10 +447,10 @@ impl Jobs {
         cx.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("extrusion"), layout, entries: &entries })
     }
 
-    fn draw_group(&self, cx: &WgpuContext, layout: &wgpu::BindGroupLayout, job: &Job) -> wgpu::BindGroup {
+    fn draw_group(&self, cx: &WgpuContext, layout: &wgpu::BindGroupLayout, job: &Job, turn: usize) -> wgpu::BindGroup {
         let Some(adj) = cx.cache.adjacency(job.mesh) else { unreachable!("a job is made only for an uploaded mesh") };
         let entries = [
-            wgpu::BindGroupEntry { binding: 1, resource: self.uniform_binding() },
+            wgpu::BindGroupEntry { binding: 1, resource: self.uniform_binding(turn) },
             wgpu::BindGroupEntry { binding: 2, resource: adj.welded.as_entire_binding() },
             wgpu::BindGroupEntry { binding: 3, resource: adj.edges.as_entire_binding() },
             wgpu::BindGroupEntry { binding: 4, resource: self.records.as_entire_binding() },
