@@ -338,7 +338,9 @@ impl Jobs {
         let mut list = Vec::with_capacity(key.len());
         let (mut records, mut weights, mut caps) = (0u64, 0u64, 0u64);
         for &(instance, mesh, _) in &key {
-            let Some(adj) = cx.cache.adjacency(mesh) else { continue };
+            // A job is made only for a mesh whose vertices and adjacency are both uploaded: the groups
+            // below bind them.
+            let (Some(adj), Some(_)) = (cx.cache.adjacency(mesh), cx.cache.mesh(mesh)) else { continue };
             let faces = u64::from(adj.faces);
             let at = |n: u64| u32::try_from(n).map_err(|_| too_large("the extrusion's lists", 4 * n, u64::MAX));
             list.push(Job {
