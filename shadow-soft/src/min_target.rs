@@ -18,7 +18,7 @@ pub fn pipeline(
     vertex: (&str, wgpu::VertexBufferLayout<'_>),
     fragment: &str,
 ) -> wgpu::RenderPipeline {
-    min_depth_pipeline(&cx.device, label, module, &[layout], vertex, Some(fragment))
+    min_depth_pipeline(&cx.pipelines, label, module, &[layout], vertex, Some(fragment))
 }
 
 /// Records a pass that clears layer 0 of `target` to 1 (nothing drawn) and, given vertices, draws them
@@ -43,13 +43,10 @@ pub fn draw(
 /// The bindings of a pass over the blockers' maps: a uniform at 0, the maps (a depth array) at 1.
 #[must_use]
 pub fn layout(cx: &WgpuContext, label: &str) -> wgpu::BindGroupLayout {
-    cx.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some(label),
-        entries: &[
-            buffer_entry(0, wgpu::BufferBindingType::Uniform, wgpu::ShaderStages::VERTEX_FRAGMENT),
-            depth_array_entry(1),
-        ],
-    })
+    cx.pipelines.group_layout(
+        label,
+        &[buffer_entry(0, wgpu::BufferBindingType::Uniform, wgpu::ShaderStages::VERTEX_FRAGMENT), depth_array_entry(1)],
+    )
 }
 
 /// A group of [`layout`]: `params` as the uniform (in the frame's transient buffer), and `maps`.

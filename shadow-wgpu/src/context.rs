@@ -173,6 +173,8 @@ pub struct WgpuContext {
     pub cache: crate::upload::SceneCache,
     /// The pipelines and layouts every pass shares (the frame bind group's layout among them).
     pub shared: crate::pipelines::Shared,
+    /// Every pipeline, shader module and layout made on the device, each once per description.
+    pub pipelines: crate::PipelineCache,
     /// While a frame is recorded into a host's encoder ([`WgpuContext::record_into`]): that encoder,
     /// lent to each pass in turn.
     lent: RefCell<Option<wgpu::CommandEncoder>>,
@@ -396,7 +398,8 @@ impl WgpuContext {
         } else {
             wgpu::TextureFormat::Depth24PlusStencil8
         };
-        let shared = crate::pipelines::Shared::new(&device, depth_stencil);
+        let pipelines = crate::PipelineCache::new(device.clone());
+        let shared = crate::pipelines::Shared::new(&pipelines, depth_stencil);
         Self {
             adapter: AdapterSummary::of(&adapter.get_info()),
             timestamps: device.features().contains(wgpu::Features::TIMESTAMP_QUERY),
@@ -406,6 +409,7 @@ impl WgpuContext {
             lost,
             cache: crate::upload::SceneCache::default(),
             shared,
+            pipelines,
             lent: RefCell::new(None),
             recording: Cell::new(false),
             gbuffer_targets: None,

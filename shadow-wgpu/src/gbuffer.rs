@@ -136,15 +136,15 @@ impl ImportPass {
     #[must_use]
     pub fn new(cx: &WgpuContext) -> Self {
         use crate::pipelines::{attribute_entry, buffer_entry, depth_entry};
-        let layout = cx.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("host surfaces"),
-            entries: &[
+        let layout = cx.pipelines.group_layout(
+            "host surfaces",
+            &[
                 depth_entry(0),
                 attribute_entry(1),
                 buffer_entry(2, wgpu::BufferBindingType::Uniform, wgpu::ShaderStages::FRAGMENT),
             ],
-        });
-        let module = crate::shaders::module(&cx.device, "import", crate::shaders::import());
+        );
+        let module = cx.pipelines.module("import", crate::shaders::import());
         let target =
             Some(wgpu::ColorTargetState { format: ATTRIBUTE, blend: None, write_mask: wgpu::ColorWrites::ALL });
         let depth = wgpu::DepthStencilState {
@@ -155,7 +155,7 @@ impl ImportPass {
             bias: Default::default(),
         };
         let pipeline = crate::pipelines::full_screen_pipeline_to(
-            &cx.device,
+            &cx.pipelines,
             ("host surfaces", &module, "fs_import".into()),
             &[&cx.shared.frame_layout, &layout],
             &[target.clone(), target.clone(), target.clone(), target],

@@ -5,6 +5,7 @@ use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
 use shadow_core::scene::{Light, LightKind};
 
+use crate::pipeline_cache::PipelineCache;
 use crate::shaders;
 
 /// Light-space depth maps.
@@ -155,24 +156,20 @@ pub struct Shared {
 impl Shared {
     /// Creates the shared pipelines.
     #[must_use]
-    pub fn new(device: &wgpu::Device, depth_stencil: wgpu::TextureFormat) -> Self {
+    pub fn new(pipelines: &PipelineCache, depth_stencil: wgpu::TextureFormat) -> Self {
         let all = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
-        let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("frame"),
-            entries: &[
+        let frame_layout = pipelines.group_layout(
+            "frame",
+            &[
                 buffer_entry(0, wgpu::BufferBindingType::Uniform, all),
                 buffer_entry(1, wgpu::BufferBindingType::Storage { read_only: true }, all),
             ],
-        });
-        let gmod = shaders::module(device, "gbuffer", shaders::gbuffer());
-        let glayout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("gbuffer"),
-            bind_group_layouts: &[Some(&frame_layout)],
-            immediate_size: 0,
-        });
+        );
+        let gmod = pipelines.module("gbuffer", shaders::gbuffer());
+        let glayout = pipelines.layout("gbuffer", &[Some(&frame_layout)]);
         let target =
             Some(wgpu::ColorTargetState { format: ATTRIBUTE, blend: None, write_mask: wgpu::ColorWrites::ALL });
-        let gbuffer = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        let gbuffer = pipelines.render(&wgpu::RenderPipelineDescriptor {
             label: Some("gbuffer"),
             layout: Some(&glayout),
             vertex: wgpu::VertexState {
@@ -199,9 +196,9 @@ impl Shared {
             multiview_mask: None,
             cache: None,
         });
-        let shade_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("shade"),
-            entries: &[
+        let shade_layout = pipelines.group_layout(
+            "shade",
+            &[
                 attribute_entry(0),
                 attribute_entry(1),
                 attribute_entry(2),
@@ -212,10 +209,10 @@ impl Shared {
                 ),
                 buffer_entry(4, wgpu::BufferBindingType::Uniform, wgpu::ShaderStages::FRAGMENT),
             ],
-        });
-        let smod = shaders::module(device, "shade", shaders::shade());
+        );
+        let smod = pipelines.module("shade", shaders::shade());
         let shade = full_screen_pipeline(
-            device,
+            pipelines,
             "shade",
             &smod,
             "fs_shade",
@@ -224,7 +221,7 @@ impl Shared {
             None,
         );
         let receivers = full_screen_pipeline(
-            device,
+            pipelines,
             "receivers",
             &smod,
             "fs_receivers",
@@ -281,20 +278,16 @@ impl<'a> From<&'a str> for FragmentEntry<'a> {
 /// precision).
 #[must_use]
 pub fn min_depth_pipeline(
-    device: &wgpu::Device,
+    pipelines: &PipelineCache,
     label: &str,
     module: &wgpu::ShaderModule,
     groups: &[&wgpu::BindGroupLayout],
     (vertex, vertices): (&str, wgpu::VertexBufferLayout<'_>),
     fragment: Option<&str>,
 ) -> wgpu::RenderPipeline {
-    let groups: Vec<Option<&wgpu::BindGroupLayout>> = groups.iter().map(|g| Some(*g)).collect();
-    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some(label),
-        bind_group_layouts: &groups,
-        immediate_size: 0,
-    });
-    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+    let groups: Vec<_> = groups.iter().map(|&g| Some(g)).collect();
+    let layout = pipelines.layout(label, &groups);
+    pipelines.render(&wgpu::RenderPipelineDescriptor {
         label: Some(label),
         layout: Some(&layout),
         vertex: wgpu::VertexState {
@@ -327,7 +320,7 @@ pub fn min_depth_pipeline(
 /// and writes the stencil), optionally with a depth-stencil state.
 #[must_use]
 pub fn full_screen_pipeline<'a>(
-    device: &wgpu::Device,
+    pipelines: &PipelineCache,
     label: &str,
     module: &wgpu::ShaderModule,
     fragment: impl Into<FragmentEntry<'a>>,
@@ -339,24 +332,20 @@ pub fn full_screen_pipeline<'a>(
         .map(|format| Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL }))
         .into_iter()
         .collect();
-    full_screen_pipeline_to(device, (label, module, fragment.into()), groups, &targets, depth_stencil)
+    full_screen_pipeline_to(pipelines, (label, module, fragment.into()), groups, &targets, depth_stencil)
 }
 
 /// [`full_screen_pipeline`] into any colour targets: `(label, module, fragment entry)`.
 pub fn full_screen_pipeline_to(
-    device: &wgpu::Device,
+    pipelines: &PipelineCache,
     (label, module, fragment): (&str, &wgpu::ShaderModule, FragmentEntry<'_>),
     groups: &[&wgpu::BindGroupLayout],
     targets: &[Option<wgpu::ColorTargetState>],
     depth_stencil: Option<wgpu::DepthStencilState>,
 ) -> wgpu::RenderPipeline {
-    let groups: Vec<Option<&wgpu::BindGroupLayout>> = groups.iter().map(|g| Some(*g)).collect();
-    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some(label),
-        bind_group_layouts: &groups,
-        immediate_size: 0,
-    });
-    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+    let groups: Vec<_> = groups.iter().map(|&g| Some(g)).collect();
+    let layout = pipelines.layout(label, &groups);
+    pipelines.render(&wgpu::RenderPipelineDescriptor {
         label: Some(label),
         layout: Some(&layout),
         vertex: wgpu::VertexState {

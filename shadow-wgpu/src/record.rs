@@ -144,10 +144,10 @@ fn visibility_for<'a>(
 
 /// The shading pipeline for a target of `format`.
 fn shade_pipeline(cx: &WgpuContext, format: wgpu::TextureFormat) -> wgpu::RenderPipeline {
-    let module = crate::shaders::module(&cx.device, "shade", crate::shaders::shade());
+    let module = cx.pipelines.module("shade", crate::shaders::shade());
     let entry = if format.is_srgb() { "fs_shade_linear" } else { "fs_shade" };
     let groups = [&cx.shared.frame_layout, &cx.shared.shade_layout];
-    full_screen_pipeline(&cx.device, "recorded shade", &module, entry, &groups, Some(format), None)
+    full_screen_pipeline(&cx.pipelines, "recorded shade", &module, entry, &groups, Some(format), None)
 }
 
 /// The recording steps: the frame's targets, the host's surfaces in place of the G-buffer pass when it

@@ -1,7 +1,7 @@
 //! Where the backend's buffers and textures come from: every one is made through the context
 //! ([`WgpuContext::create_buffer`] and its siblings), which counts them, so a test can hold a frame loop
 //! to making none after its first frame (the library crates' `clippy.toml` forbids wgpu's own creation
-//! calls outside this module).
+//! calls outside this module; pipelines come from [`crate::PipelineCache`], counted with them).
 //!
 //! Data the GPU reads in one frame only (a light view's uniform, a map query's parameters, the segments
 //! a pass draws) goes into [`Transient`] slices of one buffer the context keeps, at offsets handed out in
@@ -14,13 +14,30 @@ use std::cell::{Cell, RefCell};
 
 use crate::context::WgpuContext;
 
-/// How many buffers and textures a context has made since it was opened.
+/// How many buffers, textures, pipelines and shader modules a context has made since it was opened.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Created {
     /// Buffers.
     pub buffers: u64,
     /// Textures.
     pub textures: u64,
+    /// Render and compute pipelines ([`crate::PipelineCache`]).
+    pub pipelines: u64,
+    /// Shader modules.
+    pub shader_modules: u64,
+}
+
+impl Created {
+    /// What was made between `earlier` and these counts.
+    #[must_use]
+    pub fn since(self, earlier: Self) -> Self {
+        Self {
+            buffers: self.buffers - earlier.buffers,
+            textures: self.textures - earlier.textures,
+            pipelines: self.pipelines - earlier.pipelines,
+            shader_modules: self.shader_modules - earlier.shader_modules,
+        }
+    }
 }
 
 /// The counters and the transient buffer a context keeps.
@@ -79,13 +96,18 @@ pub(crate) const FRAMES: usize = 3;
 impl WgpuContext {
     fn count(&self, buffers: u64, textures: u64) {
         let c = self.resources.created.get();
-        self.resources.created.set(Created { buffers: c.buffers + buffers, textures: c.textures + textures });
+        self.resources.created.set(Created { buffers: c.buffers + buffers, textures: c.textures + textures, ..c });
     }
 
-    /// How many buffers and textures this context has made.
+    /// How many buffers, textures, pipelines and shader modules this context has made.
     #[must_use]
     pub fn created(&self) -> Created {
-        self.resources.created.get()
+        let compiled = self.pipelines.compiled();
+        Created {
+            pipelines: compiled.pipelines,
+            shader_modules: compiled.shader_modules,
+            ..self.resources.created.get()
+        }
     }
 
     /// Makes a buffer (counted).

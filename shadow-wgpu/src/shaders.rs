@@ -80,12 +80,3 @@ pub fn all() -> Vec<(&'static str, String)> {
         ("extrusion", extrusion()),
     ]
 }
-
-/// A shader module from WGSL text.
-#[must_use]
-pub fn module(device: &wgpu::Device, label: &str, source: String) -> wgpu::ShaderModule {
-    device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some(label),
-        source: wgpu::ShaderSource::Wgsl(source.into()),
-    })
-}

@@ -9,6 +9,7 @@ mod gpu_clock;
 mod host;
 mod hybrid;
 mod per_light;
+mod pipelines;
 mod settings;
 mod silhouette_map;
 mod smoothies;

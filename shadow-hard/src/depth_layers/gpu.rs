@@ -68,7 +68,7 @@ fn layer_pipeline(
     module: &wgpu::ShaderModule,
     (peel, cull, cw): (bool, bool, bool),
 ) -> wgpu::RenderPipeline {
-    cx.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+    cx.pipelines.render(&wgpu::RenderPipelineDescriptor {
         label: Some("depth layer"),
         layout: Some(layout),
         vertex: wgpu::VertexState {
@@ -97,22 +97,18 @@ fn layer_pipeline(
 
 impl State {
     fn new(cx: &WgpuContext, filter: Filter, lookup: LookupParams) -> Self {
-        let module = shaders::module(&cx.device, "depth_layers", shader());
-        let map_module = shaders::module(&cx.device, "shadow_map", shaders::shadow_map());
-        let layout = cx.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("depth layers"),
-            entries: &[
+        let module = cx.pipelines.module("depth_layers", shader());
+        let map_module = cx.pipelines.module("shadow_map", shaders::shadow_map());
+        let layout = cx.pipelines.group_layout(
+            "depth layers",
+            &[
                 depth_entry(0),
                 depth_entry(1),
                 buffer_entry(2, wgpu::BufferBindingType::Uniform, wgpu::ShaderStages::FRAGMENT),
             ],
-        });
+        );
         let groups = [Some(&cx.shared.frame_layout), Some(&layout)];
-        let pl = cx.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("depth layers"),
-            bind_group_layouts: &groups,
-            immediate_size: 0,
-        });
+        let pl = cx.pipelines.layout("depth layers", &groups);
         let mut passes = Vec::new();
         for peel in [false, true] {
             for cull in [false, true] {
@@ -122,7 +118,7 @@ impl State {
                 }
             }
         }
-        let combine = cx.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        let combine = cx.pipelines.render(&wgpu::RenderPipelineDescriptor {
             label: Some("combine layers"),
             layout: Some(&pl),
             vertex: wgpu::VertexState {

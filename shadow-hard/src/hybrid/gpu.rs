@@ -180,13 +180,9 @@ fn mask_state(format: wgpu::TextureFormat) -> wgpu::DepthStencilState {
 /// shader, so hierarchical depth can follow it), drawn where bit 7 is clear.
 fn far_pass(cx: &WgpuContext, module: &wgpu::ShaderModule, groups: &[&wgpu::BindGroupLayout]) -> wgpu::RenderPipeline {
     let groups: Vec<_> = groups.iter().map(|g| Some(*g)).collect();
-    let layout = cx.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some("hybrid far"),
-        bind_group_layouts: &groups,
-        immediate_size: 0,
-    });
+    let layout = cx.pipelines.layout("hybrid far", &groups);
     let outside = wgpu::StencilFaceState { compare: wgpu::CompareFunction::Equal, ..Default::default() };
-    cx.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+    cx.pipelines.render(&wgpu::RenderPipelineDescriptor {
         label: Some("hybrid far"),
         layout: Some(&layout),
         vertex: wgpu::VertexState {
@@ -353,14 +349,13 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
         cx.scoped("creating the hybrid pipelines", |cx| {
             let caster_masks = self.caster_masks.is_on();
             let source = shaders::query(self.edge_texels, self.gpu.scissor_tile > 0, caster_masks);
-            let module = shadow_wgpu::shaders::module(&cx.device, "hybrid", source);
-            let volume_module =
-                shadow_wgpu::shaders::module(&cx.device, "shadow_volume", shadow_wgpu::shaders::shadow_volume());
+            let module = cx.pipelines.module("hybrid", source);
+            let volume_module = cx.pipelines.module("shadow_volume", shadow_wgpu::shaders::shadow_volume());
             let gpu_mask = self.gpu.mask;
             let bindings = MapBindings::new(cx, &self.extra_bindings());
             let groups = [&cx.shared.frame_layout, bindings.layout()];
             let mask = full_screen_pipeline(
-                &cx.device,
+                &cx.pipelines,
                 "hybrid mask",
                 &module,
                 "fs_hybrid_mask",
@@ -378,7 +373,7 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
             let answer = |entry, (compare, read_mask, _): (_, u32, u32)| {
                 let state = stencil_test(cx.depth_stencil, compare, read_mask);
                 full_screen_pipeline(
-                    &cx.device,
+                    &cx.pipelines,
                     "hybrid answer",
                     &module,
                     entry,
@@ -527,7 +522,7 @@ fn classes(cx: &WgpuContext, state: &State, last: &LastQuery) -> Result<Image<u3
         let groups = [&cx.shared.frame_layout, state.bindings.layout()];
         let depth_stencil = Some(stencil_test(cx.depth_stencil, test.0, test.1));
         let pipeline = full_screen_pipeline(
-            &cx.device,
+            &cx.pipelines,
             "hybrid classes",
             &state.module,
             entry,

@@ -24,7 +24,7 @@ impl ShadowTechnique<WgpuBackend> for ShadowMap {
 
     fn create_state(&self, cx: &mut WgpuContext) -> Result<State, WgpuError> {
         cx.scoped("creating the shadow-map pipelines", |cx| {
-            let module = shaders::module(&cx.device, "shadow_map", shaders::shadow_map());
+            let module = cx.pipelines.module("shadow_map", shaders::shadow_map());
             State {
                 maps: DepthMaps::with_module(cx, &module, &self.map()),
                 query: MapQuery::new(cx, &module, self.filter).with_lookup(LookupParams {

@@ -58,7 +58,7 @@ impl ShadowTechnique<WgpuBackend> for ShadowVolume {
     fn create_state(&self, cx: &mut WgpuContext) -> Result<State, WgpuError> {
         let (counting, extrusion) = (self.counting, self.gpu.extrusion);
         cx.scoped("creating the shadow-volume pipelines", |cx| {
-            let module = shaders::module(&cx.device, "shadow_volume", shaders::shadow_volume());
+            let module = cx.pipelines.module("shadow_volume", shaders::shadow_volume());
             let resolve = StencilResolve::new(cx, &module, 0xff);
             let volumes = match extrusion {
                 Extrusion::Gpu => Volumes::Gpu(Box::new(GpuExtrusion::new(cx, counting))),

@@ -72,24 +72,16 @@ fn points_pipeline(
     keep: Keep,
 ) -> (wgpu::RenderPipeline, wgpu::BindGroupLayout) {
     let both = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
-    let points_layout = cx.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("silhouette points"),
-        entries: &[
-            storage_entry(0, true, both),
-            depth_array_entry(1),
-            buffer_entry(2, wgpu::BufferBindingType::Uniform, both),
-        ],
-    });
-    let pl = cx.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some("silhouette points"),
-        bind_group_layouts: &[Some(&points_layout)],
-        immediate_size: 0,
-    });
+    let points_layout = cx.pipelines.group_layout(
+        "silhouette points",
+        &[storage_entry(0, true, both), depth_array_entry(1), buffer_entry(2, wgpu::BufferBindingType::Uniform, both)],
+    );
+    let pl = cx.pipelines.layout("silhouette points", &[Some(&points_layout)]);
     let compare = match keep {
         Keep::Nearest => wgpu::CompareFunction::LessEqual,
         Keep::Last => wgpu::CompareFunction::Always,
     };
-    let points = cx.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+    let points = cx.pipelines.render(&wgpu::RenderPipelineDescriptor {
         label: Some("silhouette points"),
         layout: Some(&pl),
         vertex: wgpu::VertexState {
@@ -155,10 +147,10 @@ fn query_pipeline(cx: &WgpuContext, map_module: &wgpu::ShaderModule) -> MapQuery
 
 impl State {
     fn new(cx: &WgpuContext, s: &SilhouetteMap) -> Self {
-        let map_module = shaders::module(&cx.device, "silhouette_query", query_shader());
-        let build_module = shaders::module(&cx.device, "silhouette_build", build_shader());
+        let map_module = cx.pipelines.module("silhouette_query", query_shader());
+        let build_module = cx.pipelines.module("silhouette_build", build_shader());
         let (points, points_layout) = points_pipeline(cx, &build_module, s.keep);
-        let count = cx.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        let count = cx.pipelines.compute(&wgpu::ComputePipelineDescriptor {
             label: Some("count silhouette texels"),
             layout: None,
             module: &build_module,

@@ -114,8 +114,8 @@ impl ShadowTechnique<WgpuBackend> for VolumeReconstruction {
 
     fn create_state(&self, cx: &mut WgpuContext) -> Result<State, WgpuError> {
         cx.scoped("creating the volume-reconstruction pipelines", |cx| {
-            let maps = shaders::module(&cx.device, "shadow_map", shaders::shadow_map());
-            let module = shaders::module(&cx.device, "volume_reconstruction", shader());
+            let maps = cx.pipelines.module("shadow_map", shaders::shadow_map());
+            let module = cx.pipelines.module("volume_reconstruction", shader());
             let (ccw, ds) = (wgpu::FrontFace::Ccw, cx.depth_stencil);
             State {
                 light_pass: if self.ids == ObjectIds::Off {

@@ -26,7 +26,7 @@ impl ShadowTechnique<WgpuBackend> for Pcss {
     fn create_state(&self, cx: &mut WgpuContext) -> Result<State, WgpuError> {
         let map = DepthMaps::new(cx, &self.depth);
         cx.scoped("creating the pcss pipelines", |cx| {
-            let module = shaders::module(&cx.device, "pcss query", query_shader());
+            let module = cx.pipelines.module("pcss query", query_shader());
             let lookup = LookupParams { radius: 0.0, receiver_offset: self.depth.receiver_offset() };
             let query = MapQuery::with_entry(cx, &module, FragmentEntry::from("fs_pcss_query"), &[attribute_entry(4)])
                 .with_lookup(lookup);

@@ -94,11 +94,11 @@ impl ShadowTechnique<WgpuBackend> for PenumbraMap {
     fn create_state(&self, cx: &mut WgpuContext) -> Result<State, WgpuError> {
         let map = DepthMaps::new(cx, &self.depth);
         cx.scoped("creating the penumbra-map pipelines", |cx| {
-            let build_module = shaders::module(&cx.device, "penumbra map", build_shader());
+            let build_module = cx.pipelines.module("penumbra map", build_shader());
             let build_layout = min_target::layout(cx, "penumbra map");
             let vertex = ("vs_cone", VERTEX_LAYOUT);
             let build = min_target::pipeline(cx, "penumbra map", &build_module, &build_layout, vertex, "fs_penumbra");
-            let query_module = shaders::module(&cx.device, "penumbra query", query_shader());
+            let query_module = cx.pipelines.module("penumbra query", query_shader());
             let entry = FragmentEntry::from("fs_penumbra_query");
             let lookup = LookupParams { radius: 0.0, receiver_offset: self.depth.receiver_offset() };
             let query = MapQuery::with_entry(cx, &query_module, entry, &[depth_entry(4)]).with_lookup(lookup);

@@ -105,14 +105,14 @@ impl ShadowTechnique<WgpuBackend> for Smoothies {
         let map = DepthMaps::new(cx, &self.depth);
         let falloff = FalloffTable::new(self.falloff);
         cx.scoped("creating the smoothie pipelines", |cx| {
-            let buffer_module = shaders::module(&cx.device, "smoothie buffer", buffer_shader());
+            let buffer_module = cx.pipelines.module("smoothie buffer", buffer_shader());
             let buffer_layout = min_target::layout(cx, "smoothie buffer");
             let pass = |entry| {
                 let vertex = ("vs_smoothie", VERTEX_LAYOUT);
                 min_target::pipeline(cx, "smoothie buffer", &buffer_module, &buffer_layout, vertex, entry)
             };
             let (depth_pass, alpha_pass) = (pass("fs_smoothie_depth"), pass("fs_smoothie_alpha"));
-            let query_module = shaders::module(&cx.device, "smoothie query", query_shader());
+            let query_module = cx.pipelines.module("smoothie query", query_shader());
             let storage = wgpu::BufferBindingType::Storage { read_only: true };
             let extra = [depth_entry(4), depth_entry(5), buffer_entry(6, storage, wgpu::ShaderStages::FRAGMENT)];
             let lookup = LookupParams { radius: 0.0, receiver_offset: self.depth.receiver_offset() };

@@ -112,7 +112,7 @@ impl GpuExtrusion {
     /// The pipelines, counting `counting`'s way.
     #[must_use]
     pub fn new(cx: &WgpuContext, counting: VolumeCounting) -> Self {
-        let module = shaders::module(&cx.device, "extrusion", shaders::extrusion());
+        let module = cx.pipelines.module("extrusion", shaders::extrusion());
         let compute_layout = layout(cx, "extrusion", wgpu::ShaderStages::COMPUTE, &COMPUTE_BINDINGS);
         let draw_layout = layout(cx, "extruded volumes", wgpu::ShaderStages::VERTEX, &DRAW_BINDINGS);
         let compute = |entry| compute_pipeline(cx, &module, &compute_layout, entry);
@@ -528,7 +528,7 @@ fn layout(
             }
         })
         .collect();
-    cx.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries: &entries })
+    cx.pipelines.group_layout(label, &entries)
 }
 
 fn compute_pipeline(
@@ -537,12 +537,8 @@ fn compute_pipeline(
     layout: &wgpu::BindGroupLayout,
     entry: &str,
 ) -> wgpu::ComputePipeline {
-    let layout = cx.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some("extrusion"),
-        bind_group_layouts: &[None, None, Some(layout)],
-        immediate_size: 0,
-    });
-    cx.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+    let layout = cx.pipelines.layout("extrusion", &[None, None, Some(layout)]);
+    cx.pipelines.compute(&wgpu::ComputePipelineDescriptor {
         label: Some(entry),
         layout: Some(&layout),
         module,

@@ -75,9 +75,7 @@ impl MapBindings {
             buffer_entry(3, wgpu::BufferBindingType::Uniform, wgpu::ShaderStages::FRAGMENT),
         ];
         entries.extend_from_slice(extra);
-        let layout = cx
-            .device
-            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("map query"), entries: &entries });
+        let layout = cx.pipelines.group_layout("map query", &entries);
         let sampler = cx.device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("shadow comparison"),
             address_mode_u: wgpu::AddressMode::ClampToEdge,
@@ -166,7 +164,7 @@ impl MapQuery {
     ) -> Self {
         let bindings = MapBindings::new(cx, extra);
         let pipeline = full_screen_pipeline(
-            &cx.device,
+            &cx.pipelines,
             "map query",
             module,
             entry,
@@ -249,13 +247,9 @@ fn light_pipeline(
     bias: wgpu::DepthBiasState,
     ids: bool,
 ) -> wgpu::RenderPipeline {
-    let layout = cx.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some("light pass"),
-        bind_group_layouts: &[Some(&cx.shared.frame_layout)],
-        immediate_size: 0,
-    });
+    let layout = cx.pipelines.layout("light pass", &[Some(&cx.shared.frame_layout)]);
     let id_target = [Some(wgpu::ColorTargetState::from(ID_FORMAT))];
-    cx.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+    cx.pipelines.render(&wgpu::RenderPipelineDescriptor {
         label: Some(if ids { "light pass with IDs" } else { "light pass" }),
         layout: Some(&layout),
         vertex: wgpu::VertexState {
@@ -356,7 +350,7 @@ impl DepthMaps {
     /// The light pass for `map`'s bias, from the shadow-map shader.
     #[must_use]
     pub fn new(cx: &WgpuContext, map: &DepthMap) -> Self {
-        let module = shaders::module(&cx.device, "shadow_map", shaders::shadow_map());
+        let module = cx.pipelines.module("shadow_map", shaders::shadow_map());
         Self::with_module(cx, &module, map)
     }
 

@@ -106,12 +106,8 @@ pub fn stencil_pipeline(
     depth_stencil: wgpu::DepthStencilState,
 ) -> wgpu::RenderPipeline {
     let groups: Vec<Option<&wgpu::BindGroupLayout>> = vertex.groups.iter().copied().map(Some).collect();
-    let layout = cx.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some(vertex.entry),
-        bind_group_layouts: &groups,
-        immediate_size: 0,
-    });
-    cx.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+    let layout = cx.pipelines.layout(vertex.entry, &groups);
+    cx.pipelines.render(&wgpu::RenderPipelineDescriptor {
         label: Some(vertex.entry),
         layout: Some(&layout),
         vertex: wgpu::VertexState {
@@ -139,10 +135,7 @@ pub struct StencilResolve {
 impl StencilResolve {
     /// The pipeline, from a module holding shadow_volume.wgsl's `fs_volume_resolve`.
     pub fn new(cx: &WgpuContext, module: &wgpu::ShaderModule, read_mask: u32) -> Self {
-        let layout = cx.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("stencil resolve"),
-            entries: &[attribute_entry(0)],
-        });
+        let layout = cx.pipelines.group_layout("stencil resolve", &[attribute_entry(0)]);
         let test = wgpu::StencilFaceState { compare: wgpu::CompareFunction::NotEqual, ..Default::default() };
         let state = wgpu::DepthStencilState {
             format: cx.depth_stencil,
@@ -152,7 +145,7 @@ impl StencilResolve {
             bias: Default::default(),
         };
         let pipeline = full_screen_pipeline(
-            &cx.device,
+            &cx.pipelines,
             "stencil resolve",
             module,
             "fs_volume_resolve",

@@ -40,7 +40,7 @@ use super::tables::{TABLE_ROW, table};
 use shadow_wgpu::context::{WgpuContext, WgpuError};
 use shadow_wgpu::gbuffer::GpuGBuffer;
 use shadow_wgpu::pipelines::buffer_entry;
-use shadow_wgpu::{Transient, readback, shaders};
+use shadow_wgpu::{Transient, readback};
 
 /// Pieces of at most this many volume triangles are counted by the compute passes at the pixels their
 /// shafts hold; larger ones are rasterized through the whole mask, where a pixel's cost does not grow
@@ -201,9 +201,9 @@ impl CasterPasses {
             multisampled: false,
         };
         let floats = texture(wgpu::TextureSampleType::Float { filterable: false });
-        let layout = cx.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("hybrid casters"),
-            entries: &[
+        let layout = cx.pipelines.group_layout(
+            "hybrid casters",
+            &[
                 compute_entry(0, floats),
                 storage(8, false),
                 storage(9, false),
@@ -217,15 +217,11 @@ impl CasterPasses {
                 compute_entry(18, floats),
                 compute_entry(19, floats),
             ],
-        });
-        let module = shaders::module(&cx.device, "hybrid casters", super::shaders::casters());
-        let pipeline_layout = cx.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("hybrid casters"),
-            bind_group_layouts: &[Some(&cx.shared.frame_layout), Some(&layout)],
-            immediate_size: 0,
-        });
+        );
+        let module = cx.pipelines.module("hybrid casters", super::shaders::casters());
+        let pipeline_layout = cx.pipelines.layout("hybrid casters", &[Some(&cx.shared.frame_layout), Some(&layout)]);
         let pipeline = |entry: &str| {
-            cx.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            cx.pipelines.compute(&wgpu::ComputePipelineDescriptor {
                 label: Some(entry),
                 layout: Some(&pipeline_layout),
                 module: &module,
