@@ -34,6 +34,9 @@ pub enum Error {
     /// Images of different sizes compared.
     #[error(transparent)]
     Compare(#[from] shadow_core::metrics::SizeMismatch),
+    /// The viewer's window, or presenting to it.
+    #[error("the window: {0}")]
+    Window(String),
     /// Anything else the user asked for that cannot be done.
     #[error("{0}")]
     Usage(String),

@@ -14,6 +14,7 @@ pub mod renderer;
 pub mod results;
 pub mod setup;
 pub mod sheet;
+pub mod viewer;
 
 use std::path::Path;
 

@@ -231,6 +231,26 @@ pub(crate) enum Command {
         #[arg(long, default_value_t = 10)]
         bench_frames: u32,
     },
+    /// Open a window onto a scene: fly the camera (drag, wheel, WASD), move the light (right drag, arrow
+    /// keys, L to turn it), switch scene, backend, technique and settings in the side panel.
+    View {
+        #[command(flatten)]
+        scene: SceneArgs,
+        /// NAME[:key=value,...].
+        #[arg(long, default_value = "shadow-map")]
+        technique: String,
+        /// Backend drawing the view: wgpu or cpu.
+        #[arg(long, default_value = "wgpu", value_parser = ["wgpu", "cpu"])]
+        backend: String,
+        /// The window's size, WxH.
+        #[arg(long, default_value = "1280x800")]
+        size: String,
+        /// Steps replayed one per frame before the user's hands, separated by ';' (orbit YAW PITCH,
+        /// light YAW PITCH, zoom F, fly F R U, technique SPEC, backend wgpu|cpu, scene NAME|FILE,
+        /// wait FRAMES, screenshot FILE.png, command, quit).
+        #[arg(long)]
+        script: Option<String>,
+    },
     /// Write a scene (built-in or loaded) as .glb with its camera and lights.
     Export {
         #[command(flatten)]

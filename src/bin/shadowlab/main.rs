@@ -120,6 +120,7 @@ fn run(cli: Cli) -> Result<(), Error> {
             bench(&scene, &view, BenchArgs { choice, frames, warmup, json, realtime, sweep, out_dir })
         }
         Command::Export { scene, out } => export(&scene, &out),
+        Command::View { scene, technique, backend, size, script } => view(&scene, technique, &backend, &size, script),
         Command::Results { out, size, backend, bench_scene, bench_size, bench_frames } => {
             results(&out, &size, &backend, bench_scene, &bench_size, bench_frames)
         }
@@ -302,6 +303,15 @@ fn check_availability(renderer: &Renderer, specs: &[TechniqueSpec], choice: &str
         }
     }
     Ok(())
+}
+
+fn view(args: &SceneArgs, technique: String, backend: &str, size: &str, script: Option<String>) -> Result<(), Error> {
+    use shadowlab::viewer::{ViewerOptions, script::parse};
+    let size = parse_size(size).map_err(|e| Error::Usage(e.to_string()))?;
+    let script = script.map(|s| parse(&s)).transpose().map_err(Error::Usage)?.unwrap_or_default();
+    TechniqueRegistry::builtin().canonical(&TechniqueSpec::parse(&technique)?)?;
+    let backend = if backend == "cpu" { shadowlab::BackendKind::Cpu } else { shadowlab::BackendKind::Wgpu };
+    shadowlab::viewer::run(ViewerOptions { setup: args.setup(), technique, backend, script, size })
 }
 
 fn backends(renderer: &mut Renderer, choice: &str) -> Result<Vec<shadowlab::BackendKind>, Error> {

@@ -1,0 +1,509 @@
+//! The viewer's state and its UI: the side panel (scene, backend, technique and its settings as controls
+//! generated from the settings table, the light, readouts, screenshot and the command that reproduces
+//! the view) and the 3D view's input (orbit, zoom, fly, the light dragged).
+
+use std::collections::VecDeque;
+use std::path::PathBuf;
+
+use egui::{Color32, ComboBox, PointerButton, Slider};
+use shadow_core::LightKind;
+use shadow_core::glam::Vec3;
+use shadow_core::scenes;
+use shadow_core::technique::settings::SettingKind;
+use shadow_core::technique::settings::key_values;
+
+use super::script::Step;
+use super::view::{Gpu, View};
+use super::{FrameClock, Scene, screenshot_path};
+use crate::setup::SceneSetup;
+use crate::{BackendKind, TechniqueRegistry};
+
+/// Radians a dragged pixel turns the camera or the light.
+const TURN_PER_PIXEL: f32 = 0.008;
+/// Radians a second the turning light moves, and the arrow keys move it.
+const LIGHT_TURN_RATE: f32 = 0.6;
+/// GPU times kept for the plot.
+const PLOTTED: usize = 240;
+
+/// Everything the viewer shows and changes.
+pub(super) struct Viewer {
+    view: View,
+    scene: Scene,
+    registry: TechniqueRegistry,
+    /// The technique's settings as the controls show them, committed when a control settles.
+    settings: Vec<(String, String)>,
+    script: VecDeque<Step>,
+    wait: u32,
+    quit: bool,
+    animate: bool,
+    /// The view's size in pixels as the UI laid it out, and as it was last drawn.
+    size: (u32, u32),
+    drawn: (u32, u32),
+    texture: Option<egui::TextureId>,
+    screenshot: Option<PathBuf>,
+    screenshots: u32,
+    /// The model file field.
+    file: String,
+    error: Option<String>,
+    status: Option<String>,
+    clock: FrameClock,
+    gpu_ms: VecDeque<f64>,
+    timed: bool,
+}
+
+impl Viewer {
+    pub(super) fn new(mut view: View, scene: Scene, script: Vec<Step>) -> Self {
+        let timed = view.time_frames();
+        let mut viewer = Self {
+            view,
+            scene,
+            registry: TechniqueRegistry::builtin(),
+            settings: Vec::new(),
+            script: script.into(),
+            wait: 0,
+            quit: false,
+            animate: false,
+            size: (640, 480),
+            drawn: (0, 0),
+            texture: None,
+            screenshot: None,
+            screenshots: 0,
+            file: String::new(),
+            error: None,
+            status: None,
+            clock: FrameClock::default(),
+            gpu_ms: VecDeque::new(),
+            timed,
+        };
+        viewer.reset_settings();
+        viewer
+    }
+
+    pub(super) fn quitting(&self) -> bool {
+        self.quit
+    }
+
+    /// Takes the script's next step, unless it waits.
+    pub(super) fn step_script(&mut self) {
+        if self.wait > 0 {
+            self.wait -= 1;
+            return;
+        }
+        // A screenshot asked for is taken before the next step changes the view.
+        if self.screenshot.is_some() {
+            return;
+        }
+        let Some(step) = self.script.pop_front() else { return };
+        let orbit = &mut self.scene.orbit;
+        match step {
+            Step::Orbit(yaw, pitch) => orbit.turn(yaw.to_radians(), pitch.to_radians()),
+            Step::Zoom(f) => orbit.zoom(f),
+            Step::Fly(f, r, u) => orbit.fly(f, r, u),
+            Step::Light(yaw, pitch) => {
+                if let Some(rig) = &mut self.scene.light {
+                    rig.turn(yaw.to_radians(), pitch.to_radians());
+                }
+            }
+            Step::Technique(spec) => self.set_technique(&spec),
+            Step::Backend(name) => self.set_backend(if name == "cpu" { BackendKind::Cpu } else { BackendKind::Wgpu }),
+            Step::Scene(source) => self.open_scene(source),
+            Step::Wait(n) => self.wait = n,
+            Step::Screenshot(path) => self.screenshot = Some(path),
+            Step::Command => println!("{}", self.command()),
+            Step::Quit => self.quit = true,
+        }
+    }
+
+    /// Draws the 3D view for this frame (see [`View::draw`]).
+    pub(super) fn draw_view(
+        &mut self,
+        painter: (&Gpu, &mut egui_wgpu::Renderer, &egui::Context),
+        encoder: &mut wgpu::CommandEncoder,
+    ) {
+        if self.animate {
+            let dt = painter.2.input(|i| i.stable_dt).min(0.1);
+            if let Some(rig) = &mut self.scene.light {
+                rig.turn(LIGHT_TURN_RATE * dt, 0.0);
+            }
+        }
+        let frame = self.scene.frame();
+        match self.view.draw(painter, encoder, &frame, self.size) {
+            Ok(id) => {
+                self.texture = Some(id);
+                self.drawn = self.size;
+            }
+            Err(e) => self.fail(e.to_string()),
+        }
+        self.clock.tick();
+        if let Some(ms) = self.view.gpu_ms() {
+            self.gpu_ms.push_back(ms);
+            if self.gpu_ms.len() > PLOTTED {
+                self.gpu_ms.pop_front();
+            }
+        }
+    }
+
+    /// Takes an asked-for screenshot of the frame just submitted, once the view is drawn at the size the
+    /// UI gives it.
+    pub(super) fn after_submit(&mut self) {
+        if self.drawn != self.size {
+            return;
+        }
+        let Some(path) = self.screenshot.take() else { return };
+        let written = self.view.screenshot().and_then(|image| {
+            if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+                std::fs::create_dir_all(dir)
+                    .map_err(|e| crate::Error::Write { path: dir.to_path_buf(), why: e.to_string() })?;
+            }
+            Ok(image.save_png(&path)?)
+        });
+        match written {
+            Ok(()) => self.say(format!("wrote {}", path.display())),
+            Err(e) => self.fail(e.to_string()),
+        }
+    }
+
+    fn say(&mut self, message: String) {
+        eprintln!("{message}");
+        self.status = Some(message);
+    }
+
+    /// Shows `message` as the error line (and prints it once).
+    fn fail(&mut self, message: String) {
+        if self.error.as_ref() != Some(&message) {
+            eprintln!("{message}");
+        }
+        self.error = Some(message);
+    }
+
+    fn set_technique(&mut self, spec: &str) {
+        match self.view.set_technique(spec) {
+            Ok(()) => self.error = None,
+            Err(e) => self.fail(e.to_string()),
+        }
+        self.reset_settings();
+    }
+
+    fn set_backend(&mut self, backend: BackendKind) {
+        match self.view.set_backend(backend) {
+            Ok(()) => self.error = None,
+            Err(e) => self.fail(e.to_string()),
+        }
+    }
+
+    /// Opens a built-in scene or model file; on an error the scene stays and the error line says why.
+    pub(super) fn open_scene(&mut self, source: String) {
+        let setup = SceneSetup { source, camera: None, light: None, ..self.scene.setup.clone() };
+        match Scene::open(setup) {
+            Ok(scene) => {
+                self.scene = scene;
+                self.error = None;
+                self.view.invalidate();
+            }
+            Err(e) => self.fail(e.to_string()),
+        }
+    }
+
+    /// The controls' settings from the technique now drawing.
+    fn reset_settings(&mut self) {
+        let canonical = self.registry.canonical(self.view.technique()).unwrap_or_default();
+        self.settings = key_values(&canonical).unwrap_or_default();
+    }
+
+    /// The whole UI: the side panel and the 3D view.
+    pub(super) fn ui(&mut self, ui: &mut egui::Ui) {
+        egui::Panel::left("controls").default_size(300.0).show(ui, |ui| {
+            egui::ScrollArea::vertical().show(ui, |ui| self.panel(ui));
+        });
+        egui::CentralPanel::no_frame().show(ui, |ui| self.view_input(ui));
+    }
+
+    fn panel(&mut self, ui: &mut egui::Ui) {
+        ui.heading("shadowlab");
+        ui.separator();
+        self.scene_controls(ui);
+        ui.separator();
+        ui.horizontal(|ui| {
+            ui.label("Backend");
+            for kind in [BackendKind::Wgpu, BackendKind::Cpu] {
+                if ui.radio(self.view.backend() == kind, kind.name()).clicked() {
+                    self.set_backend(kind);
+                }
+            }
+        });
+        ui.small(format!("adapter: {}", self.view.adapter()));
+        ui.separator();
+        self.technique_controls(ui);
+        ui.separator();
+        ui.checkbox(&mut self.animate, "Turn the light (L)");
+        if ui.button("Reset camera and light (R)").clicked() {
+            self.reset_view();
+        }
+        ui.separator();
+        self.readouts(ui);
+        ui.separator();
+        ui.horizontal(|ui| {
+            if ui.button("Screenshot (P)").clicked() {
+                self.next_screenshot();
+            }
+            if ui.button("Copy as command").clicked() {
+                let command = self.command();
+                println!("{command}");
+                ui.ctx().copy_text(command);
+                self.status = Some("copied the render command (also printed)".into());
+            }
+        });
+        if let Some(e) = &self.error {
+            ui.colored_label(Color32::LIGHT_RED, e);
+        }
+        if let Some(s) = &self.status {
+            ui.label(s);
+        }
+    }
+
+    fn scene_controls(&mut self, ui: &mut egui::Ui) {
+        let current = self.scene.setup.source.clone();
+        let mut chosen = None;
+        ComboBox::from_label("Scene").selected_text(&current).show_ui(ui, |ui| {
+            for s in scenes::ALL {
+                if ui.selectable_label(current == s.name, s.name).on_hover_text(s.description).clicked() {
+                    chosen = Some(s.name.to_string());
+                }
+            }
+        });
+        ui.horizontal(|ui| {
+            ui.add(egui::TextEdit::singleline(&mut self.file).hint_text("model file").desired_width(180.0));
+            if ui.button("Open").clicked() && !self.file.trim().is_empty() {
+                chosen = Some(self.file.trim().to_string());
+            }
+        });
+        ui.small("or drop a model file on the window");
+        if let Some(source) = chosen {
+            self.open_scene(source);
+        }
+    }
+
+    fn technique_controls(&mut self, ui: &mut egui::Ui) {
+        let name = self.view.technique().name.clone();
+        let mut chosen = None;
+        ComboBox::from_label("Technique").selected_text(&name).show_ui(ui, |ui| {
+            for entry in self.registry.entries() {
+                if ui.selectable_label(name == entry.name, entry.name).on_hover_text(entry.description).clicked() {
+                    chosen = Some(entry.name);
+                }
+            }
+        });
+        if let Some(spec) = chosen {
+            self.set_technique(spec);
+            return;
+        }
+        let Ok(entry) = self.registry.get(&name) else { return };
+        let mut commit = false;
+        for key in (entry.keys)() {
+            let Some((_, value)) = self.settings.iter_mut().find(|(k, _)| k == key.key) else { continue };
+            // A control settles when a drag ends, or at once for a click or a typed value: a drag would
+            // otherwise make a technique (and compile its changed pipelines) for every value it passes.
+            let settled = |r: &egui::Response| r.drag_stopped() || (r.changed() && !r.dragged());
+            // A word the key takes besides its numbers (`auto`, `0` for off) is a box to tick.
+            if let Some(word) = key.word {
+                let mut is_word = value == word;
+                if ui.checkbox(&mut is_word, format!("{} {word}", key.key)).on_hover_text(key.help).changed() {
+                    let number = |lo: String| if key.default == word { lo } else { key.default.to_string() };
+                    *value = match (is_word, key.kind) {
+                        (true, _) => word.to_string(),
+                        (false, SettingKind::Int { lo, .. }) => number(lo.to_string()),
+                        (false, SettingKind::Float { lo, .. }) => number(lo.to_string()),
+                        (false, SettingKind::Choice(names)) => names.first().copied().unwrap_or(word).to_string(),
+                    };
+                    commit = true;
+                }
+                if is_word {
+                    continue;
+                }
+            }
+            match key.kind {
+                SettingKind::Int { lo, hi } => match value.parse::<u32>() {
+                    Ok(mut v) => {
+                        let slider = Slider::new(&mut v, lo..=hi).text(key.key).logarithmic(hi / lo.max(1) > 64);
+                        let r = ui.add(slider).on_hover_text(key.help);
+                        *value = v.to_string();
+                        commit |= settled(&r);
+                    }
+                    Err(_) => drop(ui.label(format!("{} = {value}", key.key)).on_hover_text(key.help)),
+                },
+                SettingKind::Float { lo, hi } => match value.parse::<f32>() {
+                    Ok(mut v) => {
+                        let slider = Slider::new(&mut v, lo..=hi).text(key.key).logarithmic(lo > 0.0 && hi / lo > 64.0);
+                        let r = ui.add(slider).on_hover_text(key.help);
+                        *value = v.to_string();
+                        commit |= settled(&r);
+                    }
+                    Err(_) => drop(ui.label(format!("{} = {value}", key.key)).on_hover_text(key.help)),
+                },
+                SettingKind::Choice(names) => {
+                    ComboBox::from_label(key.key).selected_text(value.as_str()).show_ui(ui, |ui| {
+                        for &n in names {
+                            if ui.selectable_label(value == n, n).clicked() {
+                                *value = n.to_string();
+                                commit = true;
+                            }
+                        }
+                    });
+                }
+            }
+        }
+        if commit {
+            let values: Vec<String> = self.settings.iter().map(|(k, v)| format!("{k}={v}")).collect();
+            self.set_technique(&format!("{name}:{}", values.join(",")));
+        }
+    }
+
+    fn readouts(&mut self, ui: &mut egui::Ui) {
+        ui.label(format!("{:.1} frames a second", self.clock.fps()));
+        match (self.gpu_ms.back(), self.view.backend()) {
+            (Some(ms), BackendKind::Wgpu) => drop(ui.label(format!("GPU: {ms:.2} ms a frame"))),
+            (_, BackendKind::Wgpu) if !self.timed => drop(ui.small("the adapter has no timestamp queries")),
+            _ => {}
+        }
+        if self.view.backend() == BackendKind::Wgpu && self.gpu_ms.len() > 1 {
+            plot(ui, &self.gpu_ms);
+        }
+    }
+
+    fn next_screenshot(&mut self) {
+        self.screenshots += 1;
+        self.screenshot = Some(screenshot_path(self.screenshots));
+    }
+
+    fn reset_view(&mut self) {
+        (self.scene.orbit, self.scene.light) = self.scene.home;
+    }
+
+    /// The 3D view: draws the last frame's texture and takes the pointer and keys.
+    fn view_input(&mut self, ui: &mut egui::Ui) {
+        let (rect, response) = ui.allocate_exact_size(ui.available_size(), egui::Sense::click_and_drag());
+        let ppp = ui.ctx().pixels_per_point();
+        self.size = ((rect.width() * ppp).round().max(1.0) as u32, (rect.height() * ppp).round().max(1.0) as u32);
+        if let Some(id) = self.texture {
+            let uv = egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0));
+            ui.painter().image(id, rect, uv, Color32::WHITE);
+        }
+        let shift = ui.input(|i| i.modifiers.shift);
+        let d = response.drag_delta() * TURN_PER_PIXEL;
+        if response.dragged_by(PointerButton::Secondary) || (response.dragged_by(PointerButton::Primary) && shift) {
+            if let Some(rig) = &mut self.scene.light {
+                rig.turn(d.x, -d.y);
+            }
+        } else if response.dragged_by(PointerButton::Primary) {
+            self.scene.orbit.turn(-d.x, d.y);
+        }
+        if response.hovered() {
+            let scroll = ui.input(|i| i.smooth_scroll_delta.y);
+            if scroll != 0.0 {
+                self.scene.orbit.zoom((-scroll * 0.002).exp());
+            }
+        }
+        if ui.ctx().egui_wants_keyboard_input() {
+            return;
+        }
+        use egui::Key;
+        let (dt, down, pressed) = ui.input(|i| {
+            let down = |k: Key| if i.key_down(k) { 1.0 } else { 0.0 };
+            let axes = [
+                down(Key::W) - down(Key::S),
+                down(Key::D) - down(Key::A),
+                down(Key::E) - down(Key::Q),
+                down(Key::ArrowRight) - down(Key::ArrowLeft),
+                down(Key::ArrowUp) - down(Key::ArrowDown),
+            ];
+            (i.stable_dt.min(0.1), axes, [Key::R, Key::L, Key::P].map(|k| i.key_pressed(k)))
+        });
+        let speed = 0.5 * self.scene.orbit.distance * dt;
+        self.scene.orbit.fly(speed * down[0], speed * down[1], speed * down[2]);
+        if let Some(rig) = &mut self.scene.light {
+            rig.turn(LIGHT_TURN_RATE * dt * down[3], LIGHT_TURN_RATE * dt * down[4]);
+        }
+        if pressed[0] {
+            self.reset_view();
+        }
+        if pressed[1] {
+            self.animate = !self.animate;
+        }
+        if pressed[2] {
+            self.next_screenshot();
+        }
+        if down.iter().any(|&a| a != 0.0) || self.animate {
+            ui.ctx().request_repaint();
+        }
+    }
+
+    /// The `shadowlab render` command that draws this view offline: the scene, the camera and first
+    /// light as they are now (the light by position and aim; its colour, cone and radius are the
+    /// scene's), the technique with its settings, the backend and the view's size.
+    pub(super) fn command(&self) -> String {
+        let setup = &self.scene.setup;
+        let frame = self.scene.frame();
+        let v = |p: Vec3| format!("{},{},{}", p.x, p.y, p.z);
+        let mut words = vec!["shadowlab render --scene".to_string(), quoted(&setup.source)];
+        if !setup.ground {
+            words.push("--ground none".into());
+        }
+        if setup.params.seed != 1 {
+            words.push(format!("--seed {}", setup.params.seed));
+        }
+        if setup.file_access == shadow_core::assets::FileAccess::Anywhere {
+            words.push("--allow-outside-files".into());
+        }
+        let c = frame.camera;
+        words.push(format!("--camera eye={},target={},fov={}", v(c.eye), v(c.target), c.fov_y.to_degrees()));
+        if let Some(light) = frame.lights.first() {
+            let text = match light.kind {
+                LightKind::Spot { position, direction, .. } => {
+                    format!("spot,pos={},target={}", v(position), v(position + direction))
+                }
+                LightKind::Point { position } => format!("point,pos={}", v(position)),
+                LightKind::Directional { direction } => format!("directional,pos={},target=0,0,0", v(-direction)),
+            };
+            words.push(format!("--light {text}"));
+        }
+        let spec = self.view.technique();
+        let settings = self.registry.canonical(spec).unwrap_or_default();
+        let spec = if settings.is_empty() { spec.name.clone() } else { format!("{}:{settings}", spec.name) };
+        words.push(format!("--technique {}", quoted(&spec)));
+        words.push(format!(
+            "--backend {} --size {}x{} --out view.png",
+            self.view.backend().name(),
+            self.size.0,
+            self.size.1
+        ));
+        words.join(" ")
+    }
+}
+
+/// `text` as one shell word.
+fn quoted(text: &str) -> String {
+    let plain = |c: char| c.is_ascii_alphanumeric() || "._/-:=,+".contains(c);
+    if !text.is_empty() && text.chars().all(plain) { text.into() } else { format!("'{}'", text.replace('\'', r"'\''")) }
+}
+
+/// A small line plot of `values`, scaled to their largest.
+fn plot(ui: &mut egui::Ui, values: &VecDeque<f64>) {
+    let (rect, _) = ui.allocate_exact_size(egui::vec2(ui.available_width(), 48.0), egui::Sense::hover());
+    let top = values.iter().copied().fold(f64::MIN_POSITIVE, f64::max);
+    let step = rect.width() / (PLOTTED - 1) as f32;
+    let points = values
+        .iter()
+        .enumerate()
+        .map(|(i, v)| egui::pos2(rect.left() + i as f32 * step, rect.bottom() - (v / top) as f32 * rect.height()))
+        .collect();
+    let painter = ui.painter_at(rect);
+    painter.rect_filled(rect, 2.0, ui.visuals().extreme_bg_color);
+    painter.add(egui::Shape::line(points, egui::Stroke::new(1.0, Color32::LIGHT_GREEN)));
+    painter.text(
+        rect.left_top(),
+        egui::Align2::LEFT_TOP,
+        format!("{top:.2} ms"),
+        egui::FontId::monospace(10.0),
+        Color32::GRAY,
+    );
+}

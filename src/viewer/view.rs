@@ -1,0 +1,190 @@
+//! The 3D view: the scene rendered at the size the UI gives it, into a texture the UI draws. On wgpu the
+//! frame is recorded into the viewer's own encoder through the real-time path (no waits, no read-backs:
+//! the texture is drawn by the same submission); on the CPU backend it is rendered there and uploaded.
+
+use shadow_core::image::Rgb8;
+use shadow_core::technique::TechniqueSpec;
+use shadow_core::{FrameInputs, Image};
+use shadow_wgpu::ColorTarget;
+
+use crate::realtime::RealtimeShadows;
+use crate::renderer::Prepared;
+use crate::{BackendKind, Error, Renderer, TechniqueRegistry};
+
+/// The view texture's format: egui draws a texture of its own as sRGB-encoded bytes in an Rgba8Unorm
+/// one, and the shading pass encodes sRGB itself into a target that does not.
+const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+
+/// The viewer's device, as winit's surface needs it.
+pub struct Gpu {
+    /// The adapter.
+    pub adapter: wgpu::Adapter,
+    /// The device.
+    pub device: wgpu::Device,
+    /// Its queue.
+    pub queue: wgpu::Queue,
+}
+
+/// The wgpu view texture, registered with egui's renderer.
+struct Target {
+    texture: wgpu::Texture,
+    id: egui::TextureId,
+}
+
+/// The CPU backend's side: its renderer, the technique on it, and the last frame.
+struct CpuSide {
+    renderer: Renderer,
+    technique: Prepared,
+    image: Option<Image<Rgb8>>,
+    texture: Option<egui::TextureHandle>,
+}
+
+/// The 3D view on either backend.
+pub struct View {
+    shadows: RealtimeShadows,
+    target: Option<Target>,
+    cpu: Option<CpuSide>,
+    backend: BackendKind,
+}
+
+impl View {
+    /// The view on `gpu`'s device with the technique of `spec`, drawing on `backend`.
+    ///
+    /// # Errors
+    /// A device shadowlab cannot use, or a spec the registry refuses.
+    pub fn new(gpu: &Gpu, spec: &str, backend: BackendKind) -> Result<Self, Error> {
+        let registry = TechniqueRegistry::builtin();
+        let shadows = RealtimeShadows::new(&gpu.adapter, gpu.device.clone(), gpu.queue.clone(), registry, spec)?;
+        let mut view = Self { shadows, target: None, cpu: None, backend: BackendKind::Wgpu };
+        view.set_backend(backend)?;
+        Ok(view)
+    }
+
+    /// The backend drawing the view.
+    #[must_use]
+    pub fn backend(&self) -> BackendKind {
+        self.backend
+    }
+
+    /// The technique's spec.
+    #[must_use]
+    pub fn technique(&self) -> &TechniqueSpec {
+        self.shadows.technique()
+    }
+
+    /// The adapter the wgpu backend draws on.
+    #[must_use]
+    pub fn adapter(&self) -> String {
+        let a = &self.shadows.context().adapter;
+        format!("{} ({})", a.name, a.backend)
+    }
+
+    /// Draws with `backend` from the next frame on; on an error the backend stays.
+    ///
+    /// # Errors
+    /// The technique has no side on that backend.
+    pub fn set_backend(&mut self, backend: BackendKind) -> Result<(), Error> {
+        if backend == BackendKind::Cpu && self.cpu.is_none() {
+            let renderer = Renderer::new(TechniqueRegistry::builtin());
+            let technique = renderer.prepare(BackendKind::Cpu, self.shadows.technique())?;
+            self.cpu = Some(CpuSide { renderer, technique, image: None, texture: None });
+        }
+        self.backend = backend;
+        Ok(())
+    }
+
+    /// Switches both backends to the technique of `spec`; on an error the current one stays.
+    ///
+    /// # Errors
+    /// A spec the registry refuses on either backend.
+    pub fn set_technique(&mut self, spec: &str) -> Result<(), Error> {
+        let parsed = TechniqueSpec::parse(spec)?;
+        if let Some(cpu) = &mut self.cpu {
+            let technique = cpu.renderer.prepare(BackendKind::Cpu, &parsed)?;
+            self.shadows.set_technique(spec)?;
+            cpu.technique = technique;
+        } else {
+            self.shadows.set_technique(spec)?;
+        }
+        Ok(())
+    }
+
+    /// Forgets every light's last build (after the scene changed under the technique).
+    pub fn invalidate(&mut self) {
+        self.shadows.invalidate();
+    }
+
+    /// Times the wgpu frames on the GPU (where the adapter has timestamps); see [`Self::gpu_ms`].
+    pub fn time_frames(&mut self) -> bool {
+        self.shadows.time_frames(true)
+    }
+
+    /// The GPU time of a recent wgpu frame, in milliseconds.
+    #[must_use]
+    pub fn gpu_ms(&self) -> Option<f64> {
+        self.shadows.gpu_ms()
+    }
+
+    /// Draws `frame` at `width x height` and returns the texture egui shows: on wgpu recorded into
+    /// `encoder` (submitted by the caller before egui's pass reads it, in the same submission), on the CPU
+    /// rendered now and uploaded through `ui`.
+    ///
+    /// # Errors
+    /// The frame's rendering failed (a technique refusing the light, say).
+    pub fn draw(
+        &mut self,
+        (gpu, egui_renderer, ui): (&Gpu, &mut egui_wgpu::Renderer, &egui::Context),
+        encoder: &mut wgpu::CommandEncoder,
+        frame: &FrameInputs,
+        (width, height): (u32, u32),
+    ) -> Result<egui::TextureId, Error> {
+        match (self.backend, &mut self.cpu) {
+            (BackendKind::Cpu, Some(cpu)) => {
+                let run = cpu.renderer.run_prepared(&mut cpu.technique, frame, width, height)?;
+                let pixels: Vec<u8> = run.color.data().iter().flatten().copied().collect();
+                let image = egui::ColorImage::from_rgb([width as usize, height as usize], &pixels);
+                let options = egui::TextureOptions::NEAREST;
+                let texture = cpu.texture.get_or_insert_with(|| ui.load_texture("cpu view", image.clone(), options));
+                texture.set(image, options);
+                cpu.image = Some(run.color);
+                Ok(texture.id())
+            }
+            _ => {
+                let fits = |t: &Target| t.texture.width() == width && t.texture.height() == height;
+                if !self.target.as_ref().is_some_and(fits) {
+                    let texture = shadow_wgpu::frame::layered(self.shadows.context(), "view", width, height, 1, FORMAT);
+                    let view = texture.create_view(&Default::default());
+                    let nearest = wgpu::FilterMode::Nearest;
+                    let id = match self.target.take() {
+                        Some(old) => {
+                            egui_renderer.update_egui_texture_from_wgpu_texture(&gpu.device, &view, nearest, old.id);
+                            old.id
+                        }
+                        None => egui_renderer.register_native_texture(&gpu.device, &view, nearest),
+                    };
+                    self.target = Some(Target { texture, id });
+                }
+                let target = self.target.as_ref().expect("made above");
+                let view = target.texture.create_view(&Default::default());
+                let color = ColorTarget { view: &view, format: FORMAT, width, height };
+                self.shadows.record(encoder, frame, &color)?;
+                Ok(target.id)
+            }
+        }
+    }
+
+    /// The last frame drawn, read back from the GPU (after its submission) or as the CPU drew it.
+    ///
+    /// # Errors
+    /// No frame drawn yet, or the read-back failed.
+    pub fn screenshot(&self) -> Result<Image<Rgb8>, Error> {
+        let none = || Error::Usage("no frame drawn yet".into());
+        match (self.backend, &self.cpu) {
+            (BackendKind::Cpu, Some(cpu)) => cpu.image.clone().ok_or_else(none),
+            _ => {
+                let target = self.target.as_ref().ok_or_else(none)?;
+                Ok(shadow_wgpu::readback::read_rgb8(self.shadows.context(), &target.texture)?)
+            }
+        }
+    }
+}
