@@ -110,6 +110,13 @@ impl Viewer {
             Step::Wait(n) => self.wait = n,
             Step::Screenshot(path) => self.screenshot = Some(path),
             Step::Command => println!("{}", self.command()),
+            Step::Memory => {
+                let m = self.view.memory();
+                println!(
+                    "gpu memory: {} buffers, {} buffer bytes, {} texture bytes",
+                    m.buffers, m.buffer_bytes, m.texture_bytes
+                );
+            }
             Step::Quit => self.quit = true,
         }
     }
@@ -368,6 +375,7 @@ impl Viewer {
         if self.view.backend() == BackendKind::Wgpu && self.gpu_ms.len() > 1 {
             plot(ui, &self.gpu_ms);
         }
+        ui.small(format!("on the GPU: {}", self.view.memory()));
     }
 
     fn next_screenshot(&mut self) {
@@ -486,13 +494,16 @@ fn quoted(text: &str) -> String {
     if !text.is_empty() && text.chars().all(plain) { text.into() } else { format!("'{}'", text.replace('\'', r"'\''")) }
 }
 
-/// A small line plot of `values`, scaled to their largest.
+/// A small rolling line plot of the last [`PLOTTED`] `values`, the newest at the right, scaled to their
+/// largest (always as many points, the missing ones at zero, so the UI's geometry does not grow as the
+/// history fills).
 fn plot(ui: &mut egui::Ui, values: &VecDeque<f64>) {
     let (rect, _) = ui.allocate_exact_size(egui::vec2(ui.available_width(), 48.0), egui::Sense::hover());
     let top = values.iter().copied().fold(f64::MIN_POSITIVE, f64::max);
     let step = rect.width() / (PLOTTED - 1) as f32;
-    let points = values
-        .iter()
+    let missing = PLOTTED.saturating_sub(values.len());
+    let padded = std::iter::repeat_n(0.0, missing).chain(values.iter().copied());
+    let points = padded
         .enumerate()
         .map(|(i, v)| egui::pos2(rect.left() + i as f32 * step, rect.bottom() - (v / top) as f32 * rect.height()))
         .collect();

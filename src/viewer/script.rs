@@ -4,10 +4,13 @@
 //! A script is steps separated by `;` or new lines:
 //! `orbit YAW PITCH` and `light YAW PITCH` turn the camera or the light (degrees), `zoom FACTOR`,
 //! `fly FORWARD RIGHT UP` (scene units), `technique SPEC`, `backend wgpu|cpu`, `scene NAME|FILE`,
-//! `wait FRAMES`, `screenshot FILE.png`, `command` (prints the `shadowlab render` command of the view) and
-//! `quit`.
+//! `wait FRAMES`, `screenshot FILE.png`, `command` (prints the `shadowlab render` command of the view),
+//! `memory` (prints the buffers and textures alive on the device) and `quit`.
 
 use std::path::PathBuf;
+
+/// Every step's verb.
+const STEPS: &str = "orbit, light, zoom, fly, technique, backend, scene, wait, screenshot, command, memory, quit";
 
 /// One step.
 #[derive(Clone, Debug, PartialEq)]
@@ -32,6 +35,8 @@ pub enum Step {
     Screenshot(PathBuf),
     /// Print the `shadowlab render` command of the view.
     Command,
+    /// Print the buffers and textures alive on the device.
+    Memory,
     /// Close the viewer.
     Quit,
 }
@@ -73,14 +78,10 @@ fn step(text: &str) -> Result<Step, String> {
         "wait" => Step::Wait(rest.parse().map_err(|_| format!("'{rest}' is not a frame count"))?),
         "screenshot" => Step::Screenshot(word()?.into()),
         "command" if rest.is_empty() => Step::Command,
+        "memory" if rest.is_empty() => Step::Memory,
         "quit" if rest.is_empty() => Step::Quit,
-        "command" | "quit" => return Err("takes nothing".into()),
-        _ => {
-            return Err(
-                "unknown step (orbit, light, zoom, fly, technique, backend, scene, wait, screenshot, command, quit)"
-                    .into(),
-            );
-        }
+        "command" | "memory" | "quit" => return Err("takes nothing".into()),
+        _ => return Err(format!("unknown step ({STEPS})")),
     })
 }
 

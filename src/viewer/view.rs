@@ -15,6 +15,30 @@ use crate::{BackendKind, Error, Renderer, TechniqueRegistry};
 /// one, and the shading pass encodes sRGB itself into a target that does not.
 const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 
+/// What is alive on the device (see [`View::memory`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct GpuMemory {
+    /// Buffers.
+    pub buffers: u64,
+    /// Their bytes.
+    pub buffer_bytes: u64,
+    /// The bytes of the textures (wgpu counts their memory on every backend, their number not).
+    pub texture_bytes: u64,
+}
+
+impl std::fmt::Display for GpuMemory {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let mb = |b: u64| b as f64 / 1e6;
+        write!(
+            f,
+            "{} buffers ({:.1} MB), textures {:.1} MB",
+            self.buffers,
+            mb(self.buffer_bytes),
+            mb(self.texture_bytes)
+        )
+    }
+}
+
 /// The viewer's device, as winit's surface needs it.
 pub struct Gpu {
     /// The adapter.
@@ -112,6 +136,19 @@ impl View {
     /// Forgets every light's last build (after the scene changed under the technique).
     pub fn invalidate(&mut self) {
         self.shadows.invalidate();
+    }
+
+    /// The buffers and textures alive on the device and their bytes, as wgpu counts them (the 3D view's,
+    /// the UI's and every technique's).
+    #[must_use]
+    pub fn memory(&self) -> GpuMemory {
+        let hal = self.shadows.context().device.get_internal_counters().hal;
+        let count = |c: &wgpu::wgt::InternalCounter| u64::try_from(c.read()).unwrap_or(0);
+        GpuMemory {
+            buffers: count(&hal.buffers),
+            buffer_bytes: count(&hal.buffer_memory),
+            texture_bytes: count(&hal.texture_memory),
+        }
     }
 
     /// Times the wgpu frames on the GPU (where the adapter has timestamps); see [`Self::gpu_ms`].

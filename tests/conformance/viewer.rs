@@ -1,8 +1,12 @@
-//! `shadowlab view` under a virtual display (xvfb-run): a script turns the camera and the light, zooms,
-//! switches the technique and then the backend, writing a screenshot and printing the `render` command
-//! of the view after each; every screenshot matches what that command renders offline within the
-//! suite's cross-backend FLIP bound, and shows the moved view, not the scene's own. Without xvfb-run or
-//! a wgpu adapter this prints one line and passes, unless SHADOWLAB_REQUIRE_GPU=1.
+//! `shadowlab view` under a virtual display (xvfb-run), driven by scripts:
+//! - turning the camera and the light, zooming, switching the technique and then the backend, with a bad
+//!   model file opened between: every screenshot matches what the printed `render` command of the view
+//!   renders offline within the suite's cross-backend FLIP bound and shows the moved view, not the
+//!   scene's own; the bad file's one-line error is shown and the viewer goes on;
+//! - a hundred switches of technique, setting and backend leave as many buffers and bytes alive on the
+//!   device as the first two rounds of them did (the first frames still free what they replaced).
+//!
+//! Without xvfb-run or a wgpu adapter this prints one line and passes, unless SHADOWLAB_REQUIRE_GPU=1.
 
 use std::path::Path;
 use std::process::Command;
@@ -22,34 +26,50 @@ fn flip(a: &Image<Rgb8>, b: &Image<Rgb8>) -> f64 {
     flip_mean(a, b, &Image::new(a.width(), a.height(), true)).expect("same size")
 }
 
-#[test]
-fn a_scripted_view_matches_its_render_command_on_both_backends() {
-    if crate::with_wgpu("the viewer").is_none() {
-        return;
+/// Whether the viewer can be tested here: a wgpu adapter and xvfb-run (`what` names the test skipped).
+fn can_view(what: &str) -> bool {
+    if crate::with_wgpu(what).is_none() {
+        return false;
     }
     if Command::new("xvfb-run").arg("--help").output().is_err() {
         let require = std::env::var("SHADOWLAB_REQUIRE_GPU").is_ok_and(|v| v == "1");
-        assert!(!require, "SHADOWLAB_REQUIRE_GPU=1 but xvfb-run is missing (apt-get install xvfb)");
-        eprintln!("the viewer skipped: no xvfb-run");
+        assert!(!require, "SHADOWLAB_REQUIRE_GPU=1 but xvfb-run is missing (apt-get install xvfb xauth)");
+        eprintln!("{what} skipped: no xvfb-run");
+        return false;
+    }
+    true
+}
+
+/// Runs `shadowlab view` on `scene` with `script` under a virtual display; its standard output and error.
+fn view(scene: &str, size: &str, script: &str) -> (String, String) {
+    let out = Command::new("xvfb-run")
+        .args(["-a", "-s", "-screen 0 1024x768x24", env!("CARGO_BIN_EXE_shadowlab")])
+        .args(["view", "--scene", scene, "--size", size, "--script", script])
+        .output()
+        .expect("xvfb-run runs");
+    let (stdout, stderr) = (String::from_utf8_lossy(&out.stdout).into(), String::from_utf8_lossy(&out.stderr).into());
+    assert!(out.status.success(), "the viewer failed: {stderr}");
+    (stdout, stderr)
+}
+
+#[test]
+fn a_scripted_view_matches_its_render_command_on_both_backends() {
+    if !can_view("the scripted view") {
         return;
     }
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("viewer");
     std::fs::create_dir_all(&dir).expect("a folder");
     let shot = |n: u32| dir.join(format!("view-{n}.png"));
+    let bad = Path::new(env!("CARGO_MANIFEST_DIR")).join("shadow-core/tests/data/bad/nan_position.obj");
     let script = format!(
         "wait 2; orbit 35 -8; light 50 10; zoom 0.85; technique pcss:res=2048; wait 2; screenshot {}; \
-         command; backend cpu; technique shadow-volume-zfail; wait 1; screenshot {}; command; quit",
+         command; scene {}; backend cpu; technique shadow-volume-zfail; wait 1; screenshot {}; command; quit",
         shot(1).display(),
+        bad.display(),
         shot(2).display()
     );
-    let out = Command::new("xvfb-run")
-        .args(["-a", "-s", "-screen 0 1024x768x24", env!("CARGO_BIN_EXE_shadowlab")])
-        .args(["view", "--scene", "cubes", "--size", "720x480", "--script", &script])
-        .output()
-        .expect("xvfb-run runs");
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "the viewer failed: {stderr}");
-    let stdout = String::from_utf8_lossy(&out.stdout);
+    let (stdout, stderr) = view("cubes", "720x480", &script);
+    assert!(stderr.lines().any(|l| l.contains("nan_position.obj")), "the bad file's error: {stderr}");
     let commands: Vec<&str> = stdout.lines().filter(|l| l.starts_with("shadowlab render ")).collect();
     assert_eq!(commands.len(), 2, "{stdout}\n{stderr}");
     for (n, command) in (1..).zip(commands) {
@@ -95,4 +115,21 @@ fn a_scripted_view_matches_its_render_command_on_both_backends() {
         let own = Image::<Rgb8>::load_png(&own).expect("the render");
         assert!(flip(&viewed, &own) > 5.0 * MAX_FLIP, "screenshot {n} shows the scene's own view");
     }
+}
+
+#[test]
+fn a_hundred_switches_leave_no_more_alive_on_the_device_than_the_first_two_rounds() {
+    if !can_view("the viewer's switches") {
+        return;
+    }
+    // One round: four switches (technique, setting, backend there and back with another technique).
+    let round = "technique shadow-volume-zfail; wait 1; technique shadow-volume-zfail:extrusion=cpu; wait 1; \
+                 backend cpu; wait 1; backend wgpu; technique shadow-map; wait 3";
+    let rounds = |n| std::iter::repeat_n(round, n).collect::<Vec<_>>().join("; ");
+    let script = format!("wait 1; {}; memory; {}; memory; quit", rounds(2), rounds(23));
+    let (stdout, stderr) = view("primitives", "400x300", &script);
+    let memory: Vec<&str> = stdout.lines().filter(|l| l.starts_with("gpu memory: ")).collect();
+    assert_eq!(memory.len(), 2, "{stdout}\n{stderr}");
+    assert_eq!(memory[0], memory[1], "after two rounds and after 25");
+    assert!(!stderr.contains("error"), "{stderr}");
 }
