@@ -5,6 +5,7 @@
 //! that shadowlab's shadows share ([`crate::realtime::RealtimeShadows`] on the viewer's device). The 3D
 //! view is a texture the UI draws ([`view::View`]); a script ([`script`]) can stand in for the user.
 
+mod overlay;
 mod panel;
 pub mod rig;
 pub mod script;
@@ -217,7 +218,7 @@ impl Open {
         for id in &out.textures_delta.free {
             self.painter.free_texture(id);
         }
-        self.viewer.after_submit();
+        self.viewer.after_submit(&context);
         self.window.pre_present_notify();
         self.gpu.queue.present(output);
         Ok(!self.viewer.quitting())

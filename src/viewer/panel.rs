@@ -6,12 +6,13 @@ use std::collections::VecDeque;
 use std::path::PathBuf;
 
 use egui::{Color32, ComboBox, PointerButton, Slider};
-use shadow_core::LightKind;
 use shadow_core::glam::Vec3;
 use shadow_core::scenes;
 use shadow_core::technique::settings::SettingKind;
 use shadow_core::technique::settings::key_values;
+use shadow_core::{FrameInputs, LightKind};
 
+use super::overlay::{Overlay, ViewKey};
 use super::script::Step;
 use super::view::{Gpu, View};
 use super::{FrameClock, Scene, screenshot_path};
@@ -22,6 +23,8 @@ use crate::{BackendKind, TechniqueRegistry};
 const TURN_PER_PIXEL: f32 = 0.008;
 /// Radians a second the turning light moves, and the arrow keys move it.
 const LIGHT_TURN_RATE: f32 = 0.6;
+/// The side panel's width in points.
+const PANEL_WIDTH: f32 = 330.0;
 /// GPU times kept for the plot.
 const PLOTTED: usize = 240;
 
@@ -36,9 +39,14 @@ pub(super) struct Viewer {
     wait: u32,
     quit: bool,
     animate: bool,
-    /// The view's size in pixels as the UI laid it out, and as it was last drawn.
+    /// The view's size in pixels as the UI laid it out.
     size: (u32, u32),
-    drawn: (u32, u32),
+    /// The last frame drawn, and what it depends on.
+    drawn: Option<(ViewKey, FrameInputs)>,
+    /// What is laid over the view, and whether a comparison waits for the next frame drawn.
+    overlay: Option<Overlay>,
+    compare_asked: bool,
+    debug_asked: bool,
     texture: Option<egui::TextureId>,
     screenshot: Option<PathBuf>,
     screenshots: u32,
@@ -64,7 +72,10 @@ impl Viewer {
             quit: false,
             animate: false,
             size: (640, 480),
-            drawn: (0, 0),
+            drawn: None,
+            overlay: None,
+            compare_asked: false,
+            debug_asked: false,
             texture: None,
             screenshot: None,
             screenshots: 0,
@@ -89,8 +100,12 @@ impl Viewer {
             self.wait -= 1;
             return;
         }
-        // A screenshot asked for is taken before the next step changes the view.
-        if self.screenshot.is_some() {
+        // A screenshot or a comparison asked for is made before the next step changes the view.
+        if self.screenshot.is_some()
+            || self.compare_asked
+            || self.debug_asked
+            || matches!(self.overlay, Some(Overlay::Computing { .. }))
+        {
             return;
         }
         let Some(step) = self.script.pop_front() else { return };
@@ -117,6 +132,8 @@ impl Viewer {
                     m.buffers, m.buffer_bytes, m.texture_bytes
                 );
             }
+            Step::Compare => self.compare_asked = true,
+            Step::Debug => self.debug_asked = true,
             Step::Quit => self.quit = true,
         }
     }
@@ -134,10 +151,27 @@ impl Viewer {
             }
         }
         let frame = self.scene.frame();
+        let key = self.key(&frame);
+        // An overlay shows the view it was made for only.
+        if self.overlay.as_ref().is_some_and(|o| *o.key() != key) {
+            self.overlay = None;
+        }
+        if let Some(overlay) = self.overlay.take() {
+            let computing = matches!(overlay, Overlay::Computing { .. });
+            match overlay.poll(painter.2) {
+                Ok(o) => {
+                    if let (true, Overlay::Errors { mismatch, false_shadow, false_light, .. }) = (computing, &o) {
+                        self.say(mismatch_line(*mismatch, *false_shadow, *false_light));
+                    }
+                    self.overlay = Some(o);
+                }
+                Err(e) => self.fail(format!("the reference: {e}")),
+            }
+        }
         match self.view.draw(painter, encoder, &frame, self.size) {
             Ok(id) => {
                 self.texture = Some(id);
-                self.drawn = self.size;
+                self.drawn = Some((key, frame));
             }
             Err(e) => self.fail(e.to_string()),
         }
@@ -152,9 +186,25 @@ impl Viewer {
 
     /// Takes an asked-for screenshot of the frame just submitted, once the view is drawn at the size the
     /// UI gives it.
-    pub(super) fn after_submit(&mut self) {
-        if self.drawn != self.size {
+    pub(super) fn after_submit(&mut self, ui: &egui::Context) {
+        let Some((key, frame)) = self.drawn.as_ref().filter(|(key, _)| key.size == self.size) else { return };
+        if std::mem::take(&mut self.debug_asked) {
+            match self.view.debug_views(frame, key.size) {
+                Ok(views) if views.is_empty() => self.say(format!("{} has no debug views", key.technique)),
+                Ok(views) => self.overlay = Some(Overlay::debug(key.clone(), views, ui)),
+                Err(e) => self.fail(e.to_string()),
+            }
             return;
+        }
+        if std::mem::take(&mut self.compare_asked) {
+            let soft = self.registry.get(&self.view.technique().name).is_ok_and(|e| e.soft);
+            match self.view.visibility().and_then(|v| Ok((v, self.view.screenshot()?))) {
+                Ok((test, picture)) => {
+                    self.overlay = Some(Overlay::compare(key.clone(), frame.clone(), soft, test, picture));
+                    self.say("computing the reference for this view".into());
+                }
+                Err(e) => self.fail(e.to_string()),
+            }
         }
         let Some(path) = self.screenshot.take() else { return };
         let written = self.view.screenshot().and_then(|image| {
@@ -173,6 +223,18 @@ impl Viewer {
     fn say(&mut self, message: String) {
         eprintln!("{message}");
         self.status = Some(message);
+    }
+
+    /// What the picture of `frame` depends on.
+    fn key(&self, frame: &FrameInputs) -> ViewKey {
+        ViewKey {
+            scene: self.scene.setup.source.clone(),
+            camera: frame.camera,
+            lights: frame.lights.clone(),
+            technique: self.view.technique().to_string(),
+            backend: self.view.backend(),
+            size: self.size,
+        }
     }
 
     /// Shows `message` as the error line (and prints it once).
@@ -219,7 +281,9 @@ impl Viewer {
 
     /// The whole UI: the side panel and the 3D view.
     pub(super) fn ui(&mut self, ui: &mut egui::Ui) {
-        egui::Panel::left("controls").default_size(300.0).show(ui, |ui| {
+        // A panel of a fixed width: one that grew with its text would resize the view, which clears its
+        // overlay.
+        egui::Panel::left("controls").exact_size(PANEL_WIDTH).resizable(false).show(ui, |ui| {
             egui::ScrollArea::vertical().show(ui, |ui| self.panel(ui));
         });
         egui::CentralPanel::no_frame().show(ui, |ui| self.view_input(ui));
@@ -247,9 +311,11 @@ impl Viewer {
             self.reset_view();
         }
         ui.separator();
+        self.overlay_controls(ui);
+        ui.separator();
         self.readouts(ui);
         ui.separator();
-        ui.horizontal(|ui| {
+        ui.horizontal_wrapped(|ui| {
             if ui.button("Screenshot (P)").clicked() {
                 self.next_screenshot();
             }
@@ -378,6 +444,35 @@ impl Viewer {
         ui.small(format!("on the GPU: {}", self.view.memory()));
     }
 
+    fn overlay_controls(&mut self, ui: &mut egui::Ui) {
+        ui.horizontal_wrapped(|ui| {
+            if ui.button("Compare with reference").on_hover_text("false shadow red, false light blue").clicked() {
+                self.compare_asked = true;
+            }
+            if ui.button("Debug views").clicked() {
+                self.debug_asked = true;
+            }
+            if self.overlay.is_some() && ui.button("Clear").clicked() {
+                self.overlay = None;
+            }
+        });
+        match &mut self.overlay {
+            Some(Overlay::Computing { .. }) => drop(ui.label("computing the reference...")),
+            Some(Overlay::Errors { mismatch, false_shadow, false_light, .. }) => {
+                ui.label(mismatch_line(*mismatch, *false_shadow, *false_light));
+            }
+            Some(Overlay::Debug { views, shown, .. }) => {
+                let names: Vec<String> = views.iter().map(|(n, _)| n.clone()).collect();
+                ComboBox::from_label("debug view").selected_text(&names[*shown]).show_ui(ui, |ui| {
+                    for (i, n) in names.iter().enumerate() {
+                        ui.selectable_value(shown, i, n);
+                    }
+                });
+            }
+            None => {}
+        }
+    }
+
     fn next_screenshot(&mut self) {
         self.screenshots += 1;
         self.screenshot = Some(screenshot_path(self.screenshots));
@@ -392,9 +487,24 @@ impl Viewer {
         let (rect, response) = ui.allocate_exact_size(ui.available_size(), egui::Sense::click_and_drag());
         let ppp = ui.ctx().pixels_per_point();
         self.size = ((rect.width() * ppp).round().max(1.0) as u32, (rect.height() * ppp).round().max(1.0) as u32);
+        let uv = egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0));
         if let Some(id) = self.texture {
-            let uv = egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0));
             ui.painter().image(id, rect, uv, Color32::WHITE);
+        }
+        match &self.overlay {
+            Some(Overlay::Errors { texture, .. }) => {
+                ui.painter().image(texture.id(), rect, uv, Color32::WHITE);
+            }
+            Some(Overlay::Debug { views, shown, .. }) => {
+                // A debug view keeps its own aspect, centred over the view.
+                let texture = &views[*shown].1;
+                let [w, h] = texture.size().map(|s| s as f32);
+                let scale = (rect.width() / w).min(rect.height() / h);
+                let at = egui::Rect::from_center_size(rect.center(), egui::vec2(w, h) * scale);
+                ui.painter().rect_filled(rect, 0.0, Color32::from_black_alpha(200));
+                ui.painter().image(texture.id(), at, uv, Color32::WHITE);
+            }
+            _ => {}
         }
         let shift = ui.input(|i| i.modifiers.shift);
         let d = response.drag_delta() * TURN_PER_PIXEL;
@@ -486,6 +596,17 @@ impl Viewer {
         ));
         words.join(" ")
     }
+}
+
+/// The comparison's numbers, as the panel and the script print them.
+fn mismatch_line(mismatch: f64, false_shadow: f64, false_light: f64) -> String {
+    let pc = |f: f64| 100.0 * f;
+    format!(
+        "mismatch {:.2}% (false shadow {:.2}%, false light {:.2}%)",
+        pc(mismatch),
+        pc(false_shadow),
+        pc(false_light)
+    )
 }
 
 /// `text` as one shell word.

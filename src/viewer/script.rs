@@ -5,12 +5,15 @@
 //! `orbit YAW PITCH` and `light YAW PITCH` turn the camera or the light (degrees), `zoom FACTOR`,
 //! `fly FORWARD RIGHT UP` (scene units), `technique SPEC`, `backend wgpu|cpu`, `scene NAME|FILE`,
 //! `wait FRAMES`, `screenshot FILE.png`, `command` (prints the `shadowlab render` command of the view),
-//! `memory` (prints the buffers and textures alive on the device) and `quit`.
+//! `memory` (prints the buffers and textures alive on the device), `compare` (compares the view with the
+//! reference and prints the mismatch; the script waits for it), `debug` (lays the technique's first debug
+//! view over the view) and `quit`.
 
 use std::path::PathBuf;
 
 /// Every step's verb.
-const STEPS: &str = "orbit, light, zoom, fly, technique, backend, scene, wait, screenshot, command, memory, quit";
+const STEPS: &str =
+    "orbit, light, zoom, fly, technique, backend, scene, wait, screenshot, command, memory, compare, debug, quit";
 
 /// One step.
 #[derive(Clone, Debug, PartialEq)]
@@ -37,6 +40,10 @@ pub enum Step {
     Command,
     /// Print the buffers and textures alive on the device.
     Memory,
+    /// Compare the view with its reference and print the mismatch.
+    Compare,
+    /// Show the technique's debug views.
+    Debug,
     /// Close the viewer.
     Quit,
 }
@@ -79,8 +86,10 @@ fn step(text: &str) -> Result<Step, String> {
         "screenshot" => Step::Screenshot(word()?.into()),
         "command" if rest.is_empty() => Step::Command,
         "memory" if rest.is_empty() => Step::Memory,
+        "compare" if rest.is_empty() => Step::Compare,
+        "debug" if rest.is_empty() => Step::Debug,
         "quit" if rest.is_empty() => Step::Quit,
-        "command" | "memory" | "quit" => return Err("takes nothing".into()),
+        "command" | "memory" | "compare" | "debug" | "quit" => return Err("takes nothing".into()),
         _ => return Err(format!("unknown step ({STEPS})")),
     })
 }

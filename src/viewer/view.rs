@@ -3,12 +3,12 @@
 //! the texture is drawn by the same submission); on the CPU backend it is rendered there and uploaded.
 
 use shadow_core::image::Rgb8;
-use shadow_core::technique::TechniqueSpec;
+use shadow_core::technique::{DebugView, TechniqueSpec};
 use shadow_core::{FrameInputs, Image};
 use shadow_wgpu::ColorTarget;
 
 use crate::realtime::RealtimeShadows;
-use crate::renderer::Prepared;
+use crate::renderer::{Prepared, RunOutput};
 use crate::{BackendKind, Error, Renderer, TechniqueRegistry};
 
 /// The view texture's format: egui draws a texture of its own as sRGB-encoded bytes in an Rgba8Unorm
@@ -59,7 +59,7 @@ struct Target {
 struct CpuSide {
     renderer: Renderer,
     technique: Prepared,
-    image: Option<Image<Rgb8>>,
+    last: Option<RunOutput>,
     texture: Option<egui::TextureHandle>,
 }
 
@@ -69,6 +69,8 @@ pub struct View {
     target: Option<Target>,
     cpu: Option<CpuSide>,
     backend: BackendKind,
+    /// The instrumented wgpu path (a device of its own), made when debug views are first asked for.
+    instrumented: Option<Renderer>,
 }
 
 impl View {
@@ -79,7 +81,7 @@ impl View {
     pub fn new(gpu: &Gpu, spec: &str, backend: BackendKind) -> Result<Self, Error> {
         let registry = TechniqueRegistry::builtin();
         let shadows = RealtimeShadows::new(&gpu.adapter, gpu.device.clone(), gpu.queue.clone(), registry, spec)?;
-        let mut view = Self { shadows, target: None, cpu: None, backend: BackendKind::Wgpu };
+        let mut view = Self { shadows, target: None, cpu: None, backend: BackendKind::Wgpu, instrumented: None };
         view.set_backend(backend)?;
         Ok(view)
     }
@@ -111,7 +113,7 @@ impl View {
         if backend == BackendKind::Cpu && self.cpu.is_none() {
             let renderer = Renderer::new(TechniqueRegistry::builtin());
             let technique = renderer.prepare(BackendKind::Cpu, self.shadows.technique())?;
-            self.cpu = Some(CpuSide { renderer, technique, image: None, texture: None });
+            self.cpu = Some(CpuSide { renderer, technique, last: None, texture: None });
         }
         self.backend = backend;
         Ok(())
@@ -178,12 +180,11 @@ impl View {
         match (self.backend, &mut self.cpu) {
             (BackendKind::Cpu, Some(cpu)) => {
                 let run = cpu.renderer.run_prepared(&mut cpu.technique, frame, width, height)?;
-                let pixels: Vec<u8> = run.color.data().iter().flatten().copied().collect();
-                let image = egui::ColorImage::from_rgb([width as usize, height as usize], &pixels);
+                let image = super::overlay::color_image(&run.color);
                 let options = egui::TextureOptions::NEAREST;
                 let texture = cpu.texture.get_or_insert_with(|| ui.load_texture("cpu view", image.clone(), options));
                 texture.set(image, options);
-                cpu.image = Some(run.color);
+                cpu.last = Some(run);
                 Ok(texture.id())
             }
             _ => {
@@ -215,13 +216,51 @@ impl View {
     /// # Errors
     /// No frame drawn yet, or the read-back failed.
     pub fn screenshot(&self) -> Result<Image<Rgb8>, Error> {
-        let none = || Error::Usage("no frame drawn yet".into());
         match (self.backend, &self.cpu) {
-            (BackendKind::Cpu, Some(cpu)) => cpu.image.clone().ok_or_else(none),
+            (BackendKind::Cpu, Some(cpu)) => Ok(cpu.last.as_ref().ok_or_else(not_drawn)?.color.clone()),
             _ => {
-                let target = self.target.as_ref().ok_or_else(none)?;
+                let target = self.target.as_ref().ok_or_else(not_drawn)?;
                 Ok(shadow_wgpu::readback::read_rgb8(self.shadows.context(), &target.texture)?)
             }
         }
     }
+
+    /// The first light's visibility in the last frame drawn (read back as [`Self::screenshot`] is).
+    ///
+    /// # Errors
+    /// No frame drawn yet, or the read-back failed.
+    pub fn visibility(&self) -> Result<Image<f32>, Error> {
+        match (self.backend, &self.cpu) {
+            (BackendKind::Cpu, Some(cpu)) => {
+                Ok(cpu.last.as_ref().and_then(|r| r.visibility.first()).ok_or_else(not_drawn)?.clone())
+            }
+            _ => {
+                let layers = self.shadows.visibility().ok_or_else(not_drawn)?;
+                Ok(shadow_wgpu::readback::read_f32(self.shadows.context(), layers, 0, wgpu::TextureAspect::All)?)
+            }
+        }
+    }
+
+    /// The technique's debug views of `frame` at `size`: the CPU frame's own, or on wgpu those of one
+    /// instrumented frame (rendered now, on a device of its own).
+    ///
+    /// # Errors
+    /// The instrumented frame failed, or no wgpu adapter for it.
+    pub fn debug_views(&mut self, frame: &FrameInputs, (width, height): (u32, u32)) -> Result<Vec<DebugView>, Error> {
+        match (self.backend, &self.cpu) {
+            (BackendKind::Cpu, Some(cpu)) => Ok(cpu.last.as_ref().ok_or_else(not_drawn)?.debug_views.clone()),
+            _ => {
+                let adapter = self.shadows.context().adapter.name.clone();
+                let renderer = self
+                    .instrumented
+                    .get_or_insert_with(|| Renderer::new(TechniqueRegistry::builtin()).with_adapter(Some(adapter)));
+                let spec = self.shadows.technique().clone();
+                Ok(renderer.run(BackendKind::Wgpu, frame, width, height, &spec)?.debug_views)
+            }
+        }
+    }
+}
+
+fn not_drawn() -> Error {
+    Error::Usage("no frame drawn yet".into())
 }
