@@ -7,7 +7,7 @@ use std::sync::mpsc::{Receiver, TryRecvError};
 
 use shadow_core::image::{Rgb8, error_map_over};
 use shadow_core::metrics::{compare_visibility, measured_pixels};
-use shadow_core::scene::{Camera, Light};
+use shadow_core::scene::{Camera, Light, LightShadow};
 use shadow_core::technique::{DebugView, TechniqueSpec};
 use shadow_core::{FrameInputs, Image};
 
@@ -19,6 +19,7 @@ pub(super) struct ViewKey {
     pub scene: String,
     pub camera: Camera,
     pub lights: Vec<Light>,
+    pub shadows: Vec<LightShadow>,
     pub technique: String,
     pub backend: BackendKind,
     pub size: (u32, u32),

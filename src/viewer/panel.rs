@@ -8,9 +8,10 @@ use std::path::PathBuf;
 use egui::{Color32, ComboBox, PointerButton, Slider};
 use shadow_core::glam::Vec3;
 use shadow_core::scenes;
+use shadow_core::technique::TechniqueSpec;
 use shadow_core::technique::settings::SettingKind;
 use shadow_core::technique::settings::key_values;
-use shadow_core::{FrameInputs, LightKind};
+use shadow_core::{FrameInputs, LightKind, LightShadow};
 
 use super::overlay::{Overlay, ViewKey};
 use super::script::Step;
@@ -53,6 +54,8 @@ pub(super) struct Viewer {
     /// The model file field.
     file: String,
     error: Option<String>,
+    /// Whether the error line is the last frame's failure to draw (a later frame drawn clears it).
+    draw_failed: bool,
     status: Option<String>,
     clock: FrameClock,
     gpu_ms: VecDeque<f64>,
@@ -81,6 +84,7 @@ impl Viewer {
             screenshots: 0,
             file: String::new(),
             error: None,
+            draw_failed: false,
             status: None,
             clock: FrameClock::default(),
             gpu_ms: VecDeque::new(),
@@ -172,8 +176,17 @@ impl Viewer {
             Ok(id) => {
                 self.texture = Some(id);
                 self.drawn = Some((key, frame));
+                if std::mem::take(&mut self.draw_failed) {
+                    self.error = None;
+                }
             }
-            Err(e) => self.fail(e.to_string()),
+            Err(e) => {
+                // No picture rather than the last technique's: the error line says why.
+                self.texture = None;
+                self.drawn = None;
+                self.draw_failed = true;
+                self.fail(e.to_string());
+            }
         }
         self.clock.tick();
         if let Some(ms) = self.view.gpu_ms() {
@@ -231,6 +244,7 @@ impl Viewer {
             scene: self.scene.setup.source.clone(),
             camera: frame.camera,
             lights: frame.lights.clone(),
+            shadows: frame.shadows.clone(),
             technique: self.view.technique().to_string(),
             backend: self.view.backend(),
             size: self.size,
@@ -306,6 +320,7 @@ impl Viewer {
         ui.separator();
         self.technique_controls(ui);
         ui.separator();
+        self.light_controls(ui);
         ui.checkbox(&mut self.animate, "Turn the light (L)");
         if ui.button("Reset camera and light (R)").clicked() {
             self.reset_view();
@@ -431,6 +446,35 @@ impl Viewer {
         }
     }
 
+    /// Each light's shadow: whether it casts, and the technique that shadows it (the frame's, or one of
+    /// its own with default settings).
+    fn light_controls(&mut self, ui: &mut egui::Ui) {
+        let frame = &mut self.scene.frame;
+        frame.shadows.resize(frame.lights.len().max(frame.shadows.len()), LightShadow::default());
+        for (k, (light, shadow)) in frame.lights.iter().zip(&mut frame.shadows).enumerate() {
+            let kind = match light.kind {
+                LightKind::Spot { .. } => "spot",
+                LightKind::Point { .. } => "point",
+                LightKind::Directional { .. } => "directional",
+            };
+            ui.horizontal(|ui| {
+                ui.checkbox(&mut shadow.casts, format!("light {} ({kind}) casts", k + 1));
+                let shown = shadow.technique.as_ref().map_or("the frame's".to_string(), |t| t.name.clone());
+                ComboBox::from_id_salt(("light technique", k)).selected_text(shown).show_ui(ui, |ui| {
+                    if ui.selectable_label(shadow.technique.is_none(), "the frame's").clicked() {
+                        shadow.technique = None;
+                    }
+                    for entry in self.registry.entries() {
+                        let chosen = shadow.technique.as_ref().is_some_and(|t| t.name == entry.name);
+                        if ui.selectable_label(chosen, entry.name).clicked() {
+                            shadow.technique = Some(TechniqueSpec::named(entry.name));
+                        }
+                    }
+                });
+            });
+        }
+    }
+
     fn readouts(&mut self, ui: &mut egui::Ui) {
         ui.label(format!("{:.1} frames a second", self.clock.fps()));
         match (self.gpu_ms.back(), self.view.backend()) {
@@ -488,8 +532,15 @@ impl Viewer {
         let ppp = ui.ctx().pixels_per_point();
         self.size = ((rect.width() * ppp).round().max(1.0) as u32, (rect.height() * ppp).round().max(1.0) as u32);
         let uv = egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0));
-        if let Some(id) = self.texture {
-            ui.painter().image(id, rect, uv, Color32::WHITE);
+        match (self.texture, &self.error) {
+            (Some(id), _) => {
+                ui.painter().image(id, rect, uv, Color32::WHITE);
+            }
+            (None, Some(e)) => {
+                let font = egui::FontId::proportional(16.0);
+                ui.painter().text(rect.center(), egui::Align2::CENTER_CENTER, e, font, Color32::LIGHT_RED);
+            }
+            (None, None) => {}
         }
         match &self.overlay {
             Some(Overlay::Errors { texture, .. }) => {
