@@ -20,7 +20,7 @@
 use shadow_core::script::LightTechniques;
 use shadow_core::technique::{DynShadowTechnique, TechniqueSpec};
 use shadow_core::{FrameInputs, LightView};
-use shadow_wgpu::{ColorTarget, FrameRecorder, FrameTimer, WgpuBackend, WgpuContext};
+use shadow_wgpu::{ColorTarget, FrameRecorder, FrameTimes, WgpuBackend, WgpuContext};
 
 use crate::renderer::Named;
 use crate::{Error, TechniqueRegistry};
@@ -34,8 +34,6 @@ pub struct RealtimeShadows {
     technique: Box<dyn DynShadowTechnique<WgpuBackend>>,
     /// The techniques lights name for themselves.
     named: Named<WgpuBackend>,
-    /// With frames timed: their GPU times, read back frames later.
-    timer: Option<FrameTimer>,
 }
 
 impl RealtimeShadows {
@@ -54,7 +52,7 @@ impl RealtimeShadows {
         let cx = WgpuContext::from_host(adapter, device, queue)?;
         let spec = TechniqueSpec::parse(spec)?;
         let technique = registry.wgpu(&spec)?;
-        Ok(Self { cx, recorder: FrameRecorder::new(), registry, spec, technique, named: Vec::new(), timer: None })
+        Ok(Self { cx, recorder: FrameRecorder::new(), registry, spec, technique, named: Vec::new() })
     }
 
     /// Switches to the technique of `spec` from the next frame on; on an error the current one stays.
@@ -96,29 +94,21 @@ impl RealtimeShadows {
         let registry = &self.registry;
         crate::renderer::name_techniques(frame, &mut self.named, |s| Ok(registry.wgpu(s)?))?;
         let techniques = LightTechniques { frame: self.technique.as_mut(), named: &mut self.named };
-        if let Some(t) = &mut self.timer {
-            t.begin(encoder);
-        }
-        let views = self.recorder.record(&mut self.cx, encoder, frame, techniques, target)?;
-        if let Some(t) = &mut self.timer {
-            t.end(encoder);
-        }
-        Ok(views)
+        Ok(self.recorder.record(&mut self.cx, encoder, frame, techniques, target)?)
     }
 
-    /// Times every frame on the GPU from now on (or stops): timestamps around each recorded frame, read
-    /// back a few frames later without waiting (see [`FrameTimer`]), for [`Self::gpu_ms`]. Returns whether
-    /// the device has timestamp queries; without them nothing is timed.
+    /// Times every frame on the GPU from now on (or stops), phase by phase, the times read back a few
+    /// frames later without waiting (see [`FrameRecorder::time_frames`]), for [`Self::gpu_times`].
+    /// Returns whether the device has timestamp queries; without them nothing is timed.
     pub fn time_frames(&mut self, on: bool) -> bool {
-        self.timer = if on { self.timer.take().or_else(|| FrameTimer::new(&self.cx)) } else { None };
-        self.timer.is_some()
+        self.recorder.time_frames(&self.cx, on)
     }
 
-    /// The GPU time of the latest timed frame whose times have come back, in milliseconds: a few frames
-    /// behind, once the host submits its frames and its device polls (as presenting does).
+    /// The GPU times of the latest timed frame whose times have come back: a few frames behind, once the
+    /// host submits its frames and its device polls (as presenting does).
     #[must_use]
-    pub fn gpu_ms(&self) -> Option<f64> {
-        self.timer.as_ref().and_then(FrameTimer::last_ms)
+    pub fn gpu_times(&self) -> Option<&FrameTimes> {
+        self.recorder.gpu_times()
     }
 
     /// The last frame's visibility, a layer per light (see [`FrameRecorder::visibility`]).

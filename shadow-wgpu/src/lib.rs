@@ -26,4 +26,4 @@ pub use gbuffer::{GpuGBuffer, HostSurfaces};
 pub use pipeline_cache::PipelineCache;
 pub use record::{ColorTarget, FrameRecorder};
 pub use resources::{Created, Transient};
-pub use timer::FrameTimer;
+pub use timer::{FrameTimer, FrameTimes};

@@ -21,6 +21,7 @@ use crate::context::{WgpuBackend, WgpuContext, WgpuError};
 use crate::frame::{GpuVisibility, check_lights, clear_lit, full_screen_shade, layer_view, layered, shade_group};
 use crate::gbuffer::{self, GpuGBuffer, HostSurfaces, ImportPass};
 use crate::pipelines::{VISIBILITY, full_screen_pipeline};
+use crate::timer::{FrameTimer, FrameTimes};
 
 /// Records frames into a host's encoder, keeping what it made for them: the visibility targets (remade
 /// when the view's size or the number of lights changes) and a shading pipeline per
@@ -31,6 +32,8 @@ pub struct FrameRecorder {
     shade: HashMap<wgpu::TextureFormat, wgpu::RenderPipeline>,
     /// The pass that makes the G-buffer from a host's surfaces, once one lends them.
     import: Option<ImportPass>,
+    /// With frames timed: their GPU times, read back frames later.
+    timer: Option<FrameTimer>,
 }
 
 /// Every light's visibility, a layer each of one R32Float array texture (1 lit, 0 shadowed).
@@ -82,7 +85,8 @@ impl FrameRecorder {
             visibility_for(&mut self.visibility, cx, target.width, target.height, frame.lights.len() as u32);
         let shade = self.shade.entry(target.format).or_insert_with(|| shade_pipeline(cx, target.format));
         let (width, height) = (target.width, target.height);
-        let steps = RecordSteps { width, height, visibility, host: None, shade: Some((shade, target.view)) };
+        let timer = self.timer.as_mut();
+        let steps = RecordSteps { width, height, visibility, host: None, shade: Some((shade, target.view)), timer };
         let FrameRun { light_views, .. } = cx.record_into(encoder, |cx| run_frame(cx, frame, steps, techniques))?;
         Ok(light_views)
     }
@@ -106,9 +110,27 @@ impl FrameRecorder {
         let visibility = visibility_for(&mut self.visibility, cx, host.width, host.height, frame.lights.len() as u32);
         let import = self.import.get_or_insert_with(|| ImportPass::new(cx));
         let (width, height) = (host.width, host.height);
-        let steps = RecordSteps { width, height, visibility, host: Some((host, import)), shade: None };
+        let timer = self.timer.as_mut();
+        let steps = RecordSteps { width, height, visibility, host: Some((host, import)), shade: None, timer };
         let FrameRun { light_views, .. } = cx.record_into(encoder, |cx| run_frame(cx, frame, steps, techniques))?;
         Ok(light_views)
+    }
+
+    /// Times every frame on the GPU from now on (or stops): timestamps at its start, after the G-buffer,
+    /// after the lights' shadows and at its end, read back a few frames later without waiting (see
+    /// [`FrameTimer`]), for [`Self::gpu_times`]. Returns whether the device has timestamp queries; without
+    /// them nothing is timed.
+    pub fn time_frames(&mut self, cx: &WgpuContext, on: bool) -> bool {
+        self.timer = if on { self.timer.take().or_else(|| FrameTimer::new(cx)) } else { None };
+        self.timer.is_some()
+    }
+
+    /// The GPU times of the latest timed frame whose times have come back (`G-buffer`, `shadows`,
+    /// `shading`): a few frames behind, once the host submits its frames and its device polls (as
+    /// presenting does).
+    #[must_use]
+    pub fn gpu_times(&self) -> Option<&FrameTimes> {
+        self.timer.as_ref().and_then(FrameTimer::last)
     }
 
     /// The last recorded frame's visibility, a layer per light (R32Float: 1 lit, 0 shadowed), for engines
@@ -158,6 +180,18 @@ struct RecordSteps<'a> {
     visibility: &'a wgpu::Texture,
     host: Option<(&'a HostSurfaces<'a>, &'a ImportPass)>,
     shade: Option<(&'a wgpu::RenderPipeline, &'a wgpu::TextureView)>,
+    timer: Option<&'a mut FrameTimer>,
+}
+
+impl RecordSteps<'_> {
+    /// Marks the end of the phase `name` on the frame's timer, when it has one.
+    fn mark(&mut self, cx: &WgpuContext, name: &'static str) {
+        if let Some(timer) = self.timer.as_deref_mut() {
+            let mut enc = cx.encoder("phase mark");
+            timer.mark(&mut enc, name);
+            cx.submit(enc);
+        }
+    }
 }
 
 impl FrameSteps<WgpuBackend> for RecordSteps<'_> {
@@ -165,10 +199,17 @@ impl FrameSteps<WgpuBackend> for RecordSteps<'_> {
     type Output = ();
 
     fn gbuffer(&mut self, cx: &mut WgpuContext, frame: &FrameInputs) -> Result<GpuGBuffer, WgpuError> {
-        match self.host {
+        if let Some(timer) = self.timer.as_deref_mut() {
+            let mut enc = cx.encoder("frame start");
+            timer.begin(&mut enc);
+            cx.submit(enc);
+        }
+        let g = match self.host {
             Some((host, import)) => gbuffer::import(cx, frame, host, import),
             None => gbuffer::render(cx, frame, self.width, self.height),
-        }
+        }?;
+        self.mark(cx, "G-buffer");
+        Ok(g)
     }
 
     fn visibility(&mut self, _cx: &mut WgpuContext, k: usize) -> Result<GpuVisibility, WgpuError> {
@@ -184,6 +225,7 @@ impl FrameSteps<WgpuBackend> for RecordSteps<'_> {
 
     fn shade(&mut self, cx: &mut WgpuContext, frame: &FrameInputs, g: &GpuGBuffer) -> Result<(), WgpuError> {
         let Some((pipeline, target)) = self.shade else { return Ok(()) };
+        self.mark(cx, "shadows");
         cx.scoped("the recorded shading pass", |cx| {
             let group = shade_group(cx, frame, g, self.visibility);
             let mut enc = cx.encoder("shade");
@@ -193,12 +235,17 @@ impl FrameSteps<WgpuBackend> for RecordSteps<'_> {
     }
 
     fn finish(
-        self,
-        _cx: &mut WgpuContext,
+        mut self,
+        cx: &mut WgpuContext,
         _gbuffer: GpuGBuffer,
         _shaded: (),
         _stats: &mut FrameStats,
     ) -> Result<(), WgpuError> {
+        if let Some(timer) = self.timer.as_deref_mut() {
+            let mut enc = cx.encoder("frame end");
+            timer.end(&mut enc, if self.shade.is_some() { "shading" } else { "shadows" });
+            cx.submit(enc);
+        }
         Ok(())
     }
 }

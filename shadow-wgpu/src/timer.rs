@@ -1,7 +1,8 @@
-//! The GPU time of frames recorded into a host's encoder, read back frames later without ever waiting.
+//! The GPU time of frames recorded into a host's encoder, phase by phase, read back frames later without
+//! ever waiting.
 //!
-//! Each timed frame gets a slot of a small ring: timestamps at its start and end, resolved and copied
-//! into a buffer the CPU can map. A buffer can only be mapped once the frame holding its copy is
+//! Each timed frame gets a slot of a small ring: timestamps at its start, between its phases and at its
+//! end, resolved and copied into a buffer the CPU can map. A buffer can only be mapped once the frame holding its copy is
 //! submitted, which the host does after recording, so the map is asked for when the next frame is
 //! recorded; it completes whenever the host's device next polls (a present, a submit, an explicit poll),
 //! and the frame after that reads it. A frame that finds every slot still on its way is not timed: the
@@ -14,12 +15,23 @@ use crate::context::WgpuContext;
 
 /// Slots in the ring: frames whose times may be on their way at once.
 const SLOTS: usize = 4;
+/// Timestamps a frame may write: its start, the ends of up to three phases.
+const MARKS: u32 = 4;
+
+/// One frame's GPU time, whole and per phase, in milliseconds.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct FrameTimes {
+    /// From the frame's start to its end.
+    pub total_ms: f64,
+    /// Each phase, named, in order.
+    pub phases: Vec<(&'static str, f64)>,
+}
 
 /// The GPU times of recorded frames (see the module notes).
 pub struct FrameTimer {
     slots: Vec<Slot>,
     period_ns: f64,
-    last_ms: Option<f64>,
+    last: Option<FrameTimes>,
     /// The slot the frame being recorded writes, between [`Self::begin`] and [`Self::end`].
     open: Option<usize>,
 }
@@ -29,6 +41,8 @@ struct Slot {
     resolve: wgpu::Buffer,
     staging: wgpu::Buffer,
     state: State,
+    /// The names of the phases that end at its second, third, ... timestamp.
+    phases: Vec<&'static str>,
 }
 
 enum State {
@@ -47,50 +61,72 @@ impl FrameTimer {
             return None;
         }
         let buffer = |label, usage| {
-            cx.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size: 16, usage, mapped_at_creation: false })
+            let size = 8 * u64::from(MARKS);
+            cx.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size, usage, mapped_at_creation: false })
         };
         let slots = (0..SLOTS)
             .map(|_| Slot {
                 set: cx.device.create_query_set(&wgpu::QuerySetDescriptor {
                     label: Some("frame time"),
                     ty: wgpu::QueryType::Timestamp,
-                    count: 2,
+                    count: MARKS,
                 }),
                 resolve: buffer("frame time", wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC),
                 staging: buffer("frame time readback", wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ),
                 state: State::Free,
+                phases: Vec::new(),
             })
             .collect();
-        Some(Self { slots, period_ns: f64::from(cx.queue.get_timestamp_period()), last_ms: None, open: None })
+        Some(Self { slots, period_ns: f64::from(cx.queue.get_timestamp_period()), last: None, open: None })
     }
 
-    /// The GPU time of the latest frame whose times have come back, in milliseconds.
+    /// The GPU times of the latest frame whose times have come back.
     #[must_use]
-    pub fn last_ms(&self) -> Option<f64> {
-        self.last_ms
+    pub fn last(&self) -> Option<&FrameTimes> {
+        self.last.as_ref()
     }
 
     /// Gathers what has come back, asks for the maps of the frames recorded since, and marks the start of
     /// the frame about to be recorded into `encoder` (unless every slot is still on its way).
     pub fn begin(&mut self, encoder: &mut wgpu::CommandEncoder) {
         for slot in &mut self.slots {
-            if let Some(ms) = slot.advance(self.period_ns) {
-                self.last_ms = Some(ms);
+            if let Some(times) = slot.advance(self.period_ns) {
+                self.last = Some(times);
             }
         }
         self.open = self.slots.iter().position(|s| matches!(s.state, State::Free));
         if let Some(k) = self.open {
-            write_mark(encoder, &self.slots[k].set, 0);
+            let slot = &mut self.slots[k];
+            slot.phases.clear();
+            write_mark(encoder, &slot.set, 0);
         }
     }
 
-    /// Marks the end of the frame recorded into `encoder` since [`Self::begin`], and copies its times out.
-    pub fn end(&mut self, encoder: &mut wgpu::CommandEncoder) {
+    /// Marks the end of the phase `name` of the frame being timed (the first phase starts at
+    /// [`Self::begin`], each next one at the mark before); a frame has room for three.
+    pub fn mark(&mut self, encoder: &mut wgpu::CommandEncoder, name: &'static str) {
+        let Some(slot) = self.open.map(|k| &mut self.slots[k]) else { return };
+        let index = slot.phases.len() as u32 + 1;
+        if index < MARKS {
+            write_mark(encoder, &slot.set, index);
+            slot.phases.push(name);
+        }
+    }
+
+    /// Marks the end of the frame recorded into `encoder` since [`Self::begin`] (the end of its last
+    /// phase, `name`), and copies its times out.
+    pub fn end(&mut self, encoder: &mut wgpu::CommandEncoder, name: &'static str) {
         let Some(k) = self.open.take() else { return };
         let slot = &mut self.slots[k];
-        write_mark(encoder, &slot.set, 1);
-        encoder.resolve_query_set(&slot.set, 0..2, &slot.resolve, 0);
-        encoder.copy_buffer_to_buffer(&slot.resolve, 0, &slot.staging, 0, 16);
+        // Every mark taken: the phase before runs on into this last one.
+        if slot.phases.len() as u32 + 1 == MARKS {
+            slot.phases.pop();
+        }
+        let index = slot.phases.len() as u32 + 1;
+        write_mark(encoder, &slot.set, index);
+        slot.phases.push(name);
+        encoder.resolve_query_set(&slot.set, 0..index + 1, &slot.resolve, 0);
+        encoder.copy_buffer_to_buffer(&slot.resolve, 0, &slot.staging, 0, 8 * u64::from(index + 1));
         slot.state = State::Recorded;
     }
 }
@@ -98,7 +134,7 @@ impl FrameTimer {
 impl Slot {
     /// Moves the slot on: asks for the map of a recorded frame's times (the host has submitted it by
     /// now), and frees a mapped one, returning its time.
-    fn advance(&mut self, period_ns: f64) -> Option<f64> {
+    fn advance(&mut self, period_ns: f64) -> Option<FrameTimes> {
         let mapped = match &self.state {
             State::Free => return None,
             State::Recorded => {
@@ -114,19 +150,23 @@ impl Slot {
             }
             State::Mapping(done) => done.lock().ok().and_then(|d| *d)?,
         };
-        let ms = if mapped { read_ms(&self.staging, period_ns) } else { None };
+        let times = if mapped { self.read(period_ns) } else { None };
         if mapped {
             self.staging.unmap();
         }
         self.state = State::Free;
-        ms
+        times
     }
-}
 
-/// The milliseconds between a mapped slot's two timestamps.
-fn read_ms(staging: &wgpu::Buffer, period_ns: f64) -> Option<f64> {
-    let bytes = staging.slice(..).get_mapped_range().ok()?;
-    let tick = |i: usize| u64::from_le_bytes(bytes[8 * i..8 * i + 8].try_into().unwrap_or_default());
-    let (start, end) = (tick(0), tick(1));
-    (end >= start).then(|| (end - start) as f64 * period_ns / 1e6)
+    /// The times of a mapped slot: between its first and last timestamps, and between each two.
+    fn read(&self, period_ns: f64) -> Option<FrameTimes> {
+        let bytes = self.staging.slice(..).get_mapped_range().ok()?;
+        let tick = |i: usize| u64::from_le_bytes(bytes[8 * i..8 * i + 8].try_into().unwrap_or_default());
+        let ticks: Vec<u64> = (0..=self.phases.len()).map(tick).collect();
+        // A pair out of order (a clock that wrapped, a reset) gives no times rather than wrong ones.
+        let ms = |a: u64, b: u64| (b >= a).then(|| (b - a) as f64 * period_ns / 1e6);
+        let phases: Option<Vec<_>> =
+            self.phases.iter().zip(ticks.windows(2)).map(|(name, w)| Some((*name, ms(w[0], w[1])?))).collect();
+        Some(FrameTimes { total_ms: ms(ticks[0], *ticks.last()?)?, phases: phases? })
+    }
 }

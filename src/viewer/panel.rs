@@ -12,6 +12,7 @@ use shadow_core::technique::TechniqueSpec;
 use shadow_core::technique::settings::SettingKind;
 use shadow_core::technique::settings::key_values;
 use shadow_core::{FrameInputs, LightKind, LightShadow};
+use shadow_wgpu::FrameTimes;
 
 use super::overlay::{Overlay, ViewKey};
 use super::script::Step;
@@ -58,7 +59,7 @@ pub(super) struct Viewer {
     draw_failed: bool,
     status: Option<String>,
     clock: FrameClock,
-    gpu_ms: VecDeque<f64>,
+    gpu_times: VecDeque<FrameTimes>,
     timed: bool,
 }
 
@@ -87,7 +88,7 @@ impl Viewer {
             draw_failed: false,
             status: None,
             clock: FrameClock::default(),
-            gpu_ms: VecDeque::new(),
+            gpu_times: VecDeque::new(),
             timed,
         };
         viewer.reset_settings();
@@ -189,10 +190,10 @@ impl Viewer {
             }
         }
         self.clock.tick();
-        if let Some(ms) = self.view.gpu_ms() {
-            self.gpu_ms.push_back(ms);
-            if self.gpu_ms.len() > PLOTTED {
-                self.gpu_ms.pop_front();
+        if let Some(times) = self.view.gpu_times() {
+            self.gpu_times.push_back(times.clone());
+            if self.gpu_times.len() > PLOTTED {
+                self.gpu_times.pop_front();
             }
         }
     }
@@ -477,13 +478,15 @@ impl Viewer {
 
     fn readouts(&mut self, ui: &mut egui::Ui) {
         ui.label(format!("{:.1} frames a second", self.clock.fps()));
-        match (self.gpu_ms.back(), self.view.backend()) {
-            (Some(ms), BackendKind::Wgpu) => drop(ui.label(format!("GPU: {ms:.2} ms a frame"))),
+        match (self.gpu_times.back(), self.view.backend()) {
+            (Some(t), BackendKind::Wgpu) => {
+                let phases: Vec<String> = t.phases.iter().map(|(name, ms)| format!("{name} {ms:.1}")).collect();
+                ui.label(format!("GPU: {:.2} ms a frame", t.total_ms));
+                ui.small(phases.join(", "));
+                plot(ui, &self.gpu_times);
+            }
             (_, BackendKind::Wgpu) if !self.timed => drop(ui.small("the adapter has no timestamp queries")),
             _ => {}
-        }
-        if self.view.backend() == BackendKind::Wgpu && self.gpu_ms.len() > 1 {
-            plot(ui, &self.gpu_ms);
         }
         ui.small(format!("on the GPU: {}", self.view.memory()));
     }
@@ -666,27 +669,36 @@ fn quoted(text: &str) -> String {
     if !text.is_empty() && text.chars().all(plain) { text.into() } else { format!("'{}'", text.replace('\'', r"'\''")) }
 }
 
-/// A small rolling line plot of the last [`PLOTTED`] `values`, the newest at the right, scaled to their
-/// largest (always as many points, the missing ones at zero, so the UI's geometry does not grow as the
-/// history fills).
-fn plot(ui: &mut egui::Ui, values: &VecDeque<f64>) {
-    let (rect, _) = ui.allocate_exact_size(egui::vec2(ui.available_width(), 48.0), egui::Sense::hover());
-    let top = values.iter().copied().fold(f64::MIN_POSITIVE, f64::max);
+/// Colours of the plot's lines: the whole frame, then its phases in order.
+const PLOT_COLOURS: [Color32; 4] = [Color32::WHITE, Color32::LIGHT_BLUE, Color32::LIGHT_GREEN, Color32::GOLD];
+
+/// A small rolling plot of the last [`PLOTTED`] frames' GPU times, the newest at the right: the whole
+/// frame and each phase, scaled to the largest frame (always as many points, the missing ones at zero,
+/// so the UI's geometry does not grow as the history fills).
+fn plot(ui: &mut egui::Ui, times: &VecDeque<FrameTimes>) {
+    let (rect, _) = ui.allocate_exact_size(egui::vec2(ui.available_width(), 56.0), egui::Sense::hover());
+    let top = times.iter().map(|t| t.total_ms).fold(f64::MIN_POSITIVE, f64::max);
     let step = rect.width() / (PLOTTED - 1) as f32;
-    let missing = PLOTTED.saturating_sub(values.len());
-    let padded = std::iter::repeat_n(0.0, missing).chain(values.iter().copied());
-    let points = padded
-        .enumerate()
-        .map(|(i, v)| egui::pos2(rect.left() + i as f32 * step, rect.bottom() - (v / top) as f32 * rect.height()))
-        .collect();
+    let missing = PLOTTED.saturating_sub(times.len());
     let painter = ui.painter_at(rect);
     painter.rect_filled(rect, 2.0, ui.visuals().extreme_bg_color);
-    painter.add(egui::Shape::line(points, egui::Stroke::new(1.0, Color32::LIGHT_GREEN)));
-    painter.text(
-        rect.left_top(),
-        egui::Align2::LEFT_TOP,
-        format!("{top:.2} ms"),
-        egui::FontId::monospace(10.0),
-        Color32::GRAY,
-    );
+    let phases = times.back().map_or(0, |t| t.phases.len());
+    for (line, colour) in PLOT_COLOURS.iter().enumerate().take(phases + 1) {
+        let value = |t: &FrameTimes| if line == 0 { t.total_ms } else { t.phases.get(line - 1).map_or(0.0, |p| p.1) };
+        let padded = std::iter::repeat_n(0.0, missing).chain(times.iter().map(value));
+        let points = padded
+            .enumerate()
+            .map(|(i, v)| egui::pos2(rect.left() + i as f32 * step, rect.bottom() - (v / top) as f32 * rect.height()))
+            .collect();
+        painter.add(egui::Shape::line(points, egui::Stroke::new(1.0, *colour)));
+    }
+    let legend: Vec<&str> = times.back().map_or(Vec::new(), |t| t.phases.iter().map(|p| p.0).collect());
+    let font = egui::FontId::monospace(10.0);
+    let mut x = rect.left() + 2.0;
+    for (text, colour) in
+        std::iter::once(format!("{top:.1} ms")).chain(legend.iter().map(|s| s.to_string())).zip(PLOT_COLOURS)
+    {
+        let r = painter.text(egui::pos2(x, rect.top()), egui::Align2::LEFT_TOP, text, font.clone(), colour);
+        x = r.right() + 8.0;
+    }
 }

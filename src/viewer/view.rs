@@ -153,15 +153,15 @@ impl View {
         }
     }
 
-    /// Times the wgpu frames on the GPU (where the adapter has timestamps); see [`Self::gpu_ms`].
+    /// Times the wgpu frames on the GPU (where the adapter has timestamps); see [`Self::gpu_times`].
     pub fn time_frames(&mut self) -> bool {
         self.shadows.time_frames(true)
     }
 
-    /// The GPU time of a recent wgpu frame, in milliseconds.
+    /// The GPU times of a recent wgpu frame, phase by phase.
     #[must_use]
-    pub fn gpu_ms(&self) -> Option<f64> {
-        self.shadows.gpu_ms()
+    pub fn gpu_times(&self) -> Option<&shadow_wgpu::FrameTimes> {
+        self.shadows.gpu_times()
     }
 
     /// Draws `frame` at `width x height` and returns the texture egui shows: on wgpu recorded into

@@ -129,7 +129,7 @@ fn realtime_shadows_switch_techniques_and_keep_theirs_on_a_refusal() {
 }
 
 #[test]
-fn timed_realtime_frames_report_their_gpu_time_frames_later() {
+fn timed_realtime_frames_report_their_gpu_time_by_phase_frames_later() {
     use shadowlab::realtime::RealtimeShadows;
     let Some(renderer) = crate::with_wgpu("timed realtime frames") else { return };
     let name = renderer.adapter().expect("an adapter").name.clone();
@@ -150,12 +150,17 @@ fn timed_realtime_frames_report_their_gpu_time_frames_later() {
         let mut encoder = device.create_command_encoder(&Default::default());
         shadows.record(&mut encoder, &frame, &target).unwrap_or_else(|e| panic!("{e}"));
         queue.submit([encoder.finish()]);
-        times.push(shadows.gpu_ms());
+        times.push(shadows.gpu_times().cloned());
         device.poll(wgpu::PollType::wait_indefinitely()).expect("the frame done");
     }
     assert_eq!(&times[..2], &[None, None], "a time before its frame was read back");
-    assert!(times[2].is_some_and(|ms| ms > 0.0 && ms < 60_000.0), "frame 1's GPU time: {:?}", times[2]);
-    assert!(!shadows.time_frames(false) && shadows.gpu_ms().is_none(), "still timing");
+    let first = times[2].as_ref().unwrap_or_else(|| panic!("no GPU time for frame 1"));
+    assert!(first.total_ms > 0.0 && first.total_ms < 60_000.0, "frame 1's GPU time: {first:?}");
+    let names: Vec<&str> = first.phases.iter().map(|(n, _)| *n).collect();
+    assert_eq!(names, ["G-buffer", "shadows", "shading"], "{first:?}");
+    let sum: f64 = first.phases.iter().map(|(_, ms)| ms).sum();
+    assert!((sum - first.total_ms).abs() < 1e-9 && first.phases.iter().all(|(_, ms)| *ms >= 0.0), "{first:?}");
+    assert!(!shadows.time_frames(false) && shadows.gpu_times().is_none(), "still timing");
 }
 
 #[test]
