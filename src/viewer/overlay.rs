@@ -1,16 +1,17 @@
 //! What the viewer lays over the 3D view on demand, for the view it was made for (it clears as soon as
 //! the view changes): the error map against the reference (ray-traced, or area-light for a soft
 //! technique), whose reference is computed on a background thread while the viewer goes on drawing; or
-//! one of the technique's debug views.
+//! an instrumented frame's debug views (one of them shown) and counters.
 
 use std::sync::mpsc::{Receiver, TryRecvError};
 
 use shadow_core::image::{Rgb8, error_map_over};
 use shadow_core::metrics::{compare_visibility, measured_pixels};
 use shadow_core::scene::{Camera, Light, LightShadow};
-use shadow_core::technique::{DebugView, TechniqueSpec};
+use shadow_core::technique::TechniqueSpec;
 use shadow_core::{FrameInputs, Image};
 
+use super::view::Inspection;
 use crate::{BackendKind, Renderer, TechniqueRegistry};
 
 /// What a picture of the view depends on: an overlay made for one key is shown only while it holds.
@@ -39,8 +40,8 @@ pub(super) enum Overlay {
     Computing { key: ViewKey, reference: Receiver<Result<Reference, String>>, test: Image<f32>, picture: Image<Rgb8> },
     /// The error map, with the mismatch over the measured pixels.
     Errors { key: ViewKey, texture: egui::TextureHandle, mismatch: f64, false_shadow: f64, false_light: f64 },
-    /// The technique's debug views, one of them shown.
-    Debug { key: ViewKey, views: Vec<(String, egui::TextureHandle)>, shown: usize },
+    /// An instrumented frame of the technique: its debug views (one of them shown) and counters.
+    Inspect { key: ViewKey, views: Vec<(String, egui::TextureHandle)>, shown: usize, counters: Vec<(String, f64)> },
 }
 
 impl Overlay {
@@ -64,22 +65,23 @@ impl Overlay {
         Self::Computing { key, reference, test, picture }
     }
 
-    /// The debug views of the view of `key`, as egui textures.
-    pub(super) fn debug(key: ViewKey, views: Vec<DebugView>, ui: &egui::Context) -> Self {
-        let views = views
+    /// The inspection of the view of `key`, its debug views as egui textures.
+    pub(super) fn inspect(key: ViewKey, inspection: Inspection, ui: &egui::Context) -> Self {
+        let views = inspection
+            .views
             .into_iter()
             .map(|v| {
                 let texture = ui.load_texture(format!("debug {}", v.name), color_image(&v.image), Default::default());
                 (v.name, texture)
             })
             .collect();
-        Self::Debug { key, views, shown: 0 }
+        Self::Inspect { key, views, shown: 0, counters: inspection.counters }
     }
 
     /// The key it was made for.
     pub(super) fn key(&self) -> &ViewKey {
         match self {
-            Self::Computing { key, .. } | Self::Errors { key, .. } | Self::Debug { key, .. } => key,
+            Self::Computing { key, .. } | Self::Errors { key, .. } | Self::Inspect { key, .. } => key,
         }
     }
 

@@ -48,7 +48,7 @@ pub(super) struct Viewer {
     /// What is laid over the view, and whether a comparison waits for the next frame drawn.
     overlay: Option<Overlay>,
     compare_asked: bool,
-    debug_asked: bool,
+    inspect_asked: bool,
     texture: Option<egui::TextureId>,
     screenshot: Option<PathBuf>,
     screenshots: u32,
@@ -79,7 +79,7 @@ impl Viewer {
             drawn: None,
             overlay: None,
             compare_asked: false,
-            debug_asked: false,
+            inspect_asked: false,
             texture: None,
             screenshot: None,
             screenshots: 0,
@@ -108,7 +108,7 @@ impl Viewer {
         // A screenshot or a comparison asked for is made before the next step changes the view.
         if self.screenshot.is_some()
             || self.compare_asked
-            || self.debug_asked
+            || self.inspect_asked
             || matches!(self.overlay, Some(Overlay::Computing { .. }))
         {
             return;
@@ -138,7 +138,7 @@ impl Viewer {
                 );
             }
             Step::Compare => self.compare_asked = true,
-            Step::Debug => self.debug_asked = true,
+            Step::Inspect => self.inspect_asked = true,
             Step::Quit => self.quit = true,
         }
     }
@@ -202,10 +202,13 @@ impl Viewer {
     /// UI gives it.
     pub(super) fn after_submit(&mut self, ui: &egui::Context) {
         let Some((key, frame)) = self.drawn.as_ref().filter(|(key, _)| key.size == self.size) else { return };
-        if std::mem::take(&mut self.debug_asked) {
-            match self.view.debug_views(frame, key.size) {
-                Ok(views) if views.is_empty() => self.say(format!("{} has no debug views", key.technique)),
-                Ok(views) => self.overlay = Some(Overlay::debug(key.clone(), views, ui)),
+        if std::mem::take(&mut self.inspect_asked) {
+            match self.view.inspect(frame, key.size) {
+                Ok(inspection) => {
+                    let counters: Vec<String> = inspection.counters.iter().map(|(k, v)| format!("{k}={v}")).collect();
+                    println!("counters: {}", counters.join(", "));
+                    self.overlay = Some(Overlay::inspect(key.clone(), inspection, ui));
+                }
                 Err(e) => self.fail(e.to_string()),
             }
             return;
@@ -496,8 +499,9 @@ impl Viewer {
             if ui.button("Compare with reference").on_hover_text("false shadow red, false light blue").clicked() {
                 self.compare_asked = true;
             }
-            if ui.button("Debug views").clicked() {
-                self.debug_asked = true;
+            let inspect = ui.button("Inspect frame").on_hover_text("an instrumented frame: counters, debug views");
+            if inspect.clicked() {
+                self.inspect_asked = true;
             }
             if self.overlay.is_some() && ui.button("Clear").clicked() {
                 self.overlay = None;
@@ -508,11 +512,20 @@ impl Viewer {
             Some(Overlay::Errors { mismatch, false_shadow, false_light, .. }) => {
                 ui.label(mismatch_line(*mismatch, *false_shadow, *false_light));
             }
-            Some(Overlay::Debug { views, shown, .. }) => {
+            Some(Overlay::Inspect { views, shown, counters, .. }) => {
                 let names: Vec<String> = views.iter().map(|(n, _)| n.clone()).collect();
-                ComboBox::from_label("debug view").selected_text(&names[*shown]).show_ui(ui, |ui| {
-                    for (i, n) in names.iter().enumerate() {
-                        ui.selectable_value(shown, i, n);
+                if let Some(name) = names.get(*shown) {
+                    ComboBox::from_label("debug view").selected_text(name).show_ui(ui, |ui| {
+                        for (i, n) in names.iter().enumerate() {
+                            ui.selectable_value(shown, i, n);
+                        }
+                    });
+                }
+                egui::Grid::new("counters").striped(true).show(ui, |ui| {
+                    for (name, value) in counters.iter() {
+                        ui.small(name);
+                        ui.small(format!("{value}"));
+                        ui.end_row();
                     }
                 });
             }
@@ -549,7 +562,7 @@ impl Viewer {
             Some(Overlay::Errors { texture, .. }) => {
                 ui.painter().image(texture.id(), rect, uv, Color32::WHITE);
             }
-            Some(Overlay::Debug { views, shown, .. }) => {
+            Some(Overlay::Inspect { views, shown, .. }) if !views.is_empty() => {
                 // A debug view keeps its own aspect, centred over the view.
                 let texture = &views[*shown].1;
                 let [w, h] = texture.size().map(|s| s as f32);

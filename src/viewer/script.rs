@@ -6,14 +6,14 @@
 //! `fly FORWARD RIGHT UP` (scene units), `technique SPEC`, `backend wgpu|cpu`, `scene NAME|FILE`,
 //! `wait FRAMES`, `screenshot FILE.png`, `command` (prints the `shadowlab render` command of the view),
 //! `memory` (prints the buffers and textures alive on the device), `compare` (compares the view with the
-//! reference and prints the mismatch; the script waits for it), `debug` (lays the technique's first debug
-//! view over the view) and `quit`.
+//! reference and prints the mismatch; the script waits for it), `inspect` (prints an instrumented frame's
+//! counters and lays its first debug view over the view) and `quit`.
 
 use std::path::PathBuf;
 
 /// Every step's verb.
 const STEPS: &str =
-    "orbit, light, zoom, fly, technique, backend, scene, wait, screenshot, command, memory, compare, debug, quit";
+    "orbit, light, zoom, fly, technique, backend, scene, wait, screenshot, command, memory, compare, inspect, quit";
 
 /// One step.
 #[derive(Clone, Debug, PartialEq)]
@@ -42,8 +42,8 @@ pub enum Step {
     Memory,
     /// Compare the view with its reference and print the mismatch.
     Compare,
-    /// Show the technique's debug views.
-    Debug,
+    /// Inspect an instrumented frame: print its counters, show its debug views.
+    Inspect,
     /// Close the viewer.
     Quit,
 }
@@ -87,9 +87,9 @@ fn step(text: &str) -> Result<Step, String> {
         "command" if rest.is_empty() => Step::Command,
         "memory" if rest.is_empty() => Step::Memory,
         "compare" if rest.is_empty() => Step::Compare,
-        "debug" if rest.is_empty() => Step::Debug,
+        "inspect" if rest.is_empty() => Step::Inspect,
         "quit" if rest.is_empty() => Step::Quit,
-        "command" | "memory" | "compare" | "debug" | "quit" => return Err("takes nothing".into()),
+        "command" | "memory" | "compare" | "inspect" | "quit" => return Err("takes nothing".into()),
         _ => return Err(format!("unknown step ({STEPS})")),
     })
 }

@@ -241,24 +241,34 @@ impl View {
         }
     }
 
-    /// The technique's debug views of `frame` at `size`: the CPU frame's own, or on wgpu those of one
-    /// instrumented frame (rendered now, on a device of its own).
+    /// The technique's debug views and counters of `frame` at `size`, from one instrumented frame rendered
+    /// now by a technique made afresh (so every light is built and counted, none kept from the frame
+    /// before): on the CPU, or on wgpu on a device of its own.
     ///
     /// # Errors
     /// The instrumented frame failed, or no wgpu adapter for it.
-    pub fn debug_views(&mut self, frame: &FrameInputs, (width, height): (u32, u32)) -> Result<Vec<DebugView>, Error> {
-        match (self.backend, &self.cpu) {
-            (BackendKind::Cpu, Some(cpu)) => Ok(cpu.last.as_ref().ok_or_else(not_drawn)?.debug_views.clone()),
+    pub fn inspect(&mut self, frame: &FrameInputs, (width, height): (u32, u32)) -> Result<Inspection, Error> {
+        let spec = self.shadows.technique().clone();
+        let run = match (self.backend, &mut self.cpu) {
+            (BackendKind::Cpu, Some(cpu)) => cpu.renderer.run(BackendKind::Cpu, frame, width, height, &spec)?,
             _ => {
                 let adapter = self.shadows.context().adapter.name.clone();
                 let renderer = self
                     .instrumented
                     .get_or_insert_with(|| Renderer::new(TechniqueRegistry::builtin()).with_adapter(Some(adapter)));
-                let spec = self.shadows.technique().clone();
-                Ok(renderer.run(BackendKind::Wgpu, frame, width, height, &spec)?.debug_views)
+                renderer.run(BackendKind::Wgpu, frame, width, height, &spec)?
             }
-        }
+        };
+        Ok(Inspection { views: run.debug_views, counters: run.stats.counters.entries() })
     }
+}
+
+/// What an instrumented frame shows of the technique: its debug views and counters.
+pub struct Inspection {
+    /// The debug views.
+    pub views: Vec<DebugView>,
+    /// Every measured counter, by name.
+    pub counters: Vec<(String, f64)>,
 }
 
 fn not_drawn() -> Error {

@@ -2,7 +2,8 @@
 //! - turning the camera and the light, zooming, switching the technique and then the backend, with a bad
 //!   model file opened between: every screenshot matches what the printed `render` command of the view
 //!   renders offline within the suite's cross-backend FLIP bound and shows the moved view, not the
-//!   scene's own; the comparison with the reference prints a small mismatch; the bad file's one-line
+//!   scene's own; the comparison with the reference prints a small mismatch, the inspected frame its
+//!   counters; the bad file's one-line
 //!   error is shown and the viewer goes on;
 //! - a hundred switches of technique, setting and backend leave as many buffers and bytes alive on the
 //!   device as the first two rounds of them did (the first frames still free what they replaced).
@@ -64,7 +65,7 @@ fn a_scripted_view_matches_its_render_command_on_both_backends() {
     let bad = Path::new(env!("CARGO_MANIFEST_DIR")).join("shadow-core/tests/data/bad/nan_position.obj");
     let script = format!(
         "wait 2; orbit 35 -8; light 50 10; zoom 0.85; technique pcss:res=2048; wait 2; screenshot {}; \
-         command; compare; scene {}; backend cpu; technique shadow-volume-zfail; wait 1; screenshot {}; command; quit",
+         command; compare; scene {}; backend cpu; technique shadow-volume-zfail; wait 1; screenshot {}; command; inspect; quit",
         shot(1).display(),
         bad.display(),
         shot(2).display()
@@ -75,6 +76,9 @@ fn a_scripted_view_matches_its_render_command_on_both_backends() {
     let mismatch = stderr.lines().find_map(|l| l.strip_prefix("mismatch ")?.split('%').next()?.parse::<f64>().ok());
     let mismatch = mismatch.unwrap_or_else(|| panic!("no mismatch printed: {stderr}"));
     assert!(mismatch > 0.0 && mismatch < 5.0, "pcss against the reference: {mismatch}%");
+    // The inspected CPU frame's counters: z-fail's volumes.
+    let counters = stdout.lines().find(|l| l.starts_with("counters: ")).unwrap_or_else(|| panic!("{stdout}"));
+    assert!(counters.contains("silhouette_edges=") && counters.contains("volume_triangles="), "{counters}");
     let commands: Vec<&str> = stdout.lines().filter(|l| l.starts_with("shadowlab render ")).collect();
     assert_eq!(commands.len(), 2, "{stdout}\n{stderr}");
     for (n, command) in (1..).zip(commands) {

@@ -247,7 +247,7 @@ pub(crate) enum Command {
         size: String,
         /// Steps replayed one per frame before the user's hands, separated by ';' (orbit YAW PITCH,
         /// light YAW PITCH, zoom F, fly F R U, technique SPEC, backend wgpu|cpu, scene NAME|FILE,
-        /// wait FRAMES, screenshot FILE.png, command, memory, quit).
+        /// wait FRAMES, screenshot FILE.png, command, compare, inspect, memory, quit).
         #[arg(long)]
         script: Option<String>,
     },
