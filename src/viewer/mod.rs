@@ -47,6 +47,14 @@ pub struct ViewerOptions {
 /// A scene that does not load, no display or no adapter that can present, or a failure drawing.
 pub fn run(options: ViewerOptions) -> Result<(), Error> {
     let scene = Scene::open(options.setup.clone())?;
+    #[cfg(all(unix, not(target_os = "macos")))]
+    if ["DISPLAY", "WAYLAND_DISPLAY", "WAYLAND_SOCKET"].iter().all(|v| std::env::var_os(v).is_none()) {
+        return Err(Error::Window(
+            "no display to open it on (DISPLAY and WAYLAND_DISPLAY are unset); `xvfb-run -a shadowlab view ...` \
+             gives it a virtual one"
+                .into(),
+        ));
+    }
     let event_loop = EventLoop::new().map_err(|e| Error::Window(e.to_string()))?;
     let mut app = App { options, scene: Some(scene), open: None, failure: None };
     event_loop.run_app(&mut app).map_err(|e| Error::Window(e.to_string()))?;

@@ -288,3 +288,18 @@ fn compare_of_every_technique_leaves_out_those_the_lights_refuse() {
     assert_eq!(code, 1, "{err}");
     assert!(err.contains("pcss") && err.contains("directional"), "{err}");
 }
+
+#[test]
+fn view_without_a_display_says_how_to_get_one() {
+    let out = Command::new(env!("CARGO_BIN_EXE_shadowlab"))
+        .args(["view", "--scene", "cubes"])
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
+        .env_remove("WAYLAND_SOCKET")
+        .output()
+        .expect("the binary runs");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(err.contains("no display") && err.contains("xvfb-run"), "{err}");
+}
