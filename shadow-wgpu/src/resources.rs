@@ -48,13 +48,15 @@ pub(crate) struct Resources {
 }
 
 /// The transient buffers, [`FRAMES`] of `size` bytes used in turn, the frame under way and how much of
-/// its buffer it has used.
+/// its buffer it has used; with the device's offset alignment and largest buffer, read once.
 #[derive(Default)]
 struct Arena {
     buffers: Vec<wgpu::Buffer>,
     size: u64,
     frame: u64,
     used: u64,
+    align: u64,
+    max_size: u64,
 }
 
 /// A slice of the transient buffer holding one piece of this frame's data.
@@ -161,17 +163,20 @@ impl WgpuContext {
     /// bind as a uniform or read-only storage, or to draw as vertices or indices.
     #[must_use]
     pub fn transient(&self, bytes: &[u8]) -> Transient {
-        let limits = self.device.limits();
-        let align =
-            u64::from(limits.min_uniform_buffer_offset_alignment.max(limits.min_storage_buffer_offset_alignment));
         // Bindings and writes are whole words; an empty storage binding is not allowed.
         let size = (bytes.len() as u64).max(4).next_multiple_of(4);
         let mut arena = self.resources.transient.borrow_mut();
-        let local = arena.used.next_multiple_of(align);
+        if arena.align == 0 {
+            let limits = self.device.limits();
+            arena.align =
+                u64::from(limits.min_uniform_buffer_offset_alignment.max(limits.min_storage_buffer_offset_alignment));
+            arena.max_size = limits.max_buffer_size;
+        }
+        let local = arena.used.next_multiple_of(arena.align);
         let offset = if !arena.buffers.is_empty() && local + size <= arena.size {
             local
         } else {
-            arena.size = (2 * (local + size)).max(MIN_TRANSIENT).min(limits.max_buffer_size);
+            arena.size = (2 * (local + size)).max(MIN_TRANSIENT).min(arena.max_size);
             let usage = wgpu::BufferUsages::UNIFORM
                 | wgpu::BufferUsages::STORAGE
                 | wgpu::BufferUsages::VERTEX

@@ -92,6 +92,7 @@ fn a_scripted_view_matches_its_render_command_on_both_backends() {
         let offline = Image::<Rgb8>::load_png(&rendered).expect("the render");
         assert_eq!((viewed.width(), viewed.height()), (offline.width(), offline.height()), "{command}");
         let error = flip(&viewed, &offline);
+        eprintln!("screenshot {n} against its render command: FLIP {error:.5}");
         assert!(error <= MAX_FLIP, "screenshot {n} against `{command}`: FLIP {error:.4}");
         // Not a blank picture: lit and shadowed ground both show.
         let lum = |p: &Rgb8| u32::from(p[0]) + u32::from(p[1]) + u32::from(p[2]);
