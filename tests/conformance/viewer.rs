@@ -6,7 +6,8 @@
 //!   counters; the bad file's one-line
 //!   error is shown and the viewer goes on;
 //! - a hundred switches of technique, setting and backend leave as many buffers and bytes alive on the
-//!   device as the first two rounds of them did (the first frames still free what they replaced).
+//!   device as the first rounds of them did (the largest of three readings on each side: writes in flight
+//!   hold staging buffers for a while).
 //!
 //! Without xvfb-run or a wgpu adapter this prints one line and passes, unless SHADOWLAB_REQUIRE_GPU=1.
 
@@ -128,7 +129,7 @@ fn a_scripted_view_matches_its_render_command_on_both_backends() {
 }
 
 #[test]
-fn a_hundred_switches_leave_no_more_alive_on_the_device_than_the_first_two_rounds() {
+fn a_hundred_switches_leave_no_more_alive_on_the_device_than_the_first_rounds() {
     if !can_view("the viewer's switches") {
         return;
     }
@@ -136,10 +137,28 @@ fn a_hundred_switches_leave_no_more_alive_on_the_device_than_the_first_two_round
     let round = "technique shadow-volume-zfail; wait 1; technique shadow-volume-zfail:extrusion=cpu; wait 1; \
                  backend cpu; wait 1; backend wgpu; technique shadow-map; wait 3";
     let rounds = |n| std::iter::repeat_n(round, n).collect::<Vec<_>>().join("; ");
-    let script = format!("wait 1; {}; memory; {}; memory; quit", rounds(2), rounds(23));
+    // Three readings after rounds 2 to 4 and three after rounds 23 to 25: what is alive at one instant
+    // includes the staging buffers of writes still in flight, so each side's largest is compared.
+    let script = format!(
+        "wait 1; {}; memory; {round}; memory; {round}; memory; {}; memory; {round}; memory; {round}; memory; quit",
+        rounds(2),
+        rounds(19)
+    );
     let (stdout, stderr) = view("primitives", "400x300", &script);
-    let memory: Vec<&str> = stdout.lines().filter(|l| l.starts_with("gpu memory: ")).collect();
-    assert_eq!(memory.len(), 2, "{stdout}\n{stderr}");
-    assert_eq!(memory[0], memory[1], "after two rounds and after 25");
+    let readings: Vec<[u64; 3]> = stdout
+        .lines()
+        .filter_map(|l| l.strip_prefix("gpu memory: "))
+        .map(|l| {
+            let n: Vec<u64> = l.split(|c: char| !c.is_ascii_digit()).filter_map(|w| w.parse().ok()).collect();
+            [n[0], n[1], n[2]]
+        })
+        .collect();
+    assert_eq!(readings.len(), 6, "{stdout}\n{stderr}");
+    let largest = |r: &[[u64; 3]]| [0, 1, 2].map(|k| r.iter().map(|x| x[k]).max().unwrap_or(0));
+    let (early, late) = (largest(&readings[..3]), largest(&readings[3..]));
+    assert!(
+        (0..3).all(|k| late[k] <= early[k]),
+        "buffers, buffer bytes, texture bytes: {early:?} early, {late:?} late"
+    );
     assert!(!stderr.contains("error"), "{stderr}");
 }
