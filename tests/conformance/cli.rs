@@ -46,7 +46,7 @@ fn scenes_json_lists_every_scene() {
     let (code, out, _) = shadowlab(&["scenes", "--json"]);
     assert_eq!(code, 0);
     let v: Vec<serde_json::Value> = serde_json::from_str(&out).unwrap();
-    assert_eq!(v.len(), shadow_core::scenes::ALL.len());
+    assert_eq!(v.len(), shadow_core::scenes::every().count());
     assert!(v.iter().all(|s| s["triangles"].as_u64().unwrap() > 0 && s["name"].is_string()));
 }
 

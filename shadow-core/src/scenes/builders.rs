@@ -8,7 +8,7 @@ use glam::{Mat4, Quat, Vec2, Vec3};
 use super::{Rng, SceneParams, built};
 use crate::mesh::Mesh;
 use crate::procedural;
-use crate::scene::{Camera, Light, Material, Scene};
+use crate::scene::{Camera, Light, Material, MeshKey, Scene};
 
 /// A scene under construction.
 struct Stage {
@@ -22,9 +22,19 @@ impl Stage {
 
     /// Adds a mesh instance with a colour. The builders only pass finite transforms of their own meshes.
     fn add(&mut self, name: &str, mesh: Mesh, color: Vec3, transform: Mat4) {
-        let m = self.scene.add_mesh(mesh);
+        let m = self.mesh(mesh);
+        self.place(name, m, color, transform);
+    }
+
+    /// Adds a mesh to be placed, once or many times, with [`Stage::place`].
+    fn mesh(&mut self, mesh: Mesh) -> MeshKey {
+        self.scene.add_mesh(mesh)
+    }
+
+    /// Places an instance of a mesh added with [`Stage::mesh`].
+    fn place(&mut self, name: &str, mesh: MeshKey, color: Vec3, transform: Mat4) {
         let mat = self.scene.add_material(Material::colored(name, color));
-        if let Err(e) = self.scene.add_instance(name, m, mat, transform) {
+        if let Err(e) = self.scene.add_instance(name, mesh, mat, transform) {
             panic!("built-in scene: {e}");
         }
     }
@@ -317,4 +327,125 @@ pub(super) fn room(_: &SceneParams) -> Scene {
         Camera::look_at(Vec3::new(0.0, 1.2, 3.0), Vec3::new(0.0, 0.7, -2.0), 55.0),
         Light::spot(Vec3::new(0.0, 3.4, 0.0), Vec3::new(0.0, 0.0, -1.0), 130.0),
     )
+}
+
+/// Where the outdoor scene's sun stands, seen from its camera.
+#[derive(Clone, Copy)]
+enum Sun {
+    /// To the right and behind, shining across the road at 45 degrees.
+    Side,
+    /// Behind the camera: the light's and the eye's frusta look the same way.
+    Behind,
+    /// Ahead, facing the camera: the duelling frusta.
+    Facing,
+}
+
+/// The sun's elevation above the horizon, in degrees: low, so shadows are long.
+const SUN_ELEVATION: f32 = 20.0;
+
+/// Half the outdoor ground's side, in metres.
+const OUTDOOR_HALF: f32 = 100.0;
+
+/// The outdoor scene of the perspective-aliasing work (Stamminger-Drettakis, the Nealen survey's Fig. 10):
+/// a 200 x 200 m ground under a low sun and a few thousand casters of every size (buildings, lamp poles,
+/// bollards, crates, trees with thin branches, picket fences along the road), seen by a camera at head
+/// height on the road, looking along it to the horizon. Instanced: each kind of caster is one mesh (a few
+/// of them for trees and buildings), so the scene stays small on the GPU.
+fn outdoor_with(p: &SceneParams, sun: Sun) -> Scene {
+    let mut rng = Rng::new(p.seed);
+    let mut s = Stage::new();
+    let ground = s.mesh(built(procedural::plane(2.0 * OUTDOOR_HALF, 2.0 * OUTDOOR_HALF)));
+    s.place("ground", ground, Vec3::new(0.55, 0.6, 0.5), Mat4::IDENTITY);
+    // The road runs along z through x = 0; fences line it at x = +-7, bollards at +-5.5, lamp poles at +-6.3.
+    let picket = s.mesh(built(procedural::cuboid(Vec3::new(0.06, 1.1, 0.1))));
+    let rail = s.mesh(built(procedural::cuboid(Vec3::new(0.05, 0.08, 10.0))));
+    let bollard = s.mesh(built(procedural::cylinder(0.12, 0.9, 12)));
+    let pole = s.mesh(built(procedural::cylinder(0.09, 6.0, 12)));
+    let wood = Vec3::new(0.6, 0.45, 0.3);
+    let metal = Vec3::splat(0.35);
+    let (start, end) = (-OUTDOOR_HALF + 2.0, OUTDOOR_HALF - 2.0);
+    // Positions every `step` metres from `from` to the road's end.
+    let along = |from: f32, step: f32| (0..).map(move |i| from + step * i as f32).take_while(move |&z| z < end);
+    for side in [-1.0f32, 1.0] {
+        for z in along(start, 0.2) {
+            s.place("picket", picket, wood, at(side * 7.0, 0.55, z));
+        }
+        for z in along(start + 5.0, 10.0) {
+            for y in [0.3, 0.85] {
+                s.place("rail", rail, wood, at(side * 7.0 - side * 0.08, y, z));
+            }
+        }
+        for z in along(start, 2.0) {
+            s.place("bollard", bollard, metal, at(side * 5.5, 0.0, z));
+        }
+        for z in along(start + 3.0, 8.0) {
+            s.place("lamp pole", pole, metal, at(side * 6.3, 0.0, z));
+        }
+    }
+    // Lots on both sides of the road: a building, or a stand of trees.
+    let building = s.mesh(built(procedural::cuboid(Vec3::ONE)));
+    let trees: Vec<_> = (0..6)
+        .map(|_| {
+            let mut parts = Vec::new();
+            let height = rng.range(1.2, 1.8);
+            branch(&mut rng, Vec3::ZERO, Vec3::Y, height, 0.1, 4, &mut parts);
+            s.mesh(Mesh::merged(&parts).unwrap_or_else(|e| panic!("outdoor tree: {e}")))
+        })
+        .collect();
+    let crate_mesh = s.mesh(built(procedural::cuboid(Vec3::splat(0.8))));
+    let mut lot_z = start + 4.0;
+    while lot_z < end - 6.0 {
+        for side in [-1.0f32, 1.0] {
+            let mut lot_x = 20.0;
+            while lot_x < OUTDOOR_HALF - 8.0 {
+                let (x, z) = (side * (lot_x + rng.range(-2.0, 2.0)), lot_z + rng.range(-2.0, 2.0));
+                if rng.unit() < 0.6 {
+                    let size = Vec3::new(rng.range(5.0, 12.0), rng.range(3.0, 25.0), rng.range(5.0, 11.0));
+                    let grey = rng.range(0.55, 0.85);
+                    let turn = Mat4::from_rotation_y(rng.range(-0.15, 0.15));
+                    let shape = at(x, size.y / 2.0, z) * turn * Mat4::from_scale(size);
+                    s.place("building", building, Vec3::new(grey, grey * 0.95, grey * 0.9), shape);
+                } else {
+                    for _ in 0..rng.range(2.0, 5.0) as u32 {
+                        let tree = trees[(rng.next_u64() % trees.len() as u64) as usize];
+                        let (tx, tz) = (x + rng.range(-5.0, 5.0), z + rng.range(-5.0, 5.0));
+                        let scale = Mat4::from_scale(Vec3::splat(rng.range(2.0, 3.5)));
+                        let turn = Mat4::from_rotation_y(rng.range(0.0, std::f32::consts::TAU));
+                        s.place("tree", tree, Vec3::new(0.5, 0.38, 0.25), at(tx, 0.0, tz) * turn * scale);
+                    }
+                }
+                for _ in 0..4 {
+                    let (cx, cz) = (x + rng.range(-7.0, 7.0), z + rng.range(-7.0, 7.0));
+                    let turn = Mat4::from_rotation_y(rng.range(0.0, std::f32::consts::TAU));
+                    s.place("crate", crate_mesh, wood * 0.8, at(cx, 0.4, cz) * turn);
+                }
+                lot_x += 16.0;
+            }
+        }
+        lot_z += 14.0;
+    }
+    // The camera looks along -z; the sun's horizontal direction of travel, then tilted down.
+    let elevation = SUN_ELEVATION.to_radians();
+    let horizontal = match sun {
+        Sun::Side => Vec3::new(-0.71, 0.0, -0.71),
+        Sun::Behind => Vec3::new(0.15, 0.0, -1.0).normalize(),
+        Sun::Facing => Vec3::new(0.15, 0.0, 1.0).normalize(),
+    };
+    let travel = horizontal * elevation.cos() - Vec3::Y * elevation.sin();
+    s.finish(
+        Camera::look_at(Vec3::new(0.0, 1.7, OUTDOOR_HALF - 5.0), Vec3::new(0.0, 1.2, -OUTDOOR_HALF), 60.0),
+        Light::directional(travel),
+    )
+}
+
+pub(super) fn outdoor(p: &SceneParams) -> Scene {
+    outdoor_with(p, Sun::Side)
+}
+
+pub(super) fn outdoor_behind(p: &SceneParams) -> Scene {
+    outdoor_with(p, Sun::Behind)
+}
+
+pub(super) fn outdoor_facing(p: &SceneParams) -> Scene {
+    outdoor_with(p, Sun::Facing)
 }

@@ -121,27 +121,56 @@ pub const ALL: &[SceneInfo] = &[
     },
 ];
 
+/// The outdoor scenes, for perspective aliasing: one ground of 200 x 200 m under a low sun, seen from head
+/// height, with the sun beside the view, behind the camera, and facing it (the duelling frusta). They are
+/// apart from [`ALL`], the papers' small scenes that the conformance loops hold to their bounds.
+pub const OUTDOOR: &[SceneInfo] = &[
+    SceneInfo {
+        name: "outdoor",
+        after: "Nealen Fig. 10",
+        description: "a 200 x 200 m street of buildings, trees, poles and fences at head height, low sun beside the view",
+        build: builders::outdoor,
+    },
+    SceneInfo {
+        name: "outdoor-behind",
+        after: "Stamminger-Drettakis",
+        description: "the outdoor street with the sun behind the camera",
+        build: builders::outdoor_behind,
+    },
+    SceneInfo {
+        name: "outdoor-facing",
+        after: "Stamminger-Drettakis",
+        description: "the outdoor street with the sun facing the camera (the duelling frusta)",
+        build: builders::outdoor_facing,
+    },
+];
+
+/// Every built-in scene: the papers' ([`ALL`]), then the outdoor ones ([`OUTDOOR`]).
+pub fn every() -> impl Iterator<Item = &'static SceneInfo> {
+    ALL.iter().chain(OUTDOOR)
+}
+
 /// Why a scene could not be built.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("unknown scene '{0}' (built-in scenes: {names})", names = names().join(", "))]
+#[error("unknown scene '{0}' (built-in scenes: {names})", names = every().map(|s| s.name).collect::<Vec<_>>().join(", "))]
 pub struct UnknownScene(pub String);
 
-/// Names of every built-in scene.
+/// Names of the papers' scenes ([`ALL`]).
 #[must_use]
 pub fn names() -> Vec<&'static str> {
     ALL.iter().map(|s| s.name).collect()
 }
 
-/// The description of a built-in scene.
+/// The description of a built-in scene (of [`ALL`] or [`OUTDOOR`]).
 #[must_use]
 pub fn info(name: &str) -> Option<&'static SceneInfo> {
-    ALL.iter().find(|s| s.name == name)
+    every().find(|s| s.name == name)
 }
 
 /// Builds a built-in scene: its meshes, one camera and one light.
 ///
 /// # Errors
-/// [`UnknownScene`] for a name not in [`ALL`].
+/// [`UnknownScene`] for a name not in [`ALL`] or [`OUTDOOR`].
 pub fn build(name: &str, params: &SceneParams) -> Result<Scene, UnknownScene> {
     let info = info(name).ok_or_else(|| UnknownScene(name.into()))?;
     let mut scene = (info.build)(params);
@@ -274,7 +303,7 @@ mod tests {
 
     #[test]
     fn every_scene_builds_deterministically_with_a_camera_and_a_light() {
-        for info in ALL {
+        for info in every() {
             let a = build(info.name, &SceneParams::default()).unwrap();
             let b = build(info.name, &SceneParams::default()).unwrap();
             assert_eq!(a.triangle_count(), b.triangle_count(), "{}", info.name);
@@ -300,6 +329,26 @@ mod tests {
         // Strike: ten pins of about 450 triangles each, a ball and a lane.
         let strike = count("strike");
         assert!(strike > 4_500.0 && strike < 6_500.0, "strike: {strike}");
+    }
+
+    #[test]
+    fn the_outdoor_scenes_are_a_street_at_head_height_under_a_low_sun() {
+        let sun = |name: &str| {
+            let s = build(name, &SceneParams::default()).unwrap();
+            let (_, camera) = s.cameras().next().unwrap();
+            let (_, light) = s.lights().next().unwrap();
+            let LightKind::Directional { direction } = light.kind else { panic!("{name}: a sun") };
+            let b = s.bounds();
+            assert!(b.size().x >= 200.0 && b.size().z >= 200.0, "{name}: {b:?}");
+            assert!(s.drawables().count() >= 3000, "{name}: {} casters", s.drawables().count());
+            assert!((camera.eye.y - 1.7).abs() < 1e-6, "{name}: the eye at head height");
+            let elevation = (-direction.y).asin().to_degrees();
+            assert!((elevation - 20.0).abs() < 0.5, "{name}: the sun at {elevation} degrees");
+            // How the sun travels along the view: with it (behind the camera) or against it (facing).
+            direction.dot((camera.target - camera.eye).normalize())
+        };
+        let (side, behind, facing) = (sun("outdoor"), sun("outdoor-behind"), sun("outdoor-facing"));
+        assert!(behind > 0.9 && facing < -0.9 && side.abs() < 0.8, "{side} {behind} {facing}");
     }
 
     #[test]

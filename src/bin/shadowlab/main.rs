@@ -139,7 +139,7 @@ fn results(
     if bench_frames == 0 {
         return Err(Error::Usage("--bench-frames must be at least 1".into()));
     }
-    if !scenes::ALL.iter().any(|s| s.name == bench_scene) {
+    if scenes::info(&bench_scene).is_none() {
         return Err(Error::Usage(format!("--bench-scene '{bench_scene}': not a built-in scene")));
     }
     let size = parse_size(size).map_err(|e| Error::Usage(e.to_string()))?;
@@ -168,8 +168,7 @@ fn print_json(v: &serde_json::Value) -> Result<(), Error> {
 }
 
 fn list_scenes(json: bool) -> Result<(), Error> {
-    let rows: Vec<(&str, usize, &str, &str)> = scenes::ALL
-        .iter()
+    let rows: Vec<(&str, usize, &str, &str)> = scenes::every()
         .map(|info| {
             let tris = scenes::build(info.name, &SceneParams::default()).map(|s| s.triangle_count()).unwrap_or(0);
             (info.name, tris, info.description, info.after)

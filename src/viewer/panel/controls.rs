@@ -65,7 +65,7 @@ impl Viewer {
         let current = self.scene.setup.source.clone();
         let mut chosen = None;
         ComboBox::from_label("Scene").selected_text(&current).show_ui(ui, |ui| {
-            for s in scenes::ALL {
+            for s in scenes::every() {
                 if ui.selectable_label(current == s.name, s.name).on_hover_text(s.description).clicked() {
                     chosen = Some(s.name.to_string());
                 }
