@@ -44,6 +44,14 @@ struct Visibility {
     layers: u32,
 }
 
+/// What a recorded frame draws on: a colour target to shade into (its G-buffer pass its own), or an
+/// engine's depth and normals standing in for the G-buffer, with no shading.
+#[derive(Clone, Copy)]
+enum Surfaces<'a> {
+    Shaded(&'a ColorTarget<'a>),
+    Host(&'a HostSurfaces<'a>),
+}
+
 /// Where a recorded frame's shading goes: a view of the host's texture, its format and size.
 pub struct ColorTarget<'a> {
     /// The view to shade into (cleared first).
@@ -80,15 +88,7 @@ impl FrameRecorder {
         techniques: impl Into<LightTechniques<'t, 'o, WgpuBackend>>,
         target: &ColorTarget<'_>,
     ) -> Result<Vec<LightView>, WgpuError> {
-        check_lights(cx, frame)?;
-        let visibility =
-            visibility_for(&mut self.visibility, cx, target.width, target.height, frame.lights.len() as u32);
-        let shade = self.shade.entry(target.format).or_insert_with(|| shade_pipeline(cx, target.format));
-        let (width, height) = (target.width, target.height);
-        let timer = self.timer.as_mut();
-        let steps = RecordSteps { width, height, visibility, host: None, shade: Some((shade, target.view)), timer };
-        let FrameRun { light_views, .. } = cx.record_into(encoder, |cx| run_frame(cx, frame, steps, techniques))?;
-        Ok(light_views)
+        self.record_frame(cx, encoder, frame, techniques.into(), Surfaces::Shaded(target))
     }
 
     /// Records one frame's shadows into `encoder` for an engine that renders its own depth and normals
@@ -106,12 +106,32 @@ impl FrameRecorder {
         techniques: impl Into<LightTechniques<'t, 'o, WgpuBackend>>,
         host: &HostSurfaces<'_>,
     ) -> Result<Vec<LightView>, WgpuError> {
+        self.record_frame(cx, encoder, frame, techniques.into(), Surfaces::Host(host))
+    }
+
+    /// The body of both: the frame's targets and steps for `surfaces`, recorded into `encoder`.
+    fn record_frame(
+        &mut self,
+        cx: &mut WgpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        frame: &FrameInputs,
+        techniques: LightTechniques<'_, '_, WgpuBackend>,
+        surfaces: Surfaces<'_>,
+    ) -> Result<Vec<LightView>, WgpuError> {
         check_lights(cx, frame)?;
-        let visibility = visibility_for(&mut self.visibility, cx, host.width, host.height, frame.lights.len() as u32);
-        let import = self.import.get_or_insert_with(|| ImportPass::new(cx));
-        let (width, height) = (host.width, host.height);
-        let timer = self.timer.as_mut();
-        let steps = RecordSteps { width, height, visibility, host: Some((host, import)), shade: None, timer };
+        let (width, height) = match surfaces {
+            Surfaces::Shaded(target) => (target.width, target.height),
+            Surfaces::Host(host) => (host.width, host.height),
+        };
+        let visibility = visibility_for(&mut self.visibility, cx, width, height, frame.lights.len() as u32);
+        let (host, shade) = match surfaces {
+            Surfaces::Shaded(target) => {
+                let shade = self.shade.entry(target.format).or_insert_with(|| shade_pipeline(cx, target.format));
+                (None, Some((&*shade, target.view)))
+            }
+            Surfaces::Host(host) => (Some((host, &*self.import.get_or_insert_with(|| ImportPass::new(cx)))), None),
+        };
+        let steps = RecordSteps { width, height, visibility, host, shade, timer: self.timer.as_mut() };
         let FrameRun { light_views, .. } = cx.record_into(encoder, |cx| run_frame(cx, frame, steps, techniques))?;
         Ok(light_views)
     }

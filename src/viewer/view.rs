@@ -52,6 +52,7 @@ pub struct Gpu {
 /// The wgpu view texture, registered with egui's renderer.
 struct Target {
     texture: wgpu::Texture,
+    view: wgpu::TextureView,
     id: egui::TextureId,
 }
 
@@ -188,23 +189,31 @@ impl View {
                 Ok(texture.id())
             }
             _ => {
-                let fits = |t: &Target| t.texture.width() == width && t.texture.height() == height;
-                if !self.target.as_ref().is_some_and(fits) {
-                    let texture = shadow_wgpu::frame::layered(self.shadows.context(), "view", width, height, 1, FORMAT);
-                    let view = texture.create_view(&Default::default());
-                    let nearest = wgpu::FilterMode::Nearest;
-                    let id = match self.target.take() {
-                        Some(old) => {
-                            egui_renderer.update_egui_texture_from_wgpu_texture(&gpu.device, &view, nearest, old.id);
-                            old.id
-                        }
-                        None => egui_renderer.register_native_texture(&gpu.device, &view, nearest),
-                    };
-                    self.target = Some(Target { texture, id });
-                }
-                let target = self.target.as_ref().expect("made above");
-                let view = target.texture.create_view(&Default::default());
-                let color = ColorTarget { view: &view, format: FORMAT, width, height };
+                // The texture of the frame before while the size stays; a new one under the same egui id
+                // when it changes.
+                let target = match self.target.take() {
+                    Some(t) if t.texture.width() == width && t.texture.height() == height => self.target.insert(t),
+                    old => {
+                        let texture =
+                            shadow_wgpu::frame::layered(self.shadows.context(), "view", width, height, 1, FORMAT);
+                        let view = texture.create_view(&Default::default());
+                        let nearest = wgpu::FilterMode::Nearest;
+                        let id = match old {
+                            Some(old) => {
+                                egui_renderer.update_egui_texture_from_wgpu_texture(
+                                    &gpu.device,
+                                    &view,
+                                    nearest,
+                                    old.id,
+                                );
+                                old.id
+                            }
+                            None => egui_renderer.register_native_texture(&gpu.device, &view, nearest),
+                        };
+                        self.target.insert(Target { texture, view, id })
+                    }
+                };
+                let color = ColorTarget { view: &target.view, format: FORMAT, width, height };
                 self.shadows.record(encoder, frame, &color)?;
                 Ok(target.id)
             }
