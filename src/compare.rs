@@ -6,8 +6,12 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 use shadow_core::image::{Rgb8, error_map_over, visibility_to_rgb};
-use shadow_core::metrics::{VisibilityMetrics, back_false_light, compare_visibility, flip_mean, measured_pixels};
+use shadow_core::metrics::{
+    VisibilityMetrics, back_false_light, compare_visibility, flip_mean, measured_pixels, min_median, near_field,
+    texel_density,
+};
 use shadow_core::stats::Phase;
+use shadow_core::technique::maps::MapSampling;
 use shadow_core::technique::{FrameStats, TechniqueSpec};
 use shadow_core::{FrameInputs, Image};
 
@@ -165,6 +169,8 @@ fn save(img: &Image<Rgb8>, dir: &Path, name: &str) -> Result<(), Error> {
 struct References {
     frame: CpuFrame,
     mask: Image<bool>,
+    /// The measured pixels in the nearest third of the view's depth range.
+    near: Image<bool>,
     reach: Image<bool>,
     /// The soft reference's spec, shaded picture and visibility.
     soft: Option<(TechniqueSpec, Image<Rgb8>, Image<f32>)>,
@@ -213,7 +219,8 @@ impl References {
             }
             _ => None,
         };
-        Ok(Self { frame, mask, reach, soft })
+        let near = near_field(&mask, &g.position, &job.frame.camera);
+        Ok(Self { frame, mask, near, reach, soft })
     }
 
     /// The reference a technique of this kind is measured against: spec, shaded picture, visibility, and
@@ -295,6 +302,13 @@ fn measure(
     });
     let mut vs_reference = metrics_map(&metrics, flip);
     vs_reference.insert("back_false_light".into(), back);
+    vs_reference
+        .insert("near_field_mismatch".into(), compare_visibility(&run.visibility[0], ref_vis, &refs.near)?.mismatch);
+    if let Some(layout) = renderer.registry().get(&spec.name).ok().and_then(|e| e.layout) {
+        let sampling = layout(spec, job.frame, &refs.frame.light_views[0], job.width as f32 / job.height as f32)?;
+        let density = sampling_report(&sampling, refs, &run.color, job.out_dir.as_deref().map(|d| (d, file.as_str())))?;
+        vs_reference.extend(density);
+    }
     if let Some(a) = acne {
         vs_reference.insert("texel_acne".into(), a);
     }
@@ -311,6 +325,67 @@ fn measure(
         flip,
     };
     Ok(Measured { run, entry, against_soft })
+}
+
+/// Texel density of a technique's maps over the measured pixels and the near field (min and median
+/// texels per pixel), with its pictures when `files` names a folder and a file stem: the density, and
+/// for more than one map which map each pixel reads over `color`.
+fn sampling_report(
+    sampling: &MapSampling,
+    refs: &References,
+    color: &Image<Rgb8>,
+    files: Option<(&Path, &str)>,
+) -> Result<BTreeMap<String, f64>, Error> {
+    let g = &refs.frame.gbuffer;
+    let density = texel_density(sampling, &g.position, &g.geometric_normal, &refs.mask);
+    let mut out = BTreeMap::new();
+    if let Some((lo, median)) = min_median(&density, &refs.mask) {
+        out.insert("texel_density_min".into(), lo);
+        out.insert("texel_density_median".into(), median);
+    }
+    if let Some((lo, median)) = min_median(&density, &refs.near) {
+        out.insert("near_texel_density_min".into(), lo);
+        out.insert("near_texel_density_median".into(), median);
+    }
+    if let Some((dir, file)) = files {
+        // log2 of texels per pixel from 1/64 to 64: the middle of the ramp is one texel per pixel.
+        let picture = shadow_core::image::false_colour(&density.map(|d| d.log2()), -6.0, 6.0);
+        save(&picture, dir, &format!("{file}.density.png"))?;
+        if sampling.view.projections.len() > 1 {
+            save(&map_picture(sampling, &g.position, &refs.reach, color), dir, &format!("{file}.maps.png"))?;
+        }
+    }
+    Ok(out)
+}
+
+/// `color` tinted by the map each receiver pixel of `reach` reads (a cascade, a cube face), cascades
+/// mixed with the next one's tint over their blend band.
+fn map_picture(
+    sampling: &MapSampling,
+    position: &Image<glam::Vec3>,
+    reach: &Image<bool>,
+    color: &Image<Rgb8>,
+) -> Image<Rgb8> {
+    const TINTS: [[f32; 3]; 6] =
+        [[1.0, 0.3, 0.3], [0.3, 1.0, 0.3], [0.35, 0.5, 1.0], [1.0, 0.9, 0.2], [1.0, 0.3, 1.0], [0.2, 1.0, 1.0]];
+    let view = &sampling.view;
+    Image::from_fn(color.width(), color.height(), |x, y| {
+        let c = *color.get(x, y);
+        if !*reach.get(x, y) {
+            return c;
+        }
+        let p = *position.get(x, y);
+        let tint = match view.cascade_pick(p) {
+            Some(pick) => {
+                let a = TINTS[pick.cascade % 6];
+                let (next, w) = pick.next.map_or((pick.cascade, 0.0), |(k, w)| (k, w));
+                let b = TINTS[next % 6];
+                [0, 1, 2].map(|i| a[i] * (1.0 - w) + b[i] * w)
+            }
+            None => TINTS[view.projection_index(p) % 6],
+        };
+        [0, 1, 2].map(|i| (f32::from(c[i]) * (0.35 + 0.65 * tint[i])).round().min(255.0) as u8)
+    })
 }
 
 /// Every pair of runs of one technique and settings on two backends, compared with each other.
@@ -413,25 +488,35 @@ pub fn report_markdown(r: &CompareReport) -> String {
     let mut s = format!(
         "# {} at {}x{}\n\nErrors against each row's reference over receiver pixels that face the light and lie in \
          its reach. Mismatch, edge band, interior, false shadow and false light are percentages of those pixels; \
-         RMSE and FLIP are on visibility and colour in [0, 1]. Soft techniques are judged by RMSE.\n\n",
+         near field is the mismatch over those in the nearest third of the view's depth range. RMSE and FLIP are \
+         on visibility and colour in [0, 1]. Soft techniques are judged by RMSE. Texels per pixel (light-map \
+         texels a pixel's footprint covers; below 1 a texel spans several pixels), smallest and median, for \
+         techniques built on depth maps.\n\n",
         r.scene, r.width, r.height
     );
-    s.push_str("| technique | backend | reference | mismatch | edge band | interior | false shadow | false light | RMSE | FLIP | total ms | picture |\n");
-    s.push_str("|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---|\n");
+    s.push_str("| technique | backend | reference | mismatch | edge band | interior | near field | false shadow | false light | RMSE | FLIP | texels/px | total ms | picture |\n");
+    s.push_str("|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|\n");
     for e in &r.results {
         let m = &e.metrics;
+        let v = |k: &str| e.vs_reference.get(k).copied();
+        let density = match (v("texel_density_min"), v("texel_density_median")) {
+            (Some(lo), Some(median)) => format!("{lo:.1e} / {median:.2}"),
+            _ => "-".into(),
+        };
         s.push_str(&format!(
-            "| `{}` | {} | `{}` | {:.3}% | {:.3}% | {:.3}% | {:.3}% | {:.3}% | {:.4} | {:.4} | {:.1} | [png]({}.png) [errors]({}.err.png) |\n",
+            "| `{}` | {} | `{}` | {:.3}% | {:.3}% | {:.3}% | {:.3}% | {:.3}% | {:.3}% | {:.4} | {:.4} | {} | {:.1} | [png]({}.png) [errors]({}.err.png) |\n",
             e.technique,
             e.backend,
             e.reference,
             m.mismatch * 100.0,
             m.edge_band_mismatch * 100.0,
             m.interior_mismatch * 100.0,
+            v("near_field_mismatch").unwrap_or(0.0) * 100.0,
             m.false_shadow * 100.0,
             m.false_light * 100.0,
             m.rmse,
             e.flip,
+            density,
             e.timings_ms.get("total").copied().unwrap_or(0.0),
             e.file,
             e.file

@@ -62,6 +62,7 @@ impl TechniqueRegistry {
             shadow_hard::depth_layers::midpoint_entry(),
             shadow_hard::depth_layers::second_depth_entry(),
             shadow_hard::depth_layers::dual_entry(),
+            shadow_hard::cascaded_shadow_map::entry(),
         ] {
             r.register(entry);
         }

@@ -11,6 +11,9 @@
 //! `mismatch = edge_band_mismatch + interior_mismatch = false_shadow + false_light`.
 
 use crate::image::{Image, Rgb8};
+use crate::scene::Camera;
+use crate::technique::maps::MapSampling;
+use glam::Vec3;
 
 /// Half-width in pixels of the band around reference shadow boundaries.
 pub const EDGE_BAND_RADIUS: i32 = 2;
@@ -82,6 +85,76 @@ pub fn measured_pixels(
         let p = *position.get(x, y);
         *receiver.get(x, y) && light.in_domain(p) && normal.get(x, y).dot(light.light.to_light(p)) > 0.0
     })
+}
+
+/// The pixels of `mask` in the nearest third of the view's depth range, where perspective aliasing is
+/// worst: view depth (along the camera's axis) at most a third of the way from the nearest measured
+/// receiver to the farthest.
+#[must_use]
+pub fn near_field(mask: &Image<bool>, position: &Image<Vec3>, camera: &Camera) -> Image<bool> {
+    let axis = (camera.target - camera.eye).normalize_or_zero();
+    let depth = |i: usize| (position.data()[i] - camera.eye).dot(axis);
+    let measured = (0..mask.data().len()).filter(|&i| mask.data()[i]);
+    let (lo, hi) = measured.map(depth).fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), d| (lo.min(d), hi.max(d)));
+    let limit = lo + (hi - lo) / 3.0;
+    Image::from_fn(mask.width(), mask.height(), |x, y| {
+        let i = (y * mask.width() + x) as usize;
+        mask.data()[i] && depth(i) <= limit
+    })
+}
+
+/// Light-map texels per screen pixel at each pixel of `mask` (NaN where it cannot be measured): the area of
+/// the pixel's footprint on its surface in the texels of the map the receiver reads. Below 1, one texel
+/// covers several pixels and its square edges show (undersampling); the survey's `d / d_i` is one over the
+/// square root of this. Measured from the pixel's right or left and lower or upper neighbour on the same
+/// plane, so pixels at depth discontinuities and on sub-pixel detail have none.
+#[must_use]
+pub fn texel_density(
+    sampling: &MapSampling,
+    position: &Image<Vec3>,
+    normal: &Image<Vec3>,
+    mask: &Image<bool>,
+) -> Image<f32> {
+    let (w, h) = (mask.width() as i32, mask.height() as i32);
+    let res = sampling.resolution as f32;
+    let same_plane = |p: Vec3, n: Vec3, x: i32, y: i32| -> Option<Vec3> {
+        if x < 0 || y < 0 || x >= w || y >= h || !*mask.get(x as u32, y as u32) {
+            return None;
+        }
+        let (q, m) = (*position.get(x as u32, y as u32), *normal.get(x as u32, y as u32));
+        let step = (q - p).length();
+        (m.dot(n) > 0.9999 && n.dot(q - p).abs() <= 1e-3 * step).then_some(q)
+    };
+    Image::from_fn(w as u32, h as u32, |x, y| {
+        if !*mask.get(x, y) {
+            return f32::NAN;
+        }
+        let (p, n) = (*position.get(x, y), *normal.get(x, y));
+        let (x, y) = (x as i32, y as i32);
+        let along = |dx: i32, dy: i32| {
+            same_plane(p, n, x + dx, y + dy).map(|q| q - p).or_else(|| same_plane(p, n, x - dx, y - dy).map(|q| p - q))
+        };
+        let (Some(du), Some(dv)) = (along(1, 0), along(0, 1)) else { return f32::NAN };
+        let proj = &sampling.view.projections[sampling.view.projection_index(p)];
+        let (uv, _) = proj.uv_depth(p);
+        let (a, _) = proj.uv_depth(p + du);
+        let (b, _) = proj.uv_depth(p + dv);
+        let (a, b) = ((a - uv) * res, (b - uv) * res);
+        (a.x * b.y - a.y * b.x).abs()
+    })
+}
+
+/// The smallest and the median of the measured (not NaN) values of `values` over `mask`, or `None` when
+/// there are none.
+#[must_use]
+pub fn min_median(values: &Image<f32>, mask: &Image<bool>) -> Option<(f64, f64)> {
+    let mut v: Vec<f32> =
+        values.data().iter().zip(mask.data()).filter(|&(v, &m)| m && !v.is_nan()).map(|(v, _)| *v).collect();
+    if v.is_empty() {
+        return None;
+    }
+    v.sort_by(f32::total_cmp);
+    Some((f64::from(v[0]), f64::from(v[v.len() / 2])))
 }
 
 fn check<A, B>(a: &Image<A>, b: &Image<B>) -> Result<(), SizeMismatch> {
@@ -238,6 +311,42 @@ mod tests {
         assert_eq!(m.pixels, 4);
         assert_eq!(m.mismatch, 1.0);
         assert!(compare_visibility(&test, &Image::new(3, 4, 1.0), &mask).is_err());
+    }
+
+    #[test]
+    fn near_field_is_the_nearest_third_of_the_depths_seen() {
+        // Receivers at depths 1 to 10 along -Z from the eye: the nearest third is up to 4.
+        let camera = Camera::look_at(Vec3::ZERO, Vec3::NEG_Z, 60.0);
+        let position = Image::from_fn(10, 1, |x, _| Vec3::new(0.0, 0.0, -1.0 - x as f32));
+        let near = near_field(&Image::new(10, 1, true), &position, &camera);
+        let cols: Vec<u32> = (0..10).filter(|&x| *near.get(x, 0)).collect();
+        assert_eq!(cols, vec![0, 1, 2, 3]);
+    }
+
+    #[test]
+    fn texel_density_counts_texels_per_pixel() {
+        // A plane facing a directional light straight on, its pixels 0.01 apart, a map of 1000 texels
+        // over 10 units: each pixel spans one texel each way.
+        let light = crate::light::LightView::fit(
+            &crate::scene::Light::directional(Vec3::NEG_Y),
+            &[crate::bounds::Aabb::new(Vec3::new(-5.0, 0.0, -5.0), Vec3::new(5.0, 0.0, 5.0))],
+        )
+        .unwrap();
+        let size = light.projections[0].world_from_uv_depth(glam::Vec2::ONE, 0.5)
+            - light.projections[0].world_from_uv_depth(glam::Vec2::ZERO, 0.5);
+        let res = 1000;
+        let texel = size.abs().max_element() / res as f32;
+        let sampling = MapSampling { view: light, resolution: res };
+        let position = Image::from_fn(8, 8, |x, y| Vec3::new(x as f32 * texel * 2.0, 0.0, y as f32 * texel));
+        let normal = Image::new(8, 8, Vec3::Y);
+        let mask = Image::from_fn(8, 8, |x, _| x != 3);
+        let d = texel_density(&sampling, &position, &normal, &mask);
+        // Two texels across, one down: 2 texels per pixel, from either neighbour, none off the mask.
+        assert!((d.get(0, 0) - 2.0).abs() < 1e-2, "{}", d.get(0, 0));
+        assert!((d.get(7, 7) - 2.0).abs() < 1e-2, "{}", d.get(7, 7));
+        assert!(d.get(3, 0).is_nan());
+        let (lo, median) = min_median(&d, &mask).unwrap();
+        assert!((lo - 2.0).abs() < 1e-2 && (median - 2.0).abs() < 1e-2);
     }
 
     #[test]

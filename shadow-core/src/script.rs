@@ -140,6 +140,8 @@ pub fn run_frame<'t, 'o: 't, B: Backend, S: FrameSteps<B>>(
     let mut phases = Phases { steps: &mut steps, stats: &mut stats };
 
     let gbuffer = phases.run(cx, Phase::GBuffer, |cx, steps| steps.gbuffer(cx, frame))?;
+    let (width, height) = B::view_size(&gbuffer);
+    let aspect = width as f32 / height.max(1) as f32;
     let mut light_views = Vec::with_capacity(frame.lights.len());
     for (k, light) in frame.lights.iter().enumerate() {
         let view = frame.light_view(light)?;
@@ -154,10 +156,15 @@ pub fn run_frame<'t, 'o: 't, B: Backend, S: FrameSteps<B>>(
         let technique = techniques.pick(shadow.technique.as_ref())?;
         let mut light_stats = FrameStats::default();
         phases.run(cx, Phase::Build, |cx, _| {
-            technique.build(cx, LightPass { frame, light: &view, slot: k, stats: &mut light_stats })
+            technique.build(cx, LightPass { frame, light: &view, slot: k, aspect, stats: &mut light_stats })
         })?;
         phases.run(cx, Phase::Query, |cx, _| {
-            technique.query(cx, LightPass { frame, light: &view, slot: k, stats: &mut light_stats }, &gbuffer, &mut vis)
+            technique.query(
+                cx,
+                LightPass { frame, light: &view, slot: k, aspect, stats: &mut light_stats },
+                &gbuffer,
+                &mut vis,
+            )
         })?;
         phases.steps.keep(k, vis);
         phases.stats.add_light(light_stats);

@@ -68,6 +68,10 @@ impl Backend for CpuBackend {
     type Visibility = Image<f32>;
     type Error = CpuError;
     const NAME: &'static str = "cpu";
+
+    fn view_size(g: &GBuffer) -> (u32, u32) {
+        (g.depth.width(), g.depth.height())
+    }
 }
 
 /// What the CPU backend keeps between frames: the ray-casting BVH of the casters (it does not depend on

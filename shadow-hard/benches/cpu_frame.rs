@@ -28,11 +28,18 @@ fn ray_traced_tree(b: Bencher) {
     let t = RayTraced::defaults();
     let mut state = t.create_state(&mut cx).expect("state");
     let mut stats = FrameStats::default();
-    t.build(&mut cx, &mut state, LightPass { frame: &f, light: &view, slot: 0, stats: &mut stats }).expect("build");
+    t.build(&mut cx, &mut state, LightPass { frame: &f, light: &view, slot: 0, aspect: 1.0, stats: &mut stats })
+        .expect("build");
     let mut out = shadow_core::Image::new(1024, 768, 1.0f32);
     b.counter(divan::counter::ItemsCount::new(g.covered_pixels())).bench_local(|| {
-        t.query(&mut cx, &mut state, LightPass { frame: &f, light: &view, slot: 0, stats: &mut stats }, &g, &mut out)
-            .expect("query");
+        t.query(
+            &mut cx,
+            &mut state,
+            LightPass { frame: &f, light: &view, slot: 0, aspect: 1.0, stats: &mut stats },
+            &g,
+            &mut out,
+        )
+        .expect("query");
     });
 }
 
@@ -45,10 +52,17 @@ fn whole_frame<T: ShadowTechnique<shadow_cpu::CpuBackend>>(b: Bencher, t: T) {
     b.bench_local(|| {
         let mut stats = FrameStats::default();
         let g = gbuffer::render_reusing(&f, 1024, 768, spare.take()).expect("gbuffer");
-        t.build(&mut cx, &mut state, LightPass { frame: &f, light: &view, slot: 0, stats: &mut stats }).expect("build");
+        t.build(&mut cx, &mut state, LightPass { frame: &f, light: &view, slot: 0, aspect: 1.0, stats: &mut stats })
+            .expect("build");
         let mut out = shadow_core::Image::new(1024, 768, 1.0f32);
-        t.query(&mut cx, &mut state, LightPass { frame: &f, light: &view, slot: 0, stats: &mut stats }, &g, &mut out)
-            .expect("query");
+        t.query(
+            &mut cx,
+            &mut state,
+            LightPass { frame: &f, light: &view, slot: 0, aspect: 1.0, stats: &mut stats },
+            &g,
+            &mut out,
+        )
+        .expect("query");
         let color = shadow_cpu::shade::shade(&g, &f.lights, &[&out]);
         spare = Some(g);
         color

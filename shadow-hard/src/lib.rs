@@ -7,12 +7,14 @@
 //!
 //! - [`ray_traced`]: the exact reference.
 //! - [`shadow_map`]: Williams' depth map with percentage-closer filtering.
+//! - [`cascaded_shadow_map`]: a directional light's maps, one per slice of the camera's view depth.
 //! - [`silhouette_map`]: Sen, Cammarano and Hanrahan's silhouette map.
 //! - [`volume_reconstruction`]: McCool's shadow volumes rebuilt from a depth map.
 //! - [`hybrid`]: Chan's shadow maps with shadow volumes at the silhouette pixels only.
 //! - [`shadow_volume`]: stencil shadow volumes, z-pass and z-fail.
 //! - [`depth_layers`]: Woo's midpoint, Wang and Molnar's second-depth and Weiskopf and Ertl's dual maps.
 
+pub mod cascaded_shadow_map;
 pub mod depth_layers;
 pub mod hybrid;
 pub mod ray_traced;
@@ -24,6 +26,7 @@ pub mod volume_reconstruction;
 /// A registry entry of a technique on the two backends.
 pub type Entry = shadow_core::technique::registry::Entry<shadow_cpu::CpuBackend, shadow_wgpu::WgpuBackend>;
 
+pub use cascaded_shadow_map::CascadedShadowMap;
 pub use depth_layers::{DepthLayers, DualShadowMap, MidpointShadowMap, SecondDepthShadowMap};
 pub use hybrid::Hybrid;
 pub use ray_traced::RayTraced;

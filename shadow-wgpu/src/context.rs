@@ -104,6 +104,10 @@ impl Backend for WgpuBackend {
     type Visibility = crate::frame::GpuVisibility;
     type Error = WgpuError;
     const NAME: &'static str = "wgpu";
+
+    fn view_size(g: &crate::gbuffer::GpuGBuffer) -> (u32, u32) {
+        (g.width, g.height)
+    }
 }
 
 /// Which adapter to use.

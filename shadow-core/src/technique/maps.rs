@@ -6,6 +6,8 @@
 use super::settings::{
     BiasMode, DepthBias, Filter, MAX_MAP_RESOLUTION, SettingField, SettingKey, SettingsError, Values,
 };
+use crate::frame::FrameInputs;
+use crate::light::LightView;
 
 /// `bias`: how the map's depth is offset.
 pub const BIAS: SettingKey = SettingKey::choice(
@@ -119,4 +121,22 @@ impl SettingField for DepthMap {
             self.bias_world.to_string(),
         ]);
     }
+}
+
+/// Which texels of light space a technique's maps hold in one frame: the projections it renders (with how
+/// a receiver picks among them) and the maps' side.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MapSampling {
+    /// The projections the maps are rendered from.
+    pub view: LightView,
+    /// Map side in texels.
+    pub resolution: u32,
+}
+
+/// A technique built on depth maps, as far as where its maps' texels fall: each backend's build renders
+/// the projections this gives, and `compare` measures texel density and draws which map each pixel
+/// reads from it, without running the technique.
+pub trait MapLayout {
+    /// The maps for `light` (its fitted view) in `frame`, seen by a view `aspect` wide per unit of height.
+    fn sampling(&self, frame: &FrameInputs, light: &LightView, aspect: f32) -> MapSampling;
 }

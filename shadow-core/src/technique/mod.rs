@@ -40,6 +40,9 @@ pub trait Backend: Sized + 'static {
     type Error: std::error::Error + Send + Sync + 'static + From<TechniqueError> + From<LightViewError>;
     /// Short name for reports ("cpu", "wgpu").
     const NAME: &'static str;
+
+    /// A G-buffer's width and height in pixels.
+    fn view_size(gbuffer: &Self::GBuffer) -> (u32, u32);
 }
 
 /// Errors every backend shares.
@@ -107,6 +110,9 @@ pub struct LightPass<'a> {
     /// frame's commands run (a frame recorded into one command buffer) needs the data of each light in
     /// a place of its own: techniques index it by this.
     pub slot: usize,
+    /// The view's width over its height: with the camera's field of view, the frustum a build may fit
+    /// its maps to (cascades, perspective maps).
+    pub aspect: f32,
     /// Counters and sub-phase times for this light.
     pub stats: &'a mut FrameStats,
 }

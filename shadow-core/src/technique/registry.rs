@@ -5,8 +5,11 @@
 //! The entry is generic over the two backends it may be built on (`C` the CPU reference, `G` the GPU), so
 //! this crate, which knows neither, can hold it.
 
+use super::maps::{MapLayout, MapSampling};
 use super::settings::{SettingKey, SettingsError, TechniqueSettings, TechniqueSpec};
 use super::{Backend, DynShadowTechnique, ShadowTechnique, Stateful};
+use crate::frame::FrameInputs;
+use crate::light::LightView;
 use crate::scene::{Light, LightKind};
 
 /// The kinds of light a technique takes (`TechniqueSettings::LIGHTS`). A light of another kind is refused
@@ -27,6 +30,8 @@ impl LightKinds {
     pub const ALL: Self = Self { spot: true, directional: true, point: true };
     /// Spot lights only.
     pub const SPOT: Self = Self { spot: true, directional: false, point: false };
+    /// Directional lights only.
+    pub const DIRECTIONAL: Self = Self { spot: false, directional: true, point: false };
     /// Lights with a position: spot and point.
     pub const POSITIONED: Self = Self { spot: true, directional: false, point: true };
     /// Lights with one projection: spot and directional.
@@ -55,6 +60,9 @@ impl LightKinds {
 /// Builds a technique for backend `B` from a spec.
 pub type Constructor<B> = fn(&TechniqueSpec) -> Result<Box<dyn DynShadowTechnique<B>>, SettingsError>;
 
+/// The maps a spec's technique renders for a light in a frame seen at an aspect ratio ([`MapLayout`]).
+pub type Layout = fn(&TechniqueSpec, &FrameInputs, &LightView, f32) -> Result<MapSampling, SettingsError>;
+
 /// One technique as the registry holds it.
 pub struct Entry<C: Backend, G: Backend> {
     /// Registry name.
@@ -81,6 +89,8 @@ pub struct Entry<C: Backend, G: Backend> {
     /// The WGSL its GPU implementation compiles beyond the backend's own, each shader whole and named:
     /// every one is validated by the conformance suite.
     pub wgsl: fn() -> Vec<(&'static str, String)>,
+    /// For a technique built on depth maps, where its texels fall ([`MapLayout`]).
+    pub layout: Option<Layout>,
 }
 
 /// No WGSL of its own.
@@ -117,6 +127,7 @@ impl<C: Backend, G: Backend> Entry<C, G> {
             cpu,
             wgpu,
             wgsl: no_wgsl,
+            layout: None,
         }
     }
 
@@ -151,6 +162,12 @@ impl<C: Backend, G: Backend> Entry<C, G> {
         Self { wgsl: shaders, ..self }
     }
 
+    /// The same entry, with the layout of its maps, which its settings type `S` gives.
+    #[must_use]
+    pub fn with_layout<S: TechniqueSettings + MapLayout>(self) -> Self {
+        Self { layout: Some(layout::<S>), ..self }
+    }
+
     /// The same entry, for a reference.
     #[must_use]
     pub fn reference(self) -> Self {
@@ -164,6 +181,19 @@ impl<C: Backend, G: Backend> Entry<C, G> {
 /// Unknown keys or bad values.
 pub fn canonical<S: TechniqueSettings>(spec: &TechniqueSpec) -> Result<String, SettingsError> {
     Ok(S::parse(&spec.name, &spec.values)?.settings_string())
+}
+
+/// The layout of a spec's maps, for a settings type that lays them out.
+///
+/// # Errors
+/// Unknown keys or bad values.
+pub fn layout<S: TechniqueSettings + MapLayout>(
+    spec: &TechniqueSpec,
+    frame: &FrameInputs,
+    light: &LightView,
+    aspect: f32,
+) -> Result<MapSampling, SettingsError> {
+    Ok(S::parse(&spec.name, &spec.values)?.sampling(frame, light, aspect))
 }
 
 /// A constructor for a settings type whose value alone is the technique, on backend `B`.

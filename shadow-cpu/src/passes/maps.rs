@@ -161,7 +161,8 @@ pub fn map_position(light: &LightView, mut p: Vec3, receiver_offset: f32) -> Map
 }
 
 /// The lookup every map-based technique shares: each receiver (moved `receiver_offset` towards the light)
-/// projected into its map and compared through `filter`.
+/// projected into its map and compared through `filter`; with cascades, faded into the next cascade's
+/// answer over the blend band at its far end.
 pub fn query_maps(
     maps: &[Image<f32>],
     light: &LightView,
@@ -173,7 +174,15 @@ pub fn query_maps(
 ) {
     per_receiver(g, out, |x, y, i| {
         let m = map_position(light, g.position.data()[i], receiver_offset);
-        shadow_lookup(&maps[m.projection], m.uv, m.depth, filter, radius, (x, y))
+        let v = shadow_lookup(&maps[m.projection], m.uv, m.depth, filter, radius, (x, y));
+        match light.cascade_pick(m.world).and_then(|pick| pick.next) {
+            Some((next, weight)) => {
+                let (uv, depth) = light.projections[next].uv_depth(m.world);
+                let w = shadow_lookup(&maps[next], uv, depth, filter, radius, (x, y));
+                v * (1.0 - weight) + w * weight
+            }
+            None => v,
+        }
     });
 }
 

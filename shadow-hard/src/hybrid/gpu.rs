@@ -415,7 +415,7 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
     }
 
     fn build(&self, cx: &mut WgpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), WgpuError> {
-        let LightPass { frame, light, slot, stats } = pass;
+        let LightPass { frame, light, slot, stats, .. } = pass;
         state.map.render(cx, frame, light, self.depth.resolution)?;
         cx.step("map");
         if state.kept.len() <= slot {

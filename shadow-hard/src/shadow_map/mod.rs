@@ -9,9 +9,12 @@ pub mod cpu;
 pub mod gpu;
 
 use crate::Entry;
+use shadow_core::FrameInputs;
+use shadow_core::light::LightView;
 use shadow_core::technique::maps::{
     BIAS, BIAS_CONSTANT, BIAS_SLOPE, BIAS_WORLD, DepthMap, FILTER, FILTER_RADIUS, resolution_key,
 };
+use shadow_core::technique::maps::{MapLayout, MapSampling};
 use shadow_core::technique::settings::{BiasMode, Filter};
 #[cfg(test)]
 use shadow_core::technique::settings::{SettingsError, TechniqueSettings};
@@ -55,6 +58,13 @@ impl ShadowMap {
     }
 }
 
+/// One map over the light's fitted view, whatever the camera sees: the uniform map.
+impl MapLayout for ShadowMap {
+    fn sampling(&self, _: &FrameInputs, light: &LightView, _: f32) -> MapSampling {
+        MapSampling { view: light.clone(), resolution: self.resolution }
+    }
+}
+
 /// The registry entry.
 #[must_use]
 pub fn entry() -> Entry {
@@ -63,6 +73,7 @@ pub fn entry() -> Entry {
         "depth map from the light with Vulkan depth bias and percentage-closer filtering",
         "Williams 1978; Reeves et al. 1987 (survey: Nealen 2005)",
     )
+    .with_layout::<ShadowMap>()
 }
 
 #[cfg(test)]

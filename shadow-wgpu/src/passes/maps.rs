@@ -27,6 +27,9 @@ struct MapParams {
     settings: [f32; 4],
     planes: [[[f32; 4]; 4]; 6],
     extra: [f32; 4],
+    cascade: [f32; 4],
+    cascade_axis: [f32; 4],
+    cascade_far: [f32; 4],
 }
 
 /// The bindings every map lookup shares (group 1, bindings 0 to 3: G-buffer positions, the maps, the
@@ -110,12 +113,21 @@ impl MapBindings {
             *slot = p.clip_from_world.to_cols_array_2d();
             *plane = p.clip_plane_from_world_plane.to_cols_array_2d();
         }
+        let (mut cascade, mut cascade_axis, mut cascade_far) = ([0.0f32; 4], [0.0f32; 4], [0.0f32; 4]);
+        if let Some(c) = &light.cascades {
+            cascade = [c.far.len() as f32, c.blend, c.near, 0.0];
+            cascade_axis = c.axis.extend(-c.axis.dot(c.eye)).to_array();
+            cascade_far[..c.far.len()].copy_from_slice(&c.far);
+        }
         let params = MapParams {
             proj,
             light: LightRaw::from(&light.light),
             settings: [0.0, lookup.radius, maps.width() as f32, lookup.receiver_offset],
             planes,
             extra: extras.settings,
+            cascade,
+            cascade_axis,
+            cascade_far,
         };
         let params = cx.transient(bytemuck::bytes_of(&params));
         let maps_view = maps.create_view(&wgpu::TextureViewDescriptor {

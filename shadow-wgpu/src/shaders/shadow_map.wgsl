@@ -12,6 +12,13 @@ struct MapParams {
     planes: array<mat4x4<f32>, 6>,
     // Technique-specific (silhouette-map: x = 1 for receiver-plane corner depths).
     extra: vec4<f32>,
+    // Cascades (twin: shadow_core::light::Cascades): x their count (0: the projections are no cascades),
+    // y the blend fraction, z the first one's near end.
+    cascade: vec4<f32>,
+    // The camera's view axis, and minus its dot with the eye: a point's view depth is dot(xyz, p) + w.
+    cascade_axis: vec4<f32>,
+    // The far end of each cascade.
+    cascade_far: vec4<f32>,
 };
 
 // The lookup filter (0 none, 1 bilinear, 2 pcf3x3, 3 pcf4x4-jitter, 4 poisson16), fixed when the query
@@ -146,6 +153,37 @@ struct MapPoint {
     world: vec3<f32>,
 };
 
+// The cascade a point reads (x) and the next one's weight in the blend band at its far end (y, 0
+// outside it). Twin: shadow_core::light::Cascades::pick.
+fn cascade_pick(p: vec3<f32>) -> vec2<f32> {
+    let count = i32(map.cascade.x);
+    let depth = dot(map.cascade_axis.xyz, p) + map.cascade_axis.w;
+    var k = count - 1;
+    for (var i = count - 1; i >= 0; i = i - 1) {
+        if (depth <= map.cascade_far[i]) {
+            k = i;
+        }
+    }
+    var near = map.cascade.z;
+    if (k > 0) {
+        near = map.cascade_far[k - 1];
+    }
+    let far = map.cascade_far[k];
+    let start = far - map.cascade.y * (far - near);
+    var weight = 0.0;
+    if (k < count - 1 && depth > start && far > start) {
+        weight = min((depth - start) / (far - start), 1.0);
+    }
+    return vec2<f32>(f32(k), weight);
+}
+
+// A world point in projection `layer`: its map coordinates and depth.
+fn in_projection(layer: i32, p: vec3<f32>) -> MapPoint {
+    let c = map.proj[layer] * vec4<f32>(p, 1.0);
+    let ndc = c.xyz / c.w;
+    return MapPoint(layer, ndc_to_uv(ndc.xy), ndc.z, p);
+}
+
 // Twin: shadow-cpu's `map_position` (Light::to_light times the offset, then the projection).
 fn map_point(receiver: vec3<f32>) -> MapPoint {
     var p = receiver;
@@ -153,12 +191,12 @@ fn map_point(receiver: vec3<f32>) -> MapPoint {
         p = p + map_to_light(p) * map.settings.w;
     }
     var layer = 0;
-    if (map.light.kind.x == 2u) {
+    if (map.cascade.x > 0.0) {
+        layer = i32(cascade_pick(p).x);
+    } else if (map.light.kind.x == 2u) {
         layer = cube_face(p - map.light.position.xyz);
     }
-    let c = map.proj[layer] * vec4<f32>(p, 1.0);
-    let ndc = c.xyz / c.w;
-    return MapPoint(layer, ndc_to_uv(ndc.xy), ndc.z, p);
+    return in_projection(layer, p);
 }
 
 // Twin: shadow_core::light::LightProjection::depth_gradient.
@@ -178,5 +216,15 @@ fn fs_shadow_map_query(in: FullScreen) -> @location(0) vec4<f32> {
         return vec4<f32>(1.0);
     }
     let m = map_point(g.xyz);
-    return vec4<f32>(shadow_lookup(m.layer, m.uv, m.depth, vec2<u32>(px)));
+    var v = shadow_lookup(m.layer, m.uv, m.depth, vec2<u32>(px));
+    // Cascades fade into the next one over the blend band at their far end (twin: shadow-cpu's
+    // `query_maps`).
+    if (map.cascade.x > 0.0) {
+        let pick = cascade_pick(m.world);
+        if (pick.y > 0.0) {
+            let next = in_projection(m.layer + 1, m.world);
+            v = v * (1.0 - pick.y) + shadow_lookup(next.layer, next.uv, next.depth, vec2<u32>(px)) * pick.y;
+        }
+    }
+    return vec4<f32>(v);
 }

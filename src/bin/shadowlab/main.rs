@@ -383,29 +383,38 @@ fn compare(
         b.finish_and_clear();
     }
     out!(
-        "{:<24} {:<5} {:<21} {:>9} {:>9} {:>9} {:>7} {:>7} {:>9}",
+        "{:<24} {:<5} {:<21} {:>9} {:>9} {:>9} {:>9} {:>7} {:>7} {:>13} {:>9}",
         "technique",
         "",
         "reference",
         "mismatch",
         "edge",
         "interior",
+        "near",
         "RMSE",
         "FLIP",
+        "texels/px",
         "total ms"
     );
     for r in &report.results {
         let m = &r.metrics;
+        let v = |k: &str| r.vs_reference.get(k).copied();
+        let density = match (v("texel_density_min"), v("texel_density_median")) {
+            (Some(lo), Some(median)) => format!("{lo:.1e} / {median:.2}"),
+            _ => "-".into(),
+        };
         out!(
-            "{:<24} {:<5} {:<21} {:>8.3}% {:>8.3}% {:>8.3}% {:>7.4} {:>7.4} {:>9.1}",
+            "{:<24} {:<5} {:<21} {:>8.3}% {:>8.3}% {:>8.3}% {:>8.3}% {:>7.4} {:>7.4} {:>13} {:>9.1}",
             r.technique,
             r.backend,
             r.reference,
             m.mismatch * 100.0,
             m.edge_band_mismatch * 100.0,
             m.interior_mismatch * 100.0,
+            v("near_field_mismatch").unwrap_or(0.0) * 100.0,
             m.rmse,
             r.flip,
+            density,
             r.timings_ms.get("total").copied().unwrap_or(0.0)
         );
     }

@@ -6,6 +6,12 @@
 //! Shadow-map lookup (DESIGN 4), written once here and mirrored in WGSL: a world point projects to light
 //! NDC; `uv = (x * 0.5 + 0.5, 0.5 - y * 0.5)`; texel `i` of an `N`-texel side is centred at `(i + 0.5) / N`;
 //! the point is lit when its depth minus the bias is at most the stored depth.
+//!
+//! A map-based technique may render other projections than the fitted ones: cascades over the camera's
+//! view ([`cascades`]). The view it renders then says how a receiver picks its projection
+//! ([`LightView::projection_index`]).
+
+pub mod cascades;
 
 use glam::camera::rh::proj::directx;
 use glam::camera::rh::view::look_to_mat4;
@@ -14,6 +20,7 @@ use glam::{Mat4, Vec2, Vec3, Vec3Swizzles, Vec4Swizzles};
 use crate::bounds::Aabb;
 use crate::geometry::LightSource;
 use crate::scene::{Light, LightKind, SceneError};
+pub use cascades::{CascadeFit, CascadePick, Cascades};
 
 /// Why a light view could not be made.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -133,6 +140,8 @@ pub struct LightView {
     /// One projection (a spot light's perspective view, a directional light's orthographic one), or a
     /// point light's six cube faces in the order +X, -X, +Y, -Y, +Z, -Z.
     pub projections: Vec<LightProjection>,
+    /// When the projections are cascades over a camera's view: how a receiver's view depth picks one.
+    pub cascades: Option<Cascades>,
 }
 
 /// Look direction and up vector of the six cube faces, in the order of [`LightView::projections`].
@@ -229,7 +238,7 @@ impl LightView {
                 })
                 .collect(),
         };
-        Ok(Self { light: *light, projections })
+        Ok(Self { light: *light, projections, cascades: None })
     }
 
     /// The same view with a point light's six cube faces widened so that an `n x n` map's outermost
@@ -261,14 +270,24 @@ impl LightView {
         }
     }
 
-    /// Index of the projection that covers world point `p` (the cube face for point lights).
+    /// Index of the projection that covers world point `p`: the cube face for point lights, the cascade of
+    /// its view depth for cascades (without their blending: see [`LightView::cascade_pick`]).
     #[must_use]
     #[inline]
     pub fn projection_index(&self, p: Vec3) -> usize {
+        if let Some(c) = &self.cascades {
+            return c.pick(c.depth(p)).cascade;
+        }
         match self.light.kind {
             LightKind::Point { position } => cube_face(p - position),
             _ => 0,
         }
+    }
+
+    /// For cascades, the cascade `p` reads and the next one it fades into.
+    #[must_use]
+    pub fn cascade_pick(&self, p: Vec3) -> Option<CascadePick> {
+        self.cascades.as_ref().map(|c| c.pick(c.depth(p)))
     }
 
     /// True where the light can reach at all: inside a spot light's cone, everywhere for the others.
