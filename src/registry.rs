@@ -63,6 +63,7 @@ impl TechniqueRegistry {
             shadow_hard::depth_layers::second_depth_entry(),
             shadow_hard::depth_layers::dual_entry(),
             shadow_hard::cascaded_shadow_map::entry(),
+            shadow_hard::lispsm::entry(),
         ] {
             r.register(entry);
         }

@@ -8,6 +8,7 @@
 //! - [`ray_traced`]: the exact reference.
 //! - [`shadow_map`]: Williams' depth map with percentage-closer filtering.
 //! - [`cascaded_shadow_map`]: a directional light's maps, one per slice of the camera's view depth.
+//! - [`lispsm`]: Wimmer, Scherzer and Purgathofer's light-space perspective shadow map.
 //! - [`silhouette_map`]: Sen, Cammarano and Hanrahan's silhouette map.
 //! - [`volume_reconstruction`]: McCool's shadow volumes rebuilt from a depth map.
 //! - [`hybrid`]: Chan's shadow maps with shadow volumes at the silhouette pixels only.
@@ -17,10 +18,12 @@
 pub mod cascaded_shadow_map;
 pub mod depth_layers;
 pub mod hybrid;
+pub mod lispsm;
 pub mod ray_traced;
 pub mod shadow_map;
 pub mod shadow_volume;
 pub mod silhouette_map;
+pub mod view_maps;
 pub mod volume_reconstruction;
 
 /// A registry entry of a technique on the two backends.
@@ -29,6 +32,7 @@ pub type Entry = shadow_core::technique::registry::Entry<shadow_cpu::CpuBackend,
 pub use cascaded_shadow_map::CascadedShadowMap;
 pub use depth_layers::{DepthLayers, DualShadowMap, MidpointShadowMap, SecondDepthShadowMap};
 pub use hybrid::Hybrid;
+pub use lispsm::Lispsm;
 pub use ray_traced::RayTraced;
 pub use shadow_map::ShadowMap;
 pub use shadow_volume::ShadowVolume;

@@ -7,11 +7,14 @@
 //! NDC; `uv = (x * 0.5 + 0.5, 0.5 - y * 0.5)`; texel `i` of an `N`-texel side is centred at `(i + 0.5) / N`;
 //! the point is lit when its depth minus the bias is at most the stored depth.
 //!
-//! A map-based technique may render other projections than the fitted ones: cascades over the camera's
-//! view ([`cascades`]). The view it renders then says how a receiver picks its projection
+//! A map-based technique may render other projections than the fitted ones, made for the camera's view:
+//! cascades ([`cascades`]) or a light-space perspective ([`lispsm`]), both fitted to the part of the view
+//! the scene fills ([`focus`]). The view it renders then says how a receiver picks its projection
 //! ([`LightView::projection_index`]).
 
 pub mod cascades;
+pub mod focus;
+pub mod lispsm;
 
 use glam::camera::rh::proj::directx;
 use glam::camera::rh::view::look_to_mat4;
