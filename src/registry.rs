@@ -64,6 +64,7 @@ impl TechniqueRegistry {
             shadow_hard::depth_layers::dual_entry(),
             shadow_hard::cascaded_shadow_map::entry(),
             shadow_hard::lispsm::entry(),
+            shadow_hard::perspective_shadow_map::entry(),
         ] {
             r.register(entry);
         }

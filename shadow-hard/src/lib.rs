@@ -9,6 +9,7 @@
 //! - [`shadow_map`]: Williams' depth map with percentage-closer filtering.
 //! - [`cascaded_shadow_map`]: a directional light's maps, one per slice of the camera's view depth.
 //! - [`lispsm`]: Wimmer, Scherzer and Purgathofer's light-space perspective shadow map.
+//! - [`perspective_shadow_map`]: Stamminger and Drettakis's map in post-perspective space.
 //! - [`silhouette_map`]: Sen, Cammarano and Hanrahan's silhouette map.
 //! - [`volume_reconstruction`]: McCool's shadow volumes rebuilt from a depth map.
 //! - [`hybrid`]: Chan's shadow maps with shadow volumes at the silhouette pixels only.
@@ -19,6 +20,7 @@ pub mod cascaded_shadow_map;
 pub mod depth_layers;
 pub mod hybrid;
 pub mod lispsm;
+pub mod perspective_shadow_map;
 pub mod ray_traced;
 pub mod shadow_map;
 pub mod shadow_volume;
@@ -33,6 +35,7 @@ pub use cascaded_shadow_map::CascadedShadowMap;
 pub use depth_layers::{DepthLayers, DualShadowMap, MidpointShadowMap, SecondDepthShadowMap};
 pub use hybrid::Hybrid;
 pub use lispsm::Lispsm;
+pub use perspective_shadow_map::PerspectiveShadowMap;
 pub use ray_traced::RayTraced;
 pub use shadow_map::ShadowMap;
 pub use shadow_volume::ShadowVolume;

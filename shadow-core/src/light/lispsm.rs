@@ -12,11 +12,10 @@
 //! perspective becomes the uniform map, focused on the body: the warp cannot help there, and it degrades
 //! gracefully instead of failing.
 
-use glam::camera::rh::proj::directx;
 use glam::camera::rh::view::look_to_mat4;
 use glam::{Mat4, Vec3, Vec4};
 
-use super::focus::{focused_body, transformed};
+use super::focus::{focused_body, focused_uniform, padded_range as padded, range, transformed, visible_depth_range};
 use super::{LightProjection, LightView, safe_up};
 use crate::bounds::Aabb;
 use crate::scene::{Camera, LightKind};
@@ -56,34 +55,32 @@ fn from_rows(rows: [Vec4; 4]) -> Mat4 {
     Mat4::from_cols(rows[0], rows[1], rows[2], rows[3]).transpose()
 }
 
-/// Padding of a range by a small fraction of its length, so that points on its ends stay inside.
-fn padded((lo, hi): (f32, f32)) -> (f32, f32) {
-    let pad = (hi - lo).abs() * 1e-3 + 1e-6;
-    (lo - pad, hi + pad)
-}
-
-fn range(values: impl Iterator<Item = f32>) -> (f32, f32) {
-    values.fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v)))
-}
-
 impl LightView {
     /// The light-space perspective view of a directional light for the view of `camera` (`aspect` wide
-    /// per unit of height) into a scene bounded by `bounds`, with the warp it used (`None` where the map
-    /// is uniform: the body is empty, or the warp too weak to be one). `n` overrides the paper's optimum
-    /// when given. Any other light's view is returned unchanged.
+    /// per unit of height) into a scene of instances bounded by `boxes`, with the warp it used (`None`
+    /// where the map is uniform: nothing is in view, or the warp is too weak to be one). `n` overrides the
+    /// paper's optimum when given. Any other light's view is returned unchanged.
+    ///
+    /// The paper's `z_n` and `z_f` are the near and far planes of a view fitted to the scene; the camera's
+    /// own near plane (5 cm at head height) would put every texel into the air in front of the lens, so
+    /// the view's depth range is the one its visible instances fill ([`visible_depth_range`]).
     #[must_use]
     pub fn light_space_perspective(
         &self,
         camera: &Camera,
         aspect: f32,
-        bounds: &Aabb,
+        boxes: &[Aabb],
         n: Option<f32>,
     ) -> (Self, Option<Warp>) {
         let LightKind::Directional { direction } = self.light.kind else { return (self.clone(), None) };
         let l = direction.normalize();
         let v = (camera.target - camera.eye).normalize();
+        let bounds = boxes.iter().fold(Aabb::EMPTY, |a, b| a.union(*b));
         let far = bounds.corners().iter().map(|&c| (c - camera.eye).dot(v)).fold(0.0f32, f32::max);
-        let body = focused_body(camera, aspect, far.max(camera.near * 2.0), bounds);
+        let Some((z_n, z_f)) = visible_depth_range(camera, aspect, far.max(camera.near * 2.0), boxes) else {
+            return (self.clone(), None);
+        };
+        let body = focused_body(camera, aspect, (z_n, z_f.max(z_n * 1.001)), &bounds);
         if body.is_empty() {
             return (self.clone(), None);
         }
@@ -97,20 +94,11 @@ impl LightView {
         let scene = bounds.transformed(light_from_world);
         let (y0, y1) = range(points.iter().map(|p| p.y));
         let depth = (y1 - y0).max(1e-6);
-        let view_depths = range(body.iter().map(|&p| (p - camera.eye).dot(v)));
-        let (z_n, z_f) = (view_depths.0.max(camera.near), view_depths.1.max(camera.near * 2.0));
         let warp = Warp { n: n.unwrap_or_else(|| Warp::optimal_n(z_n, z_f, sin_gamma)), depth, sin_gamma };
         // The light-side and far-side ends of the scene along the light: casters anywhere above the body.
         let (z_lo, z_hi) = padded((scene.min.z, scene.max.z));
         if !warp.is_perspective() {
-            let (x0, x1) = padded(range(points.iter().map(|p| p.x)));
-            let (y0, y1) = padded((y0, y1));
-            let proj = directx::orthographic(x0, x1, y0, y1, -z_hi, -z_lo);
-            let view = Self {
-                projections: vec![LightProjection::new(light_from_world, proj, -z_hi, -z_lo, true)],
-                ..self.clone()
-            };
-            return (view, None);
+            return (Self { projections: vec![focused_uniform(l, &body, &bounds)], ..self.clone() }, None);
         }
         // The perspective's centre: level with the eye across the axis and along the light, `n` before the
         // body along the axis. With q = y - c.y > 0 over the body, the map's axes are u = (x - c.x) / q
@@ -154,7 +142,7 @@ mod tests {
 
     fn warped(sun: Vec3, camera: &Camera) -> (LightView, Option<Warp>) {
         let view = LightView::fit(&Light::directional(sun), &[street()]).unwrap();
-        view.light_space_perspective(camera, 16.0 / 9.0, &street(), None)
+        view.light_space_perspective(camera, 16.0 / 9.0, &[street()], None)
     }
 
     #[test]
@@ -164,7 +152,7 @@ mod tests {
         let warp = warp.expect("a sun across the view warps");
         assert!(warp.n > 0.0 && warp.n < 100.0 * warp.depth, "{warp:?}");
         let p = &view.projections[0];
-        let body = focused_body(&camera, 16.0 / 9.0, 300.0, &street());
+        let body = focused_body(&camera, 16.0 / 9.0, (camera.near, 300.0), &street());
         for b in &body {
             // The receiver and a caster above it, towards the light, on the same light ray.
             let caster = *b + Vec3::new(-0.8, 0.35, -0.1).normalize() * 5.0;

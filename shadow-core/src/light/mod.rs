@@ -8,13 +8,14 @@
 //! the point is lit when its depth minus the bias is at most the stored depth.
 //!
 //! A map-based technique may render other projections than the fitted ones, made for the camera's view:
-//! cascades ([`cascades`]) or a light-space perspective ([`lispsm`]), both fitted to the part of the view
-//! the scene fills ([`focus`]). The view it renders then says how a receiver picks its projection
+//! cascades ([`cascades`]), a light-space perspective ([`lispsm`]) or the camera's post-perspective space
+//! ([`psm`]), the last two fitted to the part of the view the scene fills ([`focus`]). The view it renders then says how a receiver picks its projection
 //! ([`LightView::projection_index`]).
 
 pub mod cascades;
 pub mod focus;
 pub mod lispsm;
+pub mod psm;
 
 use glam::camera::rh::proj::directx;
 use glam::camera::rh::view::look_to_mat4;

@@ -20,13 +20,13 @@ pub mod cpu;
 pub mod gpu;
 
 use crate::Entry;
-use shadow_core::FrameInputs;
 use shadow_core::light::LightView;
 use shadow_core::technique::LightKinds;
 use shadow_core::technique::maps::{DepthMap, FILTER, FILTER_RADIUS, MapLayout, MapSampling, resolution_key};
 #[cfg(test)]
 use shadow_core::technique::settings::TechniqueSettings;
 use shadow_core::technique::settings::{Filter, SettingKey};
+use shadow_core::{Aabb, FrameInputs};
 
 shadow_core::technique_settings! {
     /// `lispsm`: one depth map through a perspective perpendicular to a directional light.
@@ -57,7 +57,8 @@ impl Lispsm {
 impl MapLayout for Lispsm {
     fn sampling(&self, frame: &FrameInputs, light: &LightView, aspect: f32) -> MapSampling {
         let n = (self.n > 0.0).then_some(self.n);
-        let (view, _) = light.light_space_perspective(&frame.camera, aspect, &frame.bounds, n);
+        let boxes: Vec<Aabb> = frame.instances.iter().map(|i| i.bounds).collect();
+        let (view, _) = light.light_space_perspective(&frame.camera, aspect, &boxes, n);
         MapSampling { view, resolution: self.map.resolution }
     }
 }
