@@ -7,6 +7,7 @@
 pub mod bench;
 pub mod compare;
 mod error;
+pub mod flicker;
 pub mod plot;
 pub mod realtime;
 pub mod registry;

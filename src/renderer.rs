@@ -172,6 +172,26 @@ impl Renderer {
         Ok((f, views))
     }
 
+    /// A CPU frame of a technique made earlier (`prepare` it for the CPU), built for `frame` and queried
+    /// over the receivers of `gbuffer`, another view's (see [`shadow_cpu::render_frame_over`]); the lights'
+    /// own techniques are made for the frame as [`Renderer::run_prepared`] makes them.
+    ///
+    /// # Errors
+    /// A technique prepared for the GPU, or a rendering failure.
+    pub fn run_cpu_over(
+        &mut self,
+        p: &mut Prepared,
+        frame: &FrameInputs,
+        gbuffer: &shadow_cpu::GBuffer,
+    ) -> Result<CpuFrame, Error> {
+        let PreparedKind::Cpu(t, named) = &mut p.technique else {
+            return Err(Error::Usage(format!("'{}' was prepared for the GPU, not the CPU", p.name)));
+        };
+        name_techniques(frame, named, |s| Ok(self.registry.cpu(s)?))?;
+        let techniques = LightTechniques { frame: t.as_mut(), named };
+        Ok(shadow_cpu::render_frame_over(&mut self.cpu, frame, gbuffer, techniques)?)
+    }
+
     /// The BVH of a frame's casters (for measurements against the reference).
     pub fn bvh(&mut self, frame: &FrameInputs) -> std::sync::Arc<shadow_cpu::bvh::SceneBvh> {
         self.cpu.bvh(frame)

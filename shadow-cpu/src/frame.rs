@@ -37,7 +37,28 @@ pub fn render_frame<'t, 'o: 't>(
     height: u32,
     techniques: impl Into<LightTechniques<'t, 'o, CpuBackend>>,
 ) -> Result<CpuFrame, CpuError> {
-    let steps = CpuSteps { width, height, visibility: Vec::with_capacity(frame.lights.len()) };
+    let steps = CpuSteps { width, height, given: None, visibility: Vec::with_capacity(frame.lights.len()) };
+    let FrameRun { output: (gbuffer, visibility, color), light_views, stats } =
+        run_frame(cx, frame, steps, techniques)?;
+    Ok(CpuFrame { gbuffer, light_views, visibility, color, stats })
+}
+
+/// Renders a frame over receivers given as another view's G-buffer: the techniques build for `frame`
+/// (its camera, which maps fitted to the view follow) and are queried at the points of `gbuffer`. Held
+/// still while the camera moves, those points show what the maps' changes alone do to the shadows (the
+/// shimmer that stabilised cascades remove).
+///
+/// # Errors
+/// As [`render_frame`].
+pub fn render_frame_over<'t, 'o: 't>(
+    cx: &mut CpuContext,
+    frame: &FrameInputs,
+    gbuffer: &GBuffer,
+    techniques: impl Into<LightTechniques<'t, 'o, CpuBackend>>,
+) -> Result<CpuFrame, CpuError> {
+    let (width, height) = (gbuffer.depth.width(), gbuffer.depth.height());
+    let visibility = Vec::with_capacity(frame.lights.len());
+    let steps = CpuSteps { width, height, given: Some(gbuffer.clone()), visibility };
     let FrameRun { output: (gbuffer, visibility, color), light_views, stats } =
         run_frame(cx, frame, steps, techniques)?;
     Ok(CpuFrame { gbuffer, light_views, visibility, color, stats })
@@ -47,6 +68,8 @@ pub fn render_frame<'t, 'o: 't>(
 struct CpuSteps {
     width: u32,
     height: u32,
+    /// Receivers given instead of the frame camera's view.
+    given: Option<GBuffer>,
     visibility: Vec<Image<f32>>,
 }
 
@@ -55,7 +78,10 @@ impl FrameSteps<CpuBackend> for CpuSteps {
     type Output = (GBuffer, Vec<Image<f32>>, Image<Rgb8>);
 
     fn gbuffer(&mut self, cx: &mut CpuContext, frame: &FrameInputs) -> Result<GBuffer, CpuError> {
-        gbuffer::render_reusing(frame, self.width, self.height, cx.take_spare())
+        match self.given.take() {
+            Some(g) => Ok(g),
+            None => gbuffer::render_reusing(frame, self.width, self.height, cx.take_spare()),
+        }
     }
 
     fn visibility(&mut self, _cx: &mut CpuContext, _k: usize) -> Result<Image<f32>, CpuError> {

@@ -14,5 +14,5 @@ pub mod raster;
 pub mod shade;
 
 pub use context::{CpuBackend, CpuContext, CpuError};
-pub use frame::{CpuFrame, render_frame};
+pub use frame::{CpuFrame, render_frame, render_frame_over};
 pub use gbuffer::GBuffer;

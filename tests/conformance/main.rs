@@ -20,6 +20,7 @@ mod planar;
 mod recorded;
 mod scale;
 mod suite;
+mod view_fitted;
 mod viewer;
 mod volume_reconstruction;
 mod wgsl;

@@ -36,6 +36,7 @@ fn reference_ceiling(technique: &str, scene: &str) -> Option<f64> {
         ("planar-shadow", _) => None,
         ("shadow-volume-zpass" | "shadow-volume-zfail", _) => Some(0.001),
         ("shadow-map" | "dual-shadow-map" | "midpoint-shadow-map" | "second-depth-shadow-map", _) => Some(0.03),
+        ("cascaded-shadow-map" | "lispsm" | "perspective-shadow-map", _) => Some(0.03),
         ("silhouette-map", _) => Some(0.01),
         ("volume-reconstruction", _) => Some(0.01),
         // Against the area light (lit/shadowed split at 0.5): the penumbra only outside the hard edge.

@@ -209,6 +209,27 @@ pub(crate) enum Command {
         #[arg(long)]
         out_dir: Option<PathBuf>,
     },
+    /// Temporal flicker along a walk, on the CPU: the fraction of the receivers seen at the start whose lit
+    /// state changes between consecutive frames as the maps follow the moving camera (the reference's
+    /// never does): shimmering and crawling shadow edges.
+    Flicker {
+        #[command(flatten)]
+        scene: SceneArgs,
+        #[command(flatten)]
+        view: ViewArgs,
+        /// NAME[:key=value,...], repeatable.
+        #[arg(long, required = true)]
+        technique: Vec<String>,
+        /// Frames along the walk.
+        #[arg(long, default_value_t = 60)]
+        frames: usize,
+        /// Scene units walked per frame, along the view's level direction.
+        #[arg(long, default_value_t = 0.05)]
+        step: f32,
+        /// Degrees turned left per frame.
+        #[arg(long, default_value_t = 0.15)]
+        turn: f32,
+    },
     /// Measure every technique on every built-in scene (errors on both backends, frame times on one
     /// scene) and write the results page.
     Results {

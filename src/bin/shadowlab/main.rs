@@ -120,6 +120,9 @@ fn run(cli: Cli) -> Result<(), Error> {
             bench(&scene, &view, BenchArgs { choice, frames, warmup, json, realtime, sweep, out_dir })
         }
         Command::Export { scene, out } => export(&scene, &out),
+        Command::Flicker { scene, view, technique, frames, step, turn } => {
+            flicker(&scene, &view, &technique, (frames, step, turn))
+        }
         Command::View { scene, technique, backend, size, script } => view(&scene, technique, &backend, &size, script),
         Command::Results { out, size, backend, bench_scene, bench_size, bench_frames } => {
             results(&out, &size, &backend, bench_scene, &bench_size, bench_frames)
@@ -336,6 +339,46 @@ fn render(args: &SceneArgs, view: &ViewArgs, technique: &str, backend: &str, out
         let mask = shadow_core::Image::new(w, h, true);
         shadow_core::image::visibility_to_rgb(&run.visibility[0], &mask).save_png(path.with_extension("vis.png"))?;
         eprintln!("{}: {} in {:.1} ms ({})", path.display(), run.technique, run.stats.timings.total, kind.name());
+    }
+    Ok(())
+}
+
+fn flicker(
+    args: &SceneArgs,
+    view: &ViewArgs,
+    techniques: &[String],
+    (frames, step, turn): (usize, f32, f32),
+) -> Result<(), Error> {
+    use shadowlab::flicker::{FlickerWalk, walk};
+    view.check_adapter("cpu")?;
+    if frames < 2 {
+        return Err(Error::Usage(format!("--frames {frames}: flicker needs at least 2")));
+    }
+    if !(step.is_finite() && turn.is_finite()) {
+        return Err(Error::Usage("--step and --turn must be finite numbers".into()));
+    }
+    let (frame, w, h) = args.frame(view)?;
+    let specs: Vec<TechniqueSpec> = techniques.iter().map(|t| TechniqueSpec::parse(t)).collect::<Result<_, _>>()?;
+    let mut renderer = Renderer::new(TechniqueRegistry::builtin());
+    for spec in &specs {
+        renderer.registry().canonical(spec)?;
+    }
+    check_availability(&renderer, &specs, "cpu")?;
+    let path = walk(&frame.camera, frames, step, turn.to_radians());
+    let bar = progress_bar((frames * specs.len()) as u64);
+    let walk = FlickerWalk::new(&mut renderer, &frame, &path, (w, h))?;
+    let mut rows = Vec::new();
+    for spec in &specs {
+        let f = walk.flicker(&mut renderer, spec, |k| report_progress(&bar, &format!("{spec} frame {k}")))?;
+        rows.push((spec.to_string(), f));
+    }
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    out!("{frames} frames, {step} per frame, {turn} degrees per frame, {w}x{h}, on the cpu");
+    out!("{:<48} {:>10}", "technique", "flicker");
+    for (name, f) in rows {
+        out!("{name:<48} {:>9.4}%", f * 100.0);
     }
     Ok(())
 }
