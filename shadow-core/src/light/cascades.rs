@@ -6,12 +6,18 @@
 //! one on the horizon (perspective aliasing, the survey's `d_s r_s / r_i`). Each cascade covers only its
 //! slice, so near slices get small texels and far ones large texels.
 //!
-//! *Stabilised* cascades do not shimmer when the camera moves: each slice is bounded by a sphere whose
-//! radius depends only on the slice's depths and the field of view (so it is the same whatever way the
-//! camera turns), and the map window is moved in whole texels of a light-space grid anchored at the world
-//! origin (so a caster lands on the same texels from frame to frame). The price is texels: the sphere
-//! holds more than the slice. Unstabilised cascades fit the slice's corners tightly instead, and their
-//! texels slide and change size as the camera moves.
+//! A map whose texels slide or change size as the camera moves makes its shadow edges shimmer. Three fits
+//! ([`Stabilize`]):
+//! - `sphere`: each slice bounded by a sphere whose radius depends only on the slice's depths and the
+//!   field of view (so it is the same whatever way the camera turns), and the map window moved in whole
+//!   texels of a light-space grid anchored at the world origin (so a caster lands on the same texels from
+//!   frame to frame). Never shimmers; the price is texels, for the sphere holds more than the slice.
+//! - `snapped`: the slice's corners fitted tightly, the window's side rounded up to the next step of a
+//!   ladder of sizes an eighth of an octave apart and moved in whole texels: the texel size holds until
+//!   the tight fit crosses a step, so the shadows stand still but for a jump now and then, with most of the
+//!   tight fit's texels.
+//! - `off`: the slice's corners fitted tightly, every frame anew: the most texels, sliding and changing
+//!   size as the camera moves.
 
 use glam::camera::rh::proj::directx;
 use glam::camera::rh::view::look_to_mat4;
@@ -98,6 +104,21 @@ pub fn practical_splits(near: f32, far: f32, count: usize, lambda: f32) -> Vec<f
         .collect()
 }
 
+crate::named_enum! {
+    /// How a cascade's window follows the camera (see the module docs).
+    pub enum Stabilize {
+        /// A bounding sphere of fixed size on a world texel grid.
+        Sphere = "sphere",
+        /// A tight fit, its size on a ladder, on a world texel grid.
+        Snapped = "snapped",
+        /// A tight fit, every frame anew.
+        Off = "off",
+    }
+}
+
+/// Steps per octave of the ladder of window sizes of a snapped fit.
+const LADDER: f32 = 8.0;
+
 /// How cascades are split and fitted.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CascadeFit {
@@ -107,8 +128,8 @@ pub struct CascadeFit {
     pub lambda: f32,
     /// The fraction of each cascade's range over which it fades into the next.
     pub blend: f32,
-    /// Bounding spheres on a texel grid (no shimmer) rather than tight boxes.
-    pub stabilize: bool,
+    /// How each cascade's window follows the camera.
+    pub stabilize: Stabilize,
     /// Map side in texels (the texel grid of a stabilised fit).
     pub resolution: u32,
     /// The view depth the last cascade ends at; 0 fits it to the scene.
@@ -142,7 +163,7 @@ impl LightView {
         let near = camera.near;
         let far_end = if fit.distance > 0.0 {
             fit.distance.max(near * 2.0)
-        } else if fit.stabilize {
+        } else if fit.stabilize != Stabilize::Off {
             // The distance to the farthest corner, which does not change as the camera turns, rounded up
             // to an eighth of an octave, so that moving changes it (and every radius) only now and then.
             let reach = bounds.corners().iter().map(|&c| (c - camera.eye).length()).fold(0.0f32, f32::max);
@@ -171,24 +192,40 @@ impl LightView {
                 // A cascade also covers the blend band of the one before, where the two are mixed.
                 let n = if k == 0 { near } else { cascades.blend_start(k - 1) };
                 let f = cascades.far[k];
-                let (x0, x1, y0, y1) = if fit.stabilize {
-                    let (radius, c) = slice_sphere(n, f, tan_x * tan_x + tan_y * tan_y);
-                    // One texel of slack each side, so the window snapped to the grid still holds the sphere.
-                    let texel = 2.0 * radius / (res - 2.0);
-                    let half = texel * res * 0.5;
-                    let centre = light_from_world.transform_point3(camera.eye + axis * c).xy();
-                    let snapped = (centre / texel).floor() * texel;
-                    (snapped.x - half, snapped.x + half, snapped.y - half, snapped.y + half)
-                } else {
+                let tight = || {
                     let corners = [n, f].into_iter().flat_map(|d| {
                         [(-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0), (1.0, 1.0)].map(|(sx, sy)| {
                             world_from_camera.transform_point3(Vec3::new(sx * tan_x * d, sy * tan_y * d, -d))
                         })
                     });
-                    let b = Aabb::from_points(corners.map(|p| light_from_world.transform_point3(p)));
-                    // A texel of margin, so that corners on the window's edge stay inside it.
-                    let margin = (b.max - b.min).xy() / res;
-                    (b.min.x - margin.x, b.max.x + margin.x, b.min.y - margin.y, b.max.y + margin.y)
+                    Aabb::from_points(corners.map(|p| light_from_world.transform_point3(p)))
+                };
+                // A window of side `side` texels `res - 2` wide (one texel of slack each side) around
+                // `centre`, moved in whole texels: snapping moves it less than a texel, so it still holds
+                // what `side` held.
+                let snapped = |centre: glam::Vec2, side: f32| {
+                    let texel = side / (res - 2.0);
+                    let half = texel * res * 0.5;
+                    let c = (centre / texel).floor() * texel;
+                    (c.x - half, c.x + half, c.y - half, c.y + half)
+                };
+                let (x0, x1, y0, y1) = match fit.stabilize {
+                    Stabilize::Sphere => {
+                        let (radius, c) = slice_sphere(n, f, tan_x * tan_x + tan_y * tan_y);
+                        snapped(light_from_world.transform_point3(camera.eye + axis * c).xy(), 2.0 * radius)
+                    }
+                    Stabilize::Snapped => {
+                        let b = tight();
+                        let side = (b.max - b.min).xy().max_element();
+                        let on_ladder = ((side.log2() * LADDER).ceil() / LADDER).exp2();
+                        snapped(((b.min + b.max) * 0.5).xy(), on_ladder)
+                    }
+                    Stabilize::Off => {
+                        let b = tight();
+                        // A texel of margin, so that corners on the window's edge stay inside it.
+                        let margin = (b.max - b.min).xy() / res;
+                        (b.min.x - margin.x, b.max.x + margin.x, b.min.y - margin.y, b.max.y + margin.y)
+                    }
                 };
                 let proj = directx::orthographic(x0, x1, y0, y1, z_near, z_far);
                 LightProjection::new(light_from_world, proj, z_near, z_far, true)
@@ -209,7 +246,7 @@ mod tests {
         (LightView::fit(&Light::directional(Vec3::new(0.5, -0.35, 0.2)), &[bounds]).unwrap(), bounds)
     }
 
-    fn fit(stabilize: bool) -> CascadeFit {
+    fn fit(stabilize: Stabilize) -> CascadeFit {
         CascadeFit { count: 4, lambda: 0.5, blend: 0.1, stabilize, resolution: 2048, distance: 0.0 }
     }
 
@@ -228,7 +265,7 @@ mod tests {
         let (view, bounds) = scene();
         let camera = Camera::look_at(Vec3::new(3.0, 1.7, 40.0), Vec3::new(-20.0, 1.0, -60.0), 60.0);
         let aspect = 16.0 / 9.0;
-        for stabilize in [true, false] {
+        for stabilize in [Stabilize::Sphere, Stabilize::Snapped, Stabilize::Off] {
             let v = view.cascaded(&camera, aspect, &bounds, &fit(stabilize));
             let c = v.cascades.as_ref().unwrap();
             assert_eq!(v.projections.len(), 4);
@@ -252,8 +289,8 @@ mod tests {
     #[test]
     fn stabilised_texels_stay_on_the_grid_as_the_camera_turns_and_moves() {
         let (view, bounds) = scene();
-        let texel_origin = |camera: &Camera| {
-            let v = view.cascaded(camera, 1.5, &bounds, &CascadeFit { distance: 150.0, ..fit(true) });
+        let texel_origin = |camera: &Camera, stabilize| {
+            let v = view.cascaded(camera, 1.5, &bounds, &CascadeFit { distance: 150.0, ..fit(stabilize) });
             let p = &v.projections[1];
             // The world origin's map coordinates in texels, and the texel size in world units.
             let (uv, _) = p.uv_depth(Vec3::ZERO);
@@ -263,13 +300,18 @@ mod tests {
             (uv * 2048.0, size)
         };
         let camera = Camera::look_at(Vec3::new(3.0, 1.7, 40.0), Vec3::new(-20.0, 1.0, -60.0), 60.0);
-        let (o0, s0) = texel_origin(&camera);
-        for m in [
-            Mat4::from_rotation_y(0.3),
-            Mat4::from_translation(Vec3::new(0.37, 0.0, -1.21)),
-            Mat4::from_rotation_y(-1.1) * Mat4::from_translation(Vec3::new(5.0, 0.2, 0.0)),
-        ] {
-            let (o, s) = texel_origin(&camera.transformed(m));
+        // Any turn and move for the sphere; a walker's small ones for the snapped fit, within a step
+        // of its ladder.
+        let moves = [
+            (Stabilize::Sphere, Mat4::from_rotation_y(0.3)),
+            (Stabilize::Sphere, Mat4::from_translation(Vec3::new(0.37, 0.0, -1.21))),
+            (Stabilize::Sphere, Mat4::from_rotation_y(-1.1) * Mat4::from_translation(Vec3::new(5.0, 0.2, 0.0))),
+            (Stabilize::Snapped, Mat4::from_translation(Vec3::new(0.05, 0.0, -0.05))),
+            (Stabilize::Snapped, Mat4::from_rotation_y(0.002)),
+        ];
+        for (stabilize, m) in moves {
+            let (o0, s0) = texel_origin(&camera, stabilize);
+            let (o, s) = texel_origin(&camera.transformed(m), stabilize);
             assert!((s - s0).abs() < 1e-5 * s0, "texel size changed: {s0} -> {s}");
             // The origin stays on a texel corner: whole texels from where it was.
             let shift = o - o0;

@@ -24,7 +24,7 @@ use glam::{Mat4, Vec2, Vec3, Vec3Swizzles, Vec4Swizzles};
 use crate::bounds::Aabb;
 use crate::geometry::LightSource;
 use crate::scene::{Light, LightKind, SceneError};
-pub use cascades::{CascadeFit, CascadePick, Cascades};
+pub use cascades::{CascadeFit, CascadePick, Cascades, Stabilize};
 
 /// Why a light view could not be made.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

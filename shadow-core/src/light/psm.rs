@@ -163,7 +163,8 @@ fn light_in_post_perspective(light: glam::Vec4, centre: Vec3, points: &[Vec3]) -
             *range = [range[0].min(v), range[1].max(v)];
         }
     }
-    if !(spread < MAX_HALF_ANGLE.to_radians().tan()) {
+    // NaN (a degenerate point) fails too.
+    if spread.is_nan() || spread >= MAX_HALF_ANGLE.to_radians().tan() {
         return None;
     }
     // Each NDC coordinate is k v + o over the range of v; its clip row is k (plane) + o w_row.

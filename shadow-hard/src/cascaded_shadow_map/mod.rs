@@ -5,9 +5,11 @@
 //! the camera's view depth into slices by the practical split scheme (Zhang et al. 2006) and give each
 //! slice a map of its own, fitted to it: near slices are small, so their texels are small.
 //!
-//! The fit is in shadow-core (`light::cascades`): stabilised by default, so that the shadows do not
-//! shimmer as the camera moves (a bounding sphere per slice, whose size does not change as the camera
-//! turns, moved in whole texels). Each receiver reads the cascade of its view depth and, over the last
+//! The fit is in shadow-core (`light::cascades`), stabilised so that the shadows do not shimmer as the
+//! camera moves: by default each slice's tight window has its size rounded up on a ladder and is moved in
+//! whole texels of a world grid (`stabilize=snapped`); `sphere` bounds each slice by a sphere whose size no
+//! turn of the camera changes, as Bevy and Filament do, at the price of texels; `off` fits every frame
+//! anew. Each receiver reads the cascade of its view depth and, over the last
 //! `blend` of that cascade's range, fades into the next one, so the seam between texel sizes is not a
 //! line. The maps, their bias and every lookup filter are `shadow-map`'s (the shared map passes); the
 //! slope-scaled bias follows each cascade's texel size by itself, since it is taken in that map's texels.
@@ -20,12 +22,12 @@ pub mod gpu;
 
 use crate::Entry;
 use shadow_core::FrameInputs;
-use shadow_core::light::{CascadeFit, LightView};
+use shadow_core::light::{CascadeFit, LightView, Stabilize};
 use shadow_core::technique::LightKinds;
 use shadow_core::technique::maps::{DepthMap, FILTER, FILTER_RADIUS, MapLayout, MapSampling, resolution_key};
 #[cfg(test)]
 use shadow_core::technique::settings::TechniqueSettings;
-use shadow_core::technique::settings::{Filter, OnOff, SettingKey};
+use shadow_core::technique::settings::{Filter, SettingKey};
 
 shadow_core::technique_settings! {
     /// `cascaded-shadow-map`: a directional light's depth maps, one per slice of the camera's view depth.
@@ -56,12 +58,16 @@ shadow_core::technique_settings! {
             0.5,
             "fraction of each cascade's depth range, at its far end, over which it fades into the next",
         ),
-        /// Bounding spheres on a world texel grid, so that shadows do not shimmer when the camera moves.
-        pub stabilize: OnOff = SettingKey::choice(
+        /// How each cascade's window follows the camera, so that shadows do not shimmer as it moves. The
+        /// snapped fit is the default: on the outdoor street at 1920x1080 it keeps the near third of the
+        /// view at 0.70% mismatch where the sphere's spare texels leave 0.96% (the tight fit 0.57%), and
+        /// on a walk its shadows change at 1/30 of the tight fit's points (the sphere's at 1/330).
+        pub stabilize: Stabilize = SettingKey::choice(
             "stabilize",
-            "on",
-            OnOff::NAMES,
-            "on: cascades of fixed size moved in whole texels (no shimmer); off: fitted tightly to each slice",
+            "snapped",
+            Stabilize::NAMES,
+            "sphere: fixed size, whole texels (never shimmers); snapped: tight, size on a ladder, whole texels; \
+             off: tight every frame",
         ),
         /// The view depth the last cascade ends at.
         pub distance: f32 = SettingKey::float(
@@ -86,7 +92,7 @@ impl CascadedShadowMap {
             count: self.cascades as usize,
             lambda: self.lambda,
             blend: self.blend,
-            stabilize: self.stabilize.is_on(),
+            stabilize: self.stabilize,
             resolution: self.map.resolution,
             distance: self.distance,
         }
@@ -122,7 +128,7 @@ mod tests {
         assert_eq!(
             CascadedShadowMap::defaults().settings_string(),
             "res=2048,bias=slope,bias_constant=4,bias_slope=2,bias_world=0.05,filter=none,filter_radius=1.5,\
-             cascades=4,lambda=0.75,blend=0.1,stabilize=on,distance=0"
+             cascades=4,lambda=0.75,blend=0.1,stabilize=snapped,distance=0"
         );
     }
 

@@ -251,6 +251,9 @@ pub(crate) enum Command {
         /// Frames timed.
         #[arg(long, default_value_t = 10)]
         bench_frames: u32,
+        /// View size of the outdoor street's perspective-aliasing measurements, WxH.
+        #[arg(long, default_value = "1920x1080")]
+        outdoor_size: String,
     },
     /// Open a window onto a scene: fly the camera (drag, wheel, WASD), move the light (right drag, arrow
     /// keys, L to turn it), switch scene, backend, technique and settings in the side panel.

@@ -124,18 +124,17 @@ fn run(cli: Cli) -> Result<(), Error> {
             flicker(&scene, &view, &technique, (frames, step, turn))
         }
         Command::View { scene, technique, backend, size, script } => view(&scene, technique, &backend, &size, script),
-        Command::Results { out, size, backend, bench_scene, bench_size, bench_frames } => {
-            results(&out, &size, &backend, bench_scene, &bench_size, bench_frames)
+        Command::Results { out, size, backend, bench_scene, bench_size, bench_frames, outdoor_size } => {
+            results(&out, (&size, &bench_size, &outdoor_size), &backend, bench_scene, bench_frames)
         }
     }
 }
 
 fn results(
     out: &Path,
-    size: &str,
+    (size, bench_size, outdoor_size): (&str, &str, &str),
     backend: &str,
     bench_scene: String,
-    bench_size: &str,
     bench_frames: u32,
 ) -> Result<(), Error> {
     use shadowlab::results::{ResultsJob, run_results};
@@ -148,6 +147,9 @@ fn results(
     let size = parse_size(size).map_err(|e| Error::Usage(e.to_string()))?;
     let bench_size =
         parse_size(bench_size).map_err(|e| Error::Usage(OptionError { flag: "--bench-size", ..e }.to_string()))?;
+    let outdoor_size =
+        parse_size(outdoor_size).map_err(|e| Error::Usage(OptionError { flag: "--outdoor-size", ..e }.to_string()))?;
+    let pictures = out.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new(".")).to_path_buf();
     let mut renderer = Renderer::new(TechniqueRegistry::builtin());
     let kinds = backends(&mut renderer, backend)?;
     let command = std::env::args().skip(1).collect::<Vec<_>>().join(" ");
@@ -158,6 +160,8 @@ fn results(
         bench_scene,
         bench_size,
         bench_frames,
+        outdoor_size,
+        pictures,
     };
     let text = run_results(&mut renderer, &job, |m| eprintln!("{m}"))?;
     std::fs::write(out, text).map_err(|e| Error::Write { path: out.to_path_buf(), why: e.to_string() })?;

@@ -1,9 +1,12 @@
 //! `shadowlab results`: measures every technique on every built-in scene and writes `docs/results.md`,
 //! so each number there comes from one command on a named machine and adapter.
 //!
-//! Four parts: the error of each technique against its reference on each scene (both backends), the
-//! largest disagreement between the backends, the frame time per phase on one scene (`bench`), and on a
-//! GPU adapter the real-time path on that scene (`bench --realtime`).
+//! Five parts: the error of each technique against its reference on each scene (both backends), the
+//! largest disagreement between the backends, the frame time per phase on one scene (`bench`), on a GPU
+//! adapter the real-time path on that scene (`bench --realtime`), and perspective aliasing on the outdoor
+//! street ([`outdoor`]).
+
+pub mod outdoor;
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -31,6 +34,10 @@ pub struct ResultsJob {
     pub bench_size: (u32, u32),
     /// Frames timed (after two unmeasured ones).
     pub bench_frames: u32,
+    /// View size of the outdoor street's measurements.
+    pub outdoor_size: (u32, u32),
+    /// The folder the pictures go to, beside the results page.
+    pub pictures: std::path::PathBuf,
 }
 
 /// The machine: CPU model and thread count, OS and architecture.
@@ -99,7 +106,12 @@ pub fn run_results(renderer: &mut Renderer, job: &ResultsJob, mut progress: impl
     } else {
         None
     };
-    Ok(markdown(renderer, job, &reports, (&timing, realtime.as_ref())))
+    let outdoor_job =
+        outdoor::OutdoorJob { size: job.outdoor_size, backends: job.backends.clone(), pictures: job.pictures.clone() };
+    let outdoor = outdoor::run_outdoor(renderer, &outdoor_job, &mut progress)?;
+    let mut text = markdown(renderer, job, &reports, (&timing, realtime.as_ref()));
+    outdoor::markdown(&mut text, &outdoor);
+    Ok(text)
 }
 
 fn markdown(
