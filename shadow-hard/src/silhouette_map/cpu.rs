@@ -46,7 +46,9 @@ impl ShadowTechnique<CpuBackend> for SilhouetteMap {
     }
 
     fn build(&self, _: &mut CpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), CpuError> {
-        let LightPass { frame, light, stats, .. } = pass;
+        let LightPass { frame, light, stats, aspect, .. } = pass;
+        let view = self.view(frame, light, aspect);
+        let light = &*view;
         let res = self.depth.resolution;
         render_depth_maps(frame, light, res, self.depth.depth_bias(), &mut state.maps)?;
         let edges = frame.silhouette_segments(light);
@@ -70,7 +72,9 @@ impl ShadowTechnique<CpuBackend> for SilhouetteMap {
         g: &GBuffer,
         out: &mut Image<f32>,
     ) -> Result<(), CpuError> {
-        let LightPass { light, stats, .. } = pass;
+        let LightPass { frame, light, stats, aspect, .. } = pass;
+        let view = self.view(frame, light, aspect);
+        let light = &*view;
         if state.maps.len() != light.projections.len() || state.points.len() != state.maps.len() {
             return Err(TechniqueError::NotBuilt(Self::NAME.into()).into());
         }
@@ -93,6 +97,11 @@ impl ShadowTechnique<CpuBackend> for SilhouetteMap {
         });
         stats.counters.silhouette_pixels = Some(silhouette_pixels.into_inner());
         Ok(())
+    }
+
+    /// With cascades the maps follow the camera, which the build key does not hold.
+    fn build_is_reusable(&self) -> bool {
+        self.cascades == 0
     }
 
     fn debug_views(&self, _: &mut CpuContext, state: &State) -> Result<Vec<DebugView>, CpuError> {

@@ -343,8 +343,15 @@ impl ShadowTechnique<WgpuBackend> for SilhouetteMap {
         cx.scoped("creating the silhouette-map pipelines", |cx| State::new(cx, self))
     }
 
+    /// With cascades the maps follow the camera, which the build key does not hold.
+    fn build_is_reusable(&self) -> bool {
+        self.cascades == 0
+    }
+
     fn build(&self, cx: &mut WgpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), WgpuError> {
-        let LightPass { frame, light, stats, .. } = pass;
+        let LightPass { frame, light, stats, aspect, .. } = pass;
+        let view = self.view(frame, light, aspect);
+        let light = &*view;
         let res = self.depth.resolution;
         check_size(cx, "shadow map", res, res)?;
         state.allocate(cx, res, light.projections.len() as u32)?;
@@ -369,7 +376,9 @@ impl ShadowTechnique<WgpuBackend> for SilhouetteMap {
         g: &GpuGBuffer,
         out: &mut GpuVisibility,
     ) -> Result<(), WgpuError> {
-        let LightPass { light, stats, .. } = pass;
+        let LightPass { frame, light, stats, aspect, .. } = pass;
+        let view = self.view(frame, light, aspect);
+        let light = &*view;
         let maps = state.maps.as_ref().ok_or_else(|| TechniqueError::NotBuilt(Self::NAME.into()))?;
         let points = maps.points.create_view(&wgpu::TextureViewDescriptor {
             dimension: Some(wgpu::TextureViewDimension::D2Array),

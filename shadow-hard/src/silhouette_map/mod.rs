@@ -12,11 +12,16 @@ pub mod cpu;
 pub mod gpu;
 pub mod points;
 
+use std::borrow::Cow;
+
 use crate::Entry;
+use crate::cascaded_shadow_map::CascadedShadowMap;
+use shadow_core::light::{CascadeFit, LightView};
 use shadow_core::technique::maps::{DepthMap, resolution_key};
+use shadow_core::technique::maps::{MapLayout, MapSampling};
 use shadow_core::technique::settings::SettingKey;
-#[cfg(test)]
 use shadow_core::technique::settings::TechniqueSettings;
+use shadow_core::{FrameInputs, LightKind};
 
 use points::{CornerDepth, Keep};
 
@@ -54,12 +59,44 @@ shadow_core::technique_settings! {
             Keep::NAMES,
             "the point a texel crossed by several silhouettes keeps: nearest the light, or last drawn (the paper)",
         ),
+        /// Cascades over the camera's view for a directional light (0: one map over the light's view).
+        pub cascades: u32 = SettingKey::int(
+            "cascades",
+            "0",
+            0,
+            4,
+            "for a directional light, maps over that many slices of the view as cascaded-shadow-map fits them (0: one)",
+        ),
     }
 }
 
 impl SilhouetteMap {
     /// The technique's name.
     pub const NAME: &'static str = "silhouette-map";
+
+    /// The view the maps are rendered from: the light's own, or with `cascades` on a directional light,
+    /// cascades over the camera's view, split and fitted as `cascaded-shadow-map`'s defaults but without
+    /// the blending (two reconstructed edges do not mix into one). The silhouette map answers projection
+    /// aliasing, the cascades perspective aliasing: Sen et al. name the combination as future work.
+    #[must_use]
+    pub fn view<'a>(&self, frame: &FrameInputs, light: &'a LightView, aspect: f32) -> Cow<'a, LightView> {
+        if self.cascades == 0 || !matches!(light.light.kind, LightKind::Directional { .. }) {
+            return Cow::Borrowed(light);
+        }
+        let fit = CascadeFit {
+            count: self.cascades as usize,
+            blend: 0.0,
+            resolution: self.depth.resolution,
+            ..CascadedShadowMap::defaults().fit()
+        };
+        Cow::Owned(light.cascaded(&frame.camera, aspect, &frame.bounds, &fit))
+    }
+}
+
+impl MapLayout for SilhouetteMap {
+    fn sampling(&self, frame: &FrameInputs, light: &LightView, aspect: f32) -> MapSampling {
+        MapSampling { view: self.view(frame, light, aspect).into_owned(), resolution: self.depth.resolution }
+    }
 }
 
 /// The registry entry.
@@ -71,6 +108,7 @@ pub fn entry() -> Entry {
         "Sen, Cammarano, Hanrahan 2003",
     )
     .wgsl(gpu::shaders)
+    .with_layout::<SilhouetteMap>()
 }
 
 #[cfg(test)]
@@ -82,7 +120,7 @@ mod tests {
         assert_eq!(
             SilhouetteMap::defaults().settings_string(),
             "res=1024,bias=slope,bias_constant=4,bias_slope=2,bias_world=0.05,corner_margin=0.01,\
-             corner_depth=receiver-plane,keep=nearest"
+             corner_depth=receiver-plane,keep=nearest,cascades=0"
         );
     }
 }
