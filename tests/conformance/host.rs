@@ -33,9 +33,8 @@ fn a_host_device_renders_every_technique_as_shadowlabs_own() {
     let registry = TechniqueRegistry::builtin();
     let mut compared = 0;
     for scene in ["cubes", "room"] {
-        let s = scenes::build(scene, &SceneParams::default()).expect("scene");
-        let frame = FrameInputs::from_first_camera(&s).expect("frame");
         for entry in registry.entries().iter().filter(|e| e.wgpu.is_some()) {
+            let frame = crate::frame_taken_by(scene, entry.lights);
             let spec = TechniqueSpec::named(entry.name);
             let own = renderer.run(BackendKind::Wgpu, &frame, 160, 120, &spec).expect("own device");
             let mut technique = registry.wgpu(&spec).expect("technique");
@@ -78,10 +77,9 @@ fn a_host_device_without_f32_depth_stencil_falls_back_to_depth24() {
     let mut host = WgpuContext::from_host(&adapter, device, queue).expect("no feature is required");
     assert_eq!(host.depth_stencil, wgpu::TextureFormat::Depth24PlusStencil8);
     let registry = TechniqueRegistry::builtin();
-    let s = scenes::build("cubes", &SceneParams::default()).expect("scene");
-    let frame = FrameInputs::from_first_camera(&s).expect("frame");
     let mut failures = Vec::new();
     for entry in registry.entries().iter().filter(|e| e.wgpu.is_some()) {
+        let frame = crate::frame_taken_by("cubes", entry.lights);
         let spec = TechniqueSpec::named(entry.name);
         let own = renderer.run(BackendKind::Wgpu, &frame, 160, 120, &spec).expect("own device");
         let mut technique = registry.wgpu(&spec).expect("technique");
@@ -95,6 +93,7 @@ fn a_host_device_without_f32_depth_stencil_falls_back_to_depth24() {
         }
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
+    let frame = crate::frame_taken_by("cubes", shadow_core::technique::LightKinds::ALL);
     let mut depth_mask = registry.wgpu(&TechniqueSpec::parse("hybrid:gpu_mask=depth").expect("spec")).expect("hybrid");
     let err = shadow_wgpu::render_frame(&mut host, &frame, 160, 120, depth_mask.as_mut()).err().expect("refused");
     assert!(err.to_string().contains("DEPTH32FLOAT_STENCIL8"), "{err}");

@@ -25,6 +25,23 @@ mod viewer;
 mod volume_reconstruction;
 mod wgsl;
 
+/// Built-in scene `name` under a light of a kind `lights` takes: its own light, or for the techniques of
+/// directional lights alone (cascades, the perspective warps), a directional light in its place.
+fn scene_taken_by(name: &str, lights: shadow_core::technique::LightKinds) -> shadow_core::Scene {
+    use shadow_core::scenes::{self, LightType, SceneParams};
+    let own = scenes::build(name, &SceneParams::default()).expect("built-in scene");
+    if own.lights().all(|(_, l)| lights.takes(&l)) {
+        return own;
+    }
+    let params = SceneParams { light: Some(LightType::Directional), ..SceneParams::default() };
+    scenes::build(name, &params).expect("built-in scene")
+}
+
+/// The first camera's frame of [`scene_taken_by`].
+fn frame_taken_by(name: &str, lights: shadow_core::technique::LightKinds) -> shadow_core::FrameInputs {
+    shadow_core::FrameInputs::from_first_camera(&scene_taken_by(name, lights)).expect("frame")
+}
+
 /// A renderer of the built-in techniques with a wgpu adapter resolved, or `None` (and a line saying that
 /// `what` is skipped) without one, which `SHADOWLAB_REQUIRE_GPU=1` turns into a failure.
 fn with_wgpu(what: &str) -> Option<shadowlab::Renderer> {

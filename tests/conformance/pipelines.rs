@@ -46,13 +46,14 @@ fn setup() -> Option<(WgpuContext, FrameInputs, wgpu::Texture)> {
 
 #[test]
 fn a_second_light_and_a_remade_technique_compile_nothing() {
-    let Some((mut cx, frame, target)) = setup() else { return };
-    let mut two = frame.clone();
-    two.lights.push(frame.lights[0].transformed(Mat4::from_translation(Vec3::new(0.5, 0.0, 0.25))));
+    let Some((mut cx, _, target)) = setup() else { return };
     let registry = TechniqueRegistry::builtin();
     let mut failures = Vec::new();
     let recordable = registry.entries().iter().filter(|e| e.wgpu.is_some() && !NOT_RECORDABLE.contains(&e.name));
     for entry in recordable {
+        let frame = crate::frame_taken_by("primitives", entry.lights);
+        let mut two = frame.clone();
+        two.lights.push(frame.lights[0].transformed(Mat4::from_translation(Vec3::new(0.5, 0.0, 0.25))));
         let spec = TechniqueSpec::named(entry.name);
         let mut technique = registry.wgpu(&spec).expect("technique");
         let first = made_by_a_frame(&mut cx, technique.as_mut(), &frame, &target);

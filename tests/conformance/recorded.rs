@@ -46,9 +46,8 @@ fn recorded_frames_match_the_instrumented_ones() {
     let mut recorder = FrameRecorder::new();
     let mut recorded = 0;
     for scene in ["cubes", "room"] {
-        let s = scenes::build(scene, &SceneParams::default()).expect("scene");
-        let frame = FrameInputs::from_first_camera(&s).expect("frame");
         for entry in renderer.registry().clone().entries().iter().filter(|e| e.wgpu.is_some()) {
+            let frame = crate::frame_taken_by(scene, entry.lights);
             let (spec, case) = (TechniqueSpec::named(entry.name), format!("{scene} / {}", entry.name));
             let outcome = record(&mut cx, &mut recorder, &frame, &spec, &unorm);
             if NOT_RECORDABLE.contains(&entry.name) {
@@ -141,7 +140,7 @@ fn a_moving_light_and_node_allocate_nothing_after_the_first_frame() {
     for entry in
         renderer.registry().clone().entries().iter().filter(|e| e.wgpu.is_some() && !NOT_RECORDABLE.contains(&e.name))
     {
-        let mut scene = scenes::build("primitives", &SceneParams::default()).expect("scene");
+        let mut scene = crate::scene_taken_by("primitives", entry.lights);
         let mut technique = renderer.registry().wgpu(&TechniqueSpec::named(entry.name)).expect("technique");
         let (made, last, visibility) =
             made_after_the_first_frame(&mut cx, &mut scene, technique.as_mut(), &target, FRAMES)

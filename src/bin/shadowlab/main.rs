@@ -320,9 +320,13 @@ fn view(args: &SceneArgs, technique: String, backend: &str, size: &str, script: 
     shadowlab::viewer::run(ViewerOptions { setup: args.setup(), technique, backend, script, size })
 }
 
+/// The `--backend` choice, or the usage error naming what it takes.
+fn backend_choice(choice: &str) -> Result<BackendChoice, Error> {
+    choice.parse().map_err(|e: String| Error::Usage(format!("bad --backend '{choice}': expected {e}")))
+}
+
 fn backends(renderer: &mut Renderer, choice: &str) -> Result<Vec<shadowlab::BackendKind>, Error> {
-    let choice: BackendChoice =
-        choice.parse().map_err(|e: String| Error::Usage(format!("bad --backend '{choice}': expected {e}")))?;
+    let choice = backend_choice(choice)?;
     let (kinds, note) = renderer.resolve(choice)?;
     eprintln!("{note}");
     Ok(kinds)
@@ -398,7 +402,7 @@ fn compare(
     view.check_adapter(backend)?;
     let mut renderer = Renderer::new(TechniqueRegistry::builtin()).with_adapter(view.adapter.clone());
     let (frame, w, h) = args.frame(view)?;
-    let specs = technique_specs(&renderer, &choice.technique, choice.techniques.as_deref(), &frame)?;
+    let (specs, left) = technique_specs(&renderer, &choice.technique, choice.techniques.as_deref(), &frame)?;
     let (reference, soft_reference) = match reference {
         Some(text) => {
             let spec = TechniqueSpec::parse(text)?;
@@ -411,6 +415,8 @@ fn compare(
         None => shadowlab::compare::references_for(renderer.registry(), &specs),
     };
     check_availability(&renderer, &specs, backend)?;
+    backend_choice(backend)?;
+    say_left_out(&left);
     let kinds = backends(&mut renderer, backend)?;
     let out = out_dir.unwrap_or_else(|| PathBuf::from(format!("out/compare-{}", args.name())));
     let job = CompareJob {
@@ -476,19 +482,18 @@ fn compare(
 }
 
 /// The technique specs of --technique and --techniques (every non-reference technique when neither; of
-/// those, the ones that take every light of `frame`, the others named on stderr).
+/// those, the ones that take every light of `frame`), and the names of those left out.
 fn technique_specs(
     renderer: &Renderer,
     technique: &[String],
     techniques: Option<&str>,
     frame: &FrameInputs,
-) -> Result<Vec<TechniqueSpec>, Error> {
+) -> Result<(Vec<TechniqueSpec>, Vec<&'static str>), Error> {
     let mut specs: Vec<TechniqueSpec> = technique.iter().map(|t| TechniqueSpec::parse(t)).collect::<Result<_, _>>()?;
-    let all = || {
-        let (taken, left) = renderer.registry().measurable(frame);
-        if !left.is_empty() {
-            eprintln!("left out, as they or their reference take no light of this scene's kinds: {}", left.join(", "));
-        }
+    let mut left = Vec::new();
+    let mut all = || {
+        let (taken, refused) = renderer.registry().measurable(frame);
+        left = refused;
         taken
     };
     match techniques {
@@ -502,7 +507,15 @@ fn technique_specs(
     for s in &specs {
         renderer.registry().canonical(s)?;
     }
-    Ok(specs)
+    Ok((specs, left))
+}
+
+/// Names the techniques a run leaves out for the scene's lights, once every input has been checked (a
+/// refused run says one line, its error).
+fn say_left_out(left: &[&str]) {
+    if !left.is_empty() {
+        eprintln!("left out, as they or their reference take no light of this scene's kinds: {}", left.join(", "));
+    }
 }
 
 /// A progress bar when stderr is a terminal; plain lines otherwise.
@@ -566,7 +579,7 @@ fn bench(args: &SceneArgs, view: &ViewArgs, b: BenchArgs) -> Result<(), Error> {
     let mut renderer = Renderer::new(TechniqueRegistry::builtin()).with_adapter(view.adapter.clone());
     // The scene and its view are checked before the backend says which it is.
     let first = args.frame(view)?;
-    let specs = technique_specs(&renderer, &b.choice.technique, b.choice.techniques.as_deref(), &first.0)?;
+    let (specs, left) = technique_specs(&renderer, &b.choice.technique, b.choice.techniques.as_deref(), &first.0)?;
     check_availability(&renderer, &specs, &b.choice.backend)?;
     // A triangle sweep's scenes are built up front too: a count too large is refused before anything runs.
     let mut sweep_scenes = Vec::new();
@@ -575,7 +588,10 @@ fn bench(args: &SceneArgs, view: &ViewArgs, b: BenchArgs) -> Result<(), Error> {
             sweep_scenes.push(sweep_scene(v).map_err(|e| Error::Usage(format!("--sweep tris={v}: {e}")))?);
         }
     }
-    let kinds = backends(&mut renderer, if b.realtime { "wgpu" } else { &b.choice.backend })?;
+    let backend = if b.realtime { "wgpu" } else { &b.choice.backend };
+    backend_choice(backend)?;
+    say_left_out(&left);
+    let kinds = backends(&mut renderer, backend)?;
     match sweep {
         None => bench_once(&mut renderer, (args, first), specs, kinds, &b),
         Some((key, values)) => {
