@@ -17,7 +17,7 @@ use crate::flicker::{FlickerWalk, walk};
 use crate::renderer::{BackendKind, Renderer};
 
 /// The techniques compared, the uniform map first.
-pub const TECHNIQUES: [&str; 7] = [
+pub const TECHNIQUES: [&str; 8] = [
     "shadow-map:res=4096",
     "cascaded-shadow-map",
     "cascaded-shadow-map:stabilize=sphere",
@@ -25,6 +25,7 @@ pub const TECHNIQUES: [&str; 7] = [
     "lispsm",
     "perspective-shadow-map",
     "silhouette-map:res=2048,cascades=4",
+    "dual-shadow-map:res=2048,cascades=4",
 ];
 
 /// The views: the scene and what it shows.
@@ -162,8 +163,8 @@ pub fn markdown(s: &mut String, r: &OutdoorReport) {
         s,
         "{}x{}, the street of `outdoor` seen from head height in three lights. The same texel budget for \
          every map: one 4096^2 map for `shadow-map`, `lispsm` and `perspective-shadow-map`, four 2048^2 \
-         cascades for `cascaded-shadow-map` (its three fits) and for `silhouette-map` (with a silhouette-point \
-         map beside each). Edge band: the mismatch within two pixels of the reference's shadow edges. Near \
+         cascades for `cascaded-shadow-map` (its three fits), for `silhouette-map` (with a silhouette-point \
+         map beside each) and for `dual-shadow-map`. Edge band: the mismatch within two pixels of the reference's shadow edges. Near \
          field: the mismatch over measured pixels in the nearest third of the view's depth range; the factor \
          is that over the uniform map's. Texels per pixel: the median over the near field.\n",
         r.size.0, r.size.1

@@ -22,12 +22,13 @@ fn view_fitted_maps_beat_the_uniform_map_near_the_viewer() {
     let frame = outdoor();
     let names = ["shadow-map:res=4096", "cascaded-shadow-map", "lispsm", "perspective-shadow-map"];
     let silhouettes = "silhouette-map:res=2048,cascades=4";
+    let dual = "dual-shadow-map:res=2048,cascades=4";
     let job = CompareJob {
         scene: "outdoor".into(),
         frame: &frame,
         width: 320,
         height: 180,
-        techniques: names.iter().chain([&silhouettes]).map(|n| TechniqueSpec::parse(n).expect("spec")).collect(),
+        techniques: names.iter().chain([&silhouettes, &dual]).map(|n| TechniqueSpec::parse(n).expect("spec")).collect(),
         reference: TechniqueSpec::named("ray-traced"),
         soft_reference: None,
         backends: vec![BackendKind::Cpu, BackendKind::Wgpu],
@@ -61,6 +62,9 @@ fn view_fitted_maps_beat_the_uniform_map_near_the_viewer() {
         };
         let (sm, csm) = (edges("silhouette-map"), edges("cascaded-shadow-map"));
         assert!(sm <= 0.6 * csm, "{backend}: silhouette cascades' edge band {:.3}% vs {:.3}%", sm * 100.0, csm * 100.0);
+        // Weiskopf and Ertl's dual map in cascades is as near-sighted as the plain cascades.
+        let dual = near("dual-shadow-map", backend);
+        assert!(dual <= 0.5 * uniform, "{backend}: dual cascades' near field {:.3}%", dual * 100.0);
         let best = fitted.iter().map(|f| f.1).fold(f64::INFINITY, f64::min);
         assert!(
             best <= 0.25 * uniform,

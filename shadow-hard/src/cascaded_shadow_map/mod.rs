@@ -20,14 +20,15 @@
 pub mod cpu;
 pub mod gpu;
 
+use std::borrow::Cow;
+
 use crate::Entry;
-use shadow_core::FrameInputs;
 use shadow_core::light::{CascadeFit, LightView, Stabilize};
 use shadow_core::technique::LightKinds;
 use shadow_core::technique::maps::{DepthMap, FILTER, FILTER_RADIUS, MapLayout, MapSampling, resolution_key};
-#[cfg(test)]
 use shadow_core::technique::settings::TechniqueSettings;
 use shadow_core::technique::settings::{Filter, SettingKey};
+use shadow_core::{FrameInputs, LightKind};
 
 shadow_core::technique_settings! {
     /// `cascaded-shadow-map`: a directional light's depth maps, one per slice of the camera's view depth.
@@ -106,6 +107,26 @@ impl MapLayout for CascadedShadowMap {
             resolution: self.map.resolution,
         }
     }
+}
+
+/// The view of `light` as `count` cascades over the view of `frame`'s camera (`aspect` wide per unit of
+/// height), split and fitted as this technique's defaults do, each map `resolution` texels wide and faded
+/// into the next over `blend` of its range: for techniques that put their own maps in cascades. With no
+/// cascades, or a light other than directional, the light's own view.
+#[must_use]
+pub fn cascaded_view<'a>(
+    light: &'a LightView,
+    frame: &FrameInputs,
+    aspect: f32,
+    count: u32,
+    resolution: u32,
+    blend: f32,
+) -> Cow<'a, LightView> {
+    if count == 0 || !matches!(light.light.kind, LightKind::Directional { .. }) {
+        return Cow::Borrowed(light);
+    }
+    let fit = CascadeFit { count: count as usize, blend, resolution, ..CascadedShadowMap::defaults().fit() };
+    Cow::Owned(light.cascaded(&frame.camera, aspect, &frame.bounds, &fit))
 }
 
 /// The registry entry.

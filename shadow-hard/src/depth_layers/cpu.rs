@@ -83,7 +83,9 @@ impl ShadowTechnique<CpuBackend> for DepthLayers {
     }
 
     fn build(&self, _: &mut CpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), CpuError> {
-        let LightPass { frame, light, .. } = pass;
+        let LightPass { frame, light, aspect, .. } = pass;
+        let view = self.view(frame, light, aspect);
+        let light = &*view;
         check_maps(self.resolution, 3 * light.projections.len())?;
         state.z1.clear();
         state.z2.clear();
@@ -113,12 +115,19 @@ impl ShadowTechnique<CpuBackend> for DepthLayers {
         g: &GBuffer,
         out: &mut Image<f32>,
     ) -> Result<(), CpuError> {
-        let LightPass { light, .. } = pass;
+        let LightPass { frame, light, aspect, .. } = pass;
+        let view = self.view(frame, light, aspect);
+        let light = &*view;
         if state.maps.len() != light.projections.len() {
             return Err(TechniqueError::NotBuilt(self.kind.name().into()).into());
         }
         query_maps(&state.maps, light, g, out, self.filter, self.filter_radius, 0.0);
         Ok(())
+    }
+
+    /// With cascades the maps follow the camera, which the build key does not hold.
+    fn build_is_reusable(&self) -> bool {
+        self.cascades == 0
     }
 
     fn debug_views(&self, _: &mut CpuContext, state: &State) -> Result<Vec<DebugView>, CpuError> {

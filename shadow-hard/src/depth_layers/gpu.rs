@@ -222,7 +222,9 @@ impl ShadowTechnique<WgpuBackend> for DepthLayers {
     }
 
     fn build(&self, cx: &mut WgpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), WgpuError> {
-        let LightPass { frame, light, .. } = pass;
+        let LightPass { frame, light, aspect, .. } = pass;
+        let view = self.view(frame, light, aspect);
+        let light = &*view;
         let (res, layers) = (self.resolution, light.projections.len() as u32);
         check_size(cx, "shadow map", res, res)?;
         if !state.maps.as_ref().is_some_and(|m| m.width() == res && m.depth_or_array_layers() == layers) {
@@ -250,9 +252,15 @@ impl ShadowTechnique<WgpuBackend> for DepthLayers {
         g: &GpuGBuffer,
         out: &mut GpuVisibility,
     ) -> Result<(), WgpuError> {
-        let LightPass { light, .. } = pass;
+        let LightPass { frame, light, aspect, .. } = pass;
+        let view = self.view(frame, light, aspect);
         let maps = state.maps.as_ref().ok_or_else(|| TechniqueError::NotBuilt(self.kind.name().into()))?;
-        state.query.run(cx, maps, light, g, out, &QueryExtras::NONE)
+        state.query.run(cx, maps, &view, g, out, &QueryExtras::NONE)
+    }
+
+    /// With cascades the maps follow the camera, which the build key does not hold.
+    fn build_is_reusable(&self) -> bool {
+        self.cascades == 0
     }
 }
 

@@ -18,7 +18,12 @@ use shadow_core::technique::{Backend, DynShadowTechnique, ShadowTechnique, State
 use shadow_cpu::CpuBackend;
 use shadow_wgpu::WgpuBackend;
 
+use std::borrow::Cow;
+
 use crate::Entry;
+use crate::cascaded_shadow_map::{CascadedShadowMap, cascaded_view};
+use shadow_core::FrameInputs;
+use shadow_core::light::LightView;
 
 /// Which depth-layer map (Weiskopf-Ertl 2003): the name picks it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -72,6 +77,8 @@ pub struct DepthLayers {
     pub peel_epsilon: f32,
     /// Culling in both light passes.
     pub culling: LayerCulling,
+    /// Cascades over the camera's view for a directional light (0: one map over the light's view).
+    pub cascades: u32,
 }
 
 impl DepthLayers {
@@ -88,7 +95,15 @@ impl DepthLayers {
         }
     }
 
-    const fn keys_with(culling: &'static str) -> [SettingKey; 6] {
+    /// The view the layers are peeled from: the light's own, or with `cascades` on a directional light,
+    /// cascades over the camera's view fitted as `cascaded-shadow-map`'s defaults (blended as its are).
+    #[must_use]
+    pub fn view<'a>(&self, frame: &FrameInputs, light: &'a LightView, aspect: f32) -> Cow<'a, LightView> {
+        let blend = CascadedShadowMap::defaults().blend;
+        cascaded_view(light, frame, aspect, self.cascades, self.resolution, blend)
+    }
+
+    const fn keys_with(culling: &'static str) -> [SettingKey; 7] {
         [
             resolution_key("1024", "map side in texels (16 to 16384)"),
             FILTER,
@@ -113,6 +128,13 @@ impl DepthLayers {
                 LayerCulling::NAMES,
                 "auto (back faces of closed meshes culled) or none",
             ),
+            SettingKey::int(
+                "cascades",
+                "0",
+                0,
+                4,
+                "for a directional light, maps over that many slices of the view as cascaded-shadow-map fits them (0: one)",
+            ),
         ]
     }
 
@@ -125,6 +147,7 @@ impl DepthLayers {
             z_offset: v.get("z_offset")?,
             peel_epsilon: v.get("peel_epsilon")?,
             culling: v.get("culling")?,
+            cascades: v.get("cascades")?,
         })
     }
 
@@ -136,6 +159,7 @@ impl DepthLayers {
             self.z_offset.to_string(),
             self.peel_epsilon.to_string(),
             self.culling.to_string(),
+            self.cascades.to_string(),
         ]
     }
 }
@@ -150,7 +174,7 @@ macro_rules! layer_settings {
 
         impl TechniqueSettings for $name {
             fn keys() -> &'static [SettingKey] {
-                const KEYS: [SettingKey; 6] = DepthLayers::keys_with($culling);
+                const KEYS: [SettingKey; 7] = DepthLayers::keys_with($culling);
                 &KEYS
             }
             fn from_values(v: &Values<'_>) -> Result<Self, SettingsError> {

@@ -15,13 +15,14 @@ pub mod points;
 use std::borrow::Cow;
 
 use crate::Entry;
-use crate::cascaded_shadow_map::CascadedShadowMap;
-use shadow_core::light::{CascadeFit, LightView};
+use crate::cascaded_shadow_map::cascaded_view;
+use shadow_core::FrameInputs;
+use shadow_core::light::LightView;
 use shadow_core::technique::maps::{DepthMap, resolution_key};
 use shadow_core::technique::maps::{MapLayout, MapSampling};
 use shadow_core::technique::settings::SettingKey;
+#[cfg(test)]
 use shadow_core::technique::settings::TechniqueSettings;
-use shadow_core::{FrameInputs, LightKind};
 
 use points::{CornerDepth, Keep};
 
@@ -80,16 +81,7 @@ impl SilhouetteMap {
     /// aliasing, the cascades perspective aliasing: Sen et al. name the combination as future work.
     #[must_use]
     pub fn view<'a>(&self, frame: &FrameInputs, light: &'a LightView, aspect: f32) -> Cow<'a, LightView> {
-        if self.cascades == 0 || !matches!(light.light.kind, LightKind::Directional { .. }) {
-            return Cow::Borrowed(light);
-        }
-        let fit = CascadeFit {
-            count: self.cascades as usize,
-            blend: 0.0,
-            resolution: self.depth.resolution,
-            ..CascadedShadowMap::defaults().fit()
-        };
-        Cow::Owned(light.cascaded(&frame.camera, aspect, &frame.bounds, &fit))
+        cascaded_view(light, frame, aspect, self.cascades, self.depth.resolution, 0.0)
     }
 }
 
