@@ -82,19 +82,10 @@ fn clip_polygon(mut poly: Vec<Vec3>, planes: &[HalfSpace]) -> Vec<Vec3> {
     poly
 }
 
-/// The corners of a box in the order [`FACES`] takes them.
+/// The corners of a box in the order [`FACES`] takes them (each face's four in turn around it).
 fn box_corners(b: &Aabb) -> [Vec3; 8] {
-    let (lo, hi) = (b.min, b.max);
-    [
-        Vec3::new(lo.x, lo.y, lo.z),
-        Vec3::new(hi.x, lo.y, lo.z),
-        Vec3::new(hi.x, hi.y, lo.z),
-        Vec3::new(lo.x, hi.y, lo.z),
-        Vec3::new(lo.x, lo.y, hi.z),
-        Vec3::new(hi.x, lo.y, hi.z),
-        Vec3::new(hi.x, hi.y, hi.z),
-        Vec3::new(lo.x, hi.y, hi.z),
-    ]
+    let c = b.corners();
+    [c[0], c[1], c[3], c[2], c[4], c[5], c[7], c[6]]
 }
 
 /// The vertices of the intersection of two convex hexahedra: each one's faces clipped by the other's

@@ -2,45 +2,6 @@
 //! cascade; the shared query picks each receiver's cascade and blends at the seams (shadow_map.wgsl's
 //! `cascade_pick`).
 
-use shadow_core::technique::maps::MapLayout;
-use shadow_core::technique::{LightPass, ShadowTechnique};
-use shadow_wgpu::passes::maps::LookupParams;
-use shadow_wgpu::{GpuGBuffer, GpuVisibility, WgpuBackend, WgpuContext, WgpuError};
-
 use super::CascadedShadowMap;
-use crate::view_maps::gpu::ViewMaps;
 
-impl ShadowTechnique<WgpuBackend> for CascadedShadowMap {
-    type State = ViewMaps;
-
-    fn name(&self) -> &'static str {
-        Self::NAME
-    }
-
-    fn create_state(&self, cx: &mut WgpuContext) -> Result<ViewMaps, WgpuError> {
-        cx.scoped("creating the cascaded-shadow-map pipelines", |cx| {
-            let lookup = LookupParams { radius: self.filter_radius, receiver_offset: self.map.receiver_offset() };
-            ViewMaps::new(cx, &self.map, self.filter, lookup)
-        })
-    }
-
-    fn build(&self, cx: &mut WgpuContext, state: &mut ViewMaps, pass: LightPass<'_>) -> Result<(), WgpuError> {
-        state.build(cx, pass.frame, self.sampling(pass.frame, pass.light, pass.aspect))
-    }
-
-    fn query(
-        &self,
-        cx: &mut WgpuContext,
-        state: &mut ViewMaps,
-        _: LightPass<'_>,
-        g: &GpuGBuffer,
-        out: &mut GpuVisibility,
-    ) -> Result<(), WgpuError> {
-        state.query(cx, Self::NAME, g, out)
-    }
-
-    /// The cascades are fitted to the camera, which the build key does not hold.
-    fn build_is_reusable(&self) -> bool {
-        false
-    }
-}
+crate::view_maps::gpu::view_fitted_on_gpu!(CascadedShadowMap);

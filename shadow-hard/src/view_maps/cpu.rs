@@ -51,3 +51,56 @@ impl ViewMaps {
         depth_views(prefix, &self.maps)
     }
 }
+
+/// The CPU backend of a technique whose maps are [`ViewMaps`]: a settings type with `NAME`, `map` (a
+/// `DepthMap`), `filter`, `filter_radius` and a `MapLayout`, its debug views named `$views{k}`. Its build
+/// reads the camera, which the build key does not hold, so it is made every frame.
+macro_rules! view_fitted_on_cpu {
+    ($technique:ty, $views:literal) => {
+        impl shadow_core::technique::ShadowTechnique<shadow_cpu::CpuBackend> for $technique {
+            type State = $crate::view_maps::cpu::ViewMaps;
+
+            fn name(&self) -> &'static str {
+                Self::NAME
+            }
+
+            fn create_state(&self, _: &mut shadow_cpu::CpuContext) -> Result<Self::State, shadow_cpu::CpuError> {
+                Ok(Self::State::default())
+            }
+
+            fn build(
+                &self,
+                _: &mut shadow_cpu::CpuContext,
+                state: &mut Self::State,
+                pass: shadow_core::technique::LightPass<'_>,
+            ) -> Result<(), shadow_cpu::CpuError> {
+                use shadow_core::technique::maps::MapLayout;
+                state.build(pass.frame, self.sampling(pass.frame, pass.light, pass.aspect), self.map.depth_bias())
+            }
+
+            fn query(
+                &self,
+                _: &mut shadow_cpu::CpuContext,
+                state: &mut Self::State,
+                _: shadow_core::technique::LightPass<'_>,
+                g: &shadow_cpu::GBuffer,
+                out: &mut shadow_core::Image<f32>,
+            ) -> Result<(), shadow_cpu::CpuError> {
+                state.query(Self::NAME, g, out, self.filter, self.filter_radius, self.map.receiver_offset())
+            }
+
+            fn build_is_reusable(&self) -> bool {
+                false
+            }
+
+            fn debug_views(
+                &self,
+                _: &mut shadow_cpu::CpuContext,
+                state: &Self::State,
+            ) -> Result<Vec<shadow_core::technique::DebugView>, shadow_cpu::CpuError> {
+                Ok(state.debug_views($views))
+            }
+        }
+    };
+}
+pub(crate) use view_fitted_on_cpu;

@@ -55,3 +55,55 @@ impl ViewMaps {
         self.query.run(cx, maps, view, g, out, &QueryExtras::NONE)
     }
 }
+
+/// The GPU backend of a technique whose maps are [`ViewMaps`] (the settings type as for
+/// `view_fitted_on_cpu`). Its build reads the camera, which the build key does not hold, so it is made
+/// every frame.
+macro_rules! view_fitted_on_gpu {
+    ($technique:ty) => {
+        impl shadow_core::technique::ShadowTechnique<shadow_wgpu::WgpuBackend> for $technique {
+            type State = $crate::view_maps::gpu::ViewMaps;
+
+            fn name(&self) -> &'static str {
+                Self::NAME
+            }
+
+            fn create_state(&self, cx: &mut shadow_wgpu::WgpuContext) -> Result<Self::State, shadow_wgpu::WgpuError> {
+                let what = format!("creating the {} pipelines", Self::NAME);
+                cx.scoped(&what, |cx| {
+                    let lookup = shadow_wgpu::passes::maps::LookupParams {
+                        radius: self.filter_radius,
+                        receiver_offset: self.map.receiver_offset(),
+                    };
+                    Self::State::new(cx, &self.map, self.filter, lookup)
+                })
+            }
+
+            fn build(
+                &self,
+                cx: &mut shadow_wgpu::WgpuContext,
+                state: &mut Self::State,
+                pass: shadow_core::technique::LightPass<'_>,
+            ) -> Result<(), shadow_wgpu::WgpuError> {
+                use shadow_core::technique::maps::MapLayout;
+                state.build(cx, pass.frame, self.sampling(pass.frame, pass.light, pass.aspect))
+            }
+
+            fn query(
+                &self,
+                cx: &mut shadow_wgpu::WgpuContext,
+                state: &mut Self::State,
+                _: shadow_core::technique::LightPass<'_>,
+                g: &shadow_wgpu::GpuGBuffer,
+                out: &mut shadow_wgpu::GpuVisibility,
+            ) -> Result<(), shadow_wgpu::WgpuError> {
+                state.query(cx, Self::NAME, g, out)
+            }
+
+            fn build_is_reusable(&self) -> bool {
+                false
+            }
+        }
+    };
+}
+pub(crate) use view_fitted_on_gpu;
