@@ -7,8 +7,8 @@ use std::path::{Path, PathBuf};
 use serde::Serialize;
 use shadow_core::image::{Rgb8, error_map_over, visibility_to_rgb};
 use shadow_core::metrics::{
-    VisibilityMetrics, back_false_light, compare_visibility, flip_mean, measured_pixels, min_median, near_field,
-    texel_density,
+    VisibilityMetrics, back_false_light, compare_visibility, flip_mean, light_bleeding, measured_pixels, min_median,
+    near_field, texel_density,
 };
 use shadow_core::stats::Phase;
 use shadow_core::technique::maps::MapSampling;
@@ -302,6 +302,9 @@ fn measure(
     });
     let mut vs_reference = metrics_map(&metrics, flip);
     vs_reference.insert("back_false_light".into(), back);
+    if soft {
+        vs_reference.insert("light_bleeding".into(), light_bleeding(&run.visibility[0], ref_vis, mask)?);
+    }
     vs_reference
         .insert("near_field_mismatch".into(), compare_visibility(&run.visibility[0], ref_vis, &refs.near)?.mismatch);
     if let Some(layout) = renderer.registry().get(&spec.name).ok().and_then(|e| e.layout) {

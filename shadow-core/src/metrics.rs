@@ -72,6 +72,33 @@ pub fn back_false_light(
     Ok(if n == 0 { 0.0 } else { k as f64 / n as f64 })
 }
 
+/// Largest reference visibility counted as umbra by [`light_bleeding`] (the area-light reference's 256
+/// rays: at most two reach the light).
+pub const UMBRA: f32 = 0.01;
+
+/// Smallest visibility [`light_bleeding`] counts as light in the umbra: a tenth of the light, well clear
+/// of filtering noise, plainly visible on a dark shadow.
+pub const BLEEDING: f32 = 0.1;
+
+/// Light bleeding: the fraction of `measured` pixels where `reference` is in umbra (at most [`UMBRA`])
+/// and `test` lets at least [`BLEEDING`] of the light through. The failure of filterable maps, whose
+/// bounds let light through a blocker when a second one lies behind it.
+///
+/// # Errors
+/// When the images differ in size.
+pub fn light_bleeding(test: &Image<f32>, reference: &Image<f32>, measured: &Image<bool>) -> Result<f64, SizeMismatch> {
+    check(test, reference)?;
+    check(test, measured)?;
+    let (mut n, mut k) = (0u64, 0u64);
+    for ((&t, &r), &m) in test.data().iter().zip(reference.data()).zip(measured.data()) {
+        if m {
+            n += 1;
+            k += u64::from(r <= UMBRA && t >= BLEEDING);
+        }
+    }
+    Ok(if n == 0 { 0.0 } else { k as f64 / n as f64 })
+}
+
 /// The pixels every metric is taken over: receivers inside the light's reach whose seen side faces it.
 /// `position` and `normal` are the world position and the face normal turned towards the viewer.
 #[must_use]
@@ -292,6 +319,28 @@ mod tests {
         assert_eq!(m.interior_false_shadow, 0.0);
         assert!((m.mean_abs - 41.0 / 400.0).abs() < 1e-12);
         assert!((m.rmse - (41.0f64 / 400.0).sqrt()).abs() < 1e-12);
+    }
+
+    #[test]
+    fn bleeding_counts_light_in_the_umbra_only() {
+        // Umbra for x < 5, penumbra at 5 (0.4), lit beyond; the test lets 0.2 through at x = 1 and 3
+        // (bleeding), 0.05 at x = 2 (below the threshold), and brightens the penumbra (not umbra).
+        let reference = Image::from_fn(10, 1, |x, _| match x {
+            0..5 => 0.0,
+            5 => 0.4,
+            _ => 1.0,
+        });
+        let test = Image::from_fn(10, 1, |x, _| match x {
+            1 | 3 => 0.2,
+            2 => 0.05,
+            5 => 0.9,
+            0..5 => 0.0,
+            _ => 1.0,
+        });
+        let all = Image::new(10, 1, true);
+        assert!((light_bleeding(&test, &reference, &all).unwrap() - 0.2).abs() < 1e-12);
+        let left = Image::from_fn(10, 1, |x, _| x < 2);
+        assert!((light_bleeding(&test, &reference, &left).unwrap() - 0.5).abs() < 1e-12);
     }
 
     #[test]

@@ -7,9 +7,12 @@
 //! - [`smoothies::Smoothies`] (`smoothies`): Chan and Durand's fake soft shadows.
 //! - [`pcss::Pcss`] (`pcss`): Fernando's percentage-closer soft shadows.
 //! - [`penumbra_map::PenumbraMap`] (`penumbra-map`): Wyman and Hansen's cones and sheets.
+//! - [`moment_maps`] (`variance-shadow-map`, `exponential-variance-shadow-map`, `moment-shadow-map`):
+//!   filterable maps of depth moments, sized to the penumbra.
 
 pub mod area_light;
 pub mod min_target;
+pub mod moment_maps;
 pub mod pcss;
 pub mod penumbra_map;
 pub mod smoothies;

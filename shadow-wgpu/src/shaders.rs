@@ -1,17 +1,25 @@
 //! The backend's WGSL: the frame bindings every pass shares (`common.wgsl`), the G-buffer and shading
 //! passes, and the shared passes' shaders (`shadow_map.wgsl` for `passes::maps`, `shadow_volume.wgsl` for
-//! `passes::volumes`). Each is `common.wgsl` followed by its own file; the shadow-map shader also gets the
+//! `passes::volumes`). Each is `common.wgsl` and the full-screen triangle followed by its own file; the shadow-map shader also gets the
 //! Poisson disk generated from shadow-core's constant, so the two backends share one table. A technique's
 //! own WGSL lives in its folder and is appended to one of these.
 
 use std::fmt::Write;
 
 const COMMON: &str = include_str!("shaders/common.wgsl");
+const FULL_SCREEN: &str = include_str!("shaders/full_screen.wgsl");
 
 /// `common.wgsl` + `body`: for a technique's shader that reads the frame's bindings.
 #[must_use]
 pub fn with_common(body: &str) -> String {
-    format!("{COMMON}\n{body}")
+    format!("{COMMON}\n{FULL_SCREEN}\n{body}")
+}
+
+/// The full-screen triangle (`vs_full_screen`) + `body`: for a pass over a texture's texels that reads
+/// none of the frame's bindings (a technique's own build passes).
+#[must_use]
+pub fn with_full_screen(body: &str) -> String {
+    format!("{FULL_SCREEN}\n{body}")
 }
 
 /// The Poisson disk of `shadow_core::lookup::POISSON16` as a WGSL constant.

@@ -8,6 +8,7 @@ mod extrusion;
 mod gpu_clock;
 mod host;
 mod hybrid;
+mod moment_maps;
 mod per_light;
 mod pipelines;
 mod settings;

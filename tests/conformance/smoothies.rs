@@ -61,7 +61,16 @@ fn the_remap_sharpens_the_shadow_on_the_nearer_receiver() {
     let mut rows = Vec::new();
     let mut widths = Vec::new();
     // The thesis's comparisons are measured alongside, for the record (no claim is tested for them).
-    for spec in ["smoothies", "smoothies:remap=off", "area-light-reference", "pcss", "penumbra-map"] {
+    for spec in [
+        "smoothies",
+        "smoothies:remap=off",
+        "area-light-reference",
+        "pcss",
+        "penumbra-map",
+        "variance-shadow-map",
+        "exponential-variance-shadow-map",
+        "moment-shadow-map",
+    ] {
         let (f, _) =
             renderer.run_cpu_frame(&frame, 512, 512, &TechniqueSpec::parse(spec).expect("spec")).expect("frame");
         let g = &f.gbuffer;

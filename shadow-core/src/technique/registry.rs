@@ -209,3 +209,20 @@ where
     let text = s.settings_string();
     Ok(Box::new(Stateful::new(s, text).taking(S::LIGHTS)))
 }
+
+/// A constructor for a settings type that converts into the technique `T` it configures, on backend
+/// `B`: one technique type behind several names, each name's settings type with its own keys and
+/// defaults (the depth-layer maps, the moment maps).
+///
+/// # Errors
+/// Unknown keys or bad values.
+pub fn converted<B, S, T>(spec: &TechniqueSpec) -> Result<Box<dyn DynShadowTechnique<B>>, SettingsError>
+where
+    B: Backend,
+    S: TechniqueSettings + Into<T>,
+    T: ShadowTechnique<B> + 'static,
+{
+    let s = S::parse(&spec.name, &spec.values)?;
+    let text = s.settings_string();
+    Ok(Box::new(Stateful::new(s.into(), text).taking(S::LIGHTS)))
+}

@@ -13,8 +13,8 @@ pub mod cpu;
 pub mod gpu;
 
 use shadow_core::technique::maps::{FILTER, FILTER_RADIUS, resolution_key};
-use shadow_core::technique::settings::{Filter, SettingKey, SettingsError, TechniqueSettings, TechniqueSpec, Values};
-use shadow_core::technique::{Backend, DynShadowTechnique, ShadowTechnique, Stateful};
+use shadow_core::technique::registry::converted;
+use shadow_core::technique::settings::{Filter, SettingKey, SettingsError, TechniqueSettings, Values};
 use shadow_cpu::CpuBackend;
 use shadow_wgpu::WgpuBackend;
 
@@ -216,26 +216,19 @@ layer_settings!(
     DualShadowMap, LayerKind::Dual, "auto"
 );
 
-/// A depth-layer map on backend `B`: the settings type of the spec's name (one per name, for its
-/// defaults) made into the shared technique.
-fn layers<B, S>(spec: &TechniqueSpec) -> Result<Box<dyn DynShadowTechnique<B>>, SettingsError>
-where
-    B: Backend,
-    S: TechniqueSettings + Into<DepthLayers>,
-    DepthLayers: ShadowTechnique<B>,
-{
-    let s = S::parse(&spec.name, &spec.values)?;
-    let text = s.settings_string();
-    Ok(Stateful::boxed(s.into(), text))
-}
-
 /// The entry of the layer map `S`.
 fn entry<S>(name: &'static str, description: &'static str, paper: &'static str) -> Entry
 where
     S: TechniqueSettings + Into<DepthLayers>,
 {
-    Entry::new::<S>(name, description, paper, Some(layers::<CpuBackend, S>), Some(layers::<WgpuBackend, S>))
-        .wgsl(gpu::shaders)
+    Entry::new::<S>(
+        name,
+        description,
+        paper,
+        Some(converted::<CpuBackend, S, DepthLayers>),
+        Some(converted::<WgpuBackend, S, DepthLayers>),
+    )
+    .wgsl(gpu::shaders)
 }
 
 /// The registry entry of Woo's midpoint map.

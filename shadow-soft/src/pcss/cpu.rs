@@ -25,20 +25,28 @@ fn texel_depth(map: &Image<f32>, uv: Vec2) -> f32 {
     *map.get_clamped(t.x as i32, t.y as i32)
 }
 
-/// PCSS visibility of a receiver at map point `uv`, NDC depth `depth`, whose plane's depth changes by
-/// `gradient` per unit of `uv`; `pixel` turns the Poisson disc. 1 outside the map.
-#[must_use]
-pub fn pcss_lookup(map: &Image<f32>, lens: &PcssLens, uv: Vec2, depth: f32, gradient: Vec2, pixel: (u32, u32)) -> f32 {
-    if !on_map(uv) {
-        return 1.0;
-    }
+/// The Poisson disc turned by `pixel`'s hash.
+fn turned_disc(pixel: (u32, u32)) -> [Vec2; 16] {
     let angle = hash_unit(pixel_hash(pixel.0, pixel.1)) * std::f32::consts::TAU;
     let (s, c) = angle.sin_cos();
-    let disc = POISSON16.map(|p| Vec2::new(c * p.x - s * p.y, s * p.x + c * p.y));
-    let z_r = lens.proj.linear_depth(depth);
-    let search = lens.search_radius(z_r);
+    POISSON16.map(|p| Vec2::new(c * p.x - s * p.y, s * p.x + c * p.y))
+}
+
+/// The blocker search (step 1): the mean linear depth of the blockers of a receiver at map point `uv`,
+/// NDC depth `depth`, whose plane's depth changes by `gradient` per unit of `uv`; `None` when there are
+/// none. `pixel` turns the Poisson disc. Twin: `pcss_blockers` in search.wgsl.
+#[must_use]
+pub fn blocker_depth(
+    map: &Image<f32>,
+    lens: &PcssLens,
+    uv: Vec2,
+    depth: f32,
+    gradient: Vec2,
+    pixel: (u32, u32),
+) -> Option<f32> {
+    let search = lens.search_radius(lens.proj.linear_depth(depth));
     let (mut sum, mut blockers) = (0.0, 0u32);
-    for p in disc {
+    for p in turned_disc(pixel) {
         let o = p * search;
         let d = texel_depth(map, uv + o);
         if d < depth + gradient.dot(o) {
@@ -46,10 +54,21 @@ pub fn pcss_lookup(map: &Image<f32>, lens: &PcssLens, uv: Vec2, depth: f32, grad
             blockers += 1;
         }
     }
-    if blockers == 0 {
+    (blockers > 0).then(|| sum / blockers as f32)
+}
+
+/// PCSS visibility of a receiver at map point `uv`, NDC depth `depth`, whose plane's depth changes by
+/// `gradient` per unit of `uv`; `pixel` turns the Poisson disc. 1 outside the map.
+#[must_use]
+pub fn pcss_lookup(map: &Image<f32>, lens: &PcssLens, uv: Vec2, depth: f32, gradient: Vec2, pixel: (u32, u32)) -> f32 {
+    if !on_map(uv) {
         return 1.0;
     }
-    let radius = lens.filter_radius(z_r, sum / blockers as f32);
+    let Some(z_b) = blocker_depth(map, lens, uv, depth, gradient, pixel) else {
+        return 1.0;
+    };
+    let radius = lens.filter_radius(lens.proj.linear_depth(depth), z_b);
+    let disc = turned_disc(pixel);
     disc.iter().map(|&p| p * radius).map(|o| compare_bilinear(map, uv + o, depth + gradient.dot(o))).sum::<f32>() / 16.0
 }
 

@@ -69,8 +69,15 @@ pub fn shaders() -> Vec<(&'static str, String)> {
     vec![("pcss query", query_shader())]
 }
 
-/// The WGSL of the pcss query: the shadow-map shader, then the query.
+/// The WGSL of the pcss query: the shadow-map shader, the blocker search, then the query.
 #[must_use]
 pub fn query_shader() -> String {
-    shaders::with_shadow_map(include_str!("query.wgsl"))
+    with_search(include_str!("query.wgsl"))
+}
+
+/// The shadow-map shader, the blocker search (search.wgsl: the geometric normals at binding 4 and
+/// `pcss_blockers`), then `query`: for a query that sizes its kernel as pcss does.
+#[must_use]
+pub fn with_search(query: &str) -> String {
+    shaders::with_shadow_map(&format!("{}\n{query}", include_str!("search.wgsl")))
 }

@@ -78,10 +78,15 @@ impl Pcss {
     /// # Errors
     /// [`TechniqueError::UnsupportedLight`] for point and directional lights.
     pub fn lens(light: &LightView) -> Result<PcssLens, TechniqueError> {
-        let p = crate::spot_projection(light, Self::NAME)?;
+        Ok(Self::lens_of(light, crate::spot_projection(light, Self::NAME)?))
+    }
+
+    /// The lens of `light` through its spot projection `p`.
+    #[must_use]
+    pub fn lens_of(light: &LightView, p: &LightProjection) -> PcssLens {
         // uv = (x_ndc + 1) / 2 and x_ndc = P00 x / z: a lateral offset x at distance z spans P00 x / (2 z)
         // of the map.
-        Ok(PcssLens { k: light.light.radius * p.clip_from_view.x_axis.x * 0.5, proj: *p })
+        PcssLens { k: light.light.radius * p.clip_from_view.x_axis.x * 0.5, proj: *p }
     }
 }
 
