@@ -99,13 +99,58 @@ pub fn light_bleeding(test: &Image<f32>, reference: &Image<f32>, measured: &Imag
     Ok(if n == 0 { 0.0 } else { k as f64 / n as f64 })
 }
 
+/// A straight shadow edge to measure a penumbra across: a world segment on a horizontal receiver at
+/// height `y`, from inside the shadow outwards.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EdgeLine {
+    /// Where the segment starts, in the shadow.
+    pub from: Vec3,
+    /// Where it ends, in the light.
+    pub to: Vec3,
+    /// The receiver's height: samples on other surfaces are skipped.
+    pub y: f32,
+}
+
+/// The 10%-90% width, in image pixels, of the penumbra `vis` shows along `line`: the image distance
+/// between where visibility first passes 0.1 and where it first passes 0.9, sampled at 2001 points
+/// where the G-buffer's `position` is on the receiver. `None` without a full ramp from 0.1 to 0.9.
+#[must_use]
+pub fn penumbra_width(camera: &Camera, vis: &Image<f32>, position: &Image<Vec3>, line: EdgeLine) -> Option<f32> {
+    let (w, h) = (vis.width(), vis.height());
+    let clip = camera.clip_from_world(w as f32 / h as f32);
+    let pixel = |p: Vec3| {
+        let ndc = clip.project_point3(p);
+        ((ndc.x * 0.5 + 0.5) * w as f32, (0.5 - ndc.y * 0.5) * h as f32)
+    };
+    let mut crossings = [None, None];
+    for i in 0..=2000 {
+        let p = line.from.lerp(line.to, i as f32 / 2000.0);
+        let (px, py) = pixel(p);
+        if px < 0.0 || py < 0.0 {
+            continue;
+        }
+        let (x, y) = (px as u32, py as u32);
+        if x >= w || y >= h || (position.get(x, y).y - line.y).abs() > 0.01 {
+            continue;
+        }
+        let v = *vis.get(x, y);
+        for (k, level) in [0.1, 0.9].into_iter().enumerate() {
+            if crossings[k].is_none() && v > level {
+                crossings[k] = Some((px, py));
+            }
+        }
+    }
+    let (a, b) = (crossings[0]?, crossings[1]?);
+    Some(((a.0 - b.0).powi(2) + (a.1 - b.1).powi(2)).sqrt())
+}
+
 /// The pixels every metric is taken over: receivers inside the light's reach whose seen side faces it.
 /// `position` and `normal` are the world position and the face normal turned towards the viewer.
 #[must_use]
 pub fn measured_pixels(
     receiver: &Image<bool>,
-    position: &Image<glam::Vec3>,
-    normal: &Image<glam::Vec3>,
+    position: &Image<Vec3>,
+    normal: &Image<Vec3>,
     light: &crate::light::LightView,
 ) -> Image<bool> {
     Image::from_fn(receiver.width(), receiver.height(), |x, y| {

@@ -7,6 +7,7 @@
 //! street ([`outdoor`]).
 
 pub mod outdoor;
+pub mod soft;
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -109,8 +110,11 @@ pub fn run_results(renderer: &mut Renderer, job: &ResultsJob, mut progress: impl
     let outdoor_job =
         outdoor::OutdoorJob { size: job.outdoor_size, backends: job.backends.clone(), pictures: job.pictures.clone() };
     let outdoor = outdoor::run_outdoor(renderer, &outdoor_job, &mut progress)?;
+    let soft_job = soft::SoftJob { backends: job.backends.clone(), pictures: job.pictures.clone() };
+    let soft = soft::run_soft(renderer, &soft_job, &mut progress)?;
     let mut text = markdown(renderer, job, &reports, (&timing, realtime.as_ref()));
     outdoor::markdown(&mut text, &outdoor);
+    soft::markdown(&mut text, &soft);
     Ok(text)
 }
 

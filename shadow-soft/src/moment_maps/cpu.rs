@@ -5,7 +5,6 @@ use shadow_core::Image;
 use shadow_core::glam::Vec2;
 use shadow_core::light::LightProjection;
 use shadow_core::lookup::on_map;
-use shadow_core::technique::settings::DepthBias;
 use shadow_core::technique::{DebugView, LightPass, ShadowTechnique, TechniqueError};
 use shadow_cpu::passes::maps::{map_position, render_depth_maps};
 use shadow_cpu::passes::per_receiver;
@@ -148,8 +147,8 @@ impl ShadowTechnique<CpuBackend> for MomentMap {
     fn build(&self, _: &mut CpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), CpuError> {
         let LightPass { frame, light, .. } = pass;
         let lens = self.lens(light)?;
-        render_depth_maps(frame, light, self.filter.resolution, DepthBias::NONE, &mut state.depth)?;
-        state.mips = moment_mips(&state.depth[0], &lens.proj, self.kind, self.filter.blur);
+        render_depth_maps(frame, light, self.depth.resolution, self.depth.depth_bias(), &mut state.depth)?;
+        state.mips = moment_mips(&state.depth[0], &lens.proj, self.kind, self.blur);
         state.lens = Some(lens);
         Ok(())
     }
@@ -166,9 +165,9 @@ impl ShadowTechnique<CpuBackend> for MomentMap {
         let (Some(lens), false) = (&state.lens, state.mips.is_empty()) else {
             return Err(TechniqueError::NotBuilt(self.name().into()).into());
         };
-        let (proj, depth) = (&lens.proj, &state.depth[0]);
+        let (proj, depth, offset) = (&lens.proj, &state.depth[0], self.depth.receiver_offset());
         per_receiver(g, out, |x, y, i| {
-            let m = map_position(light, g.position.data()[i], 0.0);
+            let m = map_position(light, g.position.data()[i], offset);
             if !on_map(m.uv) {
                 return 1.0;
             }

@@ -6,11 +6,9 @@
 //! its own maths.
 
 use bytemuck::{Pod, Zeroable};
-use shadow_core::technique::maps::DepthMap;
-use shadow_core::technique::settings::BiasMode;
 use shadow_core::technique::{DebugView, LightPass, ShadowTechnique, TechniqueError};
 use shadow_wgpu::passes::full_screen;
-use shadow_wgpu::passes::maps::{DepthMaps, MapQuery, QueryExtras};
+use shadow_wgpu::passes::maps::{DepthMaps, LookupParams, MapQuery, QueryExtras};
 use shadow_wgpu::pipelines::{
     ATTRIBUTE, FragmentEntry, attribute_entry, buffer_entry, depth_array_entry, full_screen_pipeline,
 };
@@ -207,21 +205,15 @@ impl ShadowTechnique<WgpuBackend> for MomentMap {
     }
 
     fn create_state(&self, cx: &mut WgpuContext) -> Result<State, WgpuError> {
-        // The moments need no rasterization bias: a receiver compares with their mean, not one depth.
-        let depth = DepthMap {
-            resolution: self.filter.resolution,
-            bias: BiasMode::None,
-            bias_constant: 0.0,
-            bias_slope: 0.0,
-            bias_world: 0.0,
-        };
-        let map = DepthMaps::new(cx, &depth);
+        let map = DepthMaps::new(cx, &self.depth);
         cx.scoped("creating the moment-map pipelines", |cx| {
             let build = BuildPasses::new(cx, self);
             let module = cx.pipelines.module("moment map query", query_shader());
             let constants = constants(self);
             let entry = FragmentEntry { name: "fs_moment_query", constants: &constants };
-            let query = MapQuery::with_entry(cx, &module, entry, &[attribute_entry(4), attribute_entry(5)]);
+            let lookup = LookupParams { radius: 0.0, receiver_offset: self.depth.receiver_offset() };
+            let query =
+                MapQuery::with_entry(cx, &module, entry, &[attribute_entry(4), attribute_entry(5)]).with_lookup(lookup);
             State { map, build, query, targets: None, lens: None }
         })
     }
@@ -229,14 +221,14 @@ impl ShadowTechnique<WgpuBackend> for MomentMap {
     fn build(&self, cx: &mut WgpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), WgpuError> {
         let LightPass { frame, light, .. } = pass;
         let lens = self.lens(light)?;
-        let res = self.filter.resolution;
+        let res = self.depth.resolution;
         state.map.render(cx, frame, light, res)?;
         let depth = state.map.maps().ok_or_else(|| TechniqueError::NotBuilt(self.name().into()))?.clone();
         let targets = match &state.targets {
             Some(t) if t.mips.width() == res => t.clone(),
             _ => state.targets.insert(cx.scoped("allocating the moment maps", |cx| Targets::new(cx, res))?).clone(),
         };
-        let params = BuildParams { depth: [lens.proj.near, lens.proj.far, self.filter.blur as f32, 0.0] };
+        let params = BuildParams { depth: [lens.proj.near, lens.proj.far, self.blur as f32, 0.0] };
         cx.scoped("the moment maps", |cx| {
             state.build.run(cx, &params, &depth, (&targets.scratch, &targets.mips));
             targets.lay_out(cx);
