@@ -26,6 +26,13 @@ mod viewer;
 mod volume_reconstruction;
 mod wgsl;
 
+/// Whether visibility `v` is shadowed, as every metric splits lit from shadowed (below one half): a
+/// test that a frame is not all lit asks for this, not for an exact 0, which a filterable map's bound
+/// leaves a trace above even in the umbra.
+fn shadowed(v: f32) -> bool {
+    v < 0.5
+}
+
 /// Built-in scene `name` under a light of a kind `lights` takes: its own light, or for the techniques of
 /// directional lights alone (cascades, the perspective warps), a directional light in its place.
 fn scene_taken_by(name: &str, lights: shadow_core::technique::LightKinds) -> shadow_core::Scene {
