@@ -31,6 +31,13 @@ pub fn normalized_depth(proj: &LightProjection, ndc: f32) -> f32 {
     ((proj.linear_depth(ndc) - proj.near) / (proj.far - proj.near)).clamp(0.0, 1.0)
 }
 
+/// Adds `v` to `sum`, moment by moment.
+fn accumulate(sum: &mut [f32; 4], v: &[f32; 4]) {
+    for (s, v) in sum.iter_mut().zip(v) {
+        *s += v;
+    }
+}
+
 /// The mean of `2 radius + 1` texels of `src` along x (`horizontal`) or y, centred on each texel and
 /// clamped to the edge (twin: `blur` in build.wgsl, summed in the same order).
 fn box_blur(src: &MomentImage, radius: u32, horizontal: bool) -> MomentImage {
@@ -40,10 +47,7 @@ fn box_blur(src: &MomentImage, radius: u32, horizontal: bool) -> MomentImage {
         let mut sum = [0.0f32; 4];
         for k in -r..=r {
             let (sx, sy) = if horizontal { (x as i32 + k, y as i32) } else { (x as i32, y as i32 + k) };
-            let m = src.get_clamped(sx, sy);
-            for (s, v) in sum.iter_mut().zip(m) {
-                *s += v;
-            }
+            accumulate(&mut sum, src.get_clamped(sx, sy));
         }
         sum.map(|s| s * scale)
     })
@@ -58,9 +62,7 @@ fn downsample(src: &MomentImage) -> MomentImage {
         let taps = [(x0, y0), (x0 + 1, y0), (x0, y0 + 1), (x0 + 1, y0 + 1)];
         let mut sum = [0.0f32; 4];
         for (tx, ty) in taps {
-            for (s, v) in sum.iter_mut().zip(src.get_clamped(tx, ty)) {
-                *s += v;
-            }
+            accumulate(&mut sum, src.get_clamped(tx, ty));
         }
         sum.map(|s| s * 0.25)
     })
@@ -125,9 +127,7 @@ pub fn average(mips: &[MomentImage], uv: Vec2, side: f32) -> [f32; 4] {
     for j in 0..GRID {
         for i in 0..GRID {
             let offset = Vec2::new(i as f32 + 0.5, j as f32 + 0.5) * cell - 0.5 * side;
-            for (s, v) in sum.iter_mut().zip(trilinear(mips, uv + offset, cell)) {
-                *s += v;
-            }
+            accumulate(&mut sum, &trilinear(mips, uv + offset, cell));
         }
     }
     sum.map(|s| s * (1.0 / (GRID * GRID) as f32))
