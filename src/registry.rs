@@ -60,6 +60,7 @@ impl TechniqueRegistry {
             shadow_soft::moment_maps::variance_entry(),
             shadow_soft::moment_maps::exponential_variance_entry(),
             shadow_soft::moment_maps::moment_entry(),
+            shadow_soft::penumbra_wedges::entry(),
             shadow_hard::shadow_volume::zpass_entry(),
             shadow_hard::shadow_volume::zfail_entry(),
             shadow_hard::depth_layers::midpoint_entry(),

@@ -9,12 +9,15 @@
 //! - [`penumbra_map::PenumbraMap`] (`penumbra-map`): Wyman and Hansen's cones and sheets.
 //! - [`moment_maps`] (`variance-shadow-map`, `exponential-variance-shadow-map`, `moment-shadow-map`):
 //!   filterable maps of depth moments, sized to the penumbra.
+//! - [`penumbra_wedges::PenumbraWedges`] (`penumbra-wedges`): Akenine-Moeller and Assarsson's soft shadow
+//!   volumes, a wedge per silhouette edge.
 
 pub mod area_light;
 pub mod min_target;
 pub mod moment_maps;
 pub mod pcss;
 pub mod penumbra_map;
+pub mod penumbra_wedges;
 pub mod smoothies;
 
 /// A registry entry of a technique on the two backends.
@@ -23,6 +26,7 @@ pub type Entry = shadow_core::technique::registry::Entry<shadow_cpu::CpuBackend,
 pub use area_light::AreaLightReference;
 pub use pcss::Pcss;
 pub use penumbra_map::PenumbraMap;
+pub use penumbra_wedges::PenumbraWedges;
 pub use smoothies::Smoothies;
 
 use shadow_core::light::{LightProjection, LightView};

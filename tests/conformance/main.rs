@@ -9,6 +9,7 @@ mod gpu_clock;
 mod host;
 mod hybrid;
 mod moment_maps;
+mod penumbra_wedges;
 mod per_light;
 mod pipelines;
 mod settings;

@@ -1,0 +1,121 @@
+// What one silhouette edge adds to a receiver's occluded share of the light (twin: coverage.rs, whose
+// notes derive it).
+
+const NEAR: f32 = 1e-3;
+const PI: f32 = 3.14159265358979;
+
+// ((a - p) x (b - p)) . (c - p): positive inside the side of the hard volume through edge a -> b.
+fn side(p: vec3<f32>, a: vec3<f32>, b: vec3<f32>, c: vec3<f32>) -> f32 {
+    return dot(cross(a - p, b - p), c - p);
+}
+
+fn inside(p: vec3<f32>, a: vec3<f32>, b: vec3<f32>, c: vec3<f32>) -> f32 {
+    return select(0.0, 1.0, side(p, a, b, c) > 0.0);
+}
+
+// det(v - eye, c - eye, p - eye): the one expression both quads meeting at vertex v ask.
+fn around(eye: vec3<f32>, v: vec3<f32>, c: vec3<f32>, p: vec3<f32>) -> f32 {
+    return dot(cross(v - eye, c - eye), p - eye);
+}
+
+fn same(s: f32, reference: f32) -> bool {
+    return (s > 0.0) == (reference > 0.0);
+}
+
+fn beyond(eye: vec3<f32>, a: vec3<f32>, b: vec3<f32>, x: vec3<f32>) -> f32 {
+    return dot(cross(a - eye, b - eye), x - eye);
+}
+
+// Whether the eye's ray towards p meets the side quad of edge a -> b.
+fn crosses_quad(p: vec3<f32>, eye: vec3<f32>, a: vec3<f32>, b: vec3<f32>, c: vec3<f32>) -> bool {
+    return same(around(eye, a, c, p), around(eye, a, c, b))
+        && same(around(eye, b, c, p), around(eye, b, c, a))
+        && same(beyond(eye, a, b, p), beyond(eye, a, b, a + (a - c)));
+}
+
+// The side quad's z-pass step at p, per unit weight.
+fn count_step(p: vec3<f32>, eye: vec3<f32>, a: vec3<f32>, b: vec3<f32>, c: vec3<f32>) -> f32 {
+    let step = inside(p, a, b, c) - inside(eye, a, b, c);
+    if (step != 0.0 && crosses_quad(p, eye, a, b, c)) {
+        return step;
+    }
+    return 0.0;
+}
+
+// A point of the edge cut where it comes `near` from the receiver along the axis.
+fn cut(from_: vec3<f32>, z_from: f32, to: vec3<f32>, z_to: f32, near: f32) -> vec3<f32> {
+    return from_ + (to - from_) * ((near - z_from) / (z_to - z_from));
+}
+
+// The signed share of the light's disc beyond edge a -> b seen from the centre, as p sees the edge.
+fn wedge_area(p: vec3<f32>, a: vec3<f32>, b: vec3<f32>, centre: vec3<f32>, radius: f32) -> f32 {
+    let w = centre - p;
+    let dist = length(w);
+    if (dist <= radius) {
+        return 0.0;
+    }
+    let axis = w / dist;
+    let near = NEAR * dist;
+    let za = dot(a - p, axis);
+    let zb = dot(b - p, axis);
+    if (za < near && zb < near) {
+        return 0.0;
+    }
+    var a2 = a;
+    var za2 = za;
+    var b2 = b;
+    var zb2 = zb;
+    if (za < near) {
+        a2 = cut(a, za, b, zb, near);
+        za2 = near;
+    }
+    if (zb < near) {
+        b2 = cut(b, zb, a, za, near);
+        zb2 = near;
+    }
+    let r = radius * dist / sqrt(dist * dist - radius * radius);
+    let pa = (a2 - p) * (dist / za2) - w;
+    let pb = (b2 - p) * (dist / zb2) - w;
+    let along = pb - pa;
+    let len = length(along);
+    if (len == 0.0) {
+        return 0.0;
+    }
+    let dir = along / len;
+    let sa = dot(pa, dir) / r;
+    let sb = dot(pb, dir) / r;
+    let n = cross(a - p, b - p);
+    let in_plane = length(n - axis * dot(n, axis));
+    let s = side(p, a, b, centre);
+    if (in_plane == 0.0) {
+        return 0.0;
+    }
+    let magnitude = abs(s) / (in_plane * r);
+    if (magnitude >= 1.0) {
+        return 0.0;
+    }
+    let h = select(-magnitude, magnitude, s > 0.0);
+    let k = sqrt(1.0 - h * h);
+    let s1 = min(max(-k, sa), sb);
+    let s2 = min(max(k, sa), sb);
+    let twice = -h * (s2 - s1) - (atan2(h, s2) - atan2(h, s1));
+    return -twice / (2.0 * PI);
+}
+
+// The share of the light's disc below the receiver's horizon (twin: horizon_share).
+fn horizon_share(p: vec3<f32>, n: vec3<f32>, centre: vec3<f32>, radius: f32) -> f32 {
+    let w = centre - p;
+    let dist = length(w);
+    if (dist <= radius) {
+        return 0.0;
+    }
+    let axis = w / dist;
+    let r = radius * dist / sqrt(dist * dist - radius * radius);
+    let in_plane = length(n - axis * dot(n, axis));
+    let above = dot(n, w);
+    if (in_plane * r <= abs(above)) {
+        return select(1.0, 0.0, above > 0.0);
+    }
+    let d = above / (in_plane * r);
+    return (acos(d) - d * sqrt(1.0 - d * d)) / PI;
+}

@@ -1,0 +1,122 @@
+//! `penumbra-wedges` on the CPU backend (twin: [`super::gpu`]), through its public rasterizer: the side
+//! quads and the wedges drawn over the G-buffer into a buffer of occluded shares, summed per pixel.
+
+use shadow_core::Image;
+use shadow_core::glam::{Mat4, Vec4};
+use shadow_core::technique::LightPass;
+use shadow_core::technique::{ShadowTechnique, TechniqueError};
+use shadow_cpu::passes::per_receiver;
+use shadow_cpu::raster::{CompareFn, CullMode, DepthBias, DepthState, DepthStencil, Fragment, RasterState, Soup, draw};
+use shadow_cpu::{CpuBackend, CpuContext, CpuError, GBuffer};
+
+use super::PenumbraWedges;
+use super::coverage::{SphereLight, count_step, horizon_share, wedge_area};
+use super::geometry::{WedgeEdge, WedgeGeometry};
+
+/// The geometry of the last build.
+#[derive(Default)]
+pub struct State {
+    built: Option<(WedgeGeometry, SphereLight)>,
+}
+
+/// The back faces of the wedges, behind the receiver: the receiver may be inside.
+const WEDGE_STATE: RasterState = RasterState {
+    cull: CullMode::Front,
+    depth: Some(DepthState { compare: CompareFn::Greater, write: false, bias: DepthBias::NONE, clamp: false }),
+    early_tests: true,
+    ..QUAD_STATE
+};
+
+/// Every crossing of the eye's ray with a side quad, wherever the receiver is.
+const QUAD_STATE: RasterState = RasterState {
+    cull: CullMode::None,
+    front_face: shadow_cpu::raster::FrontFace::Ccw,
+    depth: None,
+    stencil: None,
+    early_tests: false,
+};
+
+/// Draws `triangles` (homogeneous world points) over `g`, adding `term(edge, receiver)` of each
+/// fragment's edge (`edge_of(prim)`) into `occluded`. Returns the fragment count.
+fn accumulate(
+    g: &GBuffer,
+    ds: &mut DepthStencil,
+    occluded: &mut Image<f32>,
+    (triangles, state): (&[[Vec4; 3]], &RasterState),
+    edge_of: impl Fn(u32) -> WedgeEdge + Sync,
+    term: impl Fn(&WedgeEdge, shadow_core::glam::Vec3) -> f32 + Sync,
+) -> u64 {
+    let clip_from_world: Mat4 = g.clip_from_world;
+    let clip: Vec<[Vec4; 3]> = triangles.iter().map(|t| t.map(|v| clip_from_world * v)).collect();
+    let width = g.width();
+    let shader = |f: &Fragment| {
+        let i = (f.y * width + f.x) as usize;
+        g.receiver.data()[i].then(|| {
+            let edge = edge_of(f.prim);
+            edge.weight * term(&edge, g.position.data()[i])
+        })
+    };
+    draw(ds, occluded, &Soup { triangles: &clip, prim_base: 0, flip: false }, state, shader, |d, s| *d += s).fragments
+}
+
+impl ShadowTechnique<CpuBackend> for PenumbraWedges {
+    type State = State;
+
+    fn name(&self) -> &'static str {
+        Self::NAME
+    }
+
+    fn create_state(&self, _: &mut CpuContext) -> Result<State, CpuError> {
+        Ok(State::default())
+    }
+
+    fn build(&self, _: &mut CpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), CpuError> {
+        let LightPass { frame, light, stats, .. } = pass;
+        state.built = Some((Self::construct(frame, light, stats)?, Self::sphere(light)?));
+        Ok(())
+    }
+
+    fn query(
+        &self,
+        _: &mut CpuContext,
+        state: &mut State,
+        pass: LightPass<'_>,
+        g: &GBuffer,
+        out: &mut Image<f32>,
+    ) -> Result<(), CpuError> {
+        let LightPass { frame, stats, .. } = pass;
+        let (built, light) = state.built.as_ref().ok_or_else(|| TechniqueError::NotBuilt(Self::NAME.into()))?;
+        let (eye, c) = (g.camera.eye, light.centre);
+        let eye_count = built.eye_count(frame, eye);
+        let mut occluded = Image::new(g.width(), g.height(), 0.0f32);
+        let mut ds = DepthStencil::from_depth(&g.depth, 0);
+        let edges = &built.edges;
+        let quads = accumulate(
+            g,
+            &mut ds,
+            &mut occluded,
+            (&built.quads, &QUAD_STATE),
+            |prim| edges[prim as usize / 2],
+            |e, p| count_step(p, eye, e.a, e.b, c),
+        );
+        let wedges = if self.wedges.is_on() {
+            accumulate(
+                g,
+                &mut ds,
+                &mut occluded,
+                (&built.hulls, &WEDGE_STATE),
+                |prim| edges[built.hull_edges[prim as usize] as usize],
+                |e, p| wedge_area(p, e.a, e.b, *light),
+            )
+        } else {
+            0
+        };
+        per_receiver(g, out, |_, _, i| {
+            let horizon = horizon_share(g.position.data()[i], g.geometric_normal.data()[i], *light);
+            (1.0 - eye_count - occluded.data()[i] - horizon).clamp(0.0, 1.0)
+        });
+        stats.counters.volume_fragments = Some(quads);
+        stats.counters.extra.insert("wedge_fragments".into(), wedges as f64);
+        Ok(())
+    }
+}

@@ -1,0 +1,283 @@
+//! The geometry both backends draw (shared, built on the host): per silhouette edge of the casters (found
+//! from the light's centre by shadow-core), its hard volume's side quad and its penumbra wedge, and the
+//! light centre's count at the eye.
+//!
+//! **Side quads** `(b, a, a_inf, b_inf)`, extruded from the centre to infinity as shadow-core's volumes
+//! are: counted z-pass from the eye, they give the hard shadow volume's count at every receiver. They are
+//! drawn slightly larger than they are; which pixels they hold is decided per fragment.
+//!
+//! **Wedges.** The receivers for which edge `a -> b` cuts the light's disc are those behind the edge from
+//! some point of the sphere. They lie inside four planes, each through the edge or one of its ends and
+//! tangent to the sphere with the sphere behind it (a plane at distance `R` from the centre, the light on
+//! its outer side, holds every line from the sphere through a point of the plane on its inner side beyond
+//! that point):
+//!
+//! - the front and back planes, through the edge's line;
+//! - a side plane at each end, turned from the plane through the end and the centre by the light's
+//!   angular radius there, away from the edge (it holds the end's cone of shadow, so the wedge is
+//!   conservative where a plane through the end alone would cut the cone).
+//!
+//! Their intersection is a convex polyhedron with the edge as its apex and four rays to infinity; drawn
+//! with back faces only, against the G-buffer's depth with the test "greater", it reaches every receiver
+//! inside it exactly once. The paper's wedges are the same four planes; here the far cap lies at
+//! infinity, as the volumes' does.
+//!
+//! An edge whose line passes through the light (no plane through it is tangent) has no wedge: it is left
+//! out, and counted; its hard edge stays.
+
+use shadow_core::FrameInputs;
+use shadow_core::geometry::silhouette::Silhouette;
+use shadow_core::glam::{Mat4, Vec3, Vec4};
+
+use super::coverage::SphereLight;
+
+/// A silhouette edge as the wedges use it: its ends in world space, oriented as shadow-core orients them
+/// (the light-facing faces run along it), and its weight, negative in a mirrored instance, whose faces
+/// wind the other way in world space.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WedgeEdge {
+    /// Start.
+    pub a: Vec3,
+    /// End.
+    pub b: Vec3,
+    /// Signed multiplicity.
+    pub weight: f32,
+}
+
+/// What both backends draw for one light.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct WedgeGeometry {
+    /// The casters' silhouette edges.
+    pub edges: Vec<WedgeEdge>,
+    /// Per edge, its side quad as two triangles of homogeneous world points (w = 0 at infinity):
+    /// triangles `2 i` and `2 i + 1` are edge `i`'s.
+    pub quads: Vec<[Vec4; 3]>,
+    /// The wedges' faces, wound counter-clockwise seen from outside, homogeneous as the quads.
+    pub hulls: Vec<[Vec4; 3]>,
+    /// The edge of each wedge face.
+    pub hull_edges: Vec<u32>,
+    /// The casters' silhouettes, for the count at an eye.
+    pub silhouettes: Vec<(usize, Silhouette)>,
+    /// The light's centre.
+    pub centre: Vec3,
+    /// Edges whose line passes through the light: no wedge.
+    pub without_wedge: usize,
+}
+
+/// How much larger than the side quads they cover the quads are drawn, as a fraction of the edge's
+/// length and of its distance from the light.
+const QUAD_MARGIN: f32 = 0.01;
+
+/// Faces per wedge: two each for the front and back planes and the cap at infinity, one per end.
+pub const HULL_TRIANGLES: usize = 8;
+
+impl WedgeGeometry {
+    /// The quads and wedges of `silhouettes` (from `FrameInputs::caster_silhouettes`).
+    #[must_use]
+    pub fn build(frame: &FrameInputs, silhouettes: Vec<(usize, Silhouette)>, light: SphereLight) -> Self {
+        let mut out = Self { centre: light.centre, ..Self::default() };
+        for (i, silhouette) in &silhouettes {
+            let inst = &frame.instances[*i];
+            let at = |v: u32| inst.world_from_local.transform_point3(inst.adjacency.positions()[v as usize]);
+            let sign = if inst.mirrored { -1.0 } else { 1.0 };
+            for e in &silhouette.edges {
+                out.push(WedgeEdge { a: at(e.a), b: at(e.b), weight: sign * e.weight as f32 }, light);
+            }
+        }
+        out.silhouettes = silhouettes;
+        out
+    }
+
+    /// The light centre's count at `eye`, what z-pass counting starts from: the casting faces of `frame`
+    /// that the segment from the eye to the centre passes through, each by its weight's size.
+    #[must_use]
+    pub fn eye_count(&self, frame: &FrameInputs, eye: Vec3) -> f32 {
+        self.silhouettes.iter().map(|(i, silhouette)| crossings(frame, *i, silhouette, eye, self.centre)).sum()
+    }
+
+    fn push(&mut self, edge: WedgeEdge, light: SphereLight) {
+        let index = self.edges.len() as u32;
+        self.edges.push(edge);
+        let WedgeEdge { a, b, .. } = edge;
+        let c = light.centre;
+        // Drawn a little larger (ends moved apart and towards the light): the fragment decides exactly
+        // which pixels the quad holds (`coverage::crosses_quad`), the rasterizer only has to reach them.
+        let (a, b) = (a + ((c - a) + (a - b)) * QUAD_MARGIN, b + ((c - b) + (b - a)) * QUAD_MARGIN);
+        let (a_inf, b_inf) = ((a - c).extend(0.0), (b - c).extend(0.0));
+        self.quads.push([b.extend(1.0), a.extend(1.0), a_inf]);
+        self.quads.push([b.extend(1.0), a_inf, b_inf]);
+        match wedge(a, b, light) {
+            Some(faces) => {
+                self.hulls.extend(faces);
+                self.hull_edges.extend([index; HULL_TRIANGLES]);
+            }
+            None => self.without_wedge += 1,
+        }
+    }
+}
+
+/// A plane through `point` with unit normal `n`, as `(n, -n . point)`: positive on the inner side.
+fn plane(n: Vec3, point: Vec3) -> Vec4 {
+    n.extend(-n.dot(point))
+}
+
+/// The four planes bounding the wedge of edge `a -> b` (front, back, side at `a`, side at `b`), inner
+/// sides positive; `None` when the edge's line passes through the light.
+#[must_use]
+pub fn wedge_planes(a: Vec3, b: Vec3, light: SphereLight) -> Option<[Vec4; 4]> {
+    let (c, radius) = (light.centre, light.radius);
+    let along = (b - a).try_normalize()?;
+    let to_c = c - a;
+    let off_line = to_c - along * to_c.dot(along);
+    let rho = off_line.length();
+    if rho <= radius * (1.0 + 1e-4) || (c - b).length() <= radius {
+        return None;
+    }
+    // Through the line: n = alpha e + beta f with n . (c - a) = -radius.
+    let e = off_line / rho;
+    let f = along.cross(e);
+    let alpha = -radius / rho;
+    let beta = (1.0 - alpha * alpha).sqrt();
+    let front = plane(e * alpha + f * beta, a);
+    let back = plane(e * alpha - f * beta, a);
+    // Through an end: towards the light by -radius / distance, the rest square to it, leaning along the
+    // edge (inward).
+    let end = |p: Vec3, inward: Vec3| {
+        let to_c = c - p;
+        let dist = to_c.length();
+        let axis = to_c / dist;
+        let across = (inward - axis * inward.dot(axis)).normalize_or_zero();
+        let k = radius / dist;
+        plane(-axis * k + across * (1.0 - k * k).sqrt(), p)
+    };
+    Some([front, back, end(a, along), end(b, -along)])
+}
+
+/// The faces of edge `a -> b`'s wedge, outward and counter-clockwise; `None` as for [`wedge_planes`].
+#[must_use]
+pub fn wedge(a: Vec3, b: Vec3, light: SphereLight) -> Option<[[Vec4; 3]; HULL_TRIANGLES]> {
+    let [front, back, side_a, side_b] = wedge_planes(a, b, light)?;
+    // The rays where the side planes meet the front and back planes, pointing away from the light.
+    let ray = |p1: Vec4, p2: Vec4, from: Vec3| {
+        let d = p1.truncate().cross(p2.truncate()).normalize();
+        let d = if d.dot(from - light.centre) < 0.0 { -d } else { d };
+        d.extend(0.0)
+    };
+    let (fa, ba) = (ray(front, side_a, a), ray(back, side_a, a));
+    let (fb, bb) = (ray(front, side_b, b), ray(back, side_b, b));
+    let (a4, b4) = (a.extend(1.0), b.extend(1.0));
+    // A point strictly inside: beyond the edge's middle along the rays' mean.
+    let mean = (fa + ba + fb + bb).truncate().normalize();
+    let inner = ((a + b) * 0.5 + mean * (a - b).length().max(1.0)).extend(1.0);
+    let faces = [
+        [a4, b4, fb],
+        [a4, fb, fa],
+        [a4, b4, bb],
+        [a4, bb, ba],
+        [a4, fa, ba],
+        [b4, fb, bb],
+        [fa, fb, bb],
+        [fa, bb, ba],
+    ];
+    // Counter-clockwise from outside: the interior point lies behind each face, which for homogeneous
+    // points (w >= 0) is a positive determinant of the face's corners and the point.
+    Some(faces.map(|[p, q, r]| if Mat4::from_cols(p, q, r, inner).determinant() > 0.0 { [p, q, r] } else { [p, r, q] }))
+}
+
+/// Instance `i`'s casting faces that the segment from `eye` to the light's centre `c` passes through, each
+/// counted by its weight's size.
+fn crossings(frame: &FrameInputs, i: usize, silhouette: &Silhouette, eye: Vec3, c: Vec3) -> f32 {
+    let inst = &frame.instances[i];
+    let (from, to) = (inst.local_from_world.transform_point3(eye), inst.local_from_world.transform_point3(c));
+    let positions = inst.adjacency.positions();
+    let mut count = 0.0;
+    for (tri, &w) in inst.adjacency.triangles().iter().zip(&silhouette.face_weights) {
+        if w != 0 && segment_hits(from, to, tri.map(|v| positions[v as usize])) {
+            count += f32::from(w.unsigned_abs());
+        }
+    }
+    count
+}
+
+/// Whether the segment `from -> to` crosses the triangle (Moeller-Trumbore).
+fn segment_hits(from: Vec3, to: Vec3, [p0, p1, p2]: [Vec3; 3]) -> bool {
+    let d = to - from;
+    let (e1, e2) = (p1 - p0, p2 - p0);
+    let q = d.cross(e2);
+    let det = e1.dot(q);
+    if det.abs() < f32::MIN_POSITIVE {
+        return false;
+    }
+    let s = from - p0;
+    let u = s.dot(q) / det;
+    let r = s.cross(e1);
+    let v = d.dot(r) / det;
+    let t = e2.dot(r) / det;
+    u >= 0.0 && v >= 0.0 && u + v <= 1.0 && (0.0..=1.0).contains(&t)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::coverage::wedge_area;
+    use super::*;
+    use shadow_core::lookup::{hash_unit, pixel_hash};
+
+    const LIGHT: SphereLight = SphereLight { centre: Vec3::new(0.3, 5.0, -0.2), radius: 0.4 };
+
+    /// A pseudo-random point in the box `[-4, 4] x [-1, 4] x [-4, 4]`.
+    fn point(seed: u32, i: u32) -> Vec3 {
+        let h = |k: u32| hash_unit(pixel_hash(seed, i * 3 + k));
+        Vec3::new(8.0 * h(0) - 4.0, 5.0 * h(1) - 1.0, 8.0 * h(2) - 4.0)
+    }
+
+    #[test]
+    fn every_receiver_an_edge_covers_part_of_the_light_for_lies_inside_its_wedge() {
+        let edges = [
+            (Vec3::new(-1.0, 2.0, 1.0), Vec3::new(1.0, 2.2, 1.0)),
+            (Vec3::new(0.5, 1.5, -1.0), Vec3::new(0.4, 3.0, 0.2)),
+            (Vec3::new(2.0, 3.5, 0.0), Vec3::new(2.0, 3.5, 0.05)),
+        ];
+        for (k, &(a, b)) in edges.iter().enumerate() {
+            let planes = wedge_planes(a, b, LIGHT).expect("the line misses the light");
+            let (mut covered, mut outside) = (0, 0);
+            for i in 0..20_000 {
+                let p = point(k as u32, i);
+                let inside = planes.iter().all(|pl| pl.dot(p.extend(1.0)) >= -1e-4);
+                if wedge_area(p, a, b, LIGHT).abs() > 1e-6 {
+                    covered += 1;
+                    assert!(inside, "edge {k}: {p} has {} of the light but is outside", wedge_area(p, a, b, LIGHT));
+                } else if !inside {
+                    outside += 1;
+                }
+            }
+            assert!(covered > 20 && outside > 1000, "edge {k}: {covered} covered, {outside} outside");
+        }
+    }
+
+    #[test]
+    fn the_wedge_faces_close_around_the_wedge_facing_out() {
+        let (a, b) = (Vec3::new(-1.0, 2.0, 1.0), Vec3::new(1.0, 2.2, 1.0));
+        let faces = wedge(a, b, LIGHT).expect("a wedge");
+        let planes = wedge_planes(a, b, LIGHT).expect("planes");
+        // A point inside all four planes is behind every face (each face's corners and the point make a
+        // positive determinant); one outside is in front of some face.
+        let behind_all =
+            |p: Vec3| faces.iter().all(|&[q, r, s]| Mat4::from_cols(q, r, s, p.extend(1.0)).determinant() > 0.0);
+        for i in 0..2000 {
+            let p = point(9, i);
+            let inside = planes.iter().all(|pl| pl.dot(p.extend(1.0)) > 1e-3);
+            let outside = planes.iter().any(|pl| pl.dot(p.extend(1.0)) < -1e-3);
+            if inside {
+                assert!(behind_all(p), "{p} inside the planes but in front of a face");
+            } else if outside {
+                assert!(!behind_all(p), "{p} outside the planes but behind every face");
+            }
+        }
+    }
+
+    #[test]
+    fn an_edge_whose_line_meets_the_light_has_no_wedge() {
+        let (a, b) = (Vec3::new(0.3, 2.0, -0.2), Vec3::new(0.3, 3.0, -0.2));
+        assert!(wedge_planes(a, b, LIGHT).is_none());
+    }
+}

@@ -1,0 +1,252 @@
+//! `penumbra-wedges` on the wgpu backend (twin: [`super::cpu`]), through its public API: the shared
+//! quads and wedges, uploaded by the query, which draws both over the G-buffer in one pass into a buffer
+//! of occluded shares (wedges.wgsl, with coverage.wgsl's terms), then resolves it full-screen.
+
+use bytemuck::{Pod, Zeroable};
+use shadow_core::glam::Vec4;
+use shadow_core::technique::LightPass;
+use shadow_core::technique::{ShadowTechnique, TechniqueError};
+use shadow_wgpu::pipelines::{VISIBILITY, attribute_entry, buffer_entry, full_screen_pipeline};
+use shadow_wgpu::{GpuGBuffer, GpuVisibility, WgpuBackend, WgpuContext, WgpuError, passes, shaders};
+
+use super::PenumbraWedges;
+use super::coverage::SphereLight;
+use super::geometry::{WedgeEdge, WedgeGeometry};
+use crate::min_target;
+
+/// GPU twin of `WedgeParams` in wedges.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct WedgeParams {
+    light: [f32; 4],
+    eye: [f32; 4],
+    size: [u32; 4],
+}
+
+/// One quad or wedge corner: its homogeneous world point and its edge (`a` with the weight, `b`).
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct EdgeVertex {
+    position: [f32; 4],
+    a: [f32; 4],
+    b: [f32; 4],
+}
+
+const VERTEX_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
+    array_stride: std::mem::size_of::<EdgeVertex>() as u64,
+    step_mode: wgpu::VertexStepMode::Vertex,
+    attributes: &wgpu::vertex_attr_array![0 => Float32x4, 1 => Float32x4, 2 => Float32x4],
+};
+
+/// Pipelines, and the last build's uploads.
+pub struct State {
+    layout: wgpu::BindGroupLayout,
+    quads: wgpu::RenderPipeline,
+    wedges: wgpu::RenderPipeline,
+    resolve: wgpu::RenderPipeline,
+    built: Option<Built>,
+    /// The per-pixel sums, kept while the view's size does not change.
+    occluded: Option<wgpu::Buffer>,
+}
+
+/// One build's geometry, as vertices: uploaded by each query into the frame's transient buffer, so a
+/// kept build costs no allocation and a moving light none either.
+struct Built {
+    geometry: WedgeGeometry,
+    light: SphereLight,
+    quads: Vec<EdgeVertex>,
+    wedges: Vec<EdgeVertex>,
+}
+
+/// The corners of `triangles`, each with its edge (`edge_of(triangle)`).
+fn vertices(triangles: &[[Vec4; 3]], edge_of: impl Fn(usize) -> WedgeEdge) -> Vec<EdgeVertex> {
+    triangles
+        .iter()
+        .enumerate()
+        .flat_map(|(t, corners)| {
+            let e = edge_of(t);
+            let (a, b) = (e.a.extend(e.weight).to_array(), e.b.extend(0.0).to_array());
+            corners.map(|p| EdgeVertex { position: p.to_array(), a, b })
+        })
+        .collect()
+}
+
+/// A pipeline drawing edge geometry against the G-buffer's depth, writing only the buffer.
+fn edge_pipeline(
+    cx: &WgpuContext,
+    module: &wgpu::ShaderModule,
+    layout: &wgpu::BindGroupLayout,
+    (label, fragment): (&str, &str),
+    (cull_mode, depth_compare): (Option<wgpu::Face>, wgpu::CompareFunction),
+) -> wgpu::RenderPipeline {
+    let pipeline_layout = cx.pipelines.layout(label, &[Some(&cx.shared.frame_layout), Some(layout)]);
+    cx.pipelines.render(&wgpu::RenderPipelineDescriptor {
+        label: Some(label),
+        layout: Some(&pipeline_layout),
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some("vs_edge"),
+            compilation_options: Default::default(),
+            buffers: &[Some(VERTEX_LAYOUT)],
+        },
+        primitive: wgpu::PrimitiveState { cull_mode, ..Default::default() },
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: cx.depth_stencil,
+            depth_write_enabled: Some(false),
+            depth_compare: Some(depth_compare),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module,
+            entry_point: Some(fragment),
+            compilation_options: Default::default(),
+            targets: &[],
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
+impl ShadowTechnique<WgpuBackend> for PenumbraWedges {
+    type State = State;
+
+    fn name(&self) -> &'static str {
+        Self::NAME
+    }
+
+    fn create_state(&self, cx: &mut WgpuContext) -> Result<State, WgpuError> {
+        cx.scoped("creating the penumbra-wedge pipelines", |cx| {
+            let module = cx.pipelines.module("penumbra wedges", shader());
+            let read_write = wgpu::BufferBindingType::Storage { read_only: false };
+            let layout = cx.pipelines.group_layout(
+                "penumbra wedges",
+                &[
+                    attribute_entry(0),
+                    buffer_entry(1, read_write, wgpu::ShaderStages::FRAGMENT),
+                    buffer_entry(2, wgpu::BufferBindingType::Uniform, wgpu::ShaderStages::FRAGMENT),
+                    attribute_entry(3),
+                ],
+            );
+            // Side quads: every crossing, whatever the depth; wedges: back faces behind the receiver.
+            let quads =
+                edge_pipeline(cx, &module, &layout, ("side quads", "fs_quad"), (None, wgpu::CompareFunction::Always));
+            let wedges = edge_pipeline(
+                cx,
+                &module,
+                &layout,
+                ("wedges", "fs_wedge"),
+                (Some(wgpu::Face::Front), wgpu::CompareFunction::Greater),
+            );
+            let groups = [&cx.shared.frame_layout, &layout];
+            let resolve = full_screen_pipeline(
+                &cx.pipelines,
+                "wedge resolve",
+                &module,
+                "fs_resolve",
+                &groups,
+                Some(VISIBILITY),
+                None,
+            );
+            State { layout, quads, wedges, resolve, built: None, occluded: None }
+        })
+    }
+
+    fn build(&self, _: &mut WgpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), WgpuError> {
+        let LightPass { frame, light, stats, .. } = pass;
+        let geometry = Self::construct(frame, light, stats)?;
+        let light = Self::sphere(light)?;
+        let edges = &geometry.edges;
+        let quads = vertices(&geometry.quads, |t| edges[t / 2]);
+        let wedges = vertices(&geometry.hulls, |t| edges[geometry.hull_edges[t] as usize]);
+        state.built = Some(Built { geometry, light, quads, wedges });
+        Ok(())
+    }
+
+    fn query(
+        &self,
+        cx: &mut WgpuContext,
+        state: &mut State,
+        pass: LightPass<'_>,
+        g: &GpuGBuffer,
+        out: &mut GpuVisibility,
+    ) -> Result<(), WgpuError> {
+        let LightPass { frame, .. } = pass;
+        let built = state.built.as_ref().ok_or_else(|| TechniqueError::NotBuilt(Self::NAME.into()))?;
+        let eye = g.camera.eye;
+        let params = WedgeParams {
+            light: built.light.centre.extend(built.light.radius).to_array(),
+            eye: eye.extend(built.geometry.eye_count(frame, eye)).to_array(),
+            size: [g.width, g.height, 0, 0],
+        };
+        let size = u64::from(g.width) * u64::from(g.height) * 4;
+        let occluded = match &state.occluded {
+            Some(b) if b.size() == size => b,
+            _ => state.occluded.insert(cx.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("occluded shares"),
+                size,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })),
+        };
+        let draw_wedges = self.wedges.is_on();
+        cx.scoped("the penumbra wedges", |cx| {
+            let uniform = cx.transient(bytemuck::bytes_of(&params));
+            let group = cx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("penumbra wedges"),
+                layout: &state.layout,
+                entries: &[
+                    wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&g.position) },
+                    wgpu::BindGroupEntry { binding: 1, resource: occluded.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 2, resource: uniform.binding() },
+                    wgpu::BindGroupEntry {
+                        binding: 3,
+                        resource: wgpu::BindingResource::TextureView(&g.geometric_normal),
+                    },
+                ],
+            });
+            let depth = g.depth_view();
+            let mut enc = cx.encoder("penumbra wedges");
+            enc.clear_buffer(occluded, 0, None);
+            {
+                let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("penumbra wedges"),
+                    color_attachments: &[],
+                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                        view: &depth,
+                        depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store }),
+                        stencil_ops: None,
+                    }),
+                    timestamp_writes: None,
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                });
+                pass.set_bind_group(0, &g.frame_group, &[]);
+                pass.set_bind_group(1, &group, &[]);
+                let wedges: &[EdgeVertex] = if draw_wedges { &built.wedges } else { &[] };
+                for (pipeline, data) in [(&state.quads, &built.quads[..]), (&state.wedges, wedges)] {
+                    if let Some((vertices, count)) = min_target::vertex_buffer(cx, data) {
+                        pass.set_pipeline(pipeline);
+                        pass.set_vertex_buffer(0, vertices.slice());
+                        pass.draw(0..count, 0..1);
+                    }
+                }
+            }
+            cx.submit(enc);
+            passes::full_screen(cx, "wedge resolve", &out.view, &state.resolve, &[&g.frame_group, &group], None);
+        })
+    }
+}
+
+/// The technique's shaders as compiled, by name (its registry entry's WGSL).
+#[must_use]
+pub fn shaders() -> Vec<(&'static str, String)> {
+    vec![("penumbra wedges", shader())]
+}
+
+/// The WGSL: the frame's bindings, the coverage terms, then the passes.
+#[must_use]
+pub fn shader() -> String {
+    shaders::with_common(&format!("{}\n{}", include_str!("coverage.wgsl"), include_str!("wedges.wgsl")))
+}

@@ -1,0 +1,76 @@
+// penumbra-wedges on the GPU (twin: cpu.rs): the side quads and the wedges drawn over the G-buffer, each
+// fragment adding its edge's term to the receiver's occluded share in fixed point (there is no float
+// atomic or float blending everywhere, and integer sums come out the same in any order), then the
+// resolve.
+
+struct WedgeParams {
+    // centre, radius
+    light: vec4<f32>,
+    // eye, the light centre's count there
+    eye: vec4<f32>,
+    // x: width
+    size: vec4<u32>,
+};
+
+// The buffer's units per unit of occluded share.
+const SCALE: f32 = 1048576.0;
+
+@group(1) @binding(0) var g_position: texture_2d<f32>;
+@group(1) @binding(1) var<storage, read_write> occluded: array<atomic<i32>>;
+@group(1) @binding(2) var<uniform> params: WedgeParams;
+@group(1) @binding(3) var g_geometric_normal: texture_2d<f32>;
+
+struct EdgeVertex {
+    @builtin(position) pos: vec4<f32>,
+    // a, weight
+    @location(0) @interpolate(flat) a: vec4<f32>,
+    @location(1) @interpolate(flat) b: vec4<f32>,
+};
+
+@vertex
+fn vs_edge(@location(0) p: vec4<f32>, @location(1) a: vec4<f32>, @location(2) b: vec4<f32>) -> EdgeVertex {
+    var out: EdgeVertex;
+    out.pos = view.clip_from_world * p;
+    out.a = a;
+    out.b = b;
+    return out;
+}
+
+// The receiver under a fragment, or w = 0 where there is none.
+fn receiver(pos: vec4<f32>) -> vec4<f32> {
+    return textureLoad(g_position, vec2<i32>(pos.xy), 0);
+}
+
+fn add(pos: vec4<f32>, term: f32) {
+    let i = u32(pos.y) * params.size.x + u32(pos.x);
+    atomicAdd(&occluded[i], i32(round(term * SCALE)));
+}
+
+@fragment
+fn fs_quad(in: EdgeVertex) {
+    let g = receiver(in.pos);
+    if (g.w != 0.0) {
+        add(in.pos, in.a.w * count_step(g.xyz, params.eye.xyz, in.a.xyz, in.b.xyz, params.light.xyz));
+    }
+}
+
+@fragment
+fn fs_wedge(in: EdgeVertex) {
+    let g = receiver(in.pos);
+    if (g.w != 0.0) {
+        add(in.pos, in.a.w * wedge_area(g.xyz, in.a.xyz, in.b.xyz, params.light.xyz, params.light.w));
+    }
+}
+
+@fragment
+fn fs_resolve(in: FullScreen) -> @location(0) vec4<f32> {
+    let g = receiver(in.pos);
+    if (g.w == 0.0) {
+        discard;
+    }
+    let i = u32(in.pos.y) * params.size.x + u32(in.pos.x);
+    let n = textureLoad(g_geometric_normal, vec2<i32>(in.pos.xy), 0).xyz;
+    let horizon = horizon_share(g.xyz, n, params.light.xyz, params.light.w);
+    let share = params.eye.w + f32(atomicLoad(&occluded[i])) / SCALE + horizon;
+    return vec4<f32>(clamp(1.0 - share, 0.0, 1.0), 0.0, 0.0, 0.0);
+}
