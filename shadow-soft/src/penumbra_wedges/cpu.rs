@@ -1,5 +1,6 @@
 //! `penumbra-wedges` on the CPU backend (twin: [`super::gpu`]), through its public rasterizer: the side
-//! quads and the wedges drawn over the G-buffer into a buffer of occluded shares, summed per pixel.
+//! quads and the wedges drawn over the G-buffer into per-pixel sums of occluded shares, one per
+//! [`super::geometry::Layer`], then combined.
 
 use shadow_core::Image;
 use shadow_core::glam::{Mat4, Vec4};
@@ -11,7 +12,7 @@ use shadow_cpu::{CpuBackend, CpuContext, CpuError, GBuffer};
 
 use super::PenumbraWedges;
 use super::coverage::{SphereLight, count_step, horizon_share, wedge_area};
-use super::geometry::{WedgeEdge, WedgeGeometry};
+use super::geometry::{LAYERS, WedgeEdge, WedgeGeometry};
 
 /// The geometry of the last build.
 #[derive(Default)]
@@ -37,11 +38,11 @@ const QUAD_STATE: RasterState = RasterState {
 };
 
 /// Draws `triangles` (homogeneous world points) over `g`, adding `term(edge, receiver)` of each
-/// fragment's edge (`edge_of(prim)`) into `occluded`. Returns the fragment count.
+/// fragment's edge (`edge_of(prim)`) into its layer's sum in `occluded`. Returns the fragment count.
 fn accumulate(
     g: &GBuffer,
     ds: &mut DepthStencil,
-    occluded: &mut Image<f32>,
+    occluded: &mut Image<[f32; LAYERS]>,
     (triangles, state): (&[[Vec4; 3]], &RasterState),
     edge_of: impl Fn(u32) -> WedgeEdge + Sync,
     term: impl Fn(&WedgeEdge, shadow_core::glam::Vec3) -> f32 + Sync,
@@ -53,10 +54,13 @@ fn accumulate(
         let i = (f.y * width + f.x) as usize;
         g.receiver.data()[i].then(|| {
             let edge = edge_of(f.prim);
-            edge.weight * term(&edge, g.position.data()[i])
+            let mut sums = [0.0; LAYERS];
+            sums[edge.layer as usize] = edge.weight * term(&edge, g.position.data()[i]);
+            sums
         })
     };
-    draw(ds, occluded, &Soup { triangles: &clip, prim_base: 0, flip: false }, state, shader, |d, s| *d += s).fragments
+    let add = |d: &mut [f32; LAYERS], s: [f32; LAYERS]| d.iter_mut().zip(s).for_each(|(d, s)| *d += s);
+    draw(ds, occluded, &Soup { triangles: &clip, prim_base: 0, flip: false }, state, shader, add).fragments
 }
 
 impl ShadowTechnique<CpuBackend> for PenumbraWedges {
@@ -87,8 +91,8 @@ impl ShadowTechnique<CpuBackend> for PenumbraWedges {
         let LightPass { frame, stats, .. } = pass;
         let (built, light) = state.built.as_ref().ok_or_else(|| TechniqueError::NotBuilt(Self::NAME.into()))?;
         let (eye, c) = (g.camera.eye, light.centre);
-        let eye_count = built.eye_count(frame, eye);
-        let mut occluded = Image::new(g.width(), g.height(), 0.0f32);
+        let eye_counts = built.eye_counts(frame, eye);
+        let mut occluded = Image::new(g.width(), g.height(), [0.0f32; LAYERS]);
         let mut ds = DepthStencil::from_depth(&g.depth, 0);
         let edges = &built.edges;
         let quads = accumulate(
@@ -113,7 +117,8 @@ impl ShadowTechnique<CpuBackend> for PenumbraWedges {
         };
         per_receiver(g, out, |_, _, i| {
             let horizon = horizon_share(g.position.data()[i], g.geometric_normal.data()[i], *light);
-            (1.0 - eye_count - occluded.data()[i] - horizon).clamp(0.0, 1.0)
+            let [closed, facing, turned] = std::array::from_fn(|k| eye_counts[k] + occluded.data()[i][k]);
+            (1.0 - closed - facing.max(turned) - horizon).clamp(0.0, 1.0)
         });
         stats.counters.volume_fragments = Some(quads);
         stats.counters.extra.insert("wedge_fragments".into(), wedges as f64);

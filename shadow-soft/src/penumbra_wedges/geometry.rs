@@ -25,7 +25,11 @@
 //! An edge whose line passes through the light (no plane through it is tangent) has no wedge: it is left
 //! out, and counted; its hard edge stays.
 
+use std::cmp::Ordering;
+use std::collections::BTreeMap;
+
 use shadow_core::FrameInputs;
+use shadow_core::geometry::adjacency::Adjacency;
 use shadow_core::geometry::silhouette::Silhouette;
 use shadow_core::glam::{Mat4, Vec3, Vec4};
 
@@ -42,7 +46,29 @@ pub struct WedgeEdge {
     pub b: Vec3,
     /// Signed multiplicity.
     pub weight: f32,
+    /// The sum its terms go to.
+    pub layer: Layer,
 }
+
+/// The sums a receiver's occluded share is made of. A closed mesh casts from its light-facing faces
+/// alone. An open one casts, as Bergeron's rule has the volumes do, from every face turned towards the
+/// light; but where a ray crosses it twice (both walls of the teapot's body) that counts the light twice
+/// over the penumbra. So its light-facing faces and its faces turned around are kept apart: each is a
+/// boundary of faces, so each sum is an exact winding integral of its own, and the receiver takes the
+/// larger (a single-sided sheet is in one of them; a ray through an opening that the one misses, the
+/// other holds).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Layer {
+    /// Closed meshes' silhouettes.
+    Closed = 0,
+    /// Open meshes' light-facing faces, as wound.
+    Facing = 1,
+    /// Open meshes' faces that face away, turned around.
+    Turned = 2,
+}
+
+/// How many [`Layer`]s there are.
+pub const LAYERS: usize = 3;
 
 /// What both backends draw for one light.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -78,21 +104,34 @@ impl WedgeGeometry {
         let mut out = Self { centre: light.centre, ..Self::default() };
         for (i, silhouette) in &silhouettes {
             let inst = &frame.instances[*i];
-            let at = |v: u32| inst.world_from_local.transform_point3(inst.adjacency.positions()[v as usize]);
+            let adj = &inst.adjacency;
+            let at = |v: u32| inst.world_from_local.transform_point3(adj.positions()[v as usize]);
             let sign = if inst.mirrored { -1.0 } else { 1.0 };
-            for e in &silhouette.edges {
-                out.push(WedgeEdge { a: at(e.a), b: at(e.b), weight: sign * e.weight as f32 }, light);
+            let chains = if adj.closed() {
+                vec![(Layer::Closed, silhouette.edges.iter().map(|e| (e.a, e.b, e.weight)).collect())]
+            } else {
+                let faces = &silhouette.face_weights;
+                vec![(Layer::Facing, boundary(adj, faces, 1)), (Layer::Turned, boundary(adj, faces, -1))]
+            };
+            for (layer, chain) in chains {
+                for (a, b, weight) in chain {
+                    out.push(WedgeEdge { a: at(a), b: at(b), weight: sign * weight as f32, layer }, light);
+                }
             }
         }
         out.silhouettes = silhouettes;
         out
     }
 
-    /// The light centre's count at `eye`, what z-pass counting starts from: the casting faces of `frame`
-    /// that the segment from the eye to the centre passes through, each by its weight's size.
+    /// The light centre's count at `eye` in each [`Layer`], what z-pass counting starts from: the casting
+    /// faces of `frame` that the segment from the eye to the centre passes through.
     #[must_use]
-    pub fn eye_count(&self, frame: &FrameInputs, eye: Vec3) -> f32 {
-        self.silhouettes.iter().map(|(i, silhouette)| crossings(frame, *i, silhouette, eye, self.centre)).sum()
+    pub fn eye_counts(&self, frame: &FrameInputs, eye: Vec3) -> [f32; LAYERS] {
+        let mut counts = [0.0; LAYERS];
+        for (i, silhouette) in &self.silhouettes {
+            crossings(frame, *i, silhouette, (eye, self.centre), &mut counts);
+        }
+        counts
     }
 
     fn push(&mut self, edge: WedgeEdge, light: SphereLight) {
@@ -102,10 +141,10 @@ impl WedgeGeometry {
         let c = light.centre;
         // Drawn a little larger (ends moved apart and towards the light): the fragment decides exactly
         // which pixels the quad holds (`coverage::crosses_quad`), the rasterizer only has to reach them.
-        let (a, b) = (a + ((c - a) + (a - b)) * QUAD_MARGIN, b + ((c - b) + (b - a)) * QUAD_MARGIN);
-        let (a_inf, b_inf) = ((a - c).extend(0.0), (b - c).extend(0.0));
-        self.quads.push([b.extend(1.0), a.extend(1.0), a_inf]);
-        self.quads.push([b.extend(1.0), a_inf, b_inf]);
+        let (qa, qb) = (a + ((c - a) + (a - b)) * QUAD_MARGIN, b + ((c - b) + (b - a)) * QUAD_MARGIN);
+        let (a_inf, b_inf) = ((qa - c).extend(0.0), (qb - c).extend(0.0));
+        self.quads.push([qb.extend(1.0), qa.extend(1.0), a_inf]);
+        self.quads.push([qb.extend(1.0), a_inf, b_inf]);
         match wedge(a, b, light) {
             Some(faces) => {
                 self.hulls.extend(faces);
@@ -184,19 +223,53 @@ pub fn wedge(a: Vec3, b: Vec3, light: SphereLight) -> Option<[[Vec4; 3]; HULL_TR
     Some(faces.map(|[p, q, r]| if Mat4::from_cols(p, q, r, inner).determinant() > 0.0 { [p, q, r] } else { [p, r, q] }))
 }
 
-/// Instance `i`'s casting faces that the segment from `eye` to the light's centre `c` passes through, each
-/// counted by its weight's size.
-fn crossings(frame: &FrameInputs, i: usize, silhouette: &Silhouette, eye: Vec3, c: Vec3) -> f32 {
-    let inst = &frame.instances[i];
-    let (from, to) = (inst.local_from_world.transform_point3(eye), inst.local_from_world.transform_point3(c));
-    let positions = inst.adjacency.positions();
-    let mut count = 0.0;
-    for (tri, &w) in inst.adjacency.triangles().iter().zip(&silhouette.face_weights) {
-        if w != 0 && segment_hits(from, to, tri.map(|v| positions[v as usize])) {
-            count += f32::from(w.unsigned_abs());
+/// The boundary of an open mesh's faces whose cast weight is `side` (1: facing the light, as wound; -1:
+/// facing away, turned around): oriented edges in welded vertices with their multiplicity, in a fixed
+/// order.
+fn boundary(adj: &Adjacency, weights: &[i8], side: i8) -> Vec<(u32, u32, u32)> {
+    // Per undirected edge (lower vertex first), the sum of the faces running along it minus those
+    // running back.
+    let mut sums: BTreeMap<(u32, u32), i32> = BTreeMap::new();
+    for (tri, _) in adj.triangles().iter().zip(weights).filter(|&(_, &w)| w == side) {
+        for k in 0..3 {
+            let (a, b) = if side > 0 { (tri[k], tri[(k + 1) % 3]) } else { (tri[(k + 1) % 3], tri[k]) };
+            match a.cmp(&b) {
+                Ordering::Less => *sums.entry((a, b)).or_default() += 1,
+                Ordering::Greater => *sums.entry((b, a)).or_default() -= 1,
+                Ordering::Equal => {}
+            }
         }
     }
-    count
+    sums.into_iter()
+        .filter(|&(_, s)| s != 0)
+        .map(|((a, b), s)| if s > 0 { (a, b, s.unsigned_abs()) } else { (b, a, s.unsigned_abs()) })
+        .collect()
+}
+
+/// Adds to `counts` instance `i`'s casting faces that the segment `from -> to` passes through, each in its
+/// layer.
+fn crossings(
+    frame: &FrameInputs,
+    i: usize,
+    silhouette: &Silhouette,
+    (from, to): (Vec3, Vec3),
+    counts: &mut [f32; LAYERS],
+) {
+    let inst = &frame.instances[i];
+    let (from, to) = (inst.local_from_world.transform_point3(from), inst.local_from_world.transform_point3(to));
+    let adj = &inst.adjacency;
+    let positions = adj.positions();
+    for (tri, &w) in adj.triangles().iter().zip(&silhouette.face_weights) {
+        let layer = match (adj.closed(), w) {
+            (_, 0) => continue,
+            (true, _) => Layer::Closed,
+            (false, 1) => Layer::Facing,
+            (false, _) => Layer::Turned,
+        };
+        if segment_hits(from, to, tri.map(|v| positions[v as usize])) {
+            counts[layer as usize] += 1.0;
+        }
+    }
 }
 
 /// Whether the segment `from -> to` crosses the triangle (Moeller-Trumbore).
@@ -273,6 +346,26 @@ mod tests {
                 assert!(!behind_all(p), "{p} outside the planes but behind every face");
             }
         }
+    }
+
+    #[test]
+    fn an_open_sheet_is_the_boundary_of_its_faces_on_the_side_it_casts_from() {
+        // A square of two triangles: the shared diagonal cancels, the four sides remain, turned around
+        // when the faces cast turned.
+        let square = shadow_core::Mesh::new(
+            vec![Vec3::ZERO, Vec3::X, Vec3::new(1.0, 0.0, 1.0), Vec3::Z],
+            vec![[0, 1, 2], [0, 2, 3]],
+        )
+        .expect("a square");
+        let adj = Adjacency::build(&square);
+        let facing = boundary(&adj, &[1, 1], 1);
+        assert!(facing.iter().all(|&(_, _, w)| w == 1), "{facing:?}");
+        let mut sides: Vec<(u32, u32)> = facing.iter().map(|&(a, b, _)| (a, b)).collect();
+        sides.sort_unstable();
+        assert_eq!(sides, [(0, 1), (1, 2), (2, 3), (3, 0)]);
+        let turned = boundary(&adj, &[-1, -1], -1);
+        assert!(turned.iter().all(|&(a, b, _)| facing.contains(&(b, a, 1))) && turned.len() == 4);
+        assert!(boundary(&adj, &[1, 1], -1).is_empty(), "no face casts turned");
     }
 
     #[test]

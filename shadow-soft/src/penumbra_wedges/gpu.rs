@@ -11,7 +11,7 @@ use shadow_wgpu::{GpuGBuffer, GpuVisibility, WgpuBackend, WgpuContext, WgpuError
 
 use super::PenumbraWedges;
 use super::coverage::SphereLight;
-use super::geometry::{WedgeEdge, WedgeGeometry};
+use super::geometry::{LAYERS, WedgeEdge, WedgeGeometry};
 use crate::min_target;
 
 /// GPU twin of `WedgeParams` in wedges.wgsl.
@@ -20,10 +20,12 @@ use crate::min_target;
 struct WedgeParams {
     light: [f32; 4],
     eye: [f32; 4],
+    eye_counts: [f32; 4],
     size: [u32; 4],
 }
 
-/// One quad or wedge corner: its homogeneous world point and its edge (`a` with the weight, `b`).
+/// One quad or wedge corner: its homogeneous world point and its edge (`a` with the weight, `b` with the
+/// layer).
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 struct EdgeVertex {
@@ -45,7 +47,7 @@ pub struct State {
     wedges: wgpu::RenderPipeline,
     resolve: wgpu::RenderPipeline,
     built: Option<Built>,
-    /// The per-pixel sums, kept while the view's size does not change.
+    /// The per-pixel sums, one view's worth per layer, kept while the view's size does not change.
     occluded: Option<wgpu::Buffer>,
 }
 
@@ -65,7 +67,7 @@ fn vertices(triangles: &[[Vec4; 3]], edge_of: impl Fn(usize) -> WedgeEdge) -> Ve
         .enumerate()
         .flat_map(|(t, corners)| {
             let e = edge_of(t);
-            let (a, b) = (e.a.extend(e.weight).to_array(), e.b.extend(0.0).to_array());
+            let (a, b) = (e.a.extend(e.weight).to_array(), e.b.extend(e.layer as u32 as f32).to_array());
             corners.map(|p| EdgeVertex { position: p.to_array(), a, b })
         })
         .collect()
@@ -175,12 +177,14 @@ impl ShadowTechnique<WgpuBackend> for PenumbraWedges {
         let LightPass { frame, .. } = pass;
         let built = state.built.as_ref().ok_or_else(|| TechniqueError::NotBuilt(Self::NAME.into()))?;
         let eye = g.camera.eye;
+        let [closed, facing, turned] = built.geometry.eye_counts(frame, eye);
         let params = WedgeParams {
             light: built.light.centre.extend(built.light.radius).to_array(),
-            eye: eye.extend(built.geometry.eye_count(frame, eye)).to_array(),
+            eye: eye.extend(0.0).to_array(),
+            eye_counts: [closed, facing, turned, 0.0],
             size: [g.width, g.height, 0, 0],
         };
-        let size = u64::from(g.width) * u64::from(g.height) * 4;
+        let size = u64::from(g.width) * u64::from(g.height) * 4 * LAYERS as u64;
         let occluded = match &state.occluded {
             Some(b) if b.size() == size => b,
             _ => state.occluded.insert(cx.create_buffer(&wgpu::BufferDescriptor {

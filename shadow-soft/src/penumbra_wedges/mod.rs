@@ -5,8 +5,8 @@
 //! it covers is computed per pixel and added to a light-visibility buffer.
 //!
 //! Build (shared, [`geometry`]): the casters' silhouette edges from the light's centre (shadow-core's
-//! extraction), each with its hard volume's side quad and its wedge. Query, into one buffer per pixel
-//! holding the occluded share of the light:
+//! extraction), each with its hard volume's side quad and its wedge. Query, into per-pixel sums of the
+//! occluded share of the light:
 //!
 //! 1. **Count.** The side quads drawn over the G-buffer with no depth test; where the eye's ray crosses
 //!    one, it adds its weight if the receiver is inside that side and the eye is not, and takes it away
@@ -16,11 +16,14 @@
 //!    receiver inside adds the edge's signed share of the light's disc ([`coverage::wedge_area`]),
 //!    analytically, for a spherical light seen as the disc it subtends (the paper's lookup tables
 //!    tabulate this same area for textured lights).
-//! 3. **Visibility** `clamp(1 - occluded, 0, 1)`.
+//! 3. **Visibility** `clamp(1 - occluded - horizon, 0, 1)`, where `horizon` is the part of the disc below
+//!    the receiver's own tangent plane ([`coverage::horizon_share`]). Closed meshes' edges and open
+//!    meshes' two sides are summed apart ([`geometry::Layer`]): `occluded` is the closed meshes' sum
+//!    plus the larger of the open meshes' two.
 //!
 //! Where the count's decision (inside a side) and the area's sign could disagree, both read the same
-//! triple product of the same inputs, so the hard edge and the wedge's half-disc jump cancel exactly
-//! (the paper draws the hard quads in the wedge pass for this reason). The count is made z-pass, not with
+//! triple product of the same inputs, so the hard edge and the wedge's half-disc jump cancel exactly.
+//! The count is made z-pass, not with
 //! the stencil, for the same reason: a depth test would decide "inside" differently from the triple
 //! product at receivers on the side planes, and leave a line of wrong pixels along every hard edge.
 //! Z-pass needs the count at the eye, which the host finds from the casting faces on the segment from
@@ -30,8 +33,9 @@
 //! The approximations the paper makes, and where they show: the silhouette is the one the light's
 //! centre sees, so where another point of the light would see a different one (on curved casters, near
 //! their terminator) the penumbra is that of the centre's outline; and loops that overlap add, so where
-//! two casters cover the same part of the light it counts twice (clamped at full shadow; a receiver in
-//! one caster's umbra and another's penumbra is right, one in two penumbrae over-darkens).
+//! two casters (or two parts of one, the teapot's handle and body) cover the same part of the light it
+//! counts twice (clamped at full shadow; a receiver in one caster's umbra and another's penumbra is
+//! right, one in two penumbrae over-darkens).
 //!
 //! Spot and point lights, with the light's `radius`; a directional light has no position to find wedges
 //! from and is refused by name.

@@ -6,9 +6,10 @@
 struct WedgeParams {
     // centre, radius
     light: vec4<f32>,
-    // eye, the light centre's count there
     eye: vec4<f32>,
-    // x: width
+    // the light centre's count at the eye in each layer (closed, facing, turned)
+    eye_counts: vec4<f32>,
+    // width, height
     size: vec4<u32>,
 };
 
@@ -24,6 +25,7 @@ struct EdgeVertex {
     @builtin(position) pos: vec4<f32>,
     // a, weight
     @location(0) @interpolate(flat) a: vec4<f32>,
+    // b, layer
     @location(1) @interpolate(flat) b: vec4<f32>,
 };
 
@@ -41,16 +43,24 @@ fn receiver(pos: vec4<f32>) -> vec4<f32> {
     return textureLoad(g_position, vec2<i32>(pos.xy), 0);
 }
 
-fn add(pos: vec4<f32>, term: f32) {
-    let i = u32(pos.y) * params.size.x + u32(pos.x);
-    atomicAdd(&occluded[i], i32(round(term * SCALE)));
+// Pixel `pos`'s sum in `layer`: the layers one view after another.
+fn sum_index(pos: vec4<f32>, layer: u32) -> u32 {
+    return (layer * params.size.y + u32(pos.y)) * params.size.x + u32(pos.x);
+}
+
+fn add(in: EdgeVertex, term: f32) {
+    atomicAdd(&occluded[sum_index(in.pos, u32(in.b.w))], i32(round(in.a.w * term * SCALE)));
+}
+
+fn sum(pos: vec4<f32>, layer: u32) -> f32 {
+    return params.eye_counts[layer] + f32(atomicLoad(&occluded[sum_index(pos, layer)])) / SCALE;
 }
 
 @fragment
 fn fs_quad(in: EdgeVertex) {
     let g = receiver(in.pos);
     if (g.w != 0.0) {
-        add(in.pos, in.a.w * count_step(g.xyz, params.eye.xyz, in.a.xyz, in.b.xyz, params.light.xyz));
+        add(in, count_step(g.xyz, params.eye.xyz, in.a.xyz, in.b.xyz, params.light.xyz));
     }
 }
 
@@ -58,7 +68,7 @@ fn fs_quad(in: EdgeVertex) {
 fn fs_wedge(in: EdgeVertex) {
     let g = receiver(in.pos);
     if (g.w != 0.0) {
-        add(in.pos, in.a.w * wedge_area(g.xyz, in.a.xyz, in.b.xyz, params.light.xyz, params.light.w));
+        add(in, wedge_area(g.xyz, in.a.xyz, in.b.xyz, params.light.xyz, params.light.w));
     }
 }
 
@@ -68,9 +78,8 @@ fn fs_resolve(in: FullScreen) -> @location(0) vec4<f32> {
     if (g.w == 0.0) {
         discard;
     }
-    let i = u32(in.pos.y) * params.size.x + u32(in.pos.x);
     let n = textureLoad(g_geometric_normal, vec2<i32>(in.pos.xy), 0).xyz;
     let horizon = horizon_share(g.xyz, n, params.light.xyz, params.light.w);
-    let share = params.eye.w + f32(atomicLoad(&occluded[i])) / SCALE + horizon;
+    let share = sum(in.pos, 0u) + max(sum(in.pos, 1u), sum(in.pos, 2u)) + horizon;
     return vec4<f32>(clamp(1.0 - share, 0.0, 1.0), 0.0, 0.0, 0.0);
 }
