@@ -102,6 +102,15 @@ fn wedge_area(p: vec3<f32>, a: vec3<f32>, b: vec3<f32>, centre: vec3<f32>, radiu
     return -twice / (2.0 * PI);
 }
 
+// wedge_area inside the edge's wedge planes, 0 without computing it outside (twin: wedge_term).
+fn wedge_term(p: vec3<f32>, a: vec3<f32>, b: vec3<f32>, planes: array<vec4<f32>, 4>, centre: vec3<f32>, radius: f32) -> f32 {
+    let q = vec4<f32>(p, 1.0);
+    if (dot(planes[0], q) >= 0.0 && dot(planes[1], q) >= 0.0 && dot(planes[2], q) >= 0.0 && dot(planes[3], q) >= 0.0) {
+        return wedge_area(p, a, b, centre, radius);
+    }
+    return 0.0;
+}
+
 // The share of the light's disc below the receiver's horizon (twin: horizon_share).
 fn horizon_share(p: vec3<f32>, n: vec3<f32>, centre: vec3<f32>, radius: f32) -> f32 {
     let w = centre - p;

@@ -11,8 +11,8 @@ use shadow_cpu::raster::{CompareFn, CullMode, DepthBias, DepthState, DepthStenci
 use shadow_cpu::{CpuBackend, CpuContext, CpuError, GBuffer};
 
 use super::PenumbraWedges;
-use super::coverage::{SphereLight, count_step, horizon_share, wedge_area};
-use super::geometry::{LAYERS, WedgeEdge, WedgeGeometry};
+use super::coverage::{SphereLight, count_step, horizon_share, wedge_term};
+use super::geometry::{LAYERS, QUAD_DEPTH_BIAS, WedgeEdge, WedgeGeometry};
 
 /// The geometry of the last build.
 #[derive(Default)]
@@ -24,17 +24,17 @@ pub struct State {
 const WEDGE_STATE: RasterState = RasterState {
     cull: CullMode::Front,
     depth: Some(DepthState { compare: CompareFn::Greater, write: false, bias: DepthBias::NONE, clamp: false }),
-    early_tests: true,
     ..QUAD_STATE
 };
 
-/// Every crossing of the eye's ray with a side quad, wherever the receiver is.
+/// The side quads in front of the receiver, or so nearly level with it that the fragment must decide
+/// (see [`QUAD_DEPTH_BIAS`]).
 const QUAD_STATE: RasterState = RasterState {
     cull: CullMode::None,
     front_face: shadow_cpu::raster::FrontFace::Ccw,
-    depth: None,
+    depth: Some(DepthState { compare: CompareFn::Less, write: false, bias: QUAD_DEPTH_BIAS, clamp: false }),
     stencil: None,
-    early_tests: false,
+    early_tests: true,
 };
 
 /// Draws `triangles` (homogeneous world points) over `g`, adding `term(edge, receiver)` of each
@@ -110,7 +110,7 @@ impl ShadowTechnique<CpuBackend> for PenumbraWedges {
                 &mut occluded,
                 (&built.hulls, &WEDGE_STATE),
                 |prim| edges[built.hull_edges[prim as usize] as usize],
-                |e, p| wedge_area(p, e.a, e.b, *light),
+                |e, p| wedge_term(p, e.a, e.b, &e.planes, *light),
             )
         } else {
             0

@@ -32,6 +32,7 @@ use shadow_core::FrameInputs;
 use shadow_core::geometry::adjacency::Adjacency;
 use shadow_core::geometry::silhouette::Silhouette;
 use shadow_core::glam::{Mat4, Vec3, Vec4};
+use shadow_core::technique::settings::DepthBias;
 
 use super::coverage::SphereLight;
 
@@ -48,6 +49,8 @@ pub struct WedgeEdge {
     pub weight: f32,
     /// The sum its terms go to.
     pub layer: Layer,
+    /// Its wedge's planes ([`wedge_planes`]; all zero where it has none, so it is never drawn).
+    pub planes: [Vec4; 4],
 }
 
 /// The sums a receiver's occluded share is made of. A closed mesh casts from its light-facing faces
@@ -94,6 +97,13 @@ pub struct WedgeGeometry {
 /// length and of its distance from the light.
 const QUAD_MARGIN: f32 = 0.01;
 
+/// The depth bias the side quads are drawn with against the G-buffer's depth, test "less": a quad that
+/// meets the eye's ray behind the receiver adds nothing (the receiver and the eye are on one side of it),
+/// so the test only saves the work there; pulled this far towards the eye (Vulkan's units of the
+/// format's resolution, and of the quad's depth slope per pixel), it keeps every fragment whose crossing
+/// is within rounding of the receiver, where the fragment's own triple products decide.
+pub const QUAD_DEPTH_BIAS: DepthBias = DepthBias { constant: -64.0, slope: -4.0, clamp: 0.0 };
+
 /// Faces per wedge: two each for the front and back planes and the cap at infinity, one per end.
 pub const HULL_TRIANGLES: usize = 8;
 
@@ -115,7 +125,7 @@ impl WedgeGeometry {
             };
             for (layer, chain) in chains {
                 for (a, b, weight) in chain {
-                    out.push(WedgeEdge { a: at(a), b: at(b), weight: sign * weight as f32, layer }, light);
+                    out.push(at(a), at(b), (sign * weight as f32, layer), light);
                 }
             }
         }
@@ -134,10 +144,10 @@ impl WedgeGeometry {
         counts
     }
 
-    fn push(&mut self, edge: WedgeEdge, light: SphereLight) {
+    fn push(&mut self, a: Vec3, b: Vec3, (weight, layer): (f32, Layer), light: SphereLight) {
         let index = self.edges.len() as u32;
-        self.edges.push(edge);
-        let WedgeEdge { a, b, .. } = edge;
+        let planes = wedge_planes(a, b, light);
+        self.edges.push(WedgeEdge { a, b, weight, layer, planes: planes.unwrap_or([Vec4::ZERO; 4]) });
         let c = light.centre;
         // Drawn a little larger (ends moved apart and towards the light): the fragment decides exactly
         // which pixels the quad holds (`coverage::crosses_quad`), the rasterizer only has to reach them.
@@ -145,9 +155,9 @@ impl WedgeGeometry {
         let (a_inf, b_inf) = ((qa - c).extend(0.0), (qb - c).extend(0.0));
         self.quads.push([qb.extend(1.0), qa.extend(1.0), a_inf]);
         self.quads.push([qb.extend(1.0), a_inf, b_inf]);
-        match wedge(a, b, light) {
-            Some(faces) => {
-                self.hulls.extend(faces);
+        match planes {
+            Some(planes) => {
+                self.hulls.extend(faces(a, b, light, planes));
                 self.hull_edges.extend([index; HULL_TRIANGLES]);
             }
             None => self.without_wedge += 1,
@@ -195,7 +205,16 @@ pub fn wedge_planes(a: Vec3, b: Vec3, light: SphereLight) -> Option<[Vec4; 4]> {
 /// The faces of edge `a -> b`'s wedge, outward and counter-clockwise; `None` as for [`wedge_planes`].
 #[must_use]
 pub fn wedge(a: Vec3, b: Vec3, light: SphereLight) -> Option<[[Vec4; 3]; HULL_TRIANGLES]> {
-    let [front, back, side_a, side_b] = wedge_planes(a, b, light)?;
+    wedge_planes(a, b, light).map(|planes| faces(a, b, light, planes))
+}
+
+/// The faces of the wedge of edge `a -> b` bounded by `planes` (front, back, side at `a`, side at `b`).
+fn faces(
+    a: Vec3,
+    b: Vec3,
+    light: SphereLight,
+    [front, back, side_a, side_b]: [Vec4; 4],
+) -> [[Vec4; 3]; HULL_TRIANGLES] {
     // The rays where the side planes meet the front and back planes, pointing away from the light.
     let ray = |p1: Vec4, p2: Vec4, from: Vec3| {
         let d = p1.truncate().cross(p2.truncate()).normalize();
@@ -220,7 +239,7 @@ pub fn wedge(a: Vec3, b: Vec3, light: SphereLight) -> Option<[[Vec4; 3]; HULL_TR
     ];
     // Counter-clockwise from outside: the interior point lies behind each face, which for homogeneous
     // points (w >= 0) is a positive determinant of the face's corners and the point.
-    Some(faces.map(|[p, q, r]| if Mat4::from_cols(p, q, r, inner).determinant() > 0.0 { [p, q, r] } else { [p, r, q] }))
+    faces.map(|[p, q, r]| if Mat4::from_cols(p, q, r, inner).determinant() > 0.0 { [p, q, r] } else { [p, r, q] })
 }
 
 /// The boundary of an open mesh's faces whose cast weight is `side` (1: facing the light, as wound; -1:

@@ -11,7 +11,7 @@ use shadow_wgpu::{GpuGBuffer, GpuVisibility, WgpuBackend, WgpuContext, WgpuError
 
 use super::PenumbraWedges;
 use super::coverage::SphereLight;
-use super::geometry::{LAYERS, WedgeEdge, WedgeGeometry};
+use super::geometry::{LAYERS, QUAD_DEPTH_BIAS, WedgeEdge, WedgeGeometry};
 use crate::min_target;
 
 /// GPU twin of `WedgeParams` in wedges.wgsl.
@@ -24,20 +24,37 @@ struct WedgeParams {
     size: [u32; 4],
 }
 
-/// One quad or wedge corner: its homogeneous world point and its edge (`a` with the weight, `b` with the
-/// layer).
+/// One quad or wedge corner: its homogeneous world point and its edge's index.
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 struct EdgeVertex {
     position: [f32; 4],
+    edge: u32,
+}
+
+/// GPU twin of `Edge` in wedges.wgsl: the ends, with the weight and the layer, and the wedge's planes.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct GpuEdge {
     a: [f32; 4],
     b: [f32; 4],
+    planes: [[f32; 4]; 4],
+}
+
+impl From<&WedgeEdge> for GpuEdge {
+    fn from(e: &WedgeEdge) -> Self {
+        Self {
+            a: e.a.extend(e.weight).to_array(),
+            b: e.b.extend(e.layer as u32 as f32).to_array(),
+            planes: e.planes.map(|p| p.to_array()),
+        }
+    }
 }
 
 const VERTEX_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
     array_stride: std::mem::size_of::<EdgeVertex>() as u64,
     step_mode: wgpu::VertexStepMode::Vertex,
-    attributes: &wgpu::vertex_attr_array![0 => Float32x4, 1 => Float32x4, 2 => Float32x4],
+    attributes: &wgpu::vertex_attr_array![0 => Float32x4, 1 => Uint32],
 };
 
 /// Pipelines, and the last build's uploads.
@@ -51,25 +68,22 @@ pub struct State {
     occluded: Option<wgpu::Buffer>,
 }
 
-/// One build's geometry, as vertices: uploaded by each query into the frame's transient buffer, so a
-/// kept build costs no allocation and a moving light none either.
+/// One build's geometry, as vertices and edges: uploaded by each query into the frame's transient
+/// buffer, so a kept build costs no allocation and a moving light none either.
 struct Built {
     geometry: WedgeGeometry,
     light: SphereLight,
+    edges: Vec<GpuEdge>,
     quads: Vec<EdgeVertex>,
     wedges: Vec<EdgeVertex>,
 }
 
-/// The corners of `triangles`, each with its edge (`edge_of(triangle)`).
-fn vertices(triangles: &[[Vec4; 3]], edge_of: impl Fn(usize) -> WedgeEdge) -> Vec<EdgeVertex> {
+/// The corners of `triangles`, each with its edge's index (`edge_of(triangle)`).
+fn vertices(triangles: &[[Vec4; 3]], edge_of: impl Fn(usize) -> u32) -> Vec<EdgeVertex> {
     triangles
         .iter()
         .enumerate()
-        .flat_map(|(t, corners)| {
-            let e = edge_of(t);
-            let (a, b) = (e.a.extend(e.weight).to_array(), e.b.extend(e.layer as u32 as f32).to_array());
-            corners.map(|p| EdgeVertex { position: p.to_array(), a, b })
-        })
+        .flat_map(|(t, corners)| corners.map(|p| EdgeVertex { position: p.to_array(), edge: edge_of(t) }))
         .collect()
 }
 
@@ -79,7 +93,7 @@ fn edge_pipeline(
     module: &wgpu::ShaderModule,
     layout: &wgpu::BindGroupLayout,
     (label, fragment): (&str, &str),
-    (cull_mode, depth_compare): (Option<wgpu::Face>, wgpu::CompareFunction),
+    (cull_mode, depth_compare, bias): (Option<wgpu::Face>, wgpu::CompareFunction, wgpu::DepthBiasState),
 ) -> wgpu::RenderPipeline {
     let pipeline_layout = cx.pipelines.layout(label, &[Some(&cx.shared.frame_layout), Some(layout)]);
     cx.pipelines.render(&wgpu::RenderPipelineDescriptor {
@@ -97,7 +111,7 @@ fn edge_pipeline(
             depth_write_enabled: Some(false),
             depth_compare: Some(depth_compare),
             stencil: Default::default(),
-            bias: Default::default(),
+            bias,
         }),
         multisample: Default::default(),
         fragment: Some(wgpu::FragmentState {
@@ -129,18 +143,19 @@ impl ShadowTechnique<WgpuBackend> for PenumbraWedges {
                     buffer_entry(1, read_write, wgpu::ShaderStages::FRAGMENT),
                     buffer_entry(2, wgpu::BufferBindingType::Uniform, wgpu::ShaderStages::FRAGMENT),
                     attribute_entry(3),
+                    buffer_entry(4, wgpu::BufferBindingType::Storage { read_only: true }, wgpu::ShaderStages::FRAGMENT),
                 ],
             );
-            // Side quads: every crossing, whatever the depth; wedges: back faces behind the receiver.
-            let quads =
-                edge_pipeline(cx, &module, &layout, ("side quads", "fs_quad"), (None, wgpu::CompareFunction::Always));
-            let wedges = edge_pipeline(
-                cx,
-                &module,
-                &layout,
-                ("wedges", "fs_wedge"),
-                (Some(wgpu::Face::Front), wgpu::CompareFunction::Greater),
-            );
+            // Side quads: the crossings in front of the receiver, and those within rounding of it (the
+            // fragment decides); wedges: back faces behind the receiver.
+            let bias = QUAD_DEPTH_BIAS;
+            let quad_bias =
+                wgpu::DepthBiasState { constant: bias.constant as i32, slope_scale: bias.slope, clamp: bias.clamp };
+            let quad_state = (None, wgpu::CompareFunction::Less, quad_bias);
+            let quads = edge_pipeline(cx, &module, &layout, ("side quads", "fs_quad"), quad_state);
+            let wedge_state =
+                (Some(wgpu::Face::Front), wgpu::CompareFunction::Greater, wgpu::DepthBiasState::default());
+            let wedges = edge_pipeline(cx, &module, &layout, ("wedges", "fs_wedge"), wedge_state);
             let groups = [&cx.shared.frame_layout, &layout];
             let resolve = full_screen_pipeline(
                 &cx.pipelines,
@@ -159,10 +174,10 @@ impl ShadowTechnique<WgpuBackend> for PenumbraWedges {
         let LightPass { frame, light, stats, .. } = pass;
         let geometry = Self::construct(frame, light, stats)?;
         let light = Self::sphere(light)?;
-        let edges = &geometry.edges;
-        let quads = vertices(&geometry.quads, |t| edges[t / 2]);
-        let wedges = vertices(&geometry.hulls, |t| edges[geometry.hull_edges[t] as usize]);
-        state.built = Some(Built { geometry, light, quads, wedges });
+        let edges = geometry.edges.iter().map(GpuEdge::from).collect();
+        let quads = vertices(&geometry.quads, |t| (t / 2) as u32);
+        let wedges = vertices(&geometry.hulls, |t| geometry.hull_edges[t]);
+        state.built = Some(Built { geometry, light, edges, quads, wedges });
         Ok(())
     }
 
@@ -197,6 +212,7 @@ impl ShadowTechnique<WgpuBackend> for PenumbraWedges {
         let draw_wedges = self.wedges.is_on();
         cx.scoped("the penumbra wedges", |cx| {
             let uniform = cx.transient(bytemuck::bytes_of(&params));
+            let edges = cx.transient(bytemuck::cast_slice(&built.edges));
             let group = cx.device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("penumbra wedges"),
                 layout: &state.layout,
@@ -208,6 +224,7 @@ impl ShadowTechnique<WgpuBackend> for PenumbraWedges {
                         binding: 3,
                         resource: wgpu::BindingResource::TextureView(&g.geometric_normal),
                     },
+                    wgpu::BindGroupEntry { binding: 4, resource: edges.binding() },
                 ],
             });
             let depth = g.depth_view();

@@ -20,21 +20,27 @@ const SCALE: f32 = 1048576.0;
 @group(1) @binding(1) var<storage, read_write> occluded: array<atomic<i32>>;
 @group(1) @binding(2) var<uniform> params: WedgeParams;
 @group(1) @binding(3) var g_geometric_normal: texture_2d<f32>;
+@group(1) @binding(4) var<storage, read> edges: array<Edge>;
+
+struct Edge {
+    // a, weight
+    a: vec4<f32>,
+    // b, layer
+    b: vec4<f32>,
+    // the wedge's planes, inner sides positive
+    planes: array<vec4<f32>, 4>,
+};
 
 struct EdgeVertex {
     @builtin(position) pos: vec4<f32>,
-    // a, weight
-    @location(0) @interpolate(flat) a: vec4<f32>,
-    // b, layer
-    @location(1) @interpolate(flat) b: vec4<f32>,
+    @location(0) @interpolate(flat) edge: u32,
 };
 
 @vertex
-fn vs_edge(@location(0) p: vec4<f32>, @location(1) a: vec4<f32>, @location(2) b: vec4<f32>) -> EdgeVertex {
+fn vs_edge(@location(0) p: vec4<f32>, @location(1) edge: u32) -> EdgeVertex {
     var out: EdgeVertex;
     out.pos = view.clip_from_world * p;
-    out.a = a;
-    out.b = b;
+    out.edge = edge;
     return out;
 }
 
@@ -48,8 +54,8 @@ fn sum_index(pos: vec4<f32>, layer: u32) -> u32 {
     return (layer * params.size.y + u32(pos.y)) * params.size.x + u32(pos.x);
 }
 
-fn add(in: EdgeVertex, term: f32) {
-    atomicAdd(&occluded[sum_index(in.pos, u32(in.b.w))], i32(round(in.a.w * term * SCALE)));
+fn add(pos: vec4<f32>, e: Edge, term: f32) {
+    atomicAdd(&occluded[sum_index(pos, u32(e.b.w))], i32(round(e.a.w * term * SCALE)));
 }
 
 fn sum(pos: vec4<f32>, layer: u32) -> f32 {
@@ -60,7 +66,8 @@ fn sum(pos: vec4<f32>, layer: u32) -> f32 {
 fn fs_quad(in: EdgeVertex) {
     let g = receiver(in.pos);
     if (g.w != 0.0) {
-        add(in, count_step(g.xyz, params.eye.xyz, in.a.xyz, in.b.xyz, params.light.xyz));
+        let e = edges[in.edge];
+        add(in.pos, e, count_step(g.xyz, params.eye.xyz, e.a.xyz, e.b.xyz, params.light.xyz));
     }
 }
 
@@ -68,7 +75,8 @@ fn fs_quad(in: EdgeVertex) {
 fn fs_wedge(in: EdgeVertex) {
     let g = receiver(in.pos);
     if (g.w != 0.0) {
-        add(in, wedge_area(g.xyz, in.a.xyz, in.b.xyz, params.light.xyz, params.light.w));
+        let e = edges[in.edge];
+        add(in.pos, e, wedge_term(g.xyz, e.a.xyz, e.b.xyz, e.planes, params.light.xyz, params.light.w));
     }
 }
 
