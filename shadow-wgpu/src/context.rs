@@ -331,9 +331,11 @@ impl WgpuContext {
 
     /// The features used where the device has them: Depth32FloatStencil8 for the G-buffer's depth and
     /// the volumes' stencil (an f32 depth, as the CPU backend's; without it Depth24PlusStencil8, which
-    /// every device has), and timestamp queries, for GPU phase times.
-    pub const OPTIONAL_FEATURES: wgpu::Features =
-        wgpu::Features::DEPTH32FLOAT_STENCIL8.union(wgpu::Features::TIMESTAMP_QUERY);
+    /// every device has), timestamp queries, for GPU phase times, and early depth tests forced in a
+    /// shader, for passes whose fragments write storage (which otherwise run before their depth test).
+    pub const OPTIONAL_FEATURES: wgpu::Features = wgpu::Features::DEPTH32FLOAT_STENCIL8
+        .union(wgpu::Features::TIMESTAMP_QUERY)
+        .union(wgpu::Features::SHADER_EARLY_DEPTH_TEST);
 
     /// The limits a device must meet: WebGPU's defaults, but for 64 bytes of colour attachments per
     /// sample (the G-buffer pass writes four 16-byte targets at once). Larger maps and views, more lights

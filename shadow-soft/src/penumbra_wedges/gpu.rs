@@ -134,7 +134,8 @@ impl ShadowTechnique<WgpuBackend> for PenumbraWedges {
 
     fn create_state(&self, cx: &mut WgpuContext) -> Result<State, WgpuError> {
         cx.scoped("creating the penumbra-wedge pipelines", |cx| {
-            let module = cx.pipelines.module("penumbra wedges", shader());
+            let early = cx.device.features().contains(wgpu::Features::SHADER_EARLY_DEPTH_TEST);
+            let module = cx.pipelines.module("penumbra wedges", shader(early));
             let read_write = wgpu::BufferBindingType::Storage { read_only: false };
             let layout = cx.pipelines.group_layout(
                 "penumbra wedges",
@@ -260,14 +261,25 @@ impl ShadowTechnique<WgpuBackend> for PenumbraWedges {
     }
 }
 
-/// The technique's shaders as compiled, by name (its registry entry's WGSL).
+/// The technique's shaders as compiled, by name (its registry entry's WGSL): with the depth tests
+/// forced early and without.
 #[must_use]
 pub fn shaders() -> Vec<(&'static str, String)> {
-    vec![("penumbra wedges", shader())]
+    vec![("penumbra wedges", shader(true)), ("penumbra wedges, late depth tests", shader(false))]
 }
 
-/// The WGSL: the frame's bindings, the coverage terms, then the passes.
+/// The WGSL: the frame's bindings, the coverage terms, the passes, then the two entry points that draw
+/// edges. With `early`, their depth tests are forced before the fragment: a fragment that writes storage
+/// otherwise runs whatever its test says, and only the test "less" (quads behind the receiver) and
+/// "greater" (wedges in front of it) keep a side quad or a wedge, which reach to infinity, from shading
+/// most of the view (what they would add there is zero either way).
 #[must_use]
-pub fn shader() -> String {
-    shaders::with_common(&format!("{}\n{}", include_str!("coverage.wgsl"), include_str!("wedges.wgsl")))
+pub fn shader(early: bool) -> String {
+    let attribute = if early { " @early_depth_test(force)" } else { "" };
+    let entries = format!(
+        "@fragment{attribute}\nfn fs_quad(in: EdgeVertex) {{\n    quad_fragment(in);\n}}\n\n\
+         @fragment{attribute}\nfn fs_wedge(in: EdgeVertex) {{\n    wedge_fragment(in);\n}}\n"
+    );
+    let passes = format!("{}\n{}\n{entries}", include_str!("coverage.wgsl"), include_str!("wedges.wgsl"));
+    shaders::with_common(&passes)
 }

@@ -8,9 +8,10 @@
 //! extraction), each with its hard volume's side quad and its wedge. Query, into per-pixel sums of the
 //! occluded share of the light:
 //!
-//! 1. **Count.** The side quads drawn over the G-buffer with no depth test; where the eye's ray crosses
-//!    one, it adds its weight if the receiver is inside that side and the eye is not, and takes it away
-//!    the other way round ([`coverage::count_step`]). Started from the count at the eye, this is the
+//! 1. **Count.** The side quads drawn over the G-buffer, in front of the receiver (the test "less",
+//!    with a bias towards the eye: [`geometry::QUAD_DEPTH_BIAS`]); where the eye's ray crosses one, it
+//!    adds its weight if the receiver is inside that side and the eye is not, and takes it away the other
+//!    way round ([`coverage::count_step`]). Started from the count at the eye, this is the
 //!    z-pass count of the hard volume at the receiver: how many silhouette loops hold the light's centre.
 //! 2. **Wedges.** The wedges' back faces, drawn against the G-buffer's depth with the test "greater"; a
 //!    receiver inside adds the edge's signed share of the light's disc ([`coverage::wedge_area`]),

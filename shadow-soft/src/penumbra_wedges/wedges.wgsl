@@ -62,8 +62,8 @@ fn sum(pos: vec4<f32>, layer: u32) -> f32 {
     return params.eye_counts[layer] + f32(atomicLoad(&occluded[sum_index(pos, layer)])) / SCALE;
 }
 
-@fragment
-fn fs_quad(in: EdgeVertex) {
+// The side quads' fragments (entry point `fs_quad`, made by the host).
+fn quad_fragment(in: EdgeVertex) {
     let g = receiver(in.pos);
     if (g.w != 0.0) {
         let e = edges[in.edge];
@@ -71,8 +71,8 @@ fn fs_quad(in: EdgeVertex) {
     }
 }
 
-@fragment
-fn fs_wedge(in: EdgeVertex) {
+// The wedges' fragments (entry point `fs_wedge`).
+fn wedge_fragment(in: EdgeVertex) {
     let g = receiver(in.pos);
     if (g.w != 0.0) {
         let e = edges[in.edge];
