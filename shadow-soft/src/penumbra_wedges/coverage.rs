@@ -86,17 +86,47 @@ pub fn count_step(p: Vec3, eye: Vec3, a: Vec3, b: Vec3, c: Vec3) -> f32 {
     if step != 0.0 && crosses_quad(p, eye, a, b, c) { step } else { 0.0 }
 }
 
+/// The light as a receiver sees it: the disc the sphere's cone cuts from the plane through its centre
+/// square to the receiver's line to it.
+#[derive(Clone, Copy)]
+struct Disc {
+    /// From the receiver to the centre.
+    w: Vec3,
+    /// Its length.
+    dist: f32,
+    /// Its direction.
+    axis: Vec3,
+    /// The disc's radius: the cone's edge at distance `dist`.
+    r: f32,
+}
+
+impl Disc {
+    /// The disc `light` shows a receiver at `p`; `None` inside the sphere, which it sees whole.
+    fn seen_from(p: Vec3, light: SphereLight) -> Option<Self> {
+        let w = light.centre - p;
+        let dist = w.length();
+        (dist > light.radius).then(|| Self {
+            w,
+            dist,
+            axis: w / dist,
+            r: light.radius * dist / (dist * dist - light.radius * light.radius).sqrt(),
+        })
+    }
+
+    /// The length of `n`'s part in the light's plane, in disc radii: a plane through the receiver with
+    /// normal `n` cuts the light's plane along the chord `n . w / across(n)` radii from the centre.
+    fn across(&self, n: Vec3) -> f32 {
+        (n - self.axis * n.dot(self.axis)).length() * self.r
+    }
+}
+
 /// The signed fraction of the light's disc that lies beyond edge `a -> b` seen from the centre, as `p`
 /// sees the edge, per unit weight: negative on the inner side, where the edge takes back the part of the
 /// count's whole disc that it leaves uncovered. Zero outside the edge's wedge.
 #[must_use]
 pub fn wedge_area(p: Vec3, a: Vec3, b: Vec3, light: SphereLight) -> f32 {
-    let w = light.centre - p;
-    let dist = w.length();
-    if dist <= light.radius {
-        return 0.0;
-    }
-    let axis = w / dist;
+    let Some(disc) = Disc::seen_from(p, light) else { return 0.0 };
+    let Disc { w, dist, axis, r } = disc;
     let near = NEAR * dist;
     let (za, zb) = ((a - p).dot(axis), (b - p).dot(axis));
     if za < near && zb < near {
@@ -107,8 +137,6 @@ pub fn wedge_area(p: Vec3, a: Vec3, b: Vec3, light: SphereLight) -> f32 {
     let cut = |from: Vec3, z_from: f32, to: Vec3, z_to: f32| from + (to - from) * ((near - z_from) / (z_to - z_from));
     let (a2, za2) = if za < near { (cut(a, za, b, zb), near) } else { (a, za) };
     let (b2, zb2) = if zb < near { (cut(b, zb, a, za), near) } else { (b, zb) };
-    // The disc's radius in the plane through the centre: the cone's edge at distance `dist`.
-    let r = light.radius * dist / (dist * dist - light.radius * light.radius).sqrt();
     let project = |x: Vec3, z: f32| (x - p) * (dist / z) - w;
     let (pa, pb) = (project(a2, za2), project(b2, zb2));
     let along = pb - pa;
@@ -118,15 +146,14 @@ pub fn wedge_area(p: Vec3, a: Vec3, b: Vec3, light: SphereLight) -> f32 {
     }
     let dir = along / len;
     let (sa, sb) = (pa.dot(dir) / r, pb.dot(dir) / r);
-    // The centre's distance from the projected line, from the plane through `p` and the edge (normal n):
-    // |n . w| over the length of n's part in the light's plane, signed by `side` itself.
-    let n = (a - p).cross(b - p);
-    let in_plane = (n - axis * n.dot(axis)).length();
+    // The centre's distance from the projected line, from the plane through `p` and the edge (normal
+    // n), signed by `side` itself.
+    let across = disc.across((a - p).cross(b - p));
     let s = side(p, a, b, light.centre);
-    if in_plane == 0.0 {
+    if across == 0.0 {
         return 0.0;
     }
-    let magnitude = s.abs() / (in_plane * r);
+    let magnitude = s.abs() / across;
     if magnitude >= 1.0 {
         return 0.0;
     }
@@ -153,19 +180,13 @@ pub fn wedge_term(p: Vec3, a: Vec3, b: Vec3, planes: &[Vec4; 4], light: SphereLi
 /// which the silhouette of the light's centre has no edge for.
 #[must_use]
 pub fn horizon_share(p: Vec3, n: Vec3, light: SphereLight) -> f32 {
-    let w = light.centre - p;
-    let dist = w.length();
-    if dist <= light.radius {
-        return 0.0;
-    }
-    let axis = w / dist;
-    let r = light.radius * dist / (dist * dist - light.radius * light.radius).sqrt();
-    let in_plane = (n - axis * n.dot(axis)).length();
-    let above = n.dot(w);
-    if in_plane * r <= above.abs() {
+    let Some(disc) = Disc::seen_from(p, light) else { return 0.0 };
+    let across = disc.across(n);
+    let above = n.dot(disc.w);
+    if across <= above.abs() {
         return if above > 0.0 { 0.0 } else { 1.0 };
     }
-    let d = above / (in_plane * r);
+    let d = above / across;
     (d.acos() - d * (1.0 - d * d).sqrt()) / std::f32::consts::PI
 }
 

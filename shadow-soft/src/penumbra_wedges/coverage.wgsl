@@ -42,6 +42,31 @@ fn count_step(p: vec3<f32>, eye: vec3<f32>, a: vec3<f32>, b: vec3<f32>, c: vec3<
     return 0.0;
 }
 
+// The light as a receiver sees it (twin: Disc): w to the centre, its length and direction, and the
+// disc's radius; seen is false inside the sphere.
+struct Disc {
+    w: vec3<f32>,
+    dist: f32,
+    axis: vec3<f32>,
+    r: f32,
+    seen: bool,
+};
+
+fn disc_seen_from(p: vec3<f32>, centre: vec3<f32>, radius: f32) -> Disc {
+    var d: Disc;
+    d.w = centre - p;
+    d.dist = length(d.w);
+    d.seen = d.dist > radius;
+    d.axis = d.w / d.dist;
+    d.r = radius * d.dist / sqrt(d.dist * d.dist - radius * radius);
+    return d;
+}
+
+// The length of n's part in the light's plane, in disc radii.
+fn across(d: Disc, n: vec3<f32>) -> f32 {
+    return length(n - d.axis * dot(n, d.axis)) * d.r;
+}
+
 // A point of the edge cut where it comes `near` from the receiver along the axis.
 fn cut(from_: vec3<f32>, z_from: f32, to: vec3<f32>, z_to: f32, near: f32) -> vec3<f32> {
     return from_ + (to - from_) * ((near - z_from) / (z_to - z_from));
@@ -49,12 +74,14 @@ fn cut(from_: vec3<f32>, z_from: f32, to: vec3<f32>, z_to: f32, near: f32) -> ve
 
 // The signed share of the light's disc beyond edge a -> b seen from the centre, as p sees the edge.
 fn wedge_area(p: vec3<f32>, a: vec3<f32>, b: vec3<f32>, centre: vec3<f32>, radius: f32) -> f32 {
-    let w = centre - p;
-    let dist = length(w);
-    if (dist <= radius) {
+    let disc = disc_seen_from(p, centre, radius);
+    if (!disc.seen) {
         return 0.0;
     }
-    let axis = w / dist;
+    let w = disc.w;
+    let dist = disc.dist;
+    let axis = disc.axis;
+    let r = disc.r;
     let near = NEAR * dist;
     let za = dot(a - p, axis);
     let zb = dot(b - p, axis);
@@ -73,7 +100,6 @@ fn wedge_area(p: vec3<f32>, a: vec3<f32>, b: vec3<f32>, centre: vec3<f32>, radiu
         b2 = cut(b, zb, a, za, near);
         zb2 = near;
     }
-    let r = radius * dist / sqrt(dist * dist - radius * radius);
     let pa = (a2 - p) * (dist / za2) - w;
     let pb = (b2 - p) * (dist / zb2) - w;
     let along = pb - pa;
@@ -84,13 +110,12 @@ fn wedge_area(p: vec3<f32>, a: vec3<f32>, b: vec3<f32>, centre: vec3<f32>, radiu
     let dir = along / len;
     let sa = dot(pa, dir) / r;
     let sb = dot(pb, dir) / r;
-    let n = cross(a - p, b - p);
-    let in_plane = length(n - axis * dot(n, axis));
+    let across_ = across(disc, cross(a - p, b - p));
     let s = side(p, a, b, centre);
-    if (in_plane == 0.0) {
+    if (across_ == 0.0) {
         return 0.0;
     }
-    let magnitude = abs(s) / (in_plane * r);
+    let magnitude = abs(s) / across_;
     if (magnitude >= 1.0) {
         return 0.0;
     }
@@ -113,18 +138,15 @@ fn wedge_term(p: vec3<f32>, a: vec3<f32>, b: vec3<f32>, planes: array<vec4<f32>,
 
 // The share of the light's disc below the receiver's horizon (twin: horizon_share).
 fn horizon_share(p: vec3<f32>, n: vec3<f32>, centre: vec3<f32>, radius: f32) -> f32 {
-    let w = centre - p;
-    let dist = length(w);
-    if (dist <= radius) {
+    let disc = disc_seen_from(p, centre, radius);
+    if (!disc.seen) {
         return 0.0;
     }
-    let axis = w / dist;
-    let r = radius * dist / sqrt(dist * dist - radius * radius);
-    let in_plane = length(n - axis * dot(n, axis));
-    let above = dot(n, w);
-    if (in_plane * r <= abs(above)) {
+    let width = across(disc, n);
+    let above = dot(n, disc.w);
+    if (width <= abs(above)) {
         return select(1.0, 0.0, above > 0.0);
     }
-    let d = above / (in_plane * r);
+    let d = above / width;
     return (acos(d) - d * sqrt(1.0 - d * d)) / PI;
 }
