@@ -20,6 +20,8 @@ use crate::renderer::{BackendKind, Renderer, RunOutput};
 use crate::sheet::{SheetItem, contact_sheet, disagreement_inset};
 use shadow_core::technique::maps::RESOLUTION;
 use shadow_cpu::CpuFrame;
+use shadow_cpu::acne::AcneProbe;
+use shadow_cpu::bvh::SceneBvh;
 
 /// What to compare.
 pub struct CompareJob<'a> {
@@ -163,10 +165,13 @@ fn save(img: &Image<Rgb8>, dir: &Path, name: &str) -> Result<(), Error> {
     img.save_png(dir.join(name)).map_err(Error::from)
 }
 
-/// The references a job is measured against, on the CPU: the primary one's frame (its G-buffer, light view
-/// and visibility), the measured and reached pixels, and the soft techniques' own reference when the job
-/// mixes kinds (same view, same G-buffer and mask).
-struct References {
+/// The references of a job at one backend's receivers, traced on the CPU over the G-buffer that backend
+/// renders: each backend is measured at the very points its techniques were queried at. On sub-pixel
+/// casters (a fence's pickets, thin branches) the two backends' pixel samples land on either side of a
+/// shadow edge often enough that one shared reference would count the G-buffers' difference as shadow
+/// error. The primary reference's frame (its G-buffer, light view and visibility), the measured and
+/// reached pixels, and the soft techniques' own reference when the job mixes kinds.
+struct Ground {
     frame: CpuFrame,
     mask: Image<bool>,
     /// The measured pixels in the nearest third of the view's depth range.
@@ -176,49 +181,36 @@ struct References {
     soft: Option<(TechniqueSpec, Image<Rgb8>, Image<f32>)>,
 }
 
-impl References {
-    /// Renders the references of `job`, with their contact-sheet tiles and files.
-    fn render(
+impl Ground {
+    /// Traces the references of `job` over `backend`'s G-buffer.
+    fn trace(
         renderer: &mut Renderer,
         job: &CompareJob<'_>,
+        backend: BackendKind,
         any_soft: bool,
-        sheet: &mut Vec<SheetItem>,
         progress: &mut impl FnMut(&str),
     ) -> Result<Self, Error> {
-        let reference = &job.reference;
-        progress(&format!("reference: {reference} on cpu"));
-        let (frame, _) = renderer.run_cpu_frame(job.frame, job.width, job.height, reference)?;
+        let gbuffer = renderer.gbuffer_of(backend, job.frame, job.width, job.height)?;
+        let mut over = |renderer: &mut Renderer, spec: &TechniqueSpec| -> Result<CpuFrame, Error> {
+            progress(&format!("reference: {spec} on cpu, at {}'s pixels", backend.name()));
+            let mut reference = renderer.prepare(BackendKind::Cpu, spec)?;
+            renderer.run_cpu_over(&mut reference, job.frame, &gbuffer)
+        };
+        let frame = over(renderer, &job.reference)?;
+        let soft = match &job.soft_reference {
+            Some(spec) if any_soft => {
+                let f = over(renderer, spec)?;
+                let vis = f.visibility.into_iter().next().unwrap_or_else(|| frame.visibility[0].clone());
+                Some((spec.clone(), f.color, vis))
+            }
+            _ => None,
+        };
         let view = frame.light_views.first().ok_or_else(|| Error::Usage("the scene has no light".into()))?;
         let g = &frame.gbuffer;
         let mask = measured_pixels(&g.receiver, &g.position, &g.geometric_normal, view);
         let reach = Image::from_fn(job.width, job.height, |x, y| {
             *g.receiver.get(x, y) && view.in_domain(*g.position.get(x, y))
         });
-        // A reference's tile shows its visibility where the others show their errors.
-        let tile = |spec: &TechniqueSpec, color: &Image<Rgb8>, vis: &Image<f32>| SheetItem {
-            label: format!("{}\nreference", spec.name),
-            picture: color.clone(),
-            errors: Some(visibility_to_rgb(vis, &mask)),
-        };
-        sheet.push(tile(reference, &frame.color, &frame.visibility[0]));
-        if let Some(dir) = &job.out_dir {
-            save(&frame.color, dir, "reference.png")?;
-            save(&visibility_to_rgb(&frame.visibility[0], &mask), dir, "reference.vis.png")?;
-        }
-        let soft = match &job.soft_reference {
-            Some(spec) if any_soft => {
-                progress(&format!("reference: {spec} on cpu"));
-                let (soft_frame, _) = renderer.run_cpu_frame(job.frame, job.width, job.height, spec)?;
-                let vis = soft_frame.visibility.into_iter().next().unwrap_or_else(|| frame.visibility[0].clone());
-                sheet.push(tile(spec, &soft_frame.color, &vis));
-                if let Some(dir) = &job.out_dir {
-                    save(&soft_frame.color, dir, &format!("reference-{}.png", spec.name))?;
-                    save(&visibility_to_rgb(&vis, &mask), dir, &format!("reference-{}.vis.png", spec.name))?;
-                }
-                Some((spec.clone(), soft_frame.color, vis))
-            }
-            _ => None,
-        };
         let near = near_field(&mask, &g.position, &job.frame.camera);
         Ok(Self { frame, mask, near, reach, soft })
     }
@@ -234,6 +226,70 @@ impl References {
             Some((spec, color, vis)) if soft => (spec, color, vis, true),
             _ => (&job.reference, &self.frame.color, &self.frame.visibility[0], false),
         }
+    }
+
+    /// Writes the references' files, `-BACKEND` added to their names past the CPU's, and puts the CPU's on
+    /// the contact sheet (`sheet`), first.
+    fn show(&self, job: &CompareJob<'_>, backend: BackendKind, sheet: &mut Vec<SheetItem>) -> Result<(), Error> {
+        let tail = match backend {
+            BackendKind::Cpu => String::new(),
+            other => format!("-{}", other.name()),
+        };
+        let mut show = |spec: &TechniqueSpec, color: &Image<Rgb8>, vis: &Image<f32>, name: String| {
+            let picture = visibility_to_rgb(vis, &self.mask);
+            if let Some(dir) = &job.out_dir {
+                save(color, dir, &format!("{name}{tail}.png"))?;
+                save(&picture, dir, &format!("{name}{tail}.vis.png"))?;
+            }
+            // A reference's tile shows its visibility where the others show their errors.
+            if backend == BackendKind::Cpu {
+                let label = format!("{}\nreference", spec.name);
+                sheet.push(SheetItem { label, picture: color.clone(), errors: Some(picture) });
+            }
+            Ok::<(), Error>(())
+        };
+        show(&job.reference, &self.frame.color, &self.frame.visibility[0], "reference".into())?;
+        if let Some((spec, color, vis)) = &self.soft {
+            show(spec, color, vis, format!("reference-{}", spec.name))?;
+        }
+        Ok(())
+    }
+}
+
+/// The references of a job: one [`Ground`] per backend it measures.
+struct References {
+    grounds: Vec<(BackendKind, Ground)>,
+}
+
+impl References {
+    /// Traces the references at the pixels of each of `job`'s backends (the CPU's always: cross-backend
+    /// numbers are taken over its measured pixels).
+    fn trace(
+        renderer: &mut Renderer,
+        job: &CompareJob<'_>,
+        any_soft: bool,
+        sheet: &mut Vec<SheetItem>,
+        progress: &mut impl FnMut(&str),
+    ) -> Result<Self, Error> {
+        let mut backends = vec![BackendKind::Cpu];
+        backends.extend(job.backends.iter().copied().filter(|&b| b != BackendKind::Cpu));
+        let mut grounds = Vec::new();
+        for backend in backends {
+            let ground = Ground::trace(renderer, job, backend, any_soft, progress)?;
+            ground.show(job, backend, sheet)?;
+            grounds.push((backend, ground));
+        }
+        Ok(Self { grounds })
+    }
+
+    /// The CPU's references.
+    fn cpu(&self) -> &Ground {
+        &self.grounds[0].1
+    }
+
+    /// The references at `backend`'s pixels.
+    fn at(&self, backend: BackendKind) -> &Ground {
+        self.grounds.iter().find(|(b, _)| *b == backend).map_or(self.cpu(), |(_, g)| g)
     }
 }
 
@@ -251,19 +307,27 @@ struct Measured {
     against_soft: bool,
 }
 
-/// Runs `spec` (the `index`-th asked for) on `backend` and measures it against its kind's reference; the
-/// run's contact-sheet tile goes on `sheet`.
+/// Runs `spec` (the `index`-th asked for) on `backend` and measures it against its kind's reference at
+/// that backend's pixels (`refs`; `bvh` the frame's casters); the run's contact-sheet tile goes on
+/// `sheet`.
 fn measure(
     renderer: &mut Renderer,
     job: &CompareJob<'_>,
-    refs: &References,
-    probe: &shadow_cpu::acne::AcneProbe<'_>,
+    (refs, bvh): (&Ground, &SceneBvh),
     (index, spec): (usize, &TechniqueSpec),
     backend: BackendKind,
     sheet: &mut Vec<SheetItem>,
 ) -> Result<Measured, Error> {
     let soft = renderer.registry().get(&spec.name).is_ok_and(|e| e.soft);
     let (reference, ref_color, ref_vis, against_soft) = refs.of(job, soft);
+    let probe = AcneProbe {
+        frame: job.frame,
+        light: &refs.frame.light_views[0],
+        gbuffer: &refs.frame.gbuffer,
+        bvh,
+        reference: &refs.frame.visibility[0],
+        mask: &refs.mask,
+    };
     let mask = &refs.mask;
     let run = renderer.run(backend, job.frame, job.width, job.height, spec)?;
     let metrics = compare_visibility(&run.visibility[0], ref_vis, mask)?;
@@ -335,7 +399,7 @@ fn measure(
 /// for more than one map which map each pixel reads over `color`.
 fn sampling_report(
     sampling: &MapSampling,
-    refs: &References,
+    refs: &Ground,
     color: &Image<Rgb8>,
     files: Option<(&Path, &str)>,
 ) -> Result<BTreeMap<String, f64>, Error> {
@@ -419,18 +483,19 @@ fn write_reports(
     (sheet, runs): (&[SheetItem], &[Measured]),
     report: &CompareReport,
 ) -> Result<(), Error> {
-    let ref_vis = &refs.frame.visibility[0];
     let pairs: Vec<(&Image<f32>, &Image<f32>)> = runs
         .iter()
         .map(|m| {
-            let against = match &refs.soft {
+            let ground = refs.at(m.run.backend);
+            let against = match &ground.soft {
                 Some((_, _, vis)) if m.against_soft => vis,
-                _ => ref_vis,
+                _ => &ground.frame.visibility[0],
             };
             (&m.run.visibility[0], against)
         })
         .collect();
-    let inset = disagreement_inset(&pairs, ref_vis, &refs.mask, (job.width.min(job.height) / 8).max(8));
+    let cpu = refs.cpu();
+    let inset = disagreement_inset(&pairs, &cpu.frame.visibility[0], &cpu.mask, (job.width.min(job.height) / 8).max(8));
     save(&contact_sheet(sheet, 320, Some(inset)), dir, "contact.png")?;
     let json = serde_json::to_string_pretty(report).map_err(|e| Error::Usage(e.to_string()))?;
     let write = |name: &str, text: &str| {
@@ -454,21 +519,13 @@ pub fn run_compare(
     }
     let any_soft = job.techniques.iter().any(|s| renderer.registry().get(&s.name).is_ok_and(|e| e.soft));
     let mut sheet = Vec::new();
-    let refs = References::render(renderer, job, any_soft, &mut sheet, &mut progress)?;
+    let refs = References::trace(renderer, job, any_soft, &mut sheet, &mut progress)?;
     let bvh = renderer.bvh(job.frame);
-    let probe = shadow_cpu::acne::AcneProbe {
-        frame: job.frame,
-        light: &refs.frame.light_views[0],
-        gbuffer: &refs.frame.gbuffer,
-        bvh: &bvh,
-        reference: &refs.frame.visibility[0],
-        mask: &refs.mask,
-    };
     let mut runs = Vec::new();
     for (i, spec) in job.techniques.iter().enumerate() {
         for &backend in &job.backends {
             progress(&format!("{spec} on {}", backend.name()));
-            runs.push(measure(renderer, job, &refs, &probe, (i, spec), backend, &mut sheet)?);
+            runs.push(measure(renderer, job, (refs.at(backend), &bvh), (i, spec), backend, &mut sheet)?);
         }
     }
     let report = CompareReport {
@@ -476,7 +533,7 @@ pub fn run_compare(
         width: job.width,
         height: job.height,
         results: runs.iter().map(|m| m.entry.clone()).collect(),
-        cross_backend: cross_backend(&runs, &refs.mask)?,
+        cross_backend: cross_backend(&runs, &refs.cpu().mask)?,
         reference: job.reference.to_string(),
     };
     if let Some(dir) = &job.out_dir {

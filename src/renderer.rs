@@ -192,6 +192,27 @@ impl Renderer {
         Ok(shadow_cpu::render_frame_over(&mut self.cpu, frame, gbuffer, techniques)?)
     }
 
+    /// The surfaces a backend's G-buffer shows in `frame`'s view, as a CPU G-buffer: the points its
+    /// techniques are queried at, so a reference traced over them measures that backend at its own points.
+    ///
+    /// # Errors
+    /// A bad size, or a GPU failure.
+    pub fn gbuffer_of(
+        &mut self,
+        backend: BackendKind,
+        frame: &FrameInputs,
+        width: u32,
+        height: u32,
+    ) -> Result<shadow_cpu::GBuffer, Error> {
+        match backend {
+            BackendKind::Cpu => Ok(shadow_cpu::gbuffer::render(frame, width, height)?),
+            BackendKind::Wgpu => {
+                let surfaces = shadow_wgpu::gbuffer::read(self.gpu(true)?, frame, width, height)?;
+                Ok(shadow_cpu::GBuffer::from_surfaces(frame, surfaces))
+            }
+        }
+    }
+
     /// The BVH of a frame's casters (for measurements against the reference).
     pub fn bvh(&mut self, frame: &FrameInputs) -> std::sync::Arc<shadow_cpu::bvh::SceneBvh> {
         self.cpu.bvh(frame)

@@ -14,6 +14,7 @@ use crate::geometry::LightSource;
 use crate::geometry::adjacency::Adjacency;
 use crate::geometry::silhouette::{CastMode, Silhouette, silhouette};
 use crate::geometry::volume::{Caps, ShadowVolume, extrude};
+use crate::image::Image;
 use crate::light::{LightView, LightViewError};
 use crate::mesh::Mesh;
 use crate::scene::{Camera, CameraKey, Light, LightShadow, MeshKey, NodeKey, Scene, SceneError};
@@ -263,6 +264,26 @@ impl FrameInputs {
         let at = |v: u32| inst.world_from_local.transform_point3(inst.adjacency.positions()[v as usize]);
         sil.edges.iter().map(|e| [at(e.a), at(e.b)]).collect()
     }
+}
+
+/// The surface each pixel of a view shows, as one backend's G-buffer saw it: what another backend needs to
+/// shade or measure at exactly those points (the reference is traced at each backend's own points, so a
+/// sample that lands on the other side of a sub-pixel caster on one backend is not counted as that
+/// backend's shadow error).
+#[derive(Clone, Debug)]
+pub struct Surfaces {
+    /// World position of the visible surface.
+    pub position: Image<Vec3>,
+    /// Unit shading normal.
+    pub normal: Image<Vec3>,
+    /// Unit face normal, turned towards the viewer.
+    pub geometric_normal: Image<Vec3>,
+    /// Linear albedo.
+    pub albedo: Image<Vec3>,
+    /// Pixels that show a surface receiving shadows.
+    pub receiver: Image<bool>,
+    /// Pixels that show any surface.
+    pub covered: Image<bool>,
 }
 
 #[cfg(test)]

@@ -17,6 +17,10 @@ use crate::raster::{Batch, DepthStencil, Indexed, RasterState, draw_flat};
 /// No instance at this pixel.
 pub const NO_INSTANCE: u32 = u32::MAX;
 
+/// Some instance at this pixel, which one not known: a covered pixel of a G-buffer made from another
+/// backend's surfaces ([`GBuffer::from_surfaces`]).
+pub const SOME_INSTANCE: u32 = u32::MAX - 1;
+
 /// The camera view of a frame.
 #[derive(Clone, Debug)]
 pub struct GBuffer {
@@ -60,6 +64,38 @@ impl GBuffer {
     #[must_use]
     pub fn covered_pixels(&self) -> u64 {
         self.receiver.data().iter().filter(|&&r| r).count() as u64
+    }
+}
+
+impl GBuffer {
+    /// The G-buffer of the surfaces another backend saw in `frame`'s view (its G-buffer read back), so the
+    /// CPU can shade and measure at exactly those points: the depth is found from the positions, every
+    /// covered pixel shows [`SOME_INSTANCE`], and the clip-space vertices are the frame's own.
+    #[must_use]
+    pub fn from_surfaces(frame: &FrameInputs, s: shadow_core::frame::Surfaces) -> Self {
+        let (width, height) = (s.position.width(), s.position.height());
+        let clip_from_world = frame.camera.clip_from_world(width as f32 / height as f32);
+        let depth = Image::from_fn(width, height, |x, y| {
+            if *s.covered.get(x, y) { clip_from_world.project_point3(*s.position.get(x, y)).z } else { 1.0 }
+        });
+        let instance = s.covered.map(|&c| if c { SOME_INSTANCE } else { NO_INSTANCE });
+        Self {
+            camera: frame.camera,
+            clip_from_world,
+            depth,
+            position: s.position,
+            normal: s.normal,
+            geometric_normal: s.geometric_normal,
+            albedo: s.albedo,
+            instance,
+            receiver: s.receiver,
+            clip_vertices: frame
+                .instances
+                .iter()
+                .map(|inst| clip_vertices(inst.mesh.positions(), clip_from_world * inst.world_from_local))
+                .collect(),
+            visible: Vec::new(),
+        }
     }
 }
 
@@ -349,5 +385,29 @@ mod tests {
             // Background and surface both in view, so both branches of the resolve were compared.
             assert!(fresh.instance.data().contains(&NO_INSTANCE) && fresh.covered_pixels() > 0);
         }
+    }
+
+    /// A G-buffer made from the surfaces of a rendered one keeps its points and normals, finds the same
+    /// depth from the positions, and tells covered pixels from background.
+    #[test]
+    fn a_g_buffer_from_surfaces_is_the_one_they_came_from() {
+        let f = frame("primitives");
+        let g = render(&f, 80, 60).expect("G-buffer");
+        let covered = g.instance.map(|&i| i != NO_INSTANCE);
+        let surfaces = shadow_core::frame::Surfaces {
+            position: g.position.clone(),
+            normal: g.normal.clone(),
+            geometric_normal: g.geometric_normal.clone(),
+            albedo: g.albedo.clone(),
+            receiver: g.receiver.clone(),
+            covered: covered.clone(),
+        };
+        let made = GBuffer::from_surfaces(&f, surfaces);
+        assert_eq!((made.position, made.receiver, made.clip_vertices), (g.position, g.receiver, g.clip_vertices));
+        assert_eq!(made.instance.map(|&i| i == SOME_INSTANCE), covered);
+        for (a, b) in made.depth.data().iter().zip(g.depth.data()) {
+            assert!((a - b).abs() <= 1e-5, "depth {a} found from the position, {b} rasterized");
+        }
+        assert!(covered.data().contains(&false) && covered.data().contains(&true));
     }
 }

@@ -1,8 +1,10 @@
 //! The camera G-buffer on the GPU: the context's depth-stencil format plus world position (w: receives shadow),
 //! shading normal and albedo (w: covered), all f32 so shading matches the CPU's.
 
-use shadow_core::FrameInputs;
+use shadow_core::frame::Surfaces;
+use shadow_core::glam::Vec3;
 use shadow_core::scene::Camera;
+use shadow_core::{FrameInputs, Image};
 
 use crate::context::{WgpuContext, WgpuError};
 use crate::pipelines::{ATTRIBUTE, ViewRaw};
@@ -102,6 +104,27 @@ pub fn render(cx: &mut WgpuContext, frame: &FrameInputs, width: u32, height: u32
     fill(cx, frame, (width, height), "the G-buffer pass", |cx, pass| {
         pass.set_pipeline(&cx.shared.gbuffer);
         draw_instances(cx, pass, frame, |_| true, true);
+    })
+}
+
+/// Renders the G-buffer of a frame and reads it back: the surface each pixel shows on this backend, for
+/// measuring its results at its own points.
+///
+/// # Errors
+/// A bad size or a GPU failure.
+pub fn read(cx: &mut WgpuContext, frame: &FrameInputs, width: u32, height: u32) -> Result<Surfaces, WgpuError> {
+    let g = render(cx, frame, width, height)?;
+    let read = |view: &wgpu::TextureView| crate::readback::read_rgba32(cx, view.texture());
+    let (position, albedo) = (read(&g.position)?, read(&g.albedo)?);
+    let xyz = |image: Image<[f32; 4]>| image.map(|&[x, y, z, _]| Vec3::new(x, y, z));
+    let flag = |image: &Image<[f32; 4]>| image.map(|v| v[3] > 0.0);
+    Ok(Surfaces {
+        receiver: flag(&position),
+        covered: flag(&albedo),
+        position: xyz(position),
+        albedo: xyz(albedo),
+        normal: xyz(read(&g.normal)?),
+        geometric_normal: xyz(read(&g.geometric_normal)?),
     })
 }
 

@@ -124,3 +124,15 @@ pub fn read_rg32(cx: &WgpuContext, tex: &wgpu::Texture, layer: u32) -> Result<Im
     Image::from_vec(tex.width(), tex.height(), data)
         .ok_or_else(|| WgpuError::Gpu { during: "readback".into(), message: "size mismatch".into() })
 }
+
+/// An Rgba32Float texture as an image of quadruples.
+///
+/// # Errors
+/// A GPU failure.
+pub fn read_rgba32(cx: &WgpuContext, tex: &wgpu::Texture) -> Result<Image<[f32; 4]>, WgpuError> {
+    let bytes = read_layer(cx, tex, 0, 16, wgpu::TextureAspect::All)?;
+    let f = |c: &[u8]| f32::from_le_bytes([c[0], c[1], c[2], c[3]]);
+    let data = bytes.chunks_exact(16).map(|c| [f(&c[..4]), f(&c[4..8]), f(&c[8..12]), f(&c[12..])]).collect();
+    Image::from_vec(tex.width(), tex.height(), data)
+        .ok_or_else(|| WgpuError::Gpu { during: "readback".into(), message: "size mismatch".into() })
+}

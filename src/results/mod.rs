@@ -191,8 +191,9 @@ fn errors_table(s: &mut String, registry: &TechniqueRegistry, job: &ResultsJob, 
         "{}x{}, each scene's own camera and light, every setting at its default. Hard techniques: the \
          percentage of measured pixels whose lit/shadowed state differs from `ray-traced`'s (measured pixels \
          are receivers the light reaches whose seen side faces it). Soft techniques (marked RMSE): the RMS \
-         visibility difference from `area-light-reference`'s. A dash: the scene's light is of a kind the \
-         technique or its reference does not take.\n",
+         visibility difference from `area-light-reference`'s. Each backend is measured at its own pixels: \
+         the references are traced on the CPU over the G-buffer that backend rendered. A dash: the scene's \
+         light is of a kind the technique or its reference does not take.\n",
         job.size.0, job.size.1
     );
     let mut rows: BTreeMap<(usize, String, String), BTreeMap<&str, String>> = BTreeMap::new();

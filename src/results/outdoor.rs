@@ -166,7 +166,10 @@ pub fn markdown(s: &mut String, r: &OutdoorReport) {
          cascades for `cascaded-shadow-map` (its three fits), for `silhouette-map` (with a silhouette-point \
          map beside each) and for `dual-shadow-map`. Edge band: the mismatch within two pixels of the reference's shadow edges. Near \
          field: the mismatch over measured pixels in the nearest third of the view's depth range; the factor \
-         is that over the uniform map's. Texels per pixel: the median over the near field.\n",
+         is that over the uniform map's. Texels per pixel: the median over the near field. Each backend \
+         against the reference traced at its own pixels: on the pickets and branches the two G-buffers' \
+         samples fall on either side of shadow edges, which the cpu-vs-wgpu numbers show and neither \
+         backend's errors count.\n",
         r.size.0, r.size.1
     );
     let _ = write!(s, "| technique | backend |");

@@ -9,6 +9,7 @@ mod gpu_clock;
 mod host;
 mod hybrid;
 mod moment_maps;
+mod own_pixels;
 mod penumbra_wedges;
 mod per_light;
 mod pipelines;
