@@ -213,6 +213,12 @@ impl Renderer {
         }
     }
 
+    /// Drops what the backends keep from frame to frame for a still scene (the CPU's ray-casting BVH), so
+    /// the next frame rebuilds it and its time shows in that frame's build phase.
+    pub fn forget_caches(&mut self) {
+        self.cpu.forget();
+    }
+
     /// The BVH of a frame's casters (for measurements against the reference).
     pub fn bvh(&mut self, frame: &FrameInputs) -> std::sync::Arc<shadow_cpu::bvh::SceneBvh> {
         self.cpu.bvh(frame)

@@ -99,6 +99,12 @@ impl CpuContext {
         self.spare.take()
     }
 
+    /// Drops what the context keeps from frame to frame (the BVH), so the next frame builds it again:
+    /// for measuring what that costs.
+    pub fn forget(&mut self) {
+        self.bvh = None;
+    }
+
     /// The BVH of the frame's casters, built on first use and reused while they stay put.
     pub fn bvh(&mut self, frame: &FrameInputs) -> Arc<SceneBvh> {
         let key = SceneBvh::key(frame);

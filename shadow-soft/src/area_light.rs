@@ -17,7 +17,7 @@ use shadow_core::technique::LightPass;
 use shadow_core::technique::settings::{SettingKey, SettingsError, Values};
 use shadow_core::technique::{ShadowTechnique, TechniqueError};
 use shadow_cpu::bvh::SceneBvh;
-use shadow_cpu::passes::per_receiver;
+use shadow_cpu::passes::per_receiver_casting;
 use shadow_cpu::passes::rays::{RayOrigins, State as RayState};
 use shadow_cpu::{CpuBackend, CpuContext, CpuError, GBuffer};
 
@@ -73,21 +73,23 @@ pub struct Sphere {
 }
 
 /// The fraction of `light` visible from `origin` (already off the surface) on a surface of unit normal
-/// `n`: `samples` stratified rays (a square number) uniform in the cone the sphere subtends, each tested
-/// up to where it enters the sphere; `seed` picks the jitter. A receiver inside the sphere sees all of it.
+/// `n`, and the number of rays cast for it: `samples` stratified directions (a square number) uniform in
+/// the cone the sphere subtends, each below the surface's horizon counted blocked without a ray, the
+/// others tested up to where they enter the sphere; `seed` picks the jitter. A receiver inside the sphere
+/// sees all of it.
 #[must_use]
-pub fn sphere_visibility(bvh: &SceneBvh, origin: Vec3, n: Vec3, light: Sphere, samples: u32, seed: u32) -> f32 {
+pub fn sphere_visibility(bvh: &SceneBvh, origin: Vec3, n: Vec3, light: Sphere, samples: u32, seed: u32) -> (f32, u32) {
     let to_centre = light.centre - origin;
     let dist = to_centre.length();
     if dist <= light.radius {
-        return 1.0;
+        return (1.0, 0);
     }
     let w = to_centre / dist;
     let (u, v) = w.any_orthonormal_pair();
     // The cone of the sphere's directions: cos of its half-angle, sampled uniformly in solid angle.
     let cos_max = (1.0 - (light.radius / dist).powi(2)).max(0.0).sqrt();
     let side = samples.isqrt().max(1);
-    let mut seen = 0u32;
+    let (mut seen, mut cast) = (0u32, 0u32);
     for j in 0..side {
         for i in 0..side {
             let h = pixel_hash(seed, j * side + i);
@@ -104,12 +106,13 @@ pub fn sphere_visibility(bvh: &SceneBvh, origin: Vec3, n: Vec3, light: Sphere, s
             let along = to_centre.dot(dir);
             let miss2 = (to_centre.length_squared() - along * along).max(0.0);
             let tmax = along - (light.radius * light.radius - miss2).max(0.0).sqrt();
+            cast += 1;
             if !bvh.occluded(origin, dir, tmax) {
                 seen += 1;
             }
         }
     }
-    seen as f32 / (side * side) as f32
+    (seen as f32 / (side * side) as f32, cast)
 }
 
 impl ShadowTechnique<CpuBackend> for AreaLightReference {
@@ -147,12 +150,12 @@ impl ShadowTechnique<CpuBackend> for AreaLightReference {
         };
         let sphere = Sphere { centre, radius: light.light.radius };
         let origins = RayOrigins::new(g, frame, self.epsilon);
-        per_receiver(g, out, |x, y, i| {
+        let rays = per_receiver_casting(g, out, |x, y, i| {
             let (origin, n) = origins.at(i);
-            sphere_visibility(bvh, origin, n, sphere, self.samples, pixel_hash(x, y))
+            let (visible, cast) = sphere_visibility(bvh, origin, n, sphere, self.samples, pixel_hash(x, y));
+            (visible, u64::from(cast))
         });
-        let rays = g.covered_pixels() as f64 * f64::from(self.samples);
-        stats.counters.extra.insert("shadow_rays".into(), rays);
+        stats.counters.extra.insert("rays_cast".into(), rays as f64);
         Ok(())
     }
 }
@@ -195,25 +198,30 @@ mod tests {
     #[test]
     fn visibility_is_the_unblocked_fraction_of_the_sphere() {
         let up = Vec3::Y;
-        // Far off to the side: nothing in the way.
+        let fraction = |bvh: &SceneBvh, origin: Vec3, n: Vec3, light: Sphere, samples: u32| {
+            sphere_visibility(bvh, origin, n, light, samples, 7).0
+        };
+        // Far off to the side: nothing in the way, and every sample cast.
         let clear = occluder_from(50.0);
-        assert_eq!(sphere_visibility(&clear, Vec3::ZERO, up, LIGHT, 256, 7), 1.0);
+        assert_eq!(sphere_visibility(&clear, Vec3::ZERO, up, LIGHT, 256, 7), (1.0, 256));
         // Under the middle of the square: every ray blocked.
         let covered = occluder_from(-2.0);
-        assert_eq!(sphere_visibility(&covered, Vec3::ZERO, up, LIGHT, 256, 7), 0.0);
+        assert_eq!(sphere_visibility(&covered, Vec3::ZERO, up, LIGHT, 256, 7), (0.0, 256));
         // The square's edge right over the receiver, under the light's centre: half the cone, by symmetry
         // (stratified, so within a stratum row's worth).
         let half = occluder_from(0.0);
-        let v = sphere_visibility(&half, Vec3::ZERO, up, LIGHT, 256, 7);
+        let v = fraction(&half, Vec3::ZERO, up, LIGHT, 256);
         assert!((v - 0.5).abs() < 0.04, "half-covered: {v}");
-        // A receiver whose horizon passes through the light's centre sees the upper half of it.
-        let v = sphere_visibility(&clear, Vec3::new(0.0, 2.0, 3.0), Vec3::Y, LIGHT, 256, 7);
+        // A receiver whose horizon passes through the light's centre sees the upper half of it, and casts
+        // rays only there.
+        let (v, cast) = sphere_visibility(&clear, Vec3::new(0.0, 2.0, 3.0), Vec3::Y, LIGHT, 256, 7);
         assert!((v - 0.5).abs() < 0.04, "half below the horizon: {v}");
-        // A point light is all or nothing, and the receiver inside the sphere sees it all.
+        assert_eq!(cast as f32, v * 256.0, "rays cast over the horizon");
+        // A point light is all or nothing, and the receiver inside the sphere sees it all without a ray.
         let point = Sphere { radius: 0.0, ..LIGHT };
-        assert_eq!(sphere_visibility(&half, Vec3::new(-0.01, 0.0, 0.0), up, point, 16, 7), 1.0);
-        assert_eq!(sphere_visibility(&half, Vec3::new(0.01, 0.0, 0.0), up, point, 16, 7), 0.0);
-        assert_eq!(sphere_visibility(&covered, Vec3::new(0.0, 1.9, 0.0), up, LIGHT, 16, 7), 1.0);
+        assert_eq!(fraction(&half, Vec3::new(-0.01, 0.0, 0.0), up, point, 16), 1.0);
+        assert_eq!(fraction(&half, Vec3::new(0.01, 0.0, 0.0), up, point, 16), 0.0);
+        assert_eq!(sphere_visibility(&covered, Vec3::new(0.0, 1.9, 0.0), up, LIGHT, 16, 7), (1.0, 0));
     }
 
     #[test]
@@ -224,8 +232,10 @@ mod tests {
         let width = |radius: f32| {
             let light = Sphere { radius, ..LIGHT };
             let xs: Vec<f32> = (0..200).map(|i| -1.0 + i as f32 * 0.01).collect();
-            let v: Vec<f32> =
-                xs.iter().map(|&x| sphere_visibility(&half, Vec3::new(x, 0.0, 0.0), Vec3::Y, light, 256, 3)).collect();
+            let v: Vec<f32> = xs
+                .iter()
+                .map(|&x| sphere_visibility(&half, Vec3::new(x, 0.0, 0.0), Vec3::Y, light, 256, 3).0)
+                .collect();
             let first = |t: f32| xs[v.iter().position(|&v| v < t).unwrap()];
             first(0.1) - first(0.9)
         };

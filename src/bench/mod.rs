@@ -11,10 +11,12 @@
 pub mod realtime;
 
 use std::collections::BTreeMap;
+use std::sync::Arc;
 
 use glam::{Mat3, Vec3};
 use serde::Serialize;
 use shadow_core::FrameInputs;
+use shadow_core::geometry::adjacency::Adjacency;
 use shadow_core::scene::{Light, LightKind};
 use shadow_core::stats::{Phase, Summary};
 use shadow_core::technique::{FrameStats, TechniqueSpec};
@@ -40,6 +42,10 @@ pub struct BenchJob<'a> {
     pub techniques: Vec<TechniqueSpec>,
     /// Backends.
     pub backends: Vec<BackendKind>,
+    /// Rebuild every frame what a still scene keeps from frame to frame (the meshes' adjacency, the CPU's
+    /// ray-casting BVH), so its cost is measured: the adjacency as its own `adjacency` time, the BVH in
+    /// the build phase of the techniques that cast rays.
+    pub rebuild: bool,
 }
 
 /// Median, minimum and maximum, in milliseconds.
@@ -148,11 +154,18 @@ pub fn run_bench(
         for k in 0..total {
             let warm = if k < job.warmup { " (warm-up)" } else { "" };
             progress(&format!("{}: frame {} of {total}{warm}", backend.name(), k + 1));
-            let frame = job.frame_at(k, total);
+            let mut frame = job.frame_at(k, total);
+            let adjacency = job.rebuild.then(|| rebuild_adjacency(&mut frame));
             for lane in &mut lanes[first..] {
+                if job.rebuild {
+                    renderer.forget_caches();
+                }
                 let run = renderer.run_prepared(&mut lane.prepared, &frame, job.width, job.height)?;
                 if k >= job.warmup {
                     lane.record(&run.stats);
+                    if let Some(ms) = adjacency {
+                        lane.samples.entry("adjacency".into()).or_default().push(ms);
+                    }
                 }
             }
         }
@@ -161,6 +174,25 @@ pub fn run_bench(
     lanes.sort_by_key(|lane| lane.technique);
     let results = lanes.into_iter().map(Lane::into_entry).collect();
     Ok(BenchReport { scene: job.scene.clone(), width: job.width, height: job.height, frames: job.frames, results })
+}
+
+/// Builds the adjacency of every mesh of `frame` afresh (each mesh once, however many instances draw
+/// it), as a scene does when a mesh changes; returns the milliseconds it took.
+fn rebuild_adjacency(frame: &mut FrameInputs) -> f64 {
+    let start = std::time::Instant::now();
+    let mut built: Vec<(*const shadow_core::Mesh, Arc<Adjacency>)> = Vec::new();
+    for inst in &mut frame.instances {
+        let mesh = Arc::as_ptr(&inst.mesh);
+        inst.adjacency = match built.iter().find(|(m, _)| *m == mesh) {
+            Some((_, adj)) => adj.clone(),
+            None => {
+                let adj = Arc::new(Adjacency::build(&inst.mesh));
+                built.push((mesh, adj.clone()));
+                adj
+            }
+        };
+    }
+    start.elapsed().as_secs_f64() * 1e3
 }
 
 impl Lane {
@@ -231,6 +263,12 @@ pub fn bench_table(r: &BenchReport) -> String {
             counters_apart |= e.timings_ms.contains_key("gpu_counters");
         }
     }
+    if let Some(t) = r.results.iter().find_map(|e| e.timings_ms.get("adjacency")) {
+        s.push_str(&format!(
+            "adjacency rebuilt every frame (not in the rows): {:.1} [{:.1}..{:.1}]\n",
+            t.median, t.min, t.max
+        ));
+    }
     if counters_apart {
         s.push_str(
             "gpu rows: timestamp queries, medians per phase; the counter passes are not in them (gpu_counters)\n",
@@ -279,6 +317,7 @@ mod tests {
             warmup: 1,
             techniques: specs.to_vec(),
             backends: vec![BackendKind::Cpu, BackendKind::Cpu],
+            rebuild: false,
         };
         let mut renderer = Renderer::new(TechniqueRegistry::builtin());
         let mut steps = Vec::new();
@@ -291,6 +330,33 @@ mod tests {
             let total = e.timings_ms["total"];
             assert!(total.min > 0.0 && total.min <= total.median && total.median <= total.max, "{e:?}");
             assert!(e.counters.contains_key("covered_pixels"), "{e:?}");
+        }
+    }
+
+    #[test]
+    fn rebuilding_times_the_adjacency_and_rays_are_counted_as_cast() {
+        let scene = scenes::build("stacked-boxes", &SceneParams::default()).expect("a built-in scene");
+        let frame = FrameInputs::from_first_camera(&scene).expect("a frame");
+        let mut renderer = Renderer::new(TechniqueRegistry::builtin());
+        for rebuild in [false, true] {
+            let job = BenchJob {
+                scene: "stacked-boxes".into(),
+                frame: &frame,
+                width: 48,
+                height: 32,
+                frames: 2,
+                warmup: 1,
+                techniques: vec![TechniqueSpec::named("ray-traced")],
+                backends: vec![BackendKind::Cpu],
+                rebuild,
+            };
+            let report = run_bench(&mut renderer, &job, |_| {}).expect("bench");
+            let e = &report.results[0];
+            assert_eq!(e.timings_ms.contains_key("adjacency"), rebuild, "{e:?}");
+            assert_eq!(bench_table(&report).contains("adjacency rebuilt"), rebuild);
+            // Receivers that face away from the light cast no ray: fewer rays than receivers, but some.
+            let (rays, receivers) = (e.counters["rays_cast"], e.counters["covered_pixels"]);
+            assert!(rays > 0.0 && rays < receivers, "{rays} rays cast from {receivers} receivers");
         }
     }
 }

@@ -98,6 +98,7 @@ pub fn run_results(renderer: &mut Renderer, job: &ResultsJob, mut progress: impl
         warmup: 2,
         techniques,
         backends: job.backends.clone(),
+        rebuild: false,
     };
     let timing = run_bench(renderer, &bench, |m| progress(&format!("{}: {m}", job.bench_scene)))?;
     // The real-time path where there is a GPU adapter: the same frames recorded, two in flight.

@@ -147,8 +147,8 @@ impl Adjacency {
     #[must_use]
     pub fn build(mesh: &Mesh) -> Self {
         let (positions, remap) = weld(mesh.positions());
-        let triangles: Vec<[u32; 3]> = mesh.triangles().iter().map(|t| t.map(|i| remap[i as usize])).collect();
-        let degenerate: Vec<bool> = triangles.iter().map(|&[a, b, c]| a == b || b == c || c == a).collect();
+        let triangles: Vec<[u32; 3]> = mesh.triangles().par_iter().map(|t| t.map(|i| remap[i as usize])).collect();
+        let degenerate: Vec<bool> = triangles.par_iter().map(|&[a, b, c]| a == b || b == c || c == a).collect();
         let planes: Vec<Vec4> = triangles
             .par_iter()
             .map(|t| {
@@ -159,19 +159,7 @@ impl Adjacency {
             })
             .collect();
 
-        // Every directed edge of every non-degenerate face, keyed by its welded endpoints.
-        let mut uses: Vec<(u64, FaceUse)> = triangles
-            .par_iter()
-            .enumerate()
-            .filter(|(f, _)| !degenerate[*f])
-            .flat_map_iter(|(f, &[a, b, c])| {
-                [(a, b), (b, c), (c, a)].into_iter().map(move |(u, v)| {
-                    let key = u64::from(u.min(v)) << 32 | u64::from(u.max(v));
-                    (key, FaceUse::new(f as u32, u > v))
-                })
-            })
-            .collect();
-        uses.par_sort_unstable();
+        let uses = EdgeUses::gather(&triangles, &degenerate, positions.len());
 
         let mut adj = Self {
             component: Vec::new(),
@@ -189,8 +177,7 @@ impl Adjacency {
             non_manifold_edges: 0,
             inconsistent_edges: 0,
         };
-        for run in uses.chunk_by(|x, y| x.0 == y.0) {
-            let v = [(run[0].0 >> 32) as u32, run[0].0 as u32];
+        for (v, run) in uses.edges() {
             match *run {
                 [(_, f)] => {
                     adj.boundary.push(Edge { v });
@@ -312,6 +299,104 @@ impl Adjacency {
     }
 }
 
+/// Every face's use of each of its edges, grouped by edge in the order of the edges' welded endpoints
+/// (lower, then higher) and, within an edge, of the uses. A counting sort on the lower endpoint puts each
+/// use into its vertex's bucket; a bucket holds a handful of uses (about six on a closed mesh), sorted
+/// in place by the higher endpoint and the use. That is linear in the faces, where a comparison sort of
+/// all the uses (three million for a million faces) took most of the build; and the order is the one
+/// such a sort gives, so the edge lists come out the same.
+struct EdgeUses {
+    /// Per welded vertex, where its bucket begins in `uses`; one more entry closes the last.
+    start: Vec<u32>,
+    /// Each use with the higher endpoint of its edge, in the buckets of the lower.
+    uses: Vec<(u32, FaceUse)>,
+}
+
+impl EdgeUses {
+    /// Buckets of at most this many vertices are sorted as one task.
+    const CHUNK: usize = 8192;
+
+    fn gather(triangles: &[[u32; 3]], degenerate: &[bool], vertices: usize) -> Self {
+        // Each run of faces buckets its own uses, all runs at once; the buckets are then merged vertex by
+        // vertex, and each merged bucket sorted, so the runs' number does not change the result.
+        let runs = rayon::current_num_threads().clamp(1, 8);
+        let per_run = triangles.len().div_ceil(runs).max(1);
+        let local: Vec<Self> = triangles
+            .par_chunks(per_run)
+            .zip(degenerate.par_chunks(per_run))
+            .enumerate()
+            .map(|(k, (t, d))| Self::bucket(t, d, k * per_run, vertices))
+            .collect();
+        let mut start = vec![0u32; vertices + 1];
+        for v in 0..vertices {
+            start[v + 1] = start[v] + local.iter().map(|l| l.start[v + 1] - l.start[v]).sum::<u32>();
+        }
+        let mut uses = vec![(0, FaceUse::NONE); start[vertices] as usize];
+        // The buckets of each run of CHUNK vertices, split off one after the other, filled and sorted in
+        // parallel.
+        let mut chunks = Vec::with_capacity(vertices.div_ceil(Self::CHUNK));
+        let mut rest = uses.as_mut_slice();
+        for first in (0..vertices).step_by(Self::CHUNK) {
+            let last = (first + Self::CHUNK).min(vertices);
+            let (chunk, tail) = rest.split_at_mut((start[last] - start[first]) as usize);
+            chunks.push((first..last, chunk));
+            rest = tail;
+        }
+        chunks.into_par_iter().for_each(|(range, chunk)| {
+            let mut at = 0;
+            for v in range {
+                let from = at;
+                for l in &local {
+                    let bucket = &l.uses[l.start[v] as usize..l.start[v + 1] as usize];
+                    chunk[at..at + bucket.len()].copy_from_slice(bucket);
+                    at += bucket.len();
+                }
+                chunk[from..at].sort_unstable();
+            }
+        });
+        Self { start, uses }
+    }
+
+    /// The uses of `triangles` (the first numbered `base`) in buckets by lower endpoint, unsorted within.
+    fn bucket(triangles: &[[u32; 3]], degenerate: &[bool], base: usize, vertices: usize) -> Self {
+        let edges = |&[a, b, c]: &[u32; 3]| [(a, b), (b, c), (c, a)];
+        let cast = triangles.iter().zip(degenerate).enumerate().filter(|(_, (_, d))| !**d);
+        let mut start = vec![0u32; vertices + 1];
+        for (_, (t, _)) in cast.clone() {
+            for (u, v) in edges(t) {
+                start[u.min(v) as usize + 1] += 1;
+            }
+        }
+        for i in 1..start.len() {
+            start[i] += start[i - 1];
+        }
+        let mut next = start.clone();
+        let mut uses = vec![(0, FaceUse::NONE); start[vertices] as usize];
+        for (f, (t, _)) in cast {
+            for (u, v) in edges(t) {
+                let slot = &mut next[u.min(v) as usize];
+                uses[*slot as usize] = (u.max(v), FaceUse::new((base + f) as u32, u > v));
+                *slot += 1;
+            }
+        }
+        Self { start, uses }
+    }
+
+    /// Number of uses.
+    fn len(&self) -> usize {
+        self.uses.len()
+    }
+
+    /// Each edge's welded endpoints (lower first) and its uses, each with the higher endpoint.
+    fn edges(&self) -> impl Iterator<Item = ([u32; 2], &[(u32, FaceUse)])> {
+        self.start.windows(2).enumerate().flat_map(move |(lo, w)| {
+            self.uses[w[0] as usize..w[1] as usize]
+                .chunk_by(|x, y| x.0 == y.0)
+                .map(move |run| ([lo as u32, run[0].0], run))
+        })
+    }
+}
+
 /// The connected components of the faces through their edges (union-find with path halving), and their
 /// bounds. A face no edge joins to another (a degenerate one, say) is a component of its own.
 fn components(adj: &Adjacency) -> (Vec<u32>, Vec<Aabb>) {
@@ -338,39 +423,108 @@ fn components(adj: &Adjacency) -> (Vec<u32>, Vec<Aabb>) {
             join(e.uses[0].face(), u.face());
         }
     }
-    // Roots are each component's least face, so numbering them in face order numbers the components in
-    // order of first appearance.
-    let mut number = vec![u32::MAX; parent.len()];
-    let mut bounds = Vec::new();
-    let mut component = Vec::with_capacity(parent.len());
-    for (f, t) in adj.triangles.iter().enumerate() {
-        let r = root(&mut parent, f as u32) as usize;
-        if number[r] == u32::MAX {
-            number[r] = bounds.len() as u32;
-            bounds.push(Aabb::EMPTY);
-        }
-        let k = number[r] as usize;
-        bounds[k] = t.iter().fold(bounds[k], |b, &v| b.including(adj.positions[v as usize]));
-        component.push(k as u32);
+    // A root joins below the other, and halving only moves a face up its path, so every face's parent is
+    // at most the face and each root is its component's least face. In face order, then, a face's parent
+    // already points at its root, and a root comes before the rest of its component: one pass finds every
+    // face's root and numbers the components in order of first appearance.
+    let mut component = vec![0u32; parent.len()];
+    let mut count = 0;
+    for f in 0..parent.len() {
+        let r = parent[parent[f] as usize];
+        parent[f] = r;
+        component[f] = if r as usize == f {
+            count += 1;
+            count - 1
+        } else {
+            component[r as usize]
+        };
+    }
+    // Bounds by runs of faces of one component (a mesh's faces come component by component, mostly), the
+    // runs found in parallel and merged in order.
+    let runs: Vec<Vec<(u32, Aabb)>> = adj
+        .triangles
+        .par_chunks(16384)
+        .zip(component.par_chunks(16384))
+        .map(|(tris, comps)| {
+            let mut runs: Vec<(u32, Aabb)> = Vec::new();
+            for (t, &c) in tris.iter().zip(comps) {
+                let b = t.iter().fold(Aabb::EMPTY, |b, &v| b.including(adj.positions[v as usize]));
+                match runs.last_mut() {
+                    Some((last, bounds)) if *last == c => *bounds = bounds.union(b),
+                    _ => runs.push((c, b)),
+                }
+            }
+            runs
+        })
+        .collect();
+    let mut bounds = vec![Aabb::EMPTY; count as usize];
+    for (c, b) in runs.into_iter().flatten() {
+        bounds[c as usize] = bounds[c as usize].union(b);
     }
     (component, bounds)
 }
 
+/// Welds equal positions (by [`weld_key`]): the distinct positions in order of first appearance, and each
+/// position's index among them.
+///
+/// One hash map over half a million positions misses the cache on nearly every insert. So the positions
+/// are first split by their hash's top bits into [`WELD_PARTS`] parts (a counting sort that keeps each
+/// part in position order); each part, a few thousand keys that stay in cache, is welded on its own and
+/// in parallel, giving every position the first position with its key; a prefix count over those firsts
+/// then numbers them in order of first appearance, as one map in position order would.
 fn weld(positions: &[Vec3]) -> (Vec<Vec3>, Vec<u32>) {
-    let mut map: HashMap<[u32; 3], u32, BuildHasherDefault<WeldHasher>> =
-        HashMap::with_capacity_and_hasher(positions.len(), BuildHasherDefault::default());
-    let mut welded = Vec::with_capacity(positions.len());
-    let remap = positions
-        .iter()
-        .map(|&p| {
-            *map.entry(weld_key(p)).or_insert_with(|| {
-                welded.push(p);
-                (welded.len() - 1) as u32
-            })
+    let n = positions.len();
+    let keys: Vec<[u32; 3]> = positions.par_iter().map(|&p| weld_key(p)).collect();
+    let part = |k: &[u32; 3]| {
+        let mut h = WeldHasher::default();
+        k.iter().for_each(|&c| h.write_u32(c));
+        (h.finish() >> (64 - WELD_PARTS.trailing_zeros())) as usize
+    };
+    let parts: Vec<u16> = keys.par_iter().map(|k| part(k) as u16).collect();
+    let mut start = vec![0usize; WELD_PARTS + 1];
+    for &p in &parts {
+        start[usize::from(p) + 1] += 1;
+    }
+    for i in 1..start.len() {
+        start[i] += start[i - 1];
+    }
+    let mut next = start.clone();
+    let mut order = vec![0u32; n];
+    for (i, &p) in parts.iter().enumerate() {
+        order[next[usize::from(p)]] = i as u32;
+        next[usize::from(p)] += 1;
+    }
+    // Per part, for each of its positions (in position order) the first position with the same key.
+    let firsts: Vec<Vec<u32>> = start
+        .par_windows(2)
+        .map(|w| {
+            let members = &order[w[0]..w[1]];
+            let mut map: HashMap<[u32; 3], u32, BuildHasherDefault<WeldHasher>> =
+                HashMap::with_capacity_and_hasher(members.len(), BuildHasherDefault::default());
+            members.iter().map(|&i| *map.entry(keys[i as usize]).or_insert(i)).collect()
         })
         .collect();
+    let mut first = vec![0u32; n];
+    for (w, part) in start.windows(2).zip(&firsts) {
+        for (&i, &f) in order[w[0]..w[1]].iter().zip(part) {
+            first[i as usize] = f;
+        }
+    }
+    // Number the first positions in order; every other takes its first's number.
+    let mut number = vec![0u32; n];
+    let mut welded = Vec::new();
+    for (i, &f) in first.iter().enumerate() {
+        if f as usize == i {
+            number[i] = welded.len() as u32;
+            welded.push(positions[i]);
+        }
+    }
+    let remap = first.par_iter().map(|&f| number[f as usize]).collect();
     (welded, remap)
 }
+
+/// How many parts [`weld`] splits the positions into (a power of two).
+const WELD_PARTS: usize = 256;
 
 #[cfg(test)]
 mod tests {

@@ -6,7 +6,7 @@ use glam::{Vec2, Vec3};
 use proptest::prelude::*;
 
 use super::LightSource;
-use super::adjacency::Adjacency;
+use super::adjacency::{Adjacency, FaceUse};
 use super::silhouette::{CastMode, silhouette};
 use super::volume::tests::{all_triangles, edge_balance};
 use super::volume::{Caps, extrude};
@@ -41,6 +41,55 @@ fn open_mesh() -> impl Strategy<Value = Mesh> {
             // Indices are in range by construction; only an all-degenerate soup is refused.
             Mesh::new(positions, triangles).ok()
         })
+}
+
+/// A triangle soup whose positions repeat: drawn from a few points, one of them `-0.0` beside `0.0`, so the
+/// weld joins vertices; edges of every kind, as in [`open_mesh`].
+fn welded_mesh() -> impl Strategy<Value = Mesh> {
+    (
+        prop::collection::vec(prop::array::uniform3(-1.0f32..1.0), 2..6),
+        prop::collection::vec(0usize..8, 4..40),
+        prop::collection::vec(prop::array::uniform3(0u32..100), 1..40),
+    )
+        .prop_filter_map("a mesh needs a triangle with an area", |(mut pool, picks, tris)| {
+            pool.extend([[0.0, 0.0, 0.0], [-0.0, 0.0, -0.0]]);
+            let positions: Vec<Vec3> = picks.iter().map(|&i| Vec3::from(pool[i % pool.len()])).collect();
+            let n = positions.len() as u32;
+            Mesh::new(positions, tris.into_iter().map(|t| t.map(|i| i % n)).collect()).ok()
+        })
+}
+
+/// Welded positions, each vertex's welded index, and each edge's endpoints with its uses.
+type Plain = (Vec<Vec3>, Vec<u32>, Vec<([u32; 2], Vec<FaceUse>)>);
+
+/// The weld and the edge lists the plain way: one map in position order, and one sort of every use by
+/// its edge's endpoints, then the use.
+fn plainly(mesh: &Mesh) -> Plain {
+    let key = |p: Vec3| [p.x, p.y, p.z].map(|c| if c == 0.0 { 0 } else { c.to_bits() });
+    let (mut welded, mut ids) = (Vec::new(), HashMap::new());
+    let remap: Vec<u32> = mesh
+        .positions()
+        .iter()
+        .map(|&p| {
+            *ids.entry(key(p)).or_insert_with(|| {
+                welded.push(p);
+                welded.len() as u32 - 1
+            })
+        })
+        .collect();
+    let mut uses = Vec::new();
+    for (f, t) in mesh.triangles().iter().enumerate() {
+        let [a, b, c] = t.map(|i| remap[i as usize]);
+        if a == b || b == c || c == a {
+            continue;
+        }
+        for (u, v) in [(a, b), (b, c), (c, a)] {
+            uses.push(([u.min(v), u.max(v)], FaceUse::new(f as u32, u > v)));
+        }
+    }
+    uses.sort_unstable();
+    let edges = uses.chunk_by(|x, y| x.0 == y.0).map(|run| (run[0].0, run.iter().map(|u| u.1).collect())).collect();
+    (welded, remap, edges)
 }
 
 fn light() -> impl Strategy<Value = LightSource> {
@@ -95,6 +144,57 @@ proptest! {
         prop_assert_eq!(adj.boundary_edge_count(), boundary);
         prop_assert_eq!(adj.non_manifold_edge_count(), non_manifold);
         prop_assert_eq!(adj.edge_count(), uses.len());
+    }
+
+    #[test]
+    fn the_weld_and_the_edges_are_those_of_one_map_and_one_sort(
+        mesh in prop_oneof![closed_mesh(), open_mesh(), welded_mesh()]
+    ) {
+        let adj = Adjacency::build(&mesh);
+        let (welded, remap, edges) = plainly(&mesh);
+        prop_assert_eq!(adj.positions(), &welded[..]);
+        prop_assert_eq!(adj.remap(), &remap[..]);
+        // Every edge, in the sort's order, in the list its uses put it in.
+        let (mut manifold, mut boundary, mut complex) = (0, 0, 0);
+        for (v, uses) in &edges {
+            let reversed = |k: usize| uses[k].reversed();
+            if uses.len() == 2 && reversed(0) != reversed(1) {
+                prop_assert_eq!(adj.manifold_edges()[manifold].v, *v);
+                let faces = if reversed(0) { [uses[1], uses[0]] } else { [uses[0], uses[1]] };
+                prop_assert_eq!(adj.manifold_faces()[manifold], faces.map(|u| u.face()));
+                manifold += 1;
+            } else if uses.len() == 1 {
+                prop_assert_eq!((adj.boundary_edges()[boundary].v, adj.boundary_faces()[boundary]), (*v, uses[0]));
+                boundary += 1;
+            } else {
+                prop_assert_eq!(&adj.complex_edges()[complex].uses, uses);
+                prop_assert_eq!(adj.complex_edges()[complex].v, *v);
+                complex += 1;
+            }
+        }
+        prop_assert_eq!((manifold, boundary, complex), (adj.manifold_edges().len(), adj.boundary_edges().len(), adj.complex_edges().len()));
+        // Components: faces joined through every edge's uses, numbered in order of first appearance.
+        let mut root: Vec<usize> = (0..adj.triangles().len()).collect();
+        let find = |root: &Vec<usize>, mut f: usize| {
+            while root[f] != f {
+                f = root[f];
+            }
+            f
+        };
+        for (_, uses) in &edges {
+            for u in &uses[1..] {
+                let (a, b) = (find(&root, uses[0].face() as usize), find(&root, u.face() as usize));
+                root[a.max(b)] = a.min(b);
+            }
+        }
+        let mut numbers = HashMap::new();
+        let plain: Vec<u32> = (0..root.len())
+            .map(|f| {
+                let next = numbers.len() as u32;
+                *numbers.entry(find(&root, f)).or_insert(next)
+            })
+            .collect();
+        prop_assert_eq!(adj.components(), &plain[..]);
     }
 
     #[test]

@@ -6,7 +6,8 @@
 //!   mask when given;
 //! - [`rays`]: shadow-ray origins and the scene BVH, for the ray-traced references.
 //!
-//! [`per_receiver`] runs a technique's per-pixel answer over the G-buffer's receivers.
+//! [`per_receiver`] runs a technique's per-pixel answer over the G-buffer's receivers
+//! ([`per_receiver_casting`] for one that casts rays, counting them).
 
 pub mod maps;
 pub mod rays;
@@ -19,11 +20,33 @@ use crate::gbuffer::GBuffer;
 
 /// Fills `out` with `f(x, y, i)` at every receiver pixel (i the pixel index) and 1 elsewhere.
 pub fn per_receiver(g: &GBuffer, out: &mut Image<f32>, f: impl Fn(u32, u32, usize) -> f32 + Sync) {
+    per_receiver_casting(g, out, |x, y, i| (f(x, y, i), 0));
+}
+
+/// [`per_receiver`] for a pass that casts rays: `f` gives a receiver's visibility and the number of rays
+/// it cast (none where the light is below its horizon). Returns the rays cast over the whole image.
+pub fn per_receiver_casting(
+    g: &GBuffer,
+    out: &mut Image<f32>,
+    f: impl Fn(u32, u32, usize) -> (f32, u64) + Sync,
+) -> u64 {
     let w = g.width() as usize;
-    out.data_mut().par_chunks_mut(w).enumerate().for_each(|(y, row)| {
-        for (x, v) in row.iter_mut().enumerate() {
-            let i = y * w + x;
-            *v = if g.receiver.data()[i] { f(x as u32, y as u32, i) } else { 1.0 };
-        }
-    });
+    out.data_mut()
+        .par_chunks_mut(w)
+        .enumerate()
+        .map(|(y, row)| {
+            let mut rays = 0;
+            for (x, v) in row.iter_mut().enumerate() {
+                let i = y * w + x;
+                *v = if g.receiver.data()[i] {
+                    let (visibility, cast) = f(x as u32, y as u32, i);
+                    rays += cast;
+                    visibility
+                } else {
+                    1.0
+                };
+            }
+            rays
+        })
+        .sum()
 }

@@ -4,7 +4,7 @@ use shadow_core::Image;
 use shadow_core::scene::LightKind;
 use shadow_core::technique::LightPass;
 use shadow_core::technique::ShadowTechnique;
-use shadow_cpu::passes::per_receiver;
+use shadow_cpu::passes::per_receiver_casting;
 use shadow_cpu::passes::rays::{RayOrigins, State};
 use shadow_cpu::{CpuBackend, CpuContext, CpuError, GBuffer};
 
@@ -38,7 +38,7 @@ impl ShadowTechnique<CpuBackend> for RayTraced {
         let LightPass { frame, light, stats, .. } = pass;
         let bvh = state.bvh(Self::NAME)?;
         let origins = RayOrigins::new(g, frame, self.epsilon);
-        per_receiver(g, out, |_, _, i| {
+        let rays = per_receiver_casting(g, out, |_, _, i| {
             let (origin, n) = origins.at(i);
             let (dir, tmax) = match light.light.kind {
                 LightKind::Spot { position, .. } | LightKind::Point { position } => {
@@ -48,9 +48,10 @@ impl ShadowTechnique<CpuBackend> for RayTraced {
                 }
                 LightKind::Directional { direction } => (-direction.normalize(), f32::INFINITY),
             };
-            if n.dot(dir) <= 0.0 || bvh.occluded(origin, dir, tmax) { 0.0 } else { 1.0 }
+            // The light below the receiver's horizon: shadowed, and no ray to cast.
+            if n.dot(dir) <= 0.0 { (0.0, 0) } else { (if bvh.occluded(origin, dir, tmax) { 0.0 } else { 1.0 }, 1) }
         });
-        stats.counters.extra.insert("shadow_rays".into(), g.covered_pixels() as f64);
+        stats.counters.extra.insert("rays_cast".into(), rays as f64);
         Ok(())
     }
 }

@@ -201,6 +201,10 @@ pub(crate) enum Command {
         /// flight, no waits or read-backs inside a frame) beside the instrumented frames, with their ratio.
         #[arg(long)]
         realtime: bool,
+        /// Rebuild every frame what a still scene keeps (the meshes' adjacency, the CPU's ray-casting BVH),
+        /// so its cost is measured: the adjacency as its own time, the BVH in the build phase.
+        #[arg(long)]
+        rebuild: bool,
         /// Repeat over a parameter: res=256,512,... (map side) or tris=10000,100000,... (a sphere of that
         /// many triangles on the ground); writes sweep.csv and sweep.png.
         #[arg(long)]

@@ -116,8 +116,8 @@ fn run(cli: Cli) -> Result<(), Error> {
         Command::Compare { scene, view, choice, reference, out_dir } => {
             compare(&scene, &view, &choice, reference.as_deref(), out_dir)
         }
-        Command::Bench { scene, view, choice, frames, warmup, json, realtime, sweep, out_dir } => {
-            bench(&scene, &view, BenchArgs { choice, frames, warmup, json, realtime, sweep, out_dir })
+        Command::Bench { scene, view, choice, frames, warmup, json, realtime, rebuild, sweep, out_dir } => {
+            bench(&scene, &view, BenchArgs { choice, frames, warmup, json, realtime, rebuild, sweep, out_dir })
         }
         Command::Export { scene, out } => export(&scene, &out),
         Command::Flicker { scene, view, technique, frames, step, turn } => {
@@ -544,6 +544,7 @@ struct BenchArgs {
     warmup: u32,
     json: bool,
     realtime: bool,
+    rebuild: bool,
     sweep: Option<String>,
     out_dir: Option<PathBuf>,
 }
@@ -571,6 +572,9 @@ fn bench(args: &SceneArgs, view: &ViewArgs, b: BenchArgs) -> Result<(), Error> {
     let sweep = b.sweep.as_deref().map(parse_sweep).transpose()?;
     if b.realtime && sweep.is_some() {
         return Err(Error::Usage("--realtime does not sweep: leave out --sweep".into()));
+    }
+    if b.realtime && b.rebuild {
+        return Err(Error::Usage("--rebuild times the instrumented frames: leave out --realtime".into()));
     }
     if b.realtime && !["auto", "wgpu"].contains(&b.choice.backend.as_str()) {
         return Err(Error::Usage(format!("--realtime runs on the wgpu backend, not '{}'", b.choice.backend)));
@@ -621,6 +625,7 @@ fn bench_once(
         warmup: b.warmup,
         techniques: specs,
         backends: kinds,
+        rebuild: b.rebuild,
     };
     let bar = progress_bar(if b.realtime { realtime_steps(&job) } else { job.steps() });
     let (json, table) = if b.realtime {
@@ -700,6 +705,7 @@ fn bench_sweep(
             warmup: b.warmup,
             techniques: with_value,
             backends: kinds.clone(),
+            rebuild: b.rebuild,
         };
         let r = run_bench(renderer, &job, |m| report_progress(&bar, &format!("{key}={v}: {m}")))?;
         for e in &r.results {
