@@ -77,17 +77,20 @@ pub fn face_weights(adj: &Adjacency, light: LightSource, mode: CastMode) -> Vec<
         CastMode::Closed => 0,
         CastMode::Bergeron => -1,
     };
+    // +1 facing the light, `unlit` facing away, 0 in its plane: written without a branch, and with the
+    // light's kind matched once, not per face.
+    let sign = |f: f32| i8::from(f > 0.0) + i8::from(f < 0.0) * unlit;
     let mut weights = vec![0i8; adj.planes().len()];
-    weights.par_chunks_mut(8192).zip(adj.planes().par_chunks(8192)).for_each(|(w, planes)| {
-        for (w, &plane) in w.iter_mut().zip(planes) {
-            let f = light.facing(plane);
-            *w = if f > 0.0 {
-                1
-            } else if f < 0.0 {
-                unlit
-            } else {
-                0
-            };
+    weights.par_chunks_mut(8192).zip(adj.planes().par_chunks(8192)).for_each(|(w, planes)| match light {
+        LightSource::Point(l) => {
+            for (w, p) in w.iter_mut().zip(planes) {
+                *w = sign(p.truncate().dot(l) + p.w);
+            }
+        }
+        LightSource::Directional(d) => {
+            for (w, p) in w.iter_mut().zip(planes) {
+                *w = sign(-p.truncate().dot(d));
+            }
         }
     });
     weights
@@ -112,12 +115,11 @@ pub fn silhouette(adj: &Adjacency, light: LightSource, mode: CastMode) -> Silhou
     let mut edges: Vec<SilhouetteEdge> = adj
         .manifold_faces()
         .par_chunks(16384)
-        .enumerate()
-        .flat_map_iter(|(chunk, faces)| {
-            let base = chunk * 16384;
-            faces.iter().enumerate().filter_map(move |(i, &[f0, f1])| {
+        .zip(adj.manifold_edges().par_chunks(16384))
+        .flat_map_iter(|(faces, edges)| {
+            faces.iter().zip(edges).filter_map(|(&[f0, f1], e)| {
                 let weight = i32::from(w[f0 as usize]) - i32::from(w[f1 as usize]);
-                if weight == 0 { None } else { oriented(adj.manifold_edges()[base + i].v, weight, f0) }
+                if weight == 0 { None } else { oriented(e.v, weight, f0) }
             })
         })
         .collect();
