@@ -161,6 +161,21 @@ impl Adjacency {
 
         let uses = EdgeUses::gather(&triangles, &degenerate, positions.len());
 
+        // The edges of each run of vertices sorted into the three lists at once, the runs' lists then
+        // joined in order.
+        let lists: Vec<EdgeLists> = (0..positions.len())
+            .step_by(EdgeLists::VERTICES)
+            .collect::<Vec<_>>()
+            .into_par_iter()
+            .map(|first| {
+                let mut lists = EdgeLists::default();
+                for (v, run) in uses.edges(first..(first + EdgeLists::VERTICES).min(positions.len())) {
+                    lists.add(v, run);
+                }
+                lists
+            })
+            .collect();
+        let manifold = lists.iter().map(|l| l.manifold.len()).sum();
         let mut adj = Self {
             component: Vec::new(),
             component_bounds: Vec::new(),
@@ -169,34 +184,22 @@ impl Adjacency {
             triangles,
             planes,
             degenerate,
-            manifold: Vec::with_capacity(uses.len() / 2),
-            manifold_faces: Vec::with_capacity(uses.len() / 2),
+            manifold: Vec::with_capacity(manifold),
+            manifold_faces: Vec::with_capacity(manifold),
             boundary: Vec::new(),
             boundary_faces: Vec::new(),
             complex: Vec::new(),
             non_manifold_edges: 0,
             inconsistent_edges: 0,
         };
-        for (v, run) in uses.edges() {
-            match *run {
-                [(_, f)] => {
-                    adj.boundary.push(Edge { v });
-                    adj.boundary_faces.push(f);
-                }
-                [(_, f0), (_, f1)] if f0.reversed() != f1.reversed() => {
-                    adj.manifold.push(Edge { v });
-                    let (fwd, rev) = if f0.reversed() { (f1, f0) } else { (f0, f1) };
-                    adj.manifold_faces.push([fwd.face(), rev.face()]);
-                }
-                _ => {
-                    if run.len() == 2 {
-                        adj.inconsistent_edges += 1;
-                    } else {
-                        adj.non_manifold_edges += 1;
-                    }
-                    adj.complex.push(ComplexEdge { v, uses: run.iter().map(|u| u.1).collect() });
-                }
-            }
+        for l in lists {
+            adj.manifold.extend_from_slice(&l.manifold);
+            adj.manifold_faces.extend_from_slice(&l.manifold_faces);
+            adj.boundary.extend_from_slice(&l.boundary);
+            adj.boundary_faces.extend_from_slice(&l.boundary_faces);
+            adj.complex.extend(l.complex);
+            adj.non_manifold_edges += l.non_manifold;
+            adj.inconsistent_edges += l.inconsistent;
         }
         (adj.component, adj.component_bounds) = components(&adj);
         adj
@@ -382,18 +385,55 @@ impl EdgeUses {
         Self { start, uses }
     }
 
-    /// Number of uses.
-    fn len(&self) -> usize {
-        self.uses.len()
-    }
-
-    /// Each edge's welded endpoints (lower first) and its uses, each with the higher endpoint.
-    fn edges(&self) -> impl Iterator<Item = ([u32; 2], &[(u32, FaceUse)])> {
-        self.start.windows(2).enumerate().flat_map(move |(lo, w)| {
+    /// Each edge whose lower endpoint is in `lower`: its welded endpoints (lower first) and its uses,
+    /// each with the higher endpoint.
+    fn edges(&self, lower: std::ops::Range<usize>) -> impl Iterator<Item = ([u32; 2], &[(u32, FaceUse)])> {
+        let first = lower.start;
+        self.start[lower.start..=lower.end].windows(2).enumerate().flat_map(move |(k, w)| {
             self.uses[w[0] as usize..w[1] as usize]
                 .chunk_by(|x, y| x.0 == y.0)
-                .map(move |run| ([lo as u32, run[0].0], run))
+                .map(move |run| ([(first + k) as u32, run[0].0], run))
         })
+    }
+}
+
+/// Edges sorted by their uses (see [`Adjacency`]'s lists), for one run of lower endpoints.
+#[derive(Default)]
+struct EdgeLists {
+    manifold: Vec<Edge>,
+    manifold_faces: Vec<[u32; 2]>,
+    boundary: Vec<Edge>,
+    boundary_faces: Vec<FaceUse>,
+    complex: Vec<ComplexEdge>,
+    non_manifold: usize,
+    inconsistent: usize,
+}
+
+impl EdgeLists {
+    /// Lower endpoints a task sorts the edges of.
+    const VERTICES: usize = 16384;
+
+    /// Puts edge `v` with its uses `run` into its list.
+    fn add(&mut self, v: [u32; 2], run: &[(u32, FaceUse)]) {
+        match *run {
+            [(_, f)] => {
+                self.boundary.push(Edge { v });
+                self.boundary_faces.push(f);
+            }
+            [(_, f0), (_, f1)] if f0.reversed() != f1.reversed() => {
+                self.manifold.push(Edge { v });
+                let (fwd, rev) = if f0.reversed() { (f1, f0) } else { (f0, f1) };
+                self.manifold_faces.push([fwd.face(), rev.face()]);
+            }
+            _ => {
+                if run.len() == 2 {
+                    self.inconsistent += 1;
+                } else {
+                    self.non_manifold += 1;
+                }
+                self.complex.push(ComplexEdge { v, uses: run.iter().map(|u| u.1).collect() });
+            }
+        }
     }
 }
 

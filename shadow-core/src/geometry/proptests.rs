@@ -4,6 +4,7 @@ use std::collections::HashMap;
 
 use glam::{Vec2, Vec3};
 use proptest::prelude::*;
+use proptest::test_runner::TestCaseError;
 
 use super::LightSource;
 use super::adjacency::{Adjacency, FaceUse};
@@ -118,6 +119,68 @@ fn brute_force_uses(adj: &Adjacency) -> HashMap<(u32, u32), (u32, u32)> {
     uses
 }
 
+/// [`Adjacency::build`] against [`plainly`]: the weld, every edge in its list in the sort's order, and
+/// the components.
+fn same_as_plainly(mesh: &Mesh) -> Result<(), TestCaseError> {
+    let adj = Adjacency::build(mesh);
+    let (welded, remap, edges) = plainly(mesh);
+    prop_assert_eq!(adj.positions(), &welded[..]);
+    prop_assert_eq!(adj.remap(), &remap[..]);
+    // Every edge, in the sort's order, in the list its uses put it in.
+    let (mut manifold, mut boundary, mut complex) = (0, 0, 0);
+    for (v, uses) in &edges {
+        let reversed = |k: usize| uses[k].reversed();
+        if uses.len() == 2 && reversed(0) != reversed(1) {
+            prop_assert_eq!(adj.manifold_edges()[manifold].v, *v);
+            let faces = if reversed(0) { [uses[1], uses[0]] } else { [uses[0], uses[1]] };
+            prop_assert_eq!(adj.manifold_faces()[manifold], faces.map(|u| u.face()));
+            manifold += 1;
+        } else if uses.len() == 1 {
+            prop_assert_eq!((adj.boundary_edges()[boundary].v, adj.boundary_faces()[boundary]), (*v, uses[0]));
+            boundary += 1;
+        } else {
+            prop_assert_eq!(&adj.complex_edges()[complex].uses, uses);
+            prop_assert_eq!(adj.complex_edges()[complex].v, *v);
+            complex += 1;
+        }
+    }
+    prop_assert_eq!(
+        (manifold, boundary, complex),
+        (adj.manifold_edges().len(), adj.boundary_edges().len(), adj.complex_edges().len())
+    );
+    // Components: faces joined through every edge's uses, numbered in order of first appearance.
+    let mut root: Vec<usize> = (0..adj.triangles().len()).collect();
+    let find = |root: &Vec<usize>, mut f: usize| {
+        while root[f] != f {
+            f = root[f];
+        }
+        f
+    };
+    for (_, uses) in &edges {
+        for u in &uses[1..] {
+            let (a, b) = (find(&root, uses[0].face() as usize), find(&root, u.face() as usize));
+            root[a.max(b)] = a.min(b);
+        }
+    }
+    let mut numbers = HashMap::new();
+    let plain: Vec<u32> = (0..root.len())
+        .map(|f| {
+            let next = numbers.len() as u32;
+            *numbers.entry(find(&root, f)).or_insert(next)
+        })
+        .collect();
+    prop_assert_eq!(adj.components(), &plain[..]);
+    Ok(())
+}
+
+#[test]
+fn a_mesh_of_many_vertex_runs_is_built_as_the_plain_way_builds_it() {
+    // Over 16384 welded vertices, so the edges are sorted in several runs and the runs joined.
+    let sphere = procedural::sphere(1.0, 400, 200).expect("a sphere");
+    assert!(Adjacency::build(&sphere).vertex_count() > 3 * 16384);
+    same_as_plainly(&sphere).expect("the same adjacency");
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(200))]
 
@@ -150,51 +213,7 @@ proptest! {
     fn the_weld_and_the_edges_are_those_of_one_map_and_one_sort(
         mesh in prop_oneof![closed_mesh(), open_mesh(), welded_mesh()]
     ) {
-        let adj = Adjacency::build(&mesh);
-        let (welded, remap, edges) = plainly(&mesh);
-        prop_assert_eq!(adj.positions(), &welded[..]);
-        prop_assert_eq!(adj.remap(), &remap[..]);
-        // Every edge, in the sort's order, in the list its uses put it in.
-        let (mut manifold, mut boundary, mut complex) = (0, 0, 0);
-        for (v, uses) in &edges {
-            let reversed = |k: usize| uses[k].reversed();
-            if uses.len() == 2 && reversed(0) != reversed(1) {
-                prop_assert_eq!(adj.manifold_edges()[manifold].v, *v);
-                let faces = if reversed(0) { [uses[1], uses[0]] } else { [uses[0], uses[1]] };
-                prop_assert_eq!(adj.manifold_faces()[manifold], faces.map(|u| u.face()));
-                manifold += 1;
-            } else if uses.len() == 1 {
-                prop_assert_eq!((adj.boundary_edges()[boundary].v, adj.boundary_faces()[boundary]), (*v, uses[0]));
-                boundary += 1;
-            } else {
-                prop_assert_eq!(&adj.complex_edges()[complex].uses, uses);
-                prop_assert_eq!(adj.complex_edges()[complex].v, *v);
-                complex += 1;
-            }
-        }
-        prop_assert_eq!((manifold, boundary, complex), (adj.manifold_edges().len(), adj.boundary_edges().len(), adj.complex_edges().len()));
-        // Components: faces joined through every edge's uses, numbered in order of first appearance.
-        let mut root: Vec<usize> = (0..adj.triangles().len()).collect();
-        let find = |root: &Vec<usize>, mut f: usize| {
-            while root[f] != f {
-                f = root[f];
-            }
-            f
-        };
-        for (_, uses) in &edges {
-            for u in &uses[1..] {
-                let (a, b) = (find(&root, uses[0].face() as usize), find(&root, u.face() as usize));
-                root[a.max(b)] = a.min(b);
-            }
-        }
-        let mut numbers = HashMap::new();
-        let plain: Vec<u32> = (0..root.len())
-            .map(|f| {
-                let next = numbers.len() as u32;
-                *numbers.entry(find(&root, f)).or_insert(next)
-            })
-            .collect();
-        prop_assert_eq!(adj.components(), &plain[..]);
+        same_as_plainly(&mesh)?;
     }
 
     #[test]
