@@ -1,0 +1,166 @@
+//! Shadow rays against Embree, side by side in one run: the rays `ray-traced` casts over the G-buffer of
+//! `tree` and of `outdoor` (788k triangles) at 1024x768, traced by our BVH on one thread and on all, and,
+//! where Python has the embreex binding (`pip install numpy embreex`), the same rays through Embree's
+//! occluded query on one thread (`embree_rays.py` beside this file); with both BVH builds (Embree's is
+//! its scene commit, on all threads; the binding's copy of the triangles is left out) and the rays whose
+//! answers differ. A development measurement: Embree is never a dependency of the library.
+//! `cargo bench -p shadow-hard --bench rays`.
+
+use std::path::Path;
+use std::process::Command;
+use std::time::Instant;
+
+use rayon::prelude::*;
+use shadow_core::FrameInputs;
+use shadow_core::glam::Vec3;
+use shadow_core::scene::LightKind;
+use shadow_core::scenes::{self, SceneParams};
+use shadow_core::technique::TechniqueSettings;
+use shadow_cpu::bvh::SceneBvh;
+use shadow_cpu::gbuffer;
+use shadow_cpu::passes::rays::RayOrigins;
+use shadow_hard::RayTraced;
+
+/// Each timing is the median of this many runs.
+const RUNS: usize = 5;
+
+/// A shadow ray: origin, unit direction, far distance.
+type Ray = (Vec3, Vec3, f32);
+
+fn main() {
+    let folder = std::env::temp_dir().join("shadowlab-rays");
+    if let Err(e) = std::fs::create_dir_all(&folder) {
+        eprintln!("cannot make {}: {e}", folder.display());
+        std::process::exit(1);
+    }
+    let embree =
+        Command::new("python3").args(["-c", "import numpy, embreex"]).output().is_ok_and(|o| o.status.success());
+    if !embree {
+        println!("Embree not found (python3 with numpy and embreex: pip install numpy embreex): ours only");
+    }
+    println!(
+        "{:<8} {:>9} {:>9} | {:>10} {:>10} {:>10} {:>6} | {:>9} {:>9} {:>6} | {:>8}",
+        "scene", "triangles", "rays", "ours 1T", "ours all", "Embree 1T", "ratio", "build", "Embree", "ratio", "differ"
+    );
+    println!(
+        "{:<8} {:>9} {:>9} | {:>39} | {:>26} |",
+        "", "", "", "Mrays/s (median), ratio ours / Embree", "ms (median), ours / Embree"
+    );
+    for name in ["tree", "outdoor"] {
+        measure(name, &folder, embree);
+    }
+}
+
+fn measure(name: &str, folder: &Path, embree: bool) {
+    let scene = scenes::build(name, &SceneParams::default()).expect("built-in scene");
+    let frame = FrameInputs::from_first_camera(&scene).expect("frame");
+    let rays = shadow_rays(&frame, 1024, 768);
+    let build = median((0..RUNS).map(|_| timed(|| SceneBvh::build(&frame)).0).collect());
+    let bvh = SceneBvh::build(&frame);
+    let ours: Vec<bool> = rays.iter().map(|&(o, d, t)| bvh.occluded(o, d, t)).collect();
+    let one = median(
+        (0..RUNS).map(|_| timed(|| rays.iter().filter(|&&(o, d, t)| bvh.occluded(o, d, t)).count()).0).collect(),
+    );
+    let all = median(
+        (0..RUNS)
+            .map(|_| timed(|| rays.par_iter().with_min_len(4096).filter(|&&(o, d, t)| bvh.occluded(o, d, t)).count()).0)
+            .collect(),
+    );
+    let rate = |ms: f64| rays.len() as f64 / ms / 1e3;
+    let theirs = if embree { embree_run(name, folder, &frame, &rays) } else { None };
+    let (e_rate, e_build, differ) = match &theirs {
+        Some((trace, build, answers)) => (
+            format!("{:.2}", rate(*trace)),
+            format!("{build:.1}"),
+            ours.iter().zip(answers).filter(|(a, b)| a != b).count().to_string(),
+        ),
+        None => ("-".into(), "-".into(), "-".into()),
+    };
+    let ratio = |a: f64, b: Option<f64>| b.map_or("-".into(), |b| format!("{:.2}", a / b));
+    println!(
+        "{name:<8} {:>9} {:>9} | {:>10.2} {:>10.2} {e_rate:>10} {:>6} | {build:>9.1} {e_build:>9} {:>6} | {differ:>8}",
+        bvh.triangle_count(),
+        rays.len(),
+        rate(one),
+        rate(all),
+        ratio(rate(one), theirs.as_ref().map(|t| rate(t.0))),
+        ratio(build, theirs.as_ref().map(|t| t.1)),
+    );
+}
+
+/// The rays `ray-traced` casts over the frame's G-buffer: from each receiver whose light is above its
+/// horizon, towards the light's position (up to it) or against a directional light's direction.
+fn shadow_rays(frame: &FrameInputs, w: u32, h: u32) -> Vec<Ray> {
+    let g = gbuffer::render(frame, w, h).expect("G-buffer");
+    let origins = RayOrigins::new(&g, frame, RayTraced::defaults().epsilon);
+    let light = frame.lights[0].kind;
+    (0..g.receiver.data().len())
+        .filter(|&i| g.receiver.data()[i])
+        .filter_map(|i| {
+            let (origin, n) = origins.at(i);
+            let (dir, far) = match light {
+                LightKind::Spot { position, .. } | LightKind::Point { position } => {
+                    let d = position - origin;
+                    (d / d.length(), d.length())
+                }
+                LightKind::Directional { direction } => (-direction.normalize(), f32::INFINITY),
+            };
+            (n.dot(dir) > 0.0).then_some((origin, dir, far))
+        })
+        .collect()
+}
+
+/// Writes the casting triangles and the rays, has Embree trace them, and reads its answers: trace and
+/// build milliseconds, and whether each ray is occluded. `None` (with a line saying why) when it fails.
+fn embree_run(name: &str, folder: &Path, frame: &FrameInputs, rays: &[Ray]) -> Option<(f64, f64, Vec<bool>)> {
+    let mut tris = Vec::new();
+    for inst in frame.instances.iter().filter(|i| i.casts_shadow) {
+        let p = inst.mesh.positions();
+        for t in inst.mesh.triangles() {
+            for &k in t {
+                tris.extend(inst.world_from_local.transform_point3(p[k as usize]).to_array());
+            }
+        }
+    }
+    let flat: Vec<f32> = rays.iter().flat_map(|(o, d, t)| [o.x, o.y, o.z, d.x, d.y, d.z, *t]).collect();
+    let write = |ext: &str, v: &[f32]| {
+        let bytes: Vec<u8> = v.iter().flat_map(|f| f.to_le_bytes()).collect();
+        std::fs::write(folder.join(format!("{name}.{ext}")), bytes)
+    };
+    if let Err(e) = write("tris", &tris).and_then(|()| write("rays", &flat)) {
+        eprintln!("{name}: cannot write the ray set to {}: {e}", folder.display());
+        return None;
+    }
+    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/benches/embree_rays.py");
+    let (mut trace, mut build) = (Vec::new(), Vec::new());
+    for _ in 0..RUNS {
+        let out = Command::new("python3").arg(script).arg(folder).arg(name).output().ok()?;
+        let text = String::from_utf8_lossy(&out.stdout);
+        let field =
+            |key: &str| text.split_whitespace().find_map(|kv| kv.strip_prefix(key).and_then(|v| v.parse::<f64>().ok()));
+        match (field("trace_ms="), field("build_ms=")) {
+            (Some(t), Some(b)) => {
+                trace.push(t);
+                build.push(b);
+            }
+            _ => {
+                eprintln!("{name}: Embree run failed: {}", String::from_utf8_lossy(&out.stderr).trim());
+                return None;
+            }
+        }
+    }
+    let answers = std::fs::read(folder.join(format!("{name}.embree"))).ok()?;
+    (answers.len() == rays.len()).then(|| (median(trace), median(build), answers.iter().map(|&a| a == 1).collect()))
+}
+
+/// Milliseconds `f` took, and what it gave.
+fn timed<T>(f: impl FnOnce() -> T) -> (f64, T) {
+    let start = Instant::now();
+    let out = std::hint::black_box(f());
+    (start.elapsed().as_secs_f64() * 1e3, out)
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
