@@ -104,4 +104,31 @@ mod tests {
             assert!(bvh.occluded(origin, dir, f32::INFINITY), "{origin} {dir}");
         }
     }
+
+    /// Every shadow ray of a frame gets the answer that testing every triangle gives: the traversal never
+    /// passes by a box that holds a hit, nor reports one that no triangle has.
+    #[test]
+    fn every_shadow_ray_is_answered_as_all_triangles_answer_it() {
+        let scene = scenes::build("cubes", &SceneParams::default()).unwrap();
+        let frame = FrameInputs::from_first_camera(&scene).unwrap();
+        let bvh = SceneBvh::build(&frame);
+        let g = crate::gbuffer::render(&frame, 48, 36).unwrap();
+        // The offset `ray-traced` uses by default (shadow-hard's `epsilon`).
+        let origins = crate::passes::rays::RayOrigins::new(&g, &frame, 5e-7);
+        let light = frame.lights[0].position().expect("a positioned light");
+        let (mut cast, mut blocked) = (0, 0);
+        for i in (0..g.receiver.data().len()).filter(|&i| g.receiver.data()[i]) {
+            let (origin, n) = origins.at(i);
+            let (dir, tmax) = ((light - origin).normalize(), (light - origin).length());
+            if n.dot(dir) <= 0.0 {
+                continue;
+            }
+            let ray = Ray::new(origin.into(), dir.map(|c| if c == 0.0 { 0.0 } else { c }).into(), 0.0, tmax);
+            let any = bvh.tris.iter().any(|t| t.intersect(&ray) < tmax);
+            assert_eq!(bvh.occluded(origin, dir, tmax), any, "pixel {i}: {origin} towards {dir}");
+            cast += 1;
+            blocked += usize::from(any);
+        }
+        assert!(blocked > 0 && blocked < cast, "{blocked} of {cast} rays blocked: both answers are checked");
+    }
 }
