@@ -115,11 +115,11 @@ mod tests {
         let g = crate::gbuffer::render(&frame, 48, 36).unwrap();
         // The offset `ray-traced` uses by default (shadow-hard's `epsilon`).
         let origins = crate::passes::rays::RayOrigins::new(&g, &frame, 5e-7);
-        let light = frame.lights[0].position().expect("a positioned light");
+        let light = &frame.lights[0].kind;
         let (mut cast, mut blocked) = (0, 0);
         for i in (0..g.receiver.data().len()).filter(|&i| g.receiver.data()[i]) {
             let (origin, n) = origins.at(i);
-            let (dir, tmax) = ((light - origin).normalize(), (light - origin).length());
+            let (dir, tmax) = crate::passes::rays::towards(light, origin);
             if n.dot(dir) <= 0.0 {
                 continue;
             }

@@ -13,12 +13,11 @@ use std::time::Instant;
 use rayon::prelude::*;
 use shadow_core::FrameInputs;
 use shadow_core::glam::Vec3;
-use shadow_core::scene::LightKind;
 use shadow_core::scenes::{self, SceneParams};
 use shadow_core::technique::TechniqueSettings;
 use shadow_cpu::bvh::SceneBvh;
 use shadow_cpu::gbuffer;
-use shadow_cpu::passes::rays::RayOrigins;
+use shadow_cpu::passes::rays::{RayOrigins, towards};
 use shadow_hard::RayTraced;
 
 /// Each timing is the median of this many runs.
@@ -93,18 +92,12 @@ fn measure(name: &str, folder: &Path, embree: bool) {
 fn shadow_rays(frame: &FrameInputs, w: u32, h: u32) -> Vec<Ray> {
     let g = gbuffer::render(frame, w, h).expect("G-buffer");
     let origins = RayOrigins::new(&g, frame, RayTraced::defaults().epsilon);
-    let light = frame.lights[0].kind;
+    let light = &frame.lights[0].kind;
     (0..g.receiver.data().len())
         .filter(|&i| g.receiver.data()[i])
         .filter_map(|i| {
             let (origin, n) = origins.at(i);
-            let (dir, far) = match light {
-                LightKind::Spot { position, .. } | LightKind::Point { position } => {
-                    let d = position - origin;
-                    (d / d.length(), d.length())
-                }
-                LightKind::Directional { direction } => (-direction.normalize(), f32::INFINITY),
-            };
+            let (dir, far) = towards(light, origin);
             (n.dot(dir) > 0.0).then_some((origin, dir, far))
         })
         .collect()

@@ -4,6 +4,7 @@
 
 use shadow_core::FrameInputs;
 use shadow_core::glam::Vec3;
+use shadow_core::scene::LightKind;
 use shadow_core::technique::TechniqueError;
 
 use crate::bvh::SceneBvh;
@@ -51,5 +52,19 @@ impl<'a> RayOrigins<'a> {
     pub fn at(&self, i: usize) -> (Vec3, Vec3) {
         let n = self.g.geometric_normal.data()[i];
         (self.g.position.data()[i] + n * self.offset, n)
+    }
+}
+
+/// The shadow ray from `origin` to a light: its unit direction and how far it runs (to the light's
+/// position, or without end against a directional light's direction).
+#[must_use]
+pub fn towards(light: &LightKind, origin: Vec3) -> (Vec3, f32) {
+    match *light {
+        LightKind::Spot { position, .. } | LightKind::Point { position } => {
+            let d = position - origin;
+            let len = d.length();
+            (d / len, len)
+        }
+        LightKind::Directional { direction } => (-direction.normalize(), f32::INFINITY),
     }
 }

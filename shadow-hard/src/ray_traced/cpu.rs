@@ -1,11 +1,10 @@
 //! `ray-traced` on the CPU: one ray per receiver through the scene BVH (`passes::rays`).
 
 use shadow_core::Image;
-use shadow_core::scene::LightKind;
 use shadow_core::technique::LightPass;
 use shadow_core::technique::ShadowTechnique;
 use shadow_cpu::passes::per_receiver_casting;
-use shadow_cpu::passes::rays::{RayOrigins, State};
+use shadow_cpu::passes::rays::{RayOrigins, State, towards};
 use shadow_cpu::{CpuBackend, CpuContext, CpuError, GBuffer};
 
 use super::RayTraced;
@@ -40,14 +39,7 @@ impl ShadowTechnique<CpuBackend> for RayTraced {
         let origins = RayOrigins::new(g, frame, self.epsilon);
         let rays = per_receiver_casting(g, out, |_, _, i| {
             let (origin, n) = origins.at(i);
-            let (dir, tmax) = match light.light.kind {
-                LightKind::Spot { position, .. } | LightKind::Point { position } => {
-                    let d = position - origin;
-                    let len = d.length();
-                    (d / len, len)
-                }
-                LightKind::Directional { direction } => (-direction.normalize(), f32::INFINITY),
-            };
+            let (dir, tmax) = towards(&light.light.kind, origin);
             // The light below the receiver's horizon: shadowed, and no ray to cast.
             if n.dot(dir) <= 0.0 { (0.0, 0) } else { (if bvh.occluded(origin, dir, tmax) { 0.0 } else { 1.0 }, 1) }
         });
