@@ -3,7 +3,8 @@
 //! where Python has the embreex binding (`pip install numpy embreex`), the same rays through Embree's
 //! occluded query on one thread (`embree_rays.py` beside this file); with both BVH builds (Embree's is
 //! its scene commit, on all threads; the binding's copy of the triangles is left out) and the rays whose
-//! answers differ. A development measurement: Embree is never a dependency of the library.
+//! answers differ. Ours and Embree take turns run by run, so the ratios hold through the machine's
+//! drifts in speed. A development measurement: Embree is never a dependency of the library.
 //! `cargo bench -p shadow-hard --bench rays`.
 
 use std::path::Path;
@@ -54,19 +55,25 @@ fn measure(name: &str, folder: &Path, embree: bool) {
     let scene = scenes::build(name, &SceneParams::default()).expect("built-in scene");
     let frame = FrameInputs::from_first_camera(&scene).expect("frame");
     let rays = shadow_rays(&frame, 1024, 768);
-    let build = median((0..RUNS).map(|_| timed(|| SceneBvh::build(&frame)).0).collect());
     let bvh = SceneBvh::build(&frame);
     let ours: Vec<bool> = rays.iter().map(|&(o, d, t)| bvh.occluded(o, d, t)).collect();
-    let one = median(
-        (0..RUNS).map(|_| timed(|| rays.iter().filter(|&&(o, d, t)| bvh.occluded(o, d, t)).count()).0).collect(),
-    );
-    let all = median(
-        (0..RUNS)
-            .map(|_| timed(|| rays.par_iter().with_min_len(4096).filter(|&&(o, d, t)| bvh.occluded(o, d, t)).count()).0)
-            .collect(),
-    );
+    let embree = embree && dump(name, folder, &frame, &rays);
+    // Ours and Embree's turn about, run by run, so a drift of the machine's speed weighs on both alike.
+    let (mut build, mut one, mut all, mut theirs) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    for _ in 0..RUNS {
+        build.push(timed(|| SceneBvh::build(&frame)).0);
+        one.push(timed(|| rays.iter().filter(|&&(o, d, t)| bvh.occluded(o, d, t)).count()).0);
+        all.push(timed(|| rays.par_iter().with_min_len(4096).filter(|&&(o, d, t)| bvh.occluded(o, d, t)).count()).0);
+        if embree {
+            theirs.extend(embree_once(name, folder));
+        }
+    }
+    let (build, one, all) = (median(build), median(one), median(all));
+    let theirs =
+        (embree && theirs.len() == RUNS).then(|| embree_answers(name, folder, rays.len())).flatten().map(|answers| {
+            (median(theirs.iter().map(|t| t.0).collect()), median(theirs.iter().map(|t| t.1).collect()), answers)
+        });
     let rate = |ms: f64| rays.len() as f64 / ms / 1e3;
-    let theirs = if embree { embree_run(name, folder, &frame, &rays) } else { None };
     let (e_rate, e_build, differ) = match &theirs {
         Some((trace, build, answers)) => (
             format!("{:.2}", rate(*trace)),
@@ -103,9 +110,9 @@ fn shadow_rays(frame: &FrameInputs, w: u32, h: u32) -> Vec<Ray> {
         .collect()
 }
 
-/// Writes the casting triangles and the rays, has Embree trace them, and reads its answers: trace and
-/// build milliseconds, and whether each ray is occluded. `None` (with a line saying why) when it fails.
-fn embree_run(name: &str, folder: &Path, frame: &FrameInputs, rays: &[Ray]) -> Option<(f64, f64, Vec<bool>)> {
+/// Writes the casting triangles and the rays for `embree_rays.py`; false (with a line saying why) when
+/// it cannot.
+fn dump(name: &str, folder: &Path, frame: &FrameInputs, rays: &[Ray]) -> bool {
     let mut tris = Vec::new();
     for inst in frame.instances.iter().filter(|i| i.casts_shadow) {
         let p = inst.mesh.positions();
@@ -122,28 +129,30 @@ fn embree_run(name: &str, folder: &Path, frame: &FrameInputs, rays: &[Ray]) -> O
     };
     if let Err(e) = write("tris", &tris).and_then(|()| write("rays", &flat)) {
         eprintln!("{name}: cannot write the ray set to {}: {e}", folder.display());
-        return None;
+        return false;
     }
+    true
+}
+
+/// One Embree run over the dumped set: trace and build milliseconds. `None` (with a line saying why)
+/// when it fails.
+fn embree_once(name: &str, folder: &Path) -> Option<(f64, f64)> {
     let script = concat!(env!("CARGO_MANIFEST_DIR"), "/benches/embree_rays.py");
-    let (mut trace, mut build) = (Vec::new(), Vec::new());
-    for _ in 0..RUNS {
-        let out = Command::new("python3").arg(script).arg(folder).arg(name).output().ok()?;
-        let text = String::from_utf8_lossy(&out.stdout);
-        let field =
-            |key: &str| text.split_whitespace().find_map(|kv| kv.strip_prefix(key).and_then(|v| v.parse::<f64>().ok()));
-        match (field("trace_ms="), field("build_ms=")) {
-            (Some(t), Some(b)) => {
-                trace.push(t);
-                build.push(b);
-            }
-            _ => {
-                eprintln!("{name}: Embree run failed: {}", String::from_utf8_lossy(&out.stderr).trim());
-                return None;
-            }
-        }
+    let out = Command::new("python3").arg(script).arg(folder).arg(name).output().ok()?;
+    let text = String::from_utf8_lossy(&out.stdout);
+    let field =
+        |key: &str| text.split_whitespace().find_map(|kv| kv.strip_prefix(key).and_then(|v| v.parse::<f64>().ok()));
+    let times = field("trace_ms=").zip(field("build_ms="));
+    if times.is_none() {
+        eprintln!("{name}: Embree run failed: {}", String::from_utf8_lossy(&out.stderr).trim());
     }
+    times
+}
+
+/// Embree's answers to the dumped set: whether each ray is occluded.
+fn embree_answers(name: &str, folder: &Path, rays: usize) -> Option<Vec<bool>> {
     let answers = std::fs::read(folder.join(format!("{name}.embree"))).ok()?;
-    (answers.len() == rays.len()).then(|| (median(trace), median(build), answers.iter().map(|&a| a == 1).collect()))
+    (answers.len() == rays).then(|| answers.iter().map(|&a| a == 1).collect())
 }
 
 /// Milliseconds `f` took, and what it gave.
