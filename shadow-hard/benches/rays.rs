@@ -23,6 +23,8 @@ use shadow_hard::RayTraced;
 
 /// Each timing is the median of this many runs.
 const RUNS: usize = 5;
+/// BVH builds in a row per run, on each side (`BUILDS` in `embree_rays.py`); the median counts.
+const BUILDS: usize = 3;
 
 /// A shadow ray: origin, unit direction, far distance.
 type Ray = (Vec3, Vec3, f32);
@@ -61,7 +63,9 @@ fn measure(name: &str, folder: &Path, embree: bool) {
     // Ours and Embree's turn about, run by run, so a drift of the machine's speed weighs on both alike.
     let (mut build, mut one, mut all, mut theirs) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for _ in 0..RUNS {
-        build.push(timed(|| SceneBvh::build(&frame)).0);
+        // Each side builds its BVH a few times in a row (the first after the other's run, from cold
+        // caches) and keeps the median.
+        build.push(median((0..BUILDS).map(|_| timed(|| SceneBvh::build(&frame)).0).collect()));
         one.push(timed(|| rays.iter().filter(|&&(o, d, t)| bvh.occluded(o, d, t)).count()).0);
         all.push(timed(|| rays.par_iter().with_min_len(4096).filter(|&&(o, d, t)| bvh.occluded(o, d, t)).count()).0);
         if embree {
