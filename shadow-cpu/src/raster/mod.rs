@@ -184,7 +184,7 @@ where
     F: Fn(&Fragment) -> Option<T> + Sync,
     B: Fn(&mut T, T) + Sync,
 {
-    draw_with(ds, color, src, st, (Path::General, None), shader, blend)
+    draw_with(ds, color, src, st, (Path::General, None), None, shader, blend)
 }
 
 /// A draw whose colour is one value per primitive, `value(prim)`: a visibility buffer of primitive ids, an
@@ -212,7 +212,7 @@ where
         Some(k @ DepthKernel::Depth { write: true, .. }) => Path::Flat(k),
         _ => Path::General,
     };
-    draw_with(ds, color, src, st, (path, None), shader, |d, v| *d = v)
+    draw_with(ds, color, src, st, (path, None), None, shader, |d, v| *d = v)
 }
 
 /// Depth (and stencil) only: shadow-map renders and shadow-volume counting take branch-free inner loops.
@@ -240,15 +240,45 @@ pub fn draw_depth_masked<S: TriangleSource + ?Sized>(
     }
     let mut none = Image::new(ds.width, ds.height, ());
     let path = DepthKernel::for_state(st).map_or(Path::General, Path::Depth);
-    draw_with(ds, &mut none, src, st, (path, mask), |_| Some(()), |_, _| {})
+    draw_with(ds, &mut none, src, st, (path, mask), None, |_| Some(()), |_, _| {})
 }
 
+/// Depth peeling (Everitt, "Interactive Order-Independent Transparency", 2001): a depth-only draw that
+/// discards every fragment not more than `epsilon` beyond the depth `under` holds at its pixel, before
+/// the depth test, so a peeled fragment leaves no depth. With a writing depth test and no stencil it
+/// takes a branch-free inner loop like [`draw_depth`]'s; the same depths and counters as [`draw`] with
+/// `|f| (f.depth > under[f] + epsilon).then_some(())` and late fragment tests, which it falls back to
+/// for any other state.
+///
+/// # Panics
+/// When `under` is not the size of `ds`: a caller bug.
+pub fn draw_depth_peeled<S: TriangleSource + ?Sized>(
+    ds: &mut DepthStencil,
+    src: &S,
+    st: &RasterState,
+    under: &Image<f32>,
+    epsilon: f32,
+) -> RasterCounters {
+    assert_eq!((under.width(), under.height()), (ds.width, ds.height), "a layer to peel the size of the target");
+    let st = &RasterState { early_tests: false, ..*st };
+    let mut none = Image::new(ds.width, ds.height, ());
+    match DepthKernel::for_state(st) {
+        Some(DepthKernel::Depth { compare, write: true }) => {
+            let path = Path::Peel { compare, epsilon };
+            draw_with(ds, &mut none, src, st, (path, None), Some(under), |_| Some(()), |_, _| {})
+        }
+        _ => draw(ds, &mut none, src, st, |f| (f.depth > *under.get(f.x, f.y) + epsilon).then_some(()), |_, _| {}),
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
 fn draw_with<T, S, F, B>(
     ds: &mut DepthStencil,
     color: &mut Image<T>,
     src: &S,
     st: &RasterState,
     (path, mask): (Path, Option<&ComputationMask>),
+    under: Option<&Image<f32>>,
     shader: F,
     blend: B,
 ) -> RasterCounters
@@ -306,7 +336,8 @@ where
             .map(|(band, (((depth, stencil), col), bin))| {
                 let mut c = RasterCounters::default();
                 let y0 = band as i32 * BAND_ROWS as i32;
-                let mut rows = BandRows { depth, stencil, color: col, y0, width: w as usize };
+                let under = under.map_or(&[][..], |u| &u.data()[band * band_px..][..depth.len()]);
+                let mut rows = BandRows { depth, stencil, color: col, under, y0, width: w as usize };
                 for &t in bin {
                     raster_band(&setups[t as usize], &mut rows, st, (path, mask), (&shader, &blend), &mut c);
                 }
@@ -325,6 +356,8 @@ struct BandRows<'a, T> {
     depth: &'a mut [f32],
     stencil: &'a mut [u8],
     color: &'a mut [T],
+    /// The band's rows of the layer a peeling draw peels (empty for other draws).
+    under: &'a [f32],
     y0: i32,
     width: usize,
 }
@@ -409,6 +442,8 @@ enum Path {
     /// Depth tests that write, through the fast kernel, and where they pass the colour the fragment
     /// closure gives the primitive ([`draw_flat`]); other kernels take the general path.
     Flat(DepthKernel),
+    /// A writing depth test behind a peeled layer ([`draw_depth_peeled`]).
+    Peel { compare: CompareFn, epsilon: f32 },
 }
 
 impl Fragment {
@@ -440,6 +475,30 @@ fn row_flat<T>(
         let pass = compare.test(z, *d);
         *d = if pass { z } else { *d };
         *col = if pass { value } else { *col };
+        passed += u64::from(pass);
+    }
+    c.fragments += depth.len() as u64;
+    c.passed += passed;
+}
+
+/// One row of a peeling draw ([`draw_depth_peeled`]): a fragment passes when it lies more than
+/// `epsilon` beyond the peeled layer and passes the depth test; its depth is then written. Branch-free,
+/// as [`row_fast`].
+#[inline(always)]
+fn row_peel(
+    t: &Setup,
+    (compare, epsilon): (CompareFn, f32),
+    row: RowStart,
+    depth: &mut [f32],
+    under: &[f32],
+    c: &mut RasterCounters,
+) {
+    let RowStart { z_row, clamp, xs } = row;
+    let mut passed = 0u64;
+    for (i, (d, u)) in depth.iter_mut().zip(under).enumerate() {
+        let z = depth_at(t, z_row, xs + i as i32, clamp);
+        let pass = z > *u + epsilon && compare.test(z, *d);
+        *d = if pass { z } else { *d };
         passed += u64::from(pass);
     }
     c.fragments += depth.len() as u64;
@@ -533,6 +592,10 @@ fn raster_band<T, F, B>(
             let start = RowStart { z_row, clamp, xs: a };
             match path {
                 Path::Depth(k) => row_fast(t, k, start, &mut rows.depth[lo..hi], &mut rows.stencil[lo..hi], c),
+                Path::Peel { compare, epsilon } => {
+                    let under = &rows.under[lo..hi];
+                    row_peel(t, (compare, epsilon), start, &mut rows.depth[lo..hi], under, c);
+                }
                 Path::Flat(DepthKernel::Depth { compare, write: true }) => {
                     if let Some(v) = shader(&Fragment::of_primitive(t)) {
                         row_flat(t, compare, start, &mut rows.depth[lo..hi], &mut rows.color[lo..hi], v, c);

@@ -324,6 +324,41 @@ fn fast_kernels_match_the_general_loop() {
 }
 
 #[test]
+fn a_peeling_draw_leaves_what_the_general_loop_leaves() {
+    // Four overlapping layers; the first is drawn, then all are peeled behind it, once through the
+    // peeling kernel and once through the general loop with the peel as the fragment closure. The
+    // second layer lies within epsilon behind the first, so it must be peeled too. Depth clamping on,
+    // and a bias, so every part of the fragment depth is the one the closure sees.
+    let tris = jittered_grid(24, 9, 2.0);
+    let mut rng = shadow_core::scenes::Rng::new(3);
+    let mut all = Vec::new();
+    let first_dz = rng.range(-0.4, 0.4);
+    for dz in [first_dz, first_dz + 5e-4, rng.range(-0.4, 0.4), rng.range(-0.4, 0.4)] {
+        all.extend(tris.iter().map(|t| t.map(|v| Vec4::new(v.x, v.y, v.z + dz * v.w, v.w))));
+    }
+    let src = Soup { triangles: &all, prim_base: 0, flip: false };
+    let bias = DepthBias { constant: 2.0, slope: 1.0, clamp: 0.0 };
+    let st = RasterState {
+        depth: Some(DepthState { bias, clamp: true, ..DepthState::LESS_WRITE }),
+        ..RasterState::default()
+    };
+    let mut first = DepthStencil::new(97, 71, 1.0, 0);
+    draw_depth(&mut first, &Soup { triangles: &all[..tris.len()], ..src }, &st);
+    let under = first.into_depth_image();
+    let epsilon = 1e-3;
+    let (mut a, mut b) = (DepthStencil::new(97, 71, 1.0, 0), DepthStencil::new(97, 71, 1.0, 0));
+    let peeled = draw_depth_peeled(&mut a, &src, &st, &under, epsilon);
+    let mut none = Image::new(97, 71, ());
+    let late = RasterState { early_tests: false, ..st };
+    let general =
+        draw(&mut b, &mut none, &src, &late, |f| (f.depth > *under.get(f.x, f.y) + epsilon).then_some(()), |_, _| {});
+    assert_eq!(a, b);
+    assert_eq!(peeled, general);
+    // Both some fragments peeled away and some kept, so both outcomes were compared.
+    assert!(peeled.passed > 0 && peeled.passed < peeled.fragments, "{peeled:?}");
+}
+
+#[test]
 fn a_batch_draws_what_its_parts_draw_in_turn_and_flat_draws_what_the_general_loop_does() {
     // Three overlapping layers as three meshes, the middle one turned around: drawn one after the other
     // with the general loop (each fragment's colour its layer and triangle), then as one batch through the

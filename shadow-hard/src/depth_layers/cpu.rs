@@ -9,6 +9,8 @@
 //! `culling=auto`, open meshes are never culled: the paper's mix of solid and thin objects in one scene.
 //! The combination is taken on linear depths (see `DepthLayers::combine`).
 
+use rayon::prelude::*;
+
 use super::{DepthLayers, LayerCulling};
 use shadow_core::light::LightProjection;
 use shadow_core::technique::LightPass;
@@ -18,7 +20,7 @@ use shadow_core::{FrameInputs, Image};
 use shadow_cpu::gbuffer::{GBuffer, clip_vertices};
 use shadow_cpu::passes::maps::check_maps;
 use shadow_cpu::passes::maps::{depth_views, query_maps};
-use shadow_cpu::raster::{CullMode, DepthState, DepthStencil, Indexed, RasterState, draw, draw_depth};
+use shadow_cpu::raster::{CullMode, DepthState, DepthStencil, Indexed, RasterState, draw_depth, draw_depth_peeled};
 use shadow_cpu::{CpuBackend, CpuContext, CpuError};
 
 /// The layers and the combined map of the last build, one of each per light projection.
@@ -49,22 +51,8 @@ fn layer_pass(
                 draw_depth(&mut ds, &src, &state);
             }
             Some((z1, eps)) => {
-                // The fragment test must run before the depth test, so a peeled fragment leaves no depth.
-                let state = RasterState {
-                    cull,
-                    depth: Some(DepthState::LESS_WRITE),
-                    early_tests: false,
-                    ..RasterState::default()
-                };
-                let mut none = Image::new(res, res, ());
-                draw(
-                    &mut ds,
-                    &mut none,
-                    &src,
-                    &state,
-                    |f| (f.depth > *z1.get(f.x, f.y) + eps).then_some(()),
-                    |_, _| {},
-                );
+                let state = RasterState { cull, depth: Some(DepthState::LESS_WRITE), ..RasterState::default() };
+                draw_depth_peeled(&mut ds, &src, &state, z1, eps);
             }
         }
     }
@@ -93,13 +81,15 @@ impl ShadowTechnique<CpuBackend> for DepthLayers {
         for proj in &light.projections {
             let z1 = layer_pass(frame, proj, self.resolution, self.culling, None);
             let z2 = layer_pass(frame, proj, self.resolution, self.culling, Some((&z1, self.peel_epsilon)));
-            let combined = Image::from_fn(self.resolution, self.resolution, |x, y| {
-                let (a, b) = (*z1.get(x, y), *z2.get(x, y));
-                if a >= 1.0 {
-                    return 1.0;
-                }
-                proj.ndc_depth(self.combine(proj.linear_depth(a), proj.linear_depth(b)))
-            });
+            // Where the first layer is missing (the far plane) no caster is: the map stays at the far plane.
+            let mut combined = Image::new(self.resolution, self.resolution, 1.0f32);
+            combined.data_mut().par_iter_mut().zip(z1.data()).zip(z2.data()).with_min_len(4096).for_each(
+                |((m, &a), &b)| {
+                    if a < 1.0 {
+                        *m = proj.ndc_depth(self.combine(proj.linear_depth(a), proj.linear_depth(b)));
+                    }
+                },
+            );
             state.z1.push(z1);
             state.z2.push(z2);
             state.maps.push(combined);
