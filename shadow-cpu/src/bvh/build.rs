@@ -7,7 +7,8 @@ use rayon::prelude::*;
 
 use super::wide::{Child, LANES, LEAF, Node4, Tri4};
 
-/// Bins per axis a node's centroids are sorted into.
+/// Bins per axis a node's centroids are sorted into, at most: a node of fewer triangles gets one bin
+/// per triangle, which finds its cuts as well and sweeps fewer bins.
 const BINS: usize = 16;
 /// Triangles a leaf holds at most: one [`Tri4`].
 const LEAF_SIZE: usize = LANES;
@@ -168,25 +169,28 @@ impl Bins {
 struct Binning {
     lo: Vec3A,
     scale: Vec3A,
+    /// Bins in use (at most [`BINS`]).
+    count: usize,
 }
 
 impl Binning {
-    fn new(centres: Aabb) -> Self {
+    fn new(centres: Aabb, triangles: usize) -> Self {
+        let count = triangles.min(BINS);
         let extent = centres.hi - centres.lo;
-        // Scaled a hair under BINS, so the upper bound's centre lands in the last bin, not past it.
-        let scale = Vec3A::select(extent.cmpgt(Vec3A::ZERO), (BINS as f32 * 0.999_99) / extent, Vec3A::ZERO);
-        Self { lo: centres.lo, scale }
+        // Scaled a hair under the count, so the upper bound's centre lands in the last bin, not past it.
+        let scale = Vec3A::select(extent.cmpgt(Vec3A::ZERO), (count as f32 * 0.999_99) / extent, Vec3A::ZERO);
+        Self { lo: centres.lo, scale, count }
     }
 
     /// The bin of a centre along one axis.
     fn bin(&self, centre: Vec3A, axis: usize) -> usize {
         let at = |v: Vec3A| v.to_array()[axis];
-        (((at(centre) - at(self.lo)) * at(self.scale)) as usize).min(BINS - 1)
+        (((at(centre) - at(self.lo)) * at(self.scale)) as usize).min(self.count - 1)
     }
 
     /// The bin of a centre on each axis.
     fn bins(&self, centre: Vec3A) -> [usize; 3] {
-        ((centre - self.lo) * self.scale).to_array().map(|t| (t as usize).min(BINS - 1))
+        ((centre - self.lo) * self.scale).to_array().map(|t| (t as usize).min(self.count - 1))
     }
 
     fn fill(&self, prims: &[Prim], order: &[u32]) -> Bins {
@@ -217,8 +221,8 @@ fn split(prims: &[Prim], order: &mut [u32], start: usize, depth: u32) -> Node2 {
     if n <= LEAF_SIZE {
         return Node2::Leaf { bounds, start, count: n };
     }
-    let binning = Binning::new(centres);
-    let cut = if depth < SAH_DEPTH { best_cut(&binning.fill(prims, order), n) } else { None };
+    let binning = Binning::new(centres, n);
+    let cut = if depth < SAH_DEPTH { best_cut(&binning.fill(prims, order), binning.count, n) } else { None };
     let mid = match cut {
         Some((axis, bin)) => partition(order, |i| binning.bin(prims[i as usize].centre, axis) < bin),
         None => {
@@ -240,22 +244,22 @@ fn split(prims: &[Prim], order: &mut [u32], start: usize, depth: u32) -> Node2 {
     Node2::inner(bounds, [halves.0, halves.1])
 }
 
-/// The cut of least surface-area cost: an axis and the first bin on its upper side. `None` when every
-/// centre is in one bin on every axis.
-fn best_cut(bins: &Bins, n: usize) -> Option<(usize, usize)> {
+/// The cut of least surface-area cost among the first `used` bins: an axis and the first bin on its
+/// upper side. `None` when every centre is in one bin on every axis.
+fn best_cut(bins: &Bins, used: usize, n: usize) -> Option<(usize, usize)> {
     let mut best: Option<(f32, usize, usize)> = None;
     for axis in 0..3 {
         // The cost of the lower side of each cut, swept from below; then the upper side's from above.
         // A cut with every centre on one side splits nothing: its cost is infinite.
         let mut below = [0.0f32; BINS];
         let (mut b, mut count) = (Aabb::EMPTY, 0);
-        for (bin, cost) in below.iter_mut().enumerate().skip(1) {
+        for (bin, cost) in below.iter_mut().enumerate().take(used).skip(1) {
             b = b.grow(bins.bounds[axis][bin - 1]);
             count += bins.count[axis][bin - 1];
             *cost = if count == 0 || count as usize == n { f32::INFINITY } else { b.half_area() * count as f32 };
         }
         let (mut b, mut count) = (Aabb::EMPTY, 0);
-        for bin in (1..BINS).rev() {
+        for bin in (1..used).rev() {
             b = b.grow(bins.bounds[axis][bin]);
             count += bins.count[axis][bin];
             let cost = below[bin] + b.half_area() * count as f32;
