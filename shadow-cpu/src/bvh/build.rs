@@ -110,21 +110,15 @@ pub fn build(tris: &[[Vec3A; 3]]) -> (Vec<Node4>, Vec<Tri4>) {
         .collect();
     let mut order: Vec<u32> = (0..tris.len() as u32).collect();
     let root = split(&prims, &mut order, 0, 0);
-    // The root is always a four-wide node, even over a single leaf.
-    let root = match root {
-        Node2::Leaf { bounds, .. } => Node2::Inner {
-            bounds,
-            halves: Box::new([root, Node2::Leaf { bounds: Aabb::EMPTY, start: 0, count: 0 }]),
-            size: Size { nodes: 1, leaves: 1 },
-        },
-        inner => inner,
+    // The root is always a four-wide node: over the widened halves of an inner root, or over a root
+    // that is a single leaf.
+    let (kids, size) = match &root {
+        Node2::Inner { halves, size, .. } => (widen(halves), *size),
+        leaf => (Kids { kid: [leaf; LANES], len: 1 }, Size { nodes: 1, leaves: 1 }),
     };
-    let size = root.size();
     let mut nodes = vec![Node4::EMPTY; size.nodes];
     let mut leaves = vec![Tri4::EMPTY; size.leaves];
-    let Node2::Inner { halves, .. } = &root else { unreachable!("the root was made inner") };
-    let out = Out { tris, order: &order };
-    out.write(widen(halves), &mut nodes, 0, &mut leaves, 0);
+    Out { tris, order: &order }.write(kids, &mut nodes, 0, &mut leaves, 0);
     (nodes, leaves)
 }
 
@@ -297,14 +291,9 @@ impl<'a> Kids<'a> {
 }
 
 /// The children of a four-wide node over the binary node with `halves`: the inner child of largest
-/// area is opened into its own halves while there is room. An empty leaf (the stand-in beside a root
-/// that is a single leaf) is left out.
+/// area is opened into its own halves while there is room.
 fn widen(halves: &[Node2; 2]) -> Kids<'_> {
-    let mut kids = Kids { kid: [&halves[0]; LANES], len: 0 };
-    for half in halves.iter().filter(|h| !matches!(h, Node2::Leaf { count: 0, .. })) {
-        kids.kid[kids.len] = half;
-        kids.len += 1;
-    }
+    let mut kids = Kids { kid: [&halves[0], &halves[1], &halves[1], &halves[1]], len: 2 };
     while kids.len < LANES {
         let open = (0..kids.len)
             .filter(|&i| matches!(kids.kid[i], Node2::Inner { .. }))
@@ -330,6 +319,7 @@ impl Out<'_> {
     /// its size, so a node with many leaves below writes its subtrees in parallel.
     fn write(&self, mut kids: Kids<'_>, nodes: &mut [Node4], node_at: usize, leaves: &mut [Tri4], leaf_at: usize) {
         let parallel = leaves.len() >= PARALLEL / LEAF_SIZE;
+        // A subtree's slice holds its own node first: every inner size counts itself.
         let (node, mut nodes_rest) = nodes.split_first_mut().expect("a slot for the node");
         // The children in order along the axis their centres spread most on.
         let centre = |n: &Node2| n.bounds().lo + n.bounds().hi;
