@@ -17,12 +17,12 @@
 //! closed on its own (every face of each of its edges is in it), so it shadows nothing outside its own
 //! shadow, which lets a technique skip it wherever that cannot hold the point it counts.
 
-use std::collections::HashMap;
-use std::hash::{BuildHasherDefault, Hasher};
+use std::sync::atomic::{AtomicU32, Ordering};
 
 use glam::{Vec3, Vec4};
 use rayon::prelude::*;
 
+use super::facing::FacingRuns;
 use crate::bounds::Aabb;
 use crate::mesh::{Mesh, face_normal};
 
@@ -63,7 +63,8 @@ impl FaceUse {
 }
 
 /// An edge's two welded vertices.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct Edge {
     /// Welded vertices, `v[0] < v[1]`.
     pub v: [u32; 2],
@@ -86,7 +87,8 @@ pub struct Adjacency {
     triangles: Vec<[u32; 3]>,
     planes: Vec<Vec4>,
     degenerate: Vec<bool>,
-    manifold: Vec<Edge>,
+    /// Consistently wound manifold edges, as [`Edge`]s.
+    manifold: Vec<[u32; 2]>,
     manifold_faces: Vec<[u32; 2]>,
     boundary: Vec<Edge>,
     boundary_faces: Vec<FaceUse>,
@@ -97,24 +99,8 @@ pub struct Adjacency {
     component: Vec<u32>,
     /// Per component, the bounds of its welded vertices.
     component_bounds: Vec<Aabb>,
-}
-
-#[derive(Default)]
-struct WeldHasher(u64);
-
-impl Hasher for WeldHasher {
-    fn finish(&self) -> u64 {
-        self.0
-    }
-    fn write(&mut self, bytes: &[u8]) {
-        for &b in bytes {
-            self.write_u32(u32::from(b));
-        }
-    }
-    fn write_u32(&mut self, v: u32) {
-        // Multiply-rotate mixing: positions are not adversarial, and this is ~5x faster than SipHash here.
-        self.0 = (self.0.rotate_left(26) ^ u64::from(v)).wrapping_mul(0x9e37_79b9_7f4a_7c15);
-    }
+    /// Bounds that decide the facing of runs of faces at once.
+    facing_runs: FacingRuns,
 }
 
 /// Bit pattern of a position with `-0.0` folded into `0.0`, so the two weld.
@@ -159,33 +145,18 @@ impl Adjacency {
             })
             .collect();
 
-        let uses = EdgeUses::gather(&triangles, &degenerate, positions.len());
-
-        // The edges of each run of vertices sorted into the three lists at once, the runs' lists then
-        // joined in order.
-        let lists: Vec<EdgeLists> = (0..positions.len())
-            .step_by(EdgeLists::VERTICES)
-            .collect::<Vec<_>>()
-            .into_par_iter()
-            .map(|first| {
-                let mut lists = EdgeLists::default();
-                for (v, run) in uses.edges(first..(first + EdgeLists::VERTICES).min(positions.len())) {
-                    lists.add(v, run);
-                }
-                lists
-            })
-            .collect();
-        let manifold = lists.iter().map(|l| l.manifold.len()).sum();
+        let (manifold, manifold_faces, lists) = edges(&triangles, &degenerate, positions.len());
         let mut adj = Self {
             component: Vec::new(),
             component_bounds: Vec::new(),
+            facing_runs: FacingRuns::default(),
             positions,
             remap,
             triangles,
             planes,
             degenerate,
-            manifold: Vec::with_capacity(manifold),
-            manifold_faces: Vec::with_capacity(manifold),
+            manifold,
+            manifold_faces,
             boundary: Vec::new(),
             boundary_faces: Vec::new(),
             complex: Vec::new(),
@@ -193,15 +164,16 @@ impl Adjacency {
             inconsistent_edges: 0,
         };
         for l in lists {
-            adj.manifold.extend_from_slice(&l.manifold);
-            adj.manifold_faces.extend_from_slice(&l.manifold_faces);
             adj.boundary.extend_from_slice(&l.boundary);
             adj.boundary_faces.extend_from_slice(&l.boundary_faces);
             adj.complex.extend(l.complex);
             adj.non_manifold_edges += l.non_manifold;
             adj.inconsistent_edges += l.inconsistent;
         }
-        (adj.component, adj.component_bounds) = components(&adj);
+        // The components' union-find runs on one thread; the facing bounds fill the others meanwhile.
+        let ((component, component_bounds), facing_runs) =
+            rayon::join(|| components(&adj), || FacingRuns::new(&adj.planes, &adj.manifold_faces));
+        (adj.component, adj.component_bounds, adj.facing_runs) = (component, component_bounds, facing_runs);
         adj
     }
 
@@ -235,7 +207,7 @@ impl Adjacency {
     /// Consistently wound manifold edges.
     #[must_use]
     pub fn manifold_edges(&self) -> &[Edge] {
-        &self.manifold
+        bytemuck::cast_slice(&self.manifold)
     }
     /// The two faces of each manifold edge: first the one running from `v[0]` to `v[1]`, then the one
     /// running back.
@@ -294,6 +266,11 @@ impl Adjacency {
     pub fn component_bounds(&self) -> &[Aabb] {
         &self.component_bounds
     }
+    /// Bounds that decide the facing of runs of faces, and of the faces of runs of manifold edges, at
+    /// once.
+    pub(crate) fn facing_runs(&self) -> &FacingRuns {
+        &self.facing_runs
+    }
     /// Watertight and consistently wound: every edge has exactly two faces running opposite ways. Closed
     /// meshes cast with weight-1 silhouettes and light-facing caps; all others with Bergeron weights.
     #[must_use]
@@ -302,106 +279,125 @@ impl Adjacency {
     }
 }
 
-/// Every face's use of each of its edges, grouped by edge in the order of the edges' welded endpoints
-/// (lower, then higher) and, within an edge, of the uses. A counting sort on the lower endpoint puts each
-/// use into its vertex's bucket; a bucket holds a handful of uses (about six on a closed mesh), sorted
-/// in place by the higher endpoint and the use. That is linear in the faces, where a comparison sort of
-/// all the uses (three million for a million faces) took most of the build; and the order is the one
-/// such a sort gives, so the edge lists come out the same.
-struct EdgeUses {
-    /// Per welded vertex, where its bucket begins in `uses`; one more entry closes the last.
-    start: Vec<u32>,
-    /// Each use with the higher endpoint of its edge, in the buckets of the lower.
-    uses: Vec<(u32, FaceUse)>,
-}
-
-impl EdgeUses {
-    /// Buckets of at most this many vertices are sorted as one task.
-    const CHUNK: usize = 8192;
-
-    fn gather(triangles: &[[u32; 3]], degenerate: &[bool], vertices: usize) -> Self {
-        // Each run of faces buckets its own uses, all runs at once; the buckets are then merged vertex by
-        // vertex, and each merged bucket sorted, so the runs' number does not change the result.
-        let runs = rayon::current_num_threads().clamp(1, 8);
-        let per_run = triangles.len().div_ceil(runs).max(1);
-        let local: Vec<Self> = triangles
-            .par_chunks(per_run)
-            .zip(degenerate.par_chunks(per_run))
-            .enumerate()
-            .map(|(k, (t, d))| Self::bucket(t, d, k * per_run, vertices))
-            .collect();
-        let mut start = vec![0u32; vertices + 1];
-        for v in 0..vertices {
-            start[v + 1] = start[v] + local.iter().map(|l| l.start[v + 1] - l.start[v]).sum::<u32>();
-        }
-        let mut uses = vec![(0, FaceUse::NONE); start[vertices] as usize];
-        // The buckets of each run of CHUNK vertices, split off one after the other, filled and sorted in
-        // parallel.
-        let mut chunks = Vec::with_capacity(vertices.div_ceil(Self::CHUNK));
-        let mut rest = uses.as_mut_slice();
-        for first in (0..vertices).step_by(Self::CHUNK) {
-            let last = (first + Self::CHUNK).min(vertices);
-            let (chunk, tail) = rest.split_at_mut((start[last] - start[first]) as usize);
-            chunks.push((first..last, chunk));
-            rest = tail;
-        }
-        chunks.into_par_iter().for_each(|(range, chunk)| {
-            let mut at = 0;
-            for v in range {
-                let from = at;
-                for l in &local {
-                    let bucket = &l.uses[l.start[v] as usize..l.start[v + 1] as usize];
-                    chunk[at..at + bucket.len()].copy_from_slice(bucket);
-                    at += bucket.len();
+/// Every edge of the faces that are not degenerate, in the order of its welded endpoints (lower, then
+/// higher), sorted into [`Adjacency`]'s three lists: the consistently wound manifold edges with their
+/// face pairs, and per range of lower endpoints (in order) the other edges.
+///
+/// Each face's use of each of its edges is put in the bucket of the edge's lower endpoint by a counting
+/// sort, and each bucket (about six uses on a closed mesh) is sorted by the higher endpoint, then the
+/// use. That is linear in the faces, where a comparison sort of all the uses (three million for a
+/// million faces) took most of the build, and the order is the one such a sort gives.
+///
+/// The vertices are split into one range per thread, and each thread reads every face and keeps the
+/// uses whose lower endpoint is in its range: it counts them into its buckets, places them, sorts each
+/// bucket and reads its edges off it while it is in cache, writing only its own part of every output.
+/// Reading the faces once per thread costs far less than merging buckets filled by several threads.
+fn edges(
+    triangles: &[[u32; 3]],
+    degenerate: &[bool],
+    vertices: usize,
+) -> (Vec<[u32; 2]>, Vec<[u32; 2]>, Vec<EdgeLists>) {
+    let per_range = vertices.div_ceil(rayon::current_num_threads().clamp(1, 64)).max(1);
+    let ranges: Vec<std::ops::Range<usize>> =
+        (0..vertices).step_by(per_range).map(|lo| lo..(lo + per_range).min(vertices)).collect();
+    // Per range, where each of its buckets begins, counted from the range's first use.
+    let starts: Vec<Vec<u32>> = ranges
+        .par_iter()
+        .map(|range| {
+            let mut start = vec![0u32; range.len() + 1];
+            each_use(triangles, degenerate, |_, u, v| {
+                // Below the range, the difference wraps past every bucket.
+                if let Some(s) = start.get_mut((u.min(v) as usize).wrapping_sub(range.start) + 1) {
+                    *s += 1;
                 }
-                chunk[from..at].sort_unstable();
+            });
+            for i in 1..start.len() {
+                start[i] += start[i - 1];
             }
-        });
-        Self { start, uses }
-    }
-
-    /// The uses of `triangles` (the first numbered `base`) in buckets by lower endpoint, unsorted within.
-    fn bucket(triangles: &[[u32; 3]], degenerate: &[bool], base: usize, vertices: usize) -> Self {
-        let edges = |&[a, b, c]: &[u32; 3]| [(a, b), (b, c), (c, a)];
-        let cast = triangles.iter().zip(degenerate).enumerate().filter(|(_, (_, d))| !**d);
-        let mut start = vec![0u32; vertices + 1];
-        for (_, (t, _)) in cast.clone() {
-            for (u, v) in edges(t) {
-                start[u.min(v) as usize + 1] += 1;
-            }
-        }
-        for i in 1..start.len() {
-            start[i] += start[i - 1];
-        }
-        let mut next = start.clone();
-        let mut uses = vec![(0, FaceUse::NONE); start[vertices] as usize];
-        for (f, (t, _)) in cast {
-            for (u, v) in edges(t) {
-                let slot = &mut next[u.min(v) as usize];
-                uses[*slot as usize] = (u.max(v), FaceUse::new((base + f) as u32, u > v));
-                *slot += 1;
-            }
-        }
-        Self { start, uses }
-    }
-
-    /// Each edge whose lower endpoint is in `lower`: its welded endpoints (lower first) and its uses,
-    /// each with the higher endpoint.
-    fn edges(&self, lower: std::ops::Range<usize>) -> impl Iterator<Item = ([u32; 2], &[(u32, FaceUse)])> {
-        let first = lower.start;
-        self.start[lower.start..=lower.end].windows(2).enumerate().flat_map(move |(k, w)| {
-            self.uses[w[0] as usize..w[1] as usize]
-                .chunk_by(|x, y| x.0 == y.0)
-                .map(move |run| ([(first + k) as u32, run[0].0], run))
+            start
         })
+        .collect();
+    // A range of n uses has at most n / 2 manifold edges; each range writes its own into a part of the
+    // outputs that size. Zeroed memory is not touched until written, so parts left unused cost nothing.
+    let uses: Vec<usize> = starts.iter().map(|s| s[s.len() - 1] as usize).collect();
+    let most: usize = uses.iter().map(|n| n / 2).sum();
+    let (mut manifold, mut manifold_faces) = (vec![[0u32; 2]; most], vec![[0u32; 2]; most]);
+    let mut buffer = vec![0u64; uses.iter().sum()];
+    let mut parts = Vec::with_capacity(ranges.len());
+    let (mut buffer_rest, mut edges_rest, mut faces_rest) =
+        (buffer.as_mut_slice(), manifold.as_mut_slice(), manifold_faces.as_mut_slice());
+    for ((range, start), &n) in ranges.iter().zip(&starts).zip(&uses) {
+        let (words, b) = buffer_rest.split_at_mut(n);
+        let (edges, e) = edges_rest.split_at_mut(n / 2);
+        let (faces, f) = faces_rest.split_at_mut(n / 2);
+        parts.push((range.clone(), start, words, edges, faces));
+        (buffer_rest, edges_rest, faces_rest) = (b, e, f);
+    }
+    let lists: Vec<EdgeLists> = parts
+        .into_par_iter()
+        .map(|(range, start, words, edges, faces)| {
+            // Each use as `higher << 32 | use`: sorting the words sorts by the higher endpoint, then the use.
+            let mut next = start[..range.len()].to_vec();
+            each_use(triangles, degenerate, |f, u, v| {
+                if let Some(slot) = next.get_mut((u.min(v) as usize).wrapping_sub(range.start)) {
+                    words[*slot as usize] = u64::from(u.max(v)) << 32 | u64::from(FaceUse::new(f as u32, u > v).0);
+                    *slot += 1;
+                }
+            });
+            let mut lists = EdgeLists::default();
+            for (lower, w) in range.zip(start.windows(2)) {
+                let bucket = &mut words[w[0] as usize..w[1] as usize];
+                bucket.sort_unstable();
+                for run in bucket.chunk_by(|x, y| x >> 32 == y >> 32) {
+                    let v = [lower as u32, (run[0] >> 32) as u32];
+                    match manifold_faces_of(run) {
+                        Some(pair) => {
+                            (edges[lists.manifold], faces[lists.manifold]) = (v, pair);
+                            lists.manifold += 1;
+                        }
+                        None => lists.add(v, run),
+                    }
+                }
+            }
+            lists
+        })
+        .collect();
+    // Close the gaps the ranges left (none on a closed mesh, where every use is half a manifold edge).
+    let (mut at, mut part) = (0, 0);
+    for (l, &n) in lists.iter().zip(&uses) {
+        manifold.copy_within(part..part + l.manifold, at);
+        manifold_faces.copy_within(part..part + l.manifold, at);
+        (at, part) = (at + l.manifold, part + n / 2);
+    }
+    for list in [&mut manifold, &mut manifold_faces] {
+        list.truncate(at);
+        list.shrink_to_fit();
+    }
+    (manifold, manifold_faces, lists)
+}
+
+/// Calls `each(face, from, to)` for every edge of every face that is not degenerate, the edge's
+/// endpoints in the face's order.
+fn each_use(triangles: &[[u32; 3]], degenerate: &[bool], mut each: impl FnMut(usize, u32, u32)) {
+    for (f, (&[a, b, c], &d)) in triangles.iter().zip(degenerate).enumerate() {
+        if !d {
+            each(f, a, b);
+            each(f, b, c);
+            each(f, c, a);
+        }
     }
 }
 
-/// Edges sorted by their uses (see [`Adjacency`]'s lists), for one run of lower endpoints.
+/// The [`FaceUse`] in the low half of a word of [`edges`].
+fn face_use(word: u64) -> FaceUse {
+    FaceUse(word as u32)
+}
+
+/// Edges sorted by their uses (see [`Adjacency`]'s lists), for one range of lower endpoints.
 #[derive(Default)]
 struct EdgeLists {
-    manifold: Vec<Edge>,
-    manifold_faces: Vec<[u32; 2]>,
+    /// How many consistently wound manifold edges the range wrote into its part of the outputs.
+    manifold: usize,
     boundary: Vec<Edge>,
     boundary_faces: Vec<FaceUse>,
     complex: Vec<ComplexEdge>,
@@ -410,30 +406,32 @@ struct EdgeLists {
 }
 
 impl EdgeLists {
-    /// Lower endpoints a task sorts the edges of.
-    const VERTICES: usize = 16384;
-
-    /// Puts edge `v` with its uses `run` into its list.
-    fn add(&mut self, v: [u32; 2], run: &[(u32, FaceUse)]) {
-        match *run {
-            [(_, f)] => {
-                self.boundary.push(Edge { v });
-                self.boundary_faces.push(f);
-            }
-            [(_, f0), (_, f1)] if f0.reversed() != f1.reversed() => {
-                self.manifold.push(Edge { v });
-                let (fwd, rev) = if f0.reversed() { (f1, f0) } else { (f0, f1) };
-                self.manifold_faces.push([fwd.face(), rev.face()]);
-            }
-            _ => {
-                if run.len() == 2 {
-                    self.inconsistent += 1;
-                } else {
-                    self.non_manifold += 1;
-                }
-                self.complex.push(ComplexEdge { v, uses: run.iter().map(|u| u.1).collect() });
-            }
+    /// Puts edge `v`, with its uses `run` (as `higher << 32 | use` words), into the boundary or the
+    /// complex list: it is not a consistently wound manifold edge.
+    fn add(&mut self, v: [u32; 2], run: &[u64]) {
+        if let [f] = *run {
+            self.boundary.push(Edge { v });
+            self.boundary_faces.push(face_use(f));
+            return;
         }
+        if run.len() == 2 {
+            self.inconsistent += 1;
+        } else {
+            self.non_manifold += 1;
+        }
+        self.complex.push(ComplexEdge { v, uses: run.iter().map(|&u| face_use(u)).collect() });
+    }
+}
+
+/// The faces of a consistently wound manifold edge (two uses running opposite ways), the one running
+/// along the edge first; `None` for any other edge.
+fn manifold_faces_of(run: &[u64]) -> Option<[u32; 2]> {
+    match *run {
+        [f0, f1] if face_use(f0).reversed() != face_use(f1).reversed() => {
+            let (fwd, rev) = if face_use(f0).reversed() { (f1, f0) } else { (f0, f1) };
+            Some([face_use(fwd).face(), face_use(rev).face()])
+        }
+        _ => None,
     }
 }
 
@@ -504,66 +502,115 @@ fn components(adj: &Adjacency) -> (Vec<u32>, Vec<Aabb>) {
     (component, bounds)
 }
 
+/// A hash of a weld key: multiply-rotate mixing, whose high bits are well spread (positions are not
+/// adversarial, and this is many times faster than SipHash).
+fn weld_hash(key: [u32; 3]) -> u64 {
+    key.iter().fold(0u64, |h, &c| (h.rotate_left(26) ^ u64::from(c)).wrapping_mul(0x9e37_79b9_7f4a_7c15))
+}
+
 /// Welds equal positions (by [`weld_key`]): the distinct positions in order of first appearance, and each
 /// position's index among them.
 ///
-/// One hash map over half a million positions misses the cache on nearly every insert. So the positions
-/// are first split by their hash's top bits into [`WELD_PARTS`] parts (a counting sort that keeps each
-/// part in position order); each part, a few thousand keys that stay in cache, is welded on its own and
-/// in parallel, giving every position the first position with its key; a prefix count over those firsts
-/// then numbers them in order of first appearance, as one map in position order would.
+/// One hash table over half a million positions misses the cache on nearly every insert. So the
+/// positions are first split by their hash's top byte into [`WELD_PARTS`] parts (counting sorts that
+/// keep each part in position order); each part, a few thousand keys whose table stays in cache, is
+/// welded on its own and in parallel, giving every position the first position with its key; a prefix
+/// count over those firsts then numbers them in order of first appearance, as one table in position
+/// order would. Every step runs on all threads.
 fn weld(positions: &[Vec3]) -> (Vec<Vec3>, Vec<u32>) {
     let n = positions.len();
-    let keys: Vec<[u32; 3]> = positions.par_iter().map(|&p| weld_key(p)).collect();
-    let part = |k: &[u32; 3]| {
-        let mut h = WeldHasher::default();
-        k.iter().for_each(|&c| h.write_u32(c));
-        (h.finish() >> (64 - WELD_PARTS.trailing_zeros())) as usize
-    };
-    let parts: Vec<u16> = keys.par_iter().map(|k| part(k) as u16).collect();
-    let mut start = vec![0usize; WELD_PARTS + 1];
-    for &p in &parts {
-        start[usize::from(p) + 1] += 1;
-    }
-    for i in 1..start.len() {
-        start[i] += start[i - 1];
-    }
-    let mut next = start.clone();
-    let mut order = vec![0u32; n];
-    for (i, &p) in parts.iter().enumerate() {
-        order[next[usize::from(p)]] = i as u32;
-        next[usize::from(p)] += 1;
-    }
-    // Per part, for each of its positions (in position order) the first position with the same key.
-    let firsts: Vec<Vec<u32>> = start
-        .par_windows(2)
-        .map(|w| {
-            let members = &order[w[0]..w[1]];
-            let mut map: HashMap<[u32; 3], u32, BuildHasherDefault<WeldHasher>> =
-                HashMap::with_capacity_and_hasher(members.len(), BuildHasherDefault::default());
-            members.iter().map(|&i| *map.entry(keys[i as usize]).or_insert(i)).collect()
+    // Each run of positions sorts its own into the parts (with its keys, so a part's table reads its
+    // keys in order, not from all over the positions), all runs at once; a part's members are then its
+    // members from each run, run after run: in position order.
+    let per_run = n.div_ceil(rayon::current_num_threads().clamp(1, 64)).max(1);
+    let runs: Vec<(Vec<usize>, Vec<[u32; 4]>)> = positions
+        .par_chunks(per_run)
+        .enumerate()
+        .map(|(r, run)| {
+            let keys: Vec<([u32; 3], usize)> =
+                run.iter().map(|&p| weld_key(p)).map(|k| (k, (weld_hash(k) >> 56) as usize)).collect();
+            let mut start = vec![0usize; WELD_PARTS + 1];
+            for &(_, part) in &keys {
+                start[part + 1] += 1;
+            }
+            for i in 1..start.len() {
+                start[i] += start[i - 1];
+            }
+            let mut next = start.clone();
+            let mut members = vec![[0u32; 4]; run.len()];
+            for (j, &([x, y, z], part)) in keys.iter().enumerate() {
+                members[next[part]] = [x, y, z, (r * per_run + j) as u32];
+                next[part] += 1;
+            }
+            (start, members)
         })
         .collect();
-    let mut first = vec![0u32; n];
-    for (w, part) in start.windows(2).zip(&firsts) {
-        for (&i, &f) in order[w[0]..w[1]].iter().zip(part) {
-            first[i as usize] = f;
-        }
-    }
-    // Number the first positions in order; every other takes its first's number.
+    // Relaxed atomic stores are plain stores here; they let the parts share the array.
+    let first: Vec<AtomicU32> = (0..n).into_par_iter().map(|_| AtomicU32::new(0)).collect();
+    (0..WELD_PARTS).into_par_iter().for_each(|part| {
+        let members = || runs.iter().flat_map(|(start, members)| &members[start[part]..start[part + 1]]);
+        weld_part(members(), members().count(), &first);
+    });
+    let first: Vec<u32> = first.into_iter().map(AtomicU32::into_inner).collect();
+    // Number the first positions in order, run by run: each run counts its firsts, then numbers its own
+    // from the count of the runs before it and writes their positions. Every other position takes its
+    // first's number.
+    const RUN: usize = 16384;
+    let is_first = |k: usize, j: usize, f: u32| f as usize == k * RUN + j;
+    let counts: Vec<usize> = first
+        .par_chunks(RUN)
+        .enumerate()
+        .map(|(k, run)| run.iter().enumerate().filter(|&(j, &f)| is_first(k, j, f)).count())
+        .collect();
     let mut number = vec![0u32; n];
-    let mut welded = Vec::new();
-    for (i, &f) in first.iter().enumerate() {
-        if f as usize == i {
-            number[i] = welded.len() as u32;
-            welded.push(positions[i]);
-        }
+    let mut welded = vec![Vec3::ZERO; counts.iter().sum()];
+    let mut numbering = Vec::with_capacity(counts.len());
+    let (mut rest, mut at) = (welded.as_mut_slice(), 0);
+    for (k, (&count, (number, first))) in counts.iter().zip(number.chunks_mut(RUN).zip(first.chunks(RUN))).enumerate() {
+        let (welded, tail) = rest.split_at_mut(count);
+        numbering.push((k, at, number, first, welded));
+        (rest, at) = (tail, at + count);
     }
+    numbering.into_par_iter().for_each(|(k, at, number, first, welded)| {
+        let mut next = 0;
+        for (j, (number, &f)) in number.iter_mut().zip(first).enumerate() {
+            if is_first(k, j, f) {
+                *number = (at + next) as u32;
+                welded[next] = positions[k * RUN + j];
+                next += 1;
+            }
+        }
+    });
     let remap = first.par_iter().map(|&f| number[f as usize]).collect();
     (welded, remap)
 }
 
-/// How many parts [`weld`] splits the positions into (a power of two).
+/// For each of one part's `count` members (`[key, position]`, in position order), the first position with
+/// the same key, stored at the member's position in `first`: an open addressing table with linear
+/// probing, at most half full, holding each key beside its first position so a probe reads no other
+/// memory.
+fn weld_part<'a>(members: impl Iterator<Item = &'a [u32; 4]>, count: usize, first: &[AtomicU32]) {
+    const EMPTY: u32 = u32::MAX;
+    let size = (2 * count).next_power_of_two().max(16);
+    let mut table = vec![[0, 0, 0, EMPTY]; size];
+    for &[x, y, z, i] in members {
+        // The bits below the part's: the top ones chose the part, so they are the same for all.
+        let mut slot = (weld_hash([x, y, z]) >> 24) as usize & (size - 1);
+        let f = loop {
+            match table[slot] {
+                [_, _, _, EMPTY] => {
+                    table[slot] = [x, y, z, i];
+                    break i;
+                }
+                [a, b, c, f] if [a, b, c] == [x, y, z] => break f,
+                _ => slot = (slot + 1) & (size - 1),
+            }
+        };
+        first[i as usize].store(f, Ordering::Relaxed);
+    }
+}
+
+/// How many parts [`weld`] splits the positions into: one per value of the hash's top byte.
 const WELD_PARTS: usize = 256;
 
 #[cfg(test)]

@@ -2,10 +2,13 @@
 //!
 //! - [`adjacency`]: weld coincident positions, map edges to faces, classify manifold, boundary and
 //!   non-manifold edges, and decide whether a mesh is closed.
-//! - [`silhouette`]: the silhouette edges of a mesh for one light, with Bergeron weights for open meshes.
+//! - [`silhouette`]: the silhouette edges of a mesh for one light, with Bergeron weights for open meshes;
+//!   `facing` decides the facing of whole runs of faces at once, so it reads only faces near the
+//!   silhouette.
 //! - [`volume`]: extrusion of silhouettes to infinity (w = 0) and the front and back caps.
 
 pub mod adjacency;
+mod facing;
 pub mod silhouette;
 pub mod volume;
 

@@ -19,6 +19,7 @@ use rayon::prelude::*;
 
 use super::LightSource;
 use super::adjacency::{Adjacency, FaceUse};
+use super::facing::{EDGES, FACES, Facing};
 
 /// An oriented silhouette edge in welded vertices, with its multiplicity.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -73,27 +74,45 @@ impl Silhouette {
 /// light (or a degenerate face, whose plane is zero) casts nothing: weight 0.
 #[must_use]
 pub fn face_weights(adj: &Adjacency, light: LightSource, mode: CastMode) -> Vec<i8> {
+    weights(adj, light, mode, &adj.facing_runs().facing(light))
+}
+
+/// [`face_weights`], given the facing of each run of faces: a decided run's faces all take its weight,
+/// and only the faces of the others are tested.
+fn weights(adj: &Adjacency, light: LightSource, mode: CastMode, facing: &[Facing]) -> Vec<i8> {
     let unlit: i8 = match mode {
         CastMode::Closed => 0,
         CastMode::Bergeron => -1,
     };
     // +1 facing the light, `unlit` facing away, 0 in its plane: written without a branch, and with the
-    // light's kind matched once, not per face.
-    let sign = |f: f32| i8::from(f > 0.0) + i8::from(f < 0.0) * unlit;
-    let mut weights = vec![0i8; adj.planes().len()];
-    weights.par_chunks_mut(8192).zip(adj.planes().par_chunks(8192)).for_each(|(w, planes)| match light {
-        LightSource::Point(l) => {
-            for (w, p) in w.iter_mut().zip(planes) {
-                *w = sign(p.truncate().dot(l) + p.w);
-            }
-        }
-        LightSource::Directional(d) => {
-            for (w, p) in w.iter_mut().zip(planes) {
-                *w = sign(-p.truncate().dot(d));
-            }
-        }
-    });
+    // light's kind matched once, not per face. Each facing value is summed in the order
+    // [`LightSource::facing`] sums it, so the signs are the ones it gives.
+    let sign = move |f: f32| i8::from(f > 0.0) + i8::from(f < 0.0) * unlit;
+    let planes: &[[f32; 4]] = bytemuck::cast_slice(adj.planes());
+    let mut weights = vec![0i8; planes.len()];
+    let runs = weights.par_chunks_mut(FACES).zip(planes.par_chunks(FACES)).zip(facing).with_min_len(64);
+    match light {
+        LightSource::Point(l) => runs.for_each(|((w, planes), &facing)| {
+            fill(w, facing, unlit, planes, |[x, y, z, d]| sign(x * l.x + y * l.y + z * l.z + d));
+        }),
+        LightSource::Directional(l) => runs.for_each(|((w, planes), &facing)| {
+            fill(w, facing, unlit, planes, |[x, y, z, _]| sign(-(x * l.x + y * l.y + z * l.z)));
+        }),
+    }
     weights
+}
+
+/// The weights of one run of faces: its own where the run is decided, each face's `sign` where not.
+fn fill(w: &mut [i8], facing: Facing, unlit: i8, planes: &[[f32; 4]], sign: impl Fn([f32; 4]) -> i8) {
+    match facing {
+        Facing::Front => w.fill(1),
+        Facing::Back => w.fill(unlit),
+        Facing::Mixed => {
+            for (w, &p) in w.iter_mut().zip(planes) {
+                *w = sign(p);
+            }
+        }
+    }
 }
 
 fn oriented(v: [u32; 2], w: i32, face: u32) -> Option<SilhouetteEdge> {
@@ -107,22 +126,28 @@ fn oriented(v: [u32; 2], w: i32, face: u32) -> Option<SilhouetteEdge> {
 /// Silhouette edges of the mesh for the light, in `mode` (see [`CastMode::for_mesh`]).
 #[must_use]
 pub fn silhouette(adj: &Adjacency, light: LightSource, mode: CastMode) -> Silhouette {
-    let face_weights = face_weights(adj, light, mode);
+    let runs = adj.facing_runs();
+    let facing = runs.facing(light);
+    let face_weights = weights(adj, light, mode, &facing);
+    let facing = &facing;
     let w = &face_weights;
     let use_weight = |u: FaceUse| i32::from(w[u.face() as usize]) * u.direction();
-    // Manifold edges: the first face runs along the edge, the second against it. Only the face pairs are
-    // read until an edge turns out to be a silhouette.
-    let mut edges: Vec<SilhouetteEdge> = adj
-        .manifold_faces()
-        .par_chunks(16384)
-        .zip(adj.manifold_edges().par_chunks(16384))
-        .flat_map_iter(|(faces, edges)| {
-            faces.iter().zip(edges).filter_map(|(&[f0, f1], e)| {
-                let weight = i32::from(w[f0 as usize]) - i32::from(w[f1 as usize]);
-                if weight == 0 { None } else { oriented(e.v, weight, f0) }
+    // Manifold edges: the first face runs along the edge, the second against it. A run of edges whose
+    // faces all lie in runs of one decided facing holds no silhouette edge and is not read; in the others,
+    // only the face pairs are read until an edge turns out to be a silhouette.
+    let mut edges: Vec<SilhouetteEdge> =
+        adj.manifold_faces()
+            .par_chunks(EDGES)
+            .zip(adj.manifold_edges().par_chunks(EDGES))
+            .enumerate()
+            .with_min_len(256)
+            .filter(|(run, _)| !runs.edges_uniform(*run, facing))
+            .flat_map_iter(|(_, (faces, edges))| {
+                faces.iter().zip(edges).filter_map(|(&[f0, f1], e)| {
+                    oriented(e.v, i32::from(w[f0 as usize]) - i32::from(w[f1 as usize]), f0)
+                })
             })
-        })
-        .collect();
+            .collect();
     edges.extend(
         adj.boundary_edges()
             .iter()
@@ -221,5 +246,77 @@ mod tests {
         let shared = s.edges.iter().find(|e| (e.a.min(e.b), e.a.max(e.b)) == (0, 1)).unwrap();
         assert_eq!(shared.weight, 2);
         assert!(net_flow(&s.edges).values().all(|&f| f == 0));
+    }
+
+    /// Each face's weight tested on its own, as the module notes define it.
+    fn face_by_face(adj: &Adjacency, light: LightSource, mode: CastMode) -> Vec<i8> {
+        let unlit = if mode == CastMode::Closed { 0 } else { -1 };
+        let sign = |f: f32| {
+            if f > 0.0 {
+                1
+            } else if f < 0.0 {
+                unlit
+            } else {
+                0
+            }
+        };
+        adj.planes().iter().map(|&p| sign(light.facing(p))).collect()
+    }
+
+    /// Lights off the mesh, on its vertices (in the planes of the faces around each), and parallel light
+    /// along its edges (in the planes of the faces beside each), for a mesh of size `scale`.
+    fn lights(adj: &Adjacency, scale: f32) -> Vec<LightSource> {
+        let mut lights = vec![
+            LightSource::Point(Vec3::new(2.0, 4.0, 1.5) * scale),
+            LightSource::Point(Vec3::new(0.0, 1.5, 0.0) * scale),
+            LightSource::Point(Vec3::new(0.1, -0.2, 0.05) * scale),
+            LightSource::Directional(Vec3::new(0.3, -0.8, 0.2)),
+            LightSource::Directional(Vec3::NEG_Y),
+        ];
+        let p = adj.positions();
+        for &[a, b] in adj.manifold_edges().iter().step_by(997).map(|e| &e.v) {
+            lights.push(LightSource::Point(p[a as usize]));
+            lights.push(LightSource::Directional(p[b as usize] - p[a as usize]));
+        }
+        lights
+    }
+
+    #[test]
+    fn runs_decided_at_once_change_no_weight_and_no_edge() {
+        // Sizes where the planes are ordinary, where their normals are subnormal, and where they overflow.
+        let sphere = procedural::sphere(1.0, 96, 48).expect("a sphere");
+        for scale in [1.0, 1e-18, 1e15, 1e25] {
+            let m =
+                glam::Mat4::from_scale(Vec3::splat(scale)) * glam::Mat4::from_translation(Vec3::new(0.3, -0.1, 0.2));
+            let adj = Adjacency::build(&sphere.transformed(m));
+            assert!(adj.closed());
+            for light in lights(&adj, scale) {
+                for mode in [CastMode::Closed, CastMode::Bergeron] {
+                    let plain = face_by_face(&adj, light, mode);
+                    assert_eq!(face_weights(&adj, light, mode), plain, "{light:?} at scale {scale}");
+                    let edges: Vec<SilhouetteEdge> = adj
+                        .manifold_edges()
+                        .iter()
+                        .zip(adj.manifold_faces())
+                        .filter_map(|(e, &[f0, f1])| {
+                            oriented(e.v, i32::from(plain[f0 as usize]) - i32::from(plain[f1 as usize]), f0)
+                        })
+                        .collect();
+                    assert_eq!(silhouette(&adj, light, mode), Silhouette { edges, face_weights: plain });
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_light_off_the_mesh_decides_most_runs_at_once() {
+        // A run of 64 faces spans 29 degrees of a ring of this sphere.
+        let adj = Adjacency::build(&procedural::sphere(1.0, 400, 200).expect("a sphere"));
+        let facing = adj.facing_runs().facing(LightSource::Point(Vec3::new(2.0, 4.0, 1.5)));
+        let mixed = facing.iter().filter(|&&f| f == Facing::Mixed).count();
+        let edge_runs = adj.manifold_faces().len().div_ceil(EDGES);
+        let skipped = (0..edge_runs).filter(|&r| adj.facing_runs().edges_uniform(r, &facing)).count();
+        assert!(mixed * 4 < facing.len(), "{mixed} of {} face runs undecided", facing.len());
+        assert!(skipped * 2 > edge_runs, "{skipped} of {edge_runs} edge runs skipped");
     }
 }
