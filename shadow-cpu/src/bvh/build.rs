@@ -1,25 +1,25 @@
 //! Building the tree: a binary tree by the surface area heuristic over binned centroids (Wald, "On fast
 //! Construction of SAH-based Bounding Volume Hierarchies", 2007), on every core, then collapsed into
-//! four-wide nodes whose leaves hold up to four triangles.
+//! eight-wide nodes whose leaves hold up to eight triangles.
 
 use glam::Vec3A;
 use rayon::prelude::*;
 
-use super::wide::{Child, LANES, LEAF, Node4, Tri4};
+use super::wide::{Child, LANES, LEAF, Node8, Tri8};
 
 /// Bins per axis a node's centroids are sorted into, at most: a node of fewer triangles gets one bin
 /// per triangle, which finds its cuts as well and sweeps fewer bins.
 const BINS: usize = 16;
-/// Triangles a leaf holds at most: one [`Tri4`].
+/// Triangles a leaf holds at most: one [`Tri8`].
 const LEAF_SIZE: usize = LANES;
 /// Nodes with at least this many triangles are binned, and their halves built, in parallel.
 const PARALLEL: usize = 1 << 13;
 /// Below this depth the split is the best binned one; deeper, it is the median, so the binary tree is at
 /// most this deep plus log2 of the triangle count, and a traversal stack of [`STACK`] never overflows.
 const SAH_DEPTH: u32 = 48;
-/// Entries a traversal stack holds: a four-wide node pushes at most three more entries than it pops,
-/// and the four-wide tree is no deeper than the binary one (at most [`SAH_DEPTH`] + 32).
-pub const STACK: usize = 3 * (SAH_DEPTH as usize + 32) + 1;
+/// Entries a traversal stack holds: a wide node pushes at most `LANES - 1` more entries than it pops,
+/// and the wide tree is no deeper than the binary one (at most [`SAH_DEPTH`] + 32).
+pub const STACK: usize = (LANES - 1) * (SAH_DEPTH as usize + 32) + 1;
 
 /// An axis-aligned box.
 #[derive(Clone, Copy)]
@@ -54,14 +54,14 @@ struct Prim {
 }
 
 /// The binary tree: leaves are runs of the reordered triangle indices. An inner node knows how many
-/// four-wide nodes and leaves it is written as (when it heads a four-wide node), so every subtree's
+/// wide nodes and leaves it is written as (when it heads a wide node), so every subtree's
 /// place in the output is known before any is written and they are written in parallel.
 enum Node2 {
     Leaf { bounds: Aabb, start: usize, count: usize },
     Inner { bounds: Aabb, halves: Box<[Node2; 2]>, size: Size },
 }
 
-/// Four-wide nodes and leaves a subtree is written as.
+/// Wide nodes and leaves a subtree is written as.
 #[derive(Clone, Copy, Default)]
 struct Size {
     nodes: usize,
@@ -85,7 +85,7 @@ impl Node2 {
         }
     }
 
-    /// What the node is written as when it is a four-wide node's child.
+    /// What the node is written as when it is a wide node's child.
     fn size(&self) -> Size {
         match self {
             Self::Leaf { .. } => Size { nodes: 0, leaves: 1 },
@@ -94,12 +94,12 @@ impl Node2 {
     }
 }
 
-/// The four-wide tree over `tris`: its nodes (the root first) and its leaves.
+/// The wide tree over `tris`: its nodes (the root first) and its leaves.
 ///
 /// The builder sorts a list of triangle indices, not the triangles' boxes: partitioning 4-byte indices
 /// in place measured faster here than moving the boxes, though the passes over a node then read its
 /// boxes out of order.
-pub fn build(tris: &[[Vec3A; 3]]) -> (Vec<Node4>, Vec<Tri4>) {
+pub fn build(tris: &[[Vec3A; 3]]) -> (Vec<Node8>, Vec<Tri8>) {
     let prims: Vec<Prim> = tris
         .par_iter()
         .with_min_len(4096)
@@ -110,14 +110,14 @@ pub fn build(tris: &[[Vec3A; 3]]) -> (Vec<Node4>, Vec<Tri4>) {
         .collect();
     let mut order: Vec<u32> = (0..tris.len() as u32).collect();
     let root = split(&prims, &mut order, 0, 0);
-    // The root is always a four-wide node: over the widened halves of an inner root, or over a root
+    // The root is always a wide node: over the widened halves of an inner root, or over a root
     // that is a single leaf.
     let (kids, size) = match &root {
         Node2::Inner { halves, size, .. } => (widen(halves), *size),
         leaf => (Kids { kid: [leaf; LANES], len: 1 }, Size { nodes: 1, leaves: 1 }),
     };
-    let mut nodes = vec![Node4::EMPTY; size.nodes];
-    let mut leaves = vec![Tri4::EMPTY; size.leaves];
+    let mut nodes = vec![Node8::EMPTY; size.nodes];
+    let mut leaves = vec![Tri8::EMPTY; size.leaves];
     Out { tris, order: &order }.write(kids, &mut nodes, 0, &mut leaves, 0);
     (nodes, leaves)
 }
@@ -277,7 +277,7 @@ fn partition(order: &mut [u32], lower: impl Fn(u32) -> bool) -> usize {
     mid
 }
 
-/// Up to four children of a four-wide node.
+/// Up to [`LANES`] children of a wide node.
 #[derive(Clone, Copy)]
 struct Kids<'a> {
     kid: [&'a Node2; LANES],
@@ -290,10 +290,11 @@ impl<'a> Kids<'a> {
     }
 }
 
-/// The children of a four-wide node over the binary node with `halves`: the inner child of largest
+/// The children of a wide node over the binary node with `halves`: the inner child of largest
 /// area is opened into its own halves while there is room.
 fn widen(halves: &[Node2; 2]) -> Kids<'_> {
-    let mut kids = Kids { kid: [&halves[0], &halves[1], &halves[1], &halves[1]], len: 2 };
+    let mut kids = Kids { kid: [&halves[1]; LANES], len: 2 };
+    kids.kid[0] = &halves[0];
     while kids.len < LANES {
         let open = (0..kids.len)
             .filter(|&i| matches!(kids.kid[i], Node2::Inner { .. }))
@@ -307,7 +308,7 @@ fn widen(halves: &[Node2; 2]) -> Kids<'_> {
     kids
 }
 
-/// Writes the four-wide tree, depth first: a node, then each child's subtree in turn.
+/// Writes the wide tree, depth first: a node, then each child's subtree in turn.
 struct Out<'a> {
     tris: &'a [[Vec3A; 3]],
     order: &'a [u32],
@@ -317,7 +318,7 @@ impl Out<'_> {
     /// Writes a node over `kids` at `nodes[0]` (index `node_at` in the whole tree) and its subtrees
     /// after it, their leaves into `leaves` (from index `leaf_at`). Each subtree's slices are cut by
     /// its size, so a node with many leaves below writes its subtrees in parallel.
-    fn write(&self, mut kids: Kids<'_>, nodes: &mut [Node4], node_at: usize, leaves: &mut [Tri4], leaf_at: usize) {
+    fn write(&self, mut kids: Kids<'_>, nodes: &mut [Node8], node_at: usize, leaves: &mut [Tri8], leaf_at: usize) {
         let parallel = leaves.len() >= PARALLEL / LEAF_SIZE;
         // A subtree's slice holds its own node first: every inner size counts itself.
         let (node, mut nodes_rest) = nodes.split_first_mut().expect("a slot for the node");
@@ -329,7 +330,7 @@ impl Out<'_> {
         node.axis = axis as u32;
         let mut leaves_rest = leaves;
         let (mut next_node, mut next_leaf) = (node_at + 1, leaf_at);
-        let mut below: [Option<Subtree<'_, '_>>; LANES] = [None, None, None, None];
+        let mut below: [Option<Subtree<'_, '_>>; LANES] = std::array::from_fn(|_| None);
         for (k, kid) in kids.iter().enumerate() {
             let size = kid.size();
             let (kid_nodes, more_nodes) = std::mem::take(&mut nodes_rest).split_at_mut(size.nodes);
@@ -338,7 +339,7 @@ impl Out<'_> {
             let child = match kid {
                 Node2::Leaf { start, count, .. } => {
                     let ids = &self.order[*start..start + count];
-                    kid_leaves[0] = Tri4::new(ids.len(), |i| self.tris[ids[i] as usize]);
+                    kid_leaves[0] = Tri8::new(ids.len(), |i| self.tris[ids[i] as usize]);
                     LEAF | next_leaf as Child
                 }
                 Node2::Inner { halves, .. } => {
@@ -367,4 +368,4 @@ impl Out<'_> {
 }
 
 /// A subtree still to be written: its root's children, its slices and where they start in the tree.
-type Subtree<'k, 's> = (Kids<'k>, &'s mut [Node4], usize, &'s mut [Tri4], usize);
+type Subtree<'k, 's> = (Kids<'k>, &'s mut [Node8], usize, &'s mut [Tri8], usize);

@@ -1,6 +1,6 @@
-//! Ray casting for the exact reference: a four-wide BVH over every casting triangle in world space,
-//! built by the surface area heuristic on every core ([`build`]) and traversed for any hit, four boxes or
-//! four triangles per step ([`wide`]).
+//! Ray casting for the exact reference: an eight-wide BVH over every casting triangle in world space,
+//! built by the surface area heuristic on every core ([`build`]) and traversed for any hit, eight boxes
+//! or eight triangles per step ([`wide`]).
 
 mod build;
 mod wide;
@@ -12,15 +12,18 @@ use rayon::prelude::*;
 use shadow_core::FrameInputs;
 
 use self::build::STACK;
-use self::wide::{LEAF, Node4, Ray, Tri4};
+use self::wide::{LEAF, Node8, Ray, Tri8};
 
 /// The casters of a frame, ready for shadow rays.
 pub struct SceneBvh {
-    /// The four-wide nodes, the root first; empty when nothing casts.
-    nodes: Vec<Node4>,
+    /// The eight-wide nodes, the root first; empty when nothing casts.
+    nodes: Vec<Node8>,
     /// The leaves, in the order a depth-first walk meets them.
-    leaves: Vec<Tri4>,
+    leaves: Vec<Tri8>,
     triangles: usize,
+    /// Whether this CPU runs AVX2 (and the bit scans the walk uses).
+    #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
+    avx2: bool,
 }
 
 impl SceneBvh {
@@ -42,10 +45,10 @@ impl SceneBvh {
     pub fn build(frame: &FrameInputs) -> Self {
         let tris = casting_triangles(frame);
         if tris.is_empty() {
-            return Self { nodes: Vec::new(), leaves: Vec::new(), triangles: 0 };
+            return Self { nodes: Vec::new(), leaves: Vec::new(), triangles: 0, avx2: false };
         }
         let (nodes, leaves) = build::build(&tris);
-        Self { nodes, leaves, triangles: tris.len() }
+        Self { nodes, leaves, triangles: tris.len(), avx2: avx2() }
     }
 
     /// Number of triangles.
@@ -61,17 +64,38 @@ impl SceneBvh {
             return false;
         }
         let ray = Ray::new(origin.into(), dir.into(), 0.0, tmax);
+        #[cfg(target_arch = "x86_64")]
+        if self.avx2 {
+            // SAFETY: `avx2` is set only where `is_x86_feature_detected!` found every feature
+            // `walk_avx2` enables (see [`avx2`]).
+            #[allow(unsafe_code)]
+            return unsafe { self.walk_avx2(&ray) };
+        }
+        self.walk(&ray)
+    }
+
+    /// [`Self::walk`] compiled for AVX2: each eight-lane test is one 256-bit operation instead of two
+    /// 128-bit ones. The operations and their order are the same, so the answers are too.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,bmi1,bmi2,lzcnt")]
+    fn walk_avx2(&self, ray: &Ray) -> bool {
+        self.walk(ray)
+    }
+
+    /// Walks the tree until a leaf blocks `ray`.
+    #[inline(always)]
+    fn walk(&self, ray: &Ray) -> bool {
         let mut stack = [0u32; STACK];
         let mut top = 0;
         let mut at = 0u32;
         loop {
             if at & LEAF != 0 {
-                if self.leaves[(at & !LEAF) as usize].hit(&ray) {
+                if self.leaves[(at & !LEAF) as usize].hit(ray) {
                     return true;
                 }
             } else {
                 let node = &self.nodes[at as usize];
-                let mut enter = node.enter(&ray);
+                let mut enter = node.enter(ray);
                 // The child nearest along the node's axis is pushed last, so it is opened first: a
                 // blocked ray is most likely blocked by what it meets first.
                 if ray.dir[node.axis as usize] < 0.0 {
@@ -96,6 +120,19 @@ impl SceneBvh {
             at = stack[top];
         }
     }
+}
+
+/// Whether this CPU runs AVX2 and the bit scans the walk uses.
+fn avx2() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        is_x86_feature_detected!("avx2")
+            && is_x86_feature_detected!("bmi1")
+            && is_x86_feature_detected!("bmi2")
+            && is_x86_feature_detected!("lzcnt")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    false
 }
 
 /// Every casting triangle of the frame, in world space.
@@ -145,6 +182,8 @@ mod tests {
         let scene = scenes::build("cubes", &SceneParams::default()).unwrap();
         let frame = FrameInputs::from_first_camera(&scene).unwrap();
         let bvh = SceneBvh::build(&frame);
+        // The same tree walked without AVX2, as CPUs without it walk it.
+        let portable = SceneBvh { avx2: false, ..SceneBvh::build(&frame) };
         let tris = casting_triangles(&frame);
         let g = crate::gbuffer::render(&frame, 48, 36).unwrap();
         // The offset `ray-traced` uses by default (shadow-hard's `epsilon`).
@@ -160,6 +199,7 @@ mod tests {
             let ray = Ray::new(origin.into(), dir.map(|c| if c == 0.0 { 0.0 } else { c }).into(), 0.0, tmax);
             let any = tris.iter().any(|&[v0, v1, v2]| Triangle { v0, v1, v2 }.intersect(&ray) < tmax);
             assert_eq!(bvh.occluded(origin, dir, tmax), any, "pixel {i}: {origin} towards {dir}");
+            assert_eq!(portable.occluded(origin, dir, tmax), any, "pixel {i} without AVX2");
             cast += 1;
             blocked += usize::from(any);
         }
