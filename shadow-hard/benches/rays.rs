@@ -13,21 +13,17 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 use shadow_core::FrameInputs;
-use shadow_core::glam::Vec3;
 use shadow_core::scenes::{self, SceneParams};
 use shadow_core::technique::TechniqueSettings;
 use shadow_cpu::bvh::SceneBvh;
 use shadow_cpu::gbuffer;
-use shadow_cpu::passes::rays::{RayOrigins, towards};
+use shadow_cpu::passes::rays::{self, ShadowRay};
 use shadow_hard::RayTraced;
 
 /// Each timing is the median of this many runs.
 const RUNS: usize = 5;
 /// BVH builds in a row per run, on each side (`BUILDS` in `embree_rays.py`); the median counts.
 const BUILDS: usize = 3;
-
-/// A shadow ray: origin, unit direction, far distance.
-type Ray = (Vec3, Vec3, f32);
 
 fn main() {
     let folder = std::env::temp_dir().join("shadowlab-rays");
@@ -98,25 +94,15 @@ fn measure(name: &str, folder: &Path, embree: bool) {
     );
 }
 
-/// The rays `ray-traced` casts over the frame's G-buffer: from each receiver whose light is above its
-/// horizon, towards the light's position (up to it) or against a directional light's direction.
-fn shadow_rays(frame: &FrameInputs, w: u32, h: u32) -> Vec<Ray> {
+/// The rays `ray-traced` casts over the frame's G-buffer at `w` x `h`.
+fn shadow_rays(frame: &FrameInputs, w: u32, h: u32) -> Vec<ShadowRay> {
     let g = gbuffer::render(frame, w, h).expect("G-buffer");
-    let origins = RayOrigins::new(&g, frame, RayTraced::defaults().epsilon);
-    let light = &frame.lights[0].kind;
-    (0..g.receiver.data().len())
-        .filter(|&i| g.receiver.data()[i])
-        .filter_map(|i| {
-            let (origin, n) = origins.at(i);
-            let (dir, far) = towards(light, origin);
-            (n.dot(dir) > 0.0).then_some((origin, dir, far))
-        })
-        .collect()
+    rays::shadow_rays(&g, frame, RayTraced::defaults().epsilon)
 }
 
 /// Writes the casting triangles and the rays for `embree_rays.py`; false (with a line saying why) when
 /// it cannot.
-fn dump(name: &str, folder: &Path, frame: &FrameInputs, rays: &[Ray]) -> bool {
+fn dump(name: &str, folder: &Path, frame: &FrameInputs, rays: &[ShadowRay]) -> bool {
     let mut tris = Vec::new();
     for inst in frame.instances.iter().filter(|i| i.casts_shadow) {
         let p = inst.mesh.positions();

@@ -1,11 +1,13 @@
 //! `shadowlab results`: measures every technique on every built-in scene and writes `docs/results.md`,
 //! so each number there comes from one command on a named machine and adapter.
 //!
-//! Five parts: the error of each technique against its reference on each scene (both backends), the
-//! largest disagreement between the backends, the frame time per phase on one scene (`bench`), on a GPU
-//! adapter the real-time path on that scene (`bench --realtime`), and perspective aliasing on the outdoor
-//! street ([`outdoor`]).
+//! The error of each technique against its reference on each scene (both backends), the largest
+//! disagreement between the backends, the frame time per phase on one scene (`bench`), on a GPU adapter
+//! the real-time path on that scene (`bench --realtime`), perspective aliasing on the outdoor street
+//! ([`outdoor`]), the soft techniques against the area light ([`soft`]), and the kernels under them all
+//! timed on their own ([`kernels`]).
 
+pub mod kernels;
 pub mod outdoor;
 pub mod soft;
 
@@ -113,9 +115,11 @@ pub fn run_results(renderer: &mut Renderer, job: &ResultsJob, mut progress: impl
     let outdoor = outdoor::run_outdoor(renderer, &outdoor_job, &mut progress)?;
     let soft_job = soft::SoftJob { backends: job.backends.clone(), pictures: job.pictures.clone() };
     let soft = soft::run_soft(renderer, &soft_job, &mut progress)?;
+    let kernels = kernels::run_kernels(&mut progress)?;
     let mut text = markdown(renderer, job, &reports, (&timing, realtime.as_ref()));
     outdoor::markdown(&mut text, &outdoor);
     soft::markdown(&mut text, &soft);
+    kernels::markdown(&mut text, &kernels);
     Ok(text)
 }
 

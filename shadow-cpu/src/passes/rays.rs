@@ -68,3 +68,23 @@ pub fn towards(light: &LightKind, origin: Vec3) -> (Vec3, f32) {
         LightKind::Directional { direction } => (-direction.normalize(), f32::INFINITY),
     }
 }
+
+/// A shadow ray: origin, unit direction, and how far it runs.
+pub type ShadowRay = (Vec3, Vec3, f32);
+
+/// The rays `ray-traced` casts over `g`: from each receiver whose seen side faces the frame's first
+/// light, towards it (see [`towards`]), leaving the surface as [`RayOrigins`] places it. None without a
+/// light.
+#[must_use]
+pub fn shadow_rays(g: &GBuffer, frame: &FrameInputs, epsilon: f32) -> Vec<ShadowRay> {
+    let Some(light) = frame.lights.first() else { return Vec::new() };
+    let origins = RayOrigins::new(g, frame, epsilon);
+    (0..g.receiver.data().len())
+        .filter(|&i| g.receiver.data()[i])
+        .filter_map(|i| {
+            let (origin, n) = origins.at(i);
+            let (dir, far) = towards(&light.kind, origin);
+            (n.dot(dir) > 0.0).then_some((origin, dir, far))
+        })
+        .collect()
+}
