@@ -7,13 +7,14 @@
 //! drifts in speed. A development measurement: Embree is never a dependency of the library.
 //! `cargo bench -p shadow-hard --bench rays`.
 
+use std::hint::black_box;
 use std::path::Path;
 use std::process::Command;
-use std::time::Instant;
 
 use rayon::prelude::*;
 use shadow_core::FrameInputs;
 use shadow_core::scenes::{self, SceneParams};
+use shadow_core::stats::{Summary, timed};
 use shadow_core::technique::TechniqueSettings;
 use shadow_cpu::bvh::SceneBvh;
 use shadow_cpu::gbuffer;
@@ -61,9 +62,12 @@ fn measure(name: &str, folder: &Path, embree: bool) {
     for _ in 0..RUNS {
         // Each side builds its BVH a few times in a row (the first after the other's run, from cold
         // caches) and keeps the median.
-        build.push(median((0..BUILDS).map(|_| timed(|| SceneBvh::build(&frame)).0).collect()));
-        one.push(timed(|| rays.iter().filter(|&&(o, d, t)| bvh.occluded(o, d, t)).count()).0);
-        all.push(timed(|| rays.par_iter().with_min_len(4096).filter(|&&(o, d, t)| bvh.occluded(o, d, t)).count()).0);
+        build.push(median((0..BUILDS).map(|_| timed(|| black_box(SceneBvh::build(&frame))).1).collect()));
+        one.push(timed(|| black_box(rays.iter().filter(|&&(o, d, t)| bvh.occluded(o, d, t)).count())).1);
+        all.push(
+            timed(|| black_box(rays.par_iter().with_min_len(4096).filter(|&&(o, d, t)| bvh.occluded(o, d, t)).count()))
+                .1,
+        );
         if embree {
             theirs.extend(embree_once(name, folder));
         }
@@ -145,14 +149,6 @@ fn embree_answers(name: &str, folder: &Path, rays: usize) -> Option<Vec<bool>> {
     (answers.len() == rays).then(|| answers.iter().map(|&a| a == 1).collect())
 }
 
-/// Milliseconds `f` took, and what it gave.
-fn timed<T>(f: impl FnOnce() -> T) -> (f64, T) {
-    let start = Instant::now();
-    let out = std::hint::black_box(f());
-    (start.elapsed().as_secs_f64() * 1e3, out)
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
+fn median(v: Vec<f64>) -> f64 {
+    Summary::of(&v).median
 }

@@ -5,7 +5,6 @@
 
 use std::fmt::Write as _;
 use std::hint::black_box;
-use std::time::Instant;
 
 use rayon::prelude::*;
 use shadow_core::geometry::LightSource;
@@ -14,6 +13,7 @@ use shadow_core::geometry::silhouette::{CastMode, silhouette};
 use shadow_core::geometry::volume::{Caps, extrude};
 use shadow_core::glam::Vec3;
 use shadow_core::procedural;
+use shadow_core::stats::{Summary, timed};
 use shadow_core::technique::TechniqueSettings;
 use shadow_cpu::bvh::SceneBvh;
 use shadow_cpu::gbuffer;
@@ -96,15 +96,8 @@ pub fn run_kernels(progress: &mut impl FnMut(&str)) -> Result<KernelsReport, Err
 
 /// The median of [`RUNS`] timings of `f`, in ms.
 fn median(mut f: impl FnMut()) -> f64 {
-    let mut ms: Vec<f64> = (0..RUNS)
-        .map(|_| {
-            let start = Instant::now();
-            f();
-            start.elapsed().as_secs_f64() * 1e3
-        })
-        .collect();
-    ms.sort_by(f64::total_cmp);
-    ms[RUNS / 2]
+    let ms: Vec<f64> = (0..RUNS).map(|_| timed(&mut f).1).collect();
+    Summary::of(&ms).median
 }
 
 /// Appends the kernels' section.

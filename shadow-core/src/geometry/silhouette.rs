@@ -84,35 +84,21 @@ fn weights(adj: &Adjacency, light: LightSource, mode: CastMode, facing: &[Facing
         CastMode::Closed => 0,
         CastMode::Bergeron => -1,
     };
-    // +1 facing the light, `unlit` facing away, 0 in its plane: written without a branch, and with the
-    // light's kind matched once, not per face. Each facing value is summed in the order
-    // [`LightSource::facing`] sums it, so the signs are the ones it gives.
+    // +1 facing the light, `unlit` facing away, 0 in its plane.
     let sign = move |f: f32| i8::from(f > 0.0) + i8::from(f < 0.0) * unlit;
-    let planes: &[[f32; 4]] = bytemuck::cast_slice(adj.planes());
-    let mut weights = vec![0i8; planes.len()];
-    let runs = weights.par_chunks_mut(FACES).zip(planes.par_chunks(FACES)).zip(facing).with_min_len(64);
-    match light {
-        LightSource::Point(l) => runs.for_each(|((w, planes), &facing)| {
-            fill(w, facing, unlit, planes, |[x, y, z, d]| sign(x * l.x + y * l.y + z * l.z + d));
-        }),
-        LightSource::Directional(l) => runs.for_each(|((w, planes), &facing)| {
-            fill(w, facing, unlit, planes, |[x, y, z, _]| sign(-(x * l.x + y * l.y + z * l.z)));
-        }),
-    }
-    weights
-}
-
-/// The weights of one run of faces: its own where the run is decided, each face's `sign` where not.
-fn fill(w: &mut [i8], facing: Facing, unlit: i8, planes: &[[f32; 4]], sign: impl Fn([f32; 4]) -> i8) {
-    match facing {
-        Facing::Front => w.fill(1),
-        Facing::Back => w.fill(unlit),
-        Facing::Mixed => {
-            for (w, &p) in w.iter_mut().zip(planes) {
-                *w = sign(p);
+    let mut weights = vec![0i8; adj.planes().len()];
+    weights.par_chunks_mut(FACES).zip(adj.planes().par_chunks(FACES)).zip(facing).with_min_len(64).for_each(
+        |((w, planes), facing)| match facing {
+            Facing::Front => w.fill(1),
+            Facing::Back => w.fill(unlit),
+            Facing::Mixed => {
+                for (w, &p) in w.iter_mut().zip(planes) {
+                    *w = sign(light.facing(p));
+                }
             }
-        }
-    }
+        },
+    );
+    weights
 }
 
 fn oriented(v: [u32; 2], w: i32, face: u32) -> Option<SilhouetteEdge> {

@@ -184,7 +184,7 @@ where
     F: Fn(&Fragment) -> Option<T> + Sync,
     B: Fn(&mut T, T) + Sync,
 {
-    draw_with(ds, color, src, st, (Path::General, None), None, shader, blend)
+    draw_with(ds, color, src, st, (Path::General, None), shader, blend)
 }
 
 /// A draw whose colour is one value per primitive, `value(prim)`: a visibility buffer of primitive ids, an
@@ -212,7 +212,7 @@ where
         Some(k @ DepthKernel::Depth { write: true, .. }) => Path::Flat(k),
         _ => Path::General,
     };
-    draw_with(ds, color, src, st, (path, None), None, shader, |d, v| *d = v)
+    draw_with(ds, color, src, st, (path, None), shader, |d, v| *d = v)
 }
 
 /// Depth (and stencil) only: shadow-map renders and shadow-volume counting take branch-free inner loops.
@@ -240,7 +240,7 @@ pub fn draw_depth_masked<S: TriangleSource + ?Sized>(
     }
     let mut none = Image::new(ds.width, ds.height, ());
     let path = DepthKernel::for_state(st).map_or(Path::General, Path::Depth);
-    draw_with(ds, &mut none, src, st, (path, mask), None, |_| Some(()), |_, _| {})
+    draw_with(ds, &mut none, src, st, (path, mask), |_| Some(()), |_, _| {})
 }
 
 /// Depth peeling (Everitt, "Interactive Order-Independent Transparency", 2001): a depth-only draw that
@@ -264,21 +264,19 @@ pub fn draw_depth_peeled<S: TriangleSource + ?Sized>(
     let mut none = Image::new(ds.width, ds.height, ());
     match DepthKernel::for_state(st) {
         Some(DepthKernel::Depth { compare, write: true }) => {
-            let path = Path::Peel { compare, epsilon };
-            draw_with(ds, &mut none, src, st, (path, None), Some(under), |_| Some(()), |_, _| {})
+            let path = Path::Peel { compare, epsilon, under: under.data() };
+            draw_with(ds, &mut none, src, st, (path, None), |_| Some(()), |_, _| {})
         }
         _ => draw(ds, &mut none, src, st, |f| (f.depth > *under.get(f.x, f.y) + epsilon).then_some(()), |_, _| {}),
     }
 }
 
-#[allow(clippy::too_many_arguments)]
 fn draw_with<T, S, F, B>(
     ds: &mut DepthStencil,
     color: &mut Image<T>,
     src: &S,
     st: &RasterState,
-    (path, mask): (Path, Option<&ComputationMask>),
-    under: Option<&Image<f32>>,
+    (path, mask): (Path<'_>, Option<&ComputationMask>),
     shader: F,
     blend: B,
 ) -> RasterCounters
@@ -336,8 +334,7 @@ where
             .map(|(band, (((depth, stencil), col), bin))| {
                 let mut c = RasterCounters::default();
                 let y0 = band as i32 * BAND_ROWS as i32;
-                let under = under.map_or(&[][..], |u| &u.data()[band * band_px..][..depth.len()]);
-                let mut rows = BandRows { depth, stencil, color: col, under, y0, width: w as usize };
+                let mut rows = BandRows { depth, stencil, color: col, y0, width: w as usize };
                 for &t in bin {
                     raster_band(&setups[t as usize], &mut rows, st, (path, mask), (&shader, &blend), &mut c);
                 }
@@ -356,8 +353,6 @@ struct BandRows<'a, T> {
     depth: &'a mut [f32],
     stencil: &'a mut [u8],
     color: &'a mut [T],
-    /// The band's rows of the layer a peeling draw peels (empty for other draws).
-    under: &'a [f32],
     y0: i32,
     width: usize,
 }
@@ -434,7 +429,7 @@ struct RowStart {
 
 /// How a draw treats its fragments.
 #[derive(Clone, Copy)]
-enum Path {
+enum Path<'a> {
     /// One at a time through the fragment closure and every test of the state.
     General,
     /// Depth (and stencil) only, through a fast kernel.
@@ -442,8 +437,9 @@ enum Path {
     /// Depth tests that write, through the fast kernel, and where they pass the colour the fragment
     /// closure gives the primitive ([`draw_flat`]); other kernels take the general path.
     Flat(DepthKernel),
-    /// A writing depth test behind a peeled layer ([`draw_depth_peeled`]).
-    Peel { compare: CompareFn, epsilon: f32 },
+    /// A writing depth test behind a peeled layer ([`draw_depth_peeled`]): `under` is that layer's
+    /// depths, row by row over the whole target.
+    Peel { compare: CompareFn, epsilon: f32, under: &'a [f32] },
 }
 
 impl Fragment {
@@ -565,7 +561,7 @@ fn raster_band<T, F, B>(
     t: &Setup,
     rows: &mut BandRows<'_, T>,
     st: &RasterState,
-    (path, mask): (Path, Option<&ComputationMask>),
+    (path, mask): (Path<'_>, Option<&ComputationMask>),
     (shader, blend): (&F, &B),
     c: &mut RasterCounters,
 ) where
@@ -592,8 +588,9 @@ fn raster_band<T, F, B>(
             let start = RowStart { z_row, clamp, xs: a };
             match path {
                 Path::Depth(k) => row_fast(t, k, start, &mut rows.depth[lo..hi], &mut rows.stencil[lo..hi], c),
-                Path::Peel { compare, epsilon } => {
-                    let under = &rows.under[lo..hi];
+                Path::Peel { compare, epsilon, under } => {
+                    let at = rows.y0 as usize * rows.width;
+                    let under = &under[at + lo..at + hi];
                     row_peel(t, (compare, epsilon), start, &mut rows.depth[lo..hi], under, c);
                 }
                 Path::Flat(DepthKernel::Depth { compare, write: true }) => {
