@@ -133,17 +133,7 @@ impl Adjacency {
     #[must_use]
     pub fn build(mesh: &Mesh) -> Self {
         let (positions, remap) = weld(mesh.positions());
-        let triangles: Vec<[u32; 3]> = mesh.triangles().par_iter().map(|t| t.map(|i| remap[i as usize])).collect();
-        let degenerate: Vec<bool> = triangles.par_iter().map(|&[a, b, c]| a == b || b == c || c == a).collect();
-        let planes: Vec<Vec4> = triangles
-            .par_iter()
-            .map(|t| {
-                let p = t.map(|i| positions[i as usize]);
-                let n = power_of_two_unit(face_normal(p));
-                // Exactly zero for two equal corners; -0.0 folded so the facing test gives exactly 0.
-                if n == Vec3::ZERO { Vec4::ZERO } else { n.extend(-n.dot(p[0])) }
-            })
-            .collect();
+        let (triangles, degenerate, planes) = faces(mesh.triangles(), &remap, &positions);
 
         let (manifold, manifold_faces, lists) = edges(&triangles, &degenerate, positions.len());
         let mut adj = Self {
@@ -279,19 +269,48 @@ impl Adjacency {
     }
 }
 
+/// Each face in welded vertices, whether two of its corners weld together, and its plane, in one pass
+/// over the faces, each thread filling its own stretch of the three lists.
+fn faces(mesh_triangles: &[[u32; 3]], remap: &[u32], positions: &[Vec3]) -> (Vec<[u32; 3]>, Vec<bool>, Vec<Vec4>) {
+    const RUN: usize = 4096;
+    let n = mesh_triangles.len();
+    // Zeroed allocations, whose pages are first touched (and faulted in) by the threads writing them.
+    let (mut triangles, mut degenerate) = (vec![[0; 3]; n], vec![false; n]);
+    let mut planes: Vec<Vec4> = bytemuck::zeroed_vec(n);
+    mesh_triangles
+        .par_chunks(RUN)
+        .zip(triangles.par_chunks_mut(RUN))
+        .zip(degenerate.par_chunks_mut(RUN))
+        .zip(planes.par_chunks_mut(RUN))
+        .for_each(|(((mesh, triangles), degenerate), planes)| {
+            for (((m, t), d), plane) in mesh.iter().zip(triangles).zip(degenerate).zip(planes) {
+                *t = m.map(|i| remap[i as usize]);
+                let [a, b, c] = *t;
+                *d = a == b || b == c || c == a;
+                let p = t.map(|i| positions[i as usize]);
+                let n = power_of_two_unit(face_normal(p));
+                // Exactly zero for two equal corners; -0.0 folded so the facing test gives exactly 0.
+                *plane = if n == Vec3::ZERO { Vec4::ZERO } else { n.extend(-n.dot(p[0])) };
+            }
+        });
+    (triangles, degenerate, planes)
+}
+
 /// Every edge of the faces that are not degenerate, in the order of its welded endpoints (lower, then
 /// higher), sorted into [`Adjacency`]'s three lists: the consistently wound manifold edges with their
 /// face pairs, and per range of lower endpoints (in order) the other edges.
 ///
-/// Each face's use of each of its edges is put in the bucket of the edge's lower endpoint by a counting
-/// sort, and each bucket (about six uses on a closed mesh) is sorted by the higher endpoint, then the
-/// use. That is linear in the faces, where a comparison sort of all the uses (three million for a
-/// million faces) took most of the build, and the order is the one such a sort gives.
+/// The edges whose lower endpoint is a vertex `v` belong to the faces at `v`, and a face at `v` has one
+/// of them unless `v` is its highest corner. So a counting sort lists, per vertex, the faces of which it
+/// is a corner but not the highest one; each vertex then reads its few faces (about four on a closed
+/// mesh), writes their edges leaving it upwards as `higher << 32 | use` words, and sorts those by the
+/// higher endpoint, then the use. That is linear in the faces, and the order is the one a sort of all
+/// the uses would give.
 ///
 /// The vertices are split into one range per thread, and each thread reads every face and keeps the
-/// uses whose lower endpoint is in its range: it counts them into its buckets, places them, sorts each
-/// bucket and reads its edges off it while it is in cache, writing only its own part of every output.
-/// Reading the faces once per thread costs far less than merging buckets filled by several threads.
+/// corners in its range: it counts them into its vertices, places them, and reads each vertex's edges
+/// off its faces while they are in cache, writing only its own part of every output. Reading the faces
+/// once per thread costs far less than merging lists filled by several threads.
 fn edges(
     triangles: &[[u32; 3]],
     degenerate: &[bool],
@@ -300,56 +319,71 @@ fn edges(
     let per_range = vertices.div_ceil(rayon::current_num_threads().clamp(1, 64)).max(1);
     let ranges: Vec<std::ops::Range<usize>> =
         (0..vertices).step_by(per_range).map(|lo| lo..(lo + per_range).min(vertices)).collect();
-    // Per range, where each of its buckets begins, counted from the range's first use.
-    let starts: Vec<Vec<u32>> = ranges
+    // Per range, where each of its vertices' faces begin, and how many edges leave its vertices upwards,
+    // each counted once per face using it.
+    let counts: Vec<(Vec<u32>, usize)> = ranges
         .par_iter()
         .map(|range| {
-            let mut start = vec![0u32; range.len() + 1];
-            each_use(triangles, degenerate, |_, u, v| {
-                // Below the range, the difference wraps past every bucket.
-                if let Some(s) = start.get_mut((u.min(v) as usize).wrapping_sub(range.start) + 1) {
+            let (mut start, mut uses) = (vec![0u32; range.len() + 1], 0);
+            each_lower_corner(triangles, degenerate, |_, v, up| {
+                // Below the range, the difference wraps past every vertex.
+                if let Some(s) = start.get_mut((v as usize).wrapping_sub(range.start) + 1) {
                     *s += 1;
+                    uses += up;
                 }
             });
             for i in 1..start.len() {
                 start[i] += start[i - 1];
             }
-            start
+            (start, uses)
         })
         .collect();
     // A range of n uses has at most n / 2 manifold edges; each range writes its own into a part of the
     // outputs that size. Zeroed memory is not touched until written, so parts left unused cost nothing.
-    let uses: Vec<usize> = starts.iter().map(|s| s[s.len() - 1] as usize).collect();
-    let most: usize = uses.iter().map(|n| n / 2).sum();
+    let most: usize = counts.iter().map(|(_, n)| n / 2).sum();
     let (mut manifold, mut manifold_faces) = (vec![[0u32; 2]; most], vec![[0u32; 2]; most]);
-    let mut buffer = vec![0u64; uses.iter().sum()];
+    let mut corners = vec![0u32; counts.iter().map(|(start, _)| start[start.len() - 1] as usize).sum()];
     let mut parts = Vec::with_capacity(ranges.len());
-    let (mut buffer_rest, mut edges_rest, mut faces_rest) =
-        (buffer.as_mut_slice(), manifold.as_mut_slice(), manifold_faces.as_mut_slice());
-    for ((range, start), &n) in ranges.iter().zip(&starts).zip(&uses) {
-        let (words, b) = buffer_rest.split_at_mut(n);
+    let (mut corners_rest, mut edges_rest, mut faces_rest) =
+        (corners.as_mut_slice(), manifold.as_mut_slice(), manifold_faces.as_mut_slice());
+    for (range, (start, n)) in ranges.iter().zip(&counts) {
+        let (faces_at, c) = corners_rest.split_at_mut(start[start.len() - 1] as usize);
         let (edges, e) = edges_rest.split_at_mut(n / 2);
         let (faces, f) = faces_rest.split_at_mut(n / 2);
-        parts.push((range.clone(), start, words, edges, faces));
-        (buffer_rest, edges_rest, faces_rest) = (b, e, f);
+        parts.push((range.clone(), start, faces_at, edges, faces));
+        (corners_rest, edges_rest, faces_rest) = (c, e, f);
     }
     let lists: Vec<EdgeLists> = parts
         .into_par_iter()
-        .map(|(range, start, words, edges, faces)| {
-            // Each use as `higher << 32 | use`: sorting the words sorts by the higher endpoint, then the use.
+        .map(|(range, start, faces_at, edges, faces)| {
             let mut next = start[..range.len()].to_vec();
-            each_use(triangles, degenerate, |f, u, v| {
-                if let Some(slot) = next.get_mut((u.min(v) as usize).wrapping_sub(range.start)) {
-                    words[*slot as usize] = u64::from(u.max(v)) << 32 | u64::from(FaceUse::new(f as u32, u > v).0);
+            each_lower_corner(triangles, degenerate, |f, v, _| {
+                if let Some(slot) = next.get_mut((v as usize).wrapping_sub(range.start)) {
+                    faces_at[*slot as usize] = f;
                     *slot += 1;
                 }
             });
-            let mut lists = EdgeLists::default();
+            let (mut lists, mut words) = (EdgeLists::default(), Vec::new());
             for (lower, w) in range.zip(start.windows(2)) {
-                let bucket = &mut words[w[0] as usize..w[1] as usize];
-                bucket.sort_unstable();
-                for run in bucket.chunk_by(|x, y| x >> 32 == y >> 32) {
-                    let v = [lower as u32, (run[0] >> 32) as u32];
+                let lower = lower as u32;
+                words.clear();
+                for &f in &faces_at[w[0] as usize..w[1] as usize] {
+                    let t = triangles[f as usize];
+                    // The face was listed under this corner of it, so the search finds it.
+                    let k = t.iter().position(|&v| v == lower).unwrap_or_default();
+                    // The face runs from `lower` up to the corner after it, and down to `lower` from the
+                    // corner before it.
+                    let (after, before) = (t[(k + 1) % 3], t[(k + 2) % 3]);
+                    if after > lower {
+                        words.push(u64::from(after) << 32 | u64::from(FaceUse::new(f, false).0));
+                    }
+                    if before > lower {
+                        words.push(u64::from(before) << 32 | u64::from(FaceUse::new(f, true).0));
+                    }
+                }
+                words.sort_unstable();
+                for run in words.chunk_by(|x, y| x >> 32 == y >> 32) {
+                    let v = [lower, (run[0] >> 32) as u32];
                     match manifold_faces_of(run) {
                         Some(pair) => {
                             (edges[lists.manifold], faces[lists.manifold]) = (v, pair);
@@ -364,7 +398,7 @@ fn edges(
         .collect();
     // Close the gaps the ranges left (none on a closed mesh, where every use is half a manifold edge).
     let (mut at, mut part) = (0, 0);
-    for (l, &n) in lists.iter().zip(&uses) {
+    for (l, (_, n)) in lists.iter().zip(&counts) {
         manifold.copy_within(part..part + l.manifold, at);
         manifold_faces.copy_within(part..part + l.manifold, at);
         (at, part) = (at + l.manifold, part + n / 2);
@@ -376,14 +410,17 @@ fn edges(
     (manifold, manifold_faces, lists)
 }
 
-/// Calls `each(face, from, to)` for every edge of every face that is not degenerate, the edge's
-/// endpoints in the face's order.
-fn each_use(triangles: &[[u32; 3]], degenerate: &[bool], mut each: impl FnMut(usize, u32, u32)) {
+/// Calls `each(face, corner, up)` for every corner of every face that is not degenerate but its highest
+/// one, with `up` the number of the face's edges that leave the corner upwards (one or two).
+fn each_lower_corner(triangles: &[[u32; 3]], degenerate: &[bool], mut each: impl FnMut(u32, u32, usize)) {
     for (f, (&[a, b, c], &d)) in triangles.iter().zip(degenerate).enumerate() {
         if !d {
-            each(f, a, b);
-            each(f, b, c);
-            each(f, c, a);
+            for v in [a, b, c] {
+                let up = usize::from(a > v) + usize::from(b > v) + usize::from(c > v);
+                if up > 0 {
+                    each(f as u32, v, up);
+                }
+            }
         }
     }
 }
@@ -462,19 +499,17 @@ fn components(adj: &Adjacency) -> (Vec<u32>, Vec<Aabb>) {
         }
     }
     // A root joins below the other, and halving only moves a face up its path, so every face's parent is
-    // at most the face and each root is its component's least face. In face order, then, a face's parent
-    // already points at its root, and a root comes before the rest of its component: one pass finds every
-    // face's root and numbers the components in order of first appearance.
-    let mut component = vec![0u32; parent.len()];
+    // a lesser face (or itself, for a root). In face order, then, a face's parent has already been given
+    // its component's number: one pass numbers the components in order of first appearance, in place.
+    let mut component = parent;
     let mut count = 0;
-    for f in 0..parent.len() {
-        let r = parent[parent[f] as usize];
-        parent[f] = r;
-        component[f] = if r as usize == f {
+    for f in 0..component.len() {
+        let p = component[f] as usize;
+        component[f] = if p == f {
             count += 1;
             count - 1
         } else {
-            component[r as usize]
+            component[p]
         };
     }
     // Bounds by runs of faces of one component (a mesh's faces come component by component, mostly), the
@@ -527,20 +562,22 @@ fn weld(positions: &[Vec3]) -> (Vec<Vec3>, Vec<u32>) {
         .par_chunks(per_run)
         .enumerate()
         .map(|(r, run)| {
-            let keys: Vec<([u32; 3], usize)> =
-                run.iter().map(|&p| weld_key(p)).map(|k| (k, (weld_hash(k) >> 56) as usize)).collect();
+            // Hashing twice costs less than keeping every key and its part between the two passes.
+            let part = |k: [u32; 3]| (weld_hash(k) >> 56) as usize;
             let mut start = vec![0usize; WELD_PARTS + 1];
-            for &(_, part) in &keys {
-                start[part + 1] += 1;
+            for &p in run {
+                start[part(weld_key(p)) + 1] += 1;
             }
             for i in 1..start.len() {
                 start[i] += start[i - 1];
             }
             let mut next = start.clone();
             let mut members = vec![[0u32; 4]; run.len()];
-            for (j, &([x, y, z], part)) in keys.iter().enumerate() {
-                members[next[part]] = [x, y, z, (r * per_run + j) as u32];
-                next[part] += 1;
+            for (j, &p) in run.iter().enumerate() {
+                let [x, y, z] = weld_key(p);
+                let slot = &mut next[part([x, y, z])];
+                members[*slot] = [x, y, z, (r * per_run + j) as u32];
+                *slot += 1;
             }
             (start, members)
         })
