@@ -111,6 +111,7 @@ impl<T> Image<T> {
     /// # Panics
     /// When the image is empty.
     #[must_use]
+    #[inline]
     pub fn get_clamped(&self, x: i32, y: i32) -> &T {
         let clamp = |v: i32, n: u32| v.clamp(0, n as i32 - 1) as u32;
         self.get(clamp(x, self.width), clamp(y, self.height))

@@ -78,11 +78,31 @@ pub fn floor(v: f32) -> i64 {
     i - i64::from(i as f32 > v)
 }
 
+/// `v.floor()` bit for bit (signed zeros, NaN and the integers from 2^23 up included), without the libm
+/// call `floor` makes on a plain x86-64 target: a bilinear lookup floors twice.
+#[inline]
+#[must_use]
+pub fn floor_f32(v: f32) -> f32 {
+    if v.abs() < 8_388_608.0 {
+        let t = v as i32 as f32;
+        (if t > v { t - 1.0 } else { t }).copysign(v)
+    } else {
+        v
+    }
+}
+
+/// [`floor_f32`] of both components.
+#[inline]
+#[must_use]
+pub fn floor_vec2(v: Vec2) -> Vec2 {
+    Vec2::new(floor_f32(v.x), floor_f32(v.y))
+}
+
 /// Comparison against the texel holding `uv` (WGSL twin: `compare_nearest`).
 #[must_use]
 pub fn compare_nearest(map: &Image<f32>, uv: Vec2, depth: f32) -> f32 {
     let n = map.width() as f32;
-    let t = (uv * n).floor();
+    let t = floor_vec2(uv * n);
     compare_texel(map, t.x as i32, t.y as i32, depth)
 }
 
@@ -107,7 +127,7 @@ pub fn on_map(uv: Vec2) -> bool {
 #[must_use]
 pub fn bilinear(n: u32, uv: Vec2, texel: impl Fn(i32, i32) -> f32) -> f32 {
     let st = uv * n as f32 - Vec2::splat(0.5);
-    let i = st.floor();
+    let i = floor_vec2(st);
     let f = st - i;
     let (x, y) = (i.x as i32, i.y as i32);
     let top = texel(x, y) * (1.0 - f.x) + texel(x + 1, y) * f.x;
@@ -307,6 +327,20 @@ mod tests {
     use super::*;
 
     /// A 4x4 map: the left half at depth 0.2 (an occluder), the right half at 1.0.
+    #[test]
+    fn floor_f32_is_floor_bit_for_bit() {
+        // Every 65537th bit pattern (all exponents, both signs, NaNs and infinities among them), and the
+        // values around the integers near zero and near 2^23, where the conversion's shortcut ends.
+        let strided = (0..=u32::MAX / 65_537).map(|k| f32::from_bits(k * 65_537));
+        let near = [0.0f32, 1.0, 2.0, 8_388_607.0, 8_388_608.0, 16_777_216.0, 2_147_483_648.0]
+            .into_iter()
+            .flat_map(|v| [v, v.next_up(), v.next_down(), v + 0.5, -v, -v.next_up(), -v.next_down(), -v - 0.5]);
+        for v in strided.chain(near).chain([f32::MIN_POSITIVE, -f32::MIN_POSITIVE, f32::INFINITY, f32::NEG_INFINITY]) {
+            let (want, got) = (v.floor(), floor_f32(v));
+            assert!(want.to_bits() == got.to_bits() || want.is_nan() && got.is_nan(), "{v:e}: {got:e} for {want:e}");
+        }
+    }
+
     fn half_map() -> Image<f32> {
         Image::from_fn(4, 4, |x, _| if x < 2 { 0.2 } else { 1.0 })
     }

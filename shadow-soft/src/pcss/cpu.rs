@@ -3,7 +3,7 @@
 
 use shadow_core::Image;
 use shadow_core::glam::Vec2;
-use shadow_core::lookup::{POISSON16, compare_bilinear, hash_unit, on_map, pixel_hash};
+use shadow_core::lookup::{POISSON16, compare_bilinear, floor_vec2, hash_unit, on_map, pixel_hash};
 use shadow_core::technique::LightPass;
 use shadow_core::technique::{DebugView, ShadowTechnique, TechniqueError};
 use shadow_cpu::passes::maps::{map_position, render_depth_maps};
@@ -21,7 +21,7 @@ pub struct State {
 
 /// The NDC depth of the texel holding `uv`, clamped to the map's edge.
 fn texel_depth(map: &Image<f32>, uv: Vec2) -> f32 {
-    let t = (uv * map.width() as f32).floor();
+    let t = floor_vec2(uv * map.width() as f32);
     *map.get_clamped(t.x as i32, t.y as i32)
 }
 
