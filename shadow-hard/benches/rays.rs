@@ -63,11 +63,8 @@ fn measure(name: &str, folder: &Path, embree: bool) {
         // Each side builds its BVH a few times in a row (the first after the other's run, from cold
         // caches) and keeps the median.
         build.push(median((0..BUILDS).map(|_| timed(|| black_box(SceneBvh::build(&frame))).1).collect()));
-        one.push(timed(|| black_box(rays.iter().filter(|&&(o, d, t)| bvh.occluded(o, d, t)).count())).1);
-        all.push(
-            timed(|| black_box(rays.par_iter().with_min_len(4096).filter(|&&(o, d, t)| bvh.occluded(o, d, t)).count()))
-                .1,
-        );
+        one.push(timed(|| black_box(rays::count_blocked(&bvh, &rays))).1);
+        all.push(timed(|| black_box(rays.par_chunks(4096).map(|c| rays::count_blocked(&bvh, c)).sum::<usize>())).1);
         if embree {
             theirs.extend(embree_once(name, folder));
         }

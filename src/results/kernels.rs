@@ -17,7 +17,7 @@ use shadow_core::stats::{Summary, timed};
 use shadow_core::technique::TechniqueSettings;
 use shadow_cpu::bvh::SceneBvh;
 use shadow_cpu::gbuffer;
-use shadow_cpu::passes::rays::shadow_rays;
+use shadow_cpu::passes::rays::{count_blocked, shadow_rays};
 use shadow_hard::RayTraced;
 
 use super::scene_frame;
@@ -76,10 +76,10 @@ pub fn run_kernels(progress: &mut impl FnMut(&str)) -> Result<KernelsReport, Err
         });
         let bvh = SceneBvh::build(&frame);
         let one = median(|| {
-            black_box(set.iter().filter(|&&(o, d, t)| bvh.occluded(o, d, t)).count());
+            black_box(count_blocked(&bvh, &set));
         });
         let all = median(|| {
-            black_box(set.par_iter().with_min_len(4096).filter(|&&(o, d, t)| bvh.occluded(o, d, t)).count());
+            black_box(set.par_chunks(4096).map(|c| count_blocked(&bvh, c)).sum::<usize>());
         });
         let rate = |ms: f64| set.len() as f64 / ms / 1e3;
         rays.push(RaysRow {

@@ -16,30 +16,34 @@ pub mod volumes;
 use rayon::prelude::*;
 use shadow_core::Image;
 
+use crate::bvh::LastBlocker;
+#[cfg(doc)]
+use crate::bvh::SceneBvh;
 use crate::gbuffer::GBuffer;
 
 /// Fills `out` with `f(x, y, i)` at every receiver pixel (i the pixel index) and 1 elsewhere.
 pub fn per_receiver(g: &GBuffer, out: &mut Image<f32>, f: impl Fn(u32, u32, usize) -> f32 + Sync) {
-    per_receiver_casting(g, out, |x, y, i| (f(x, y, i), 0));
+    per_receiver_casting(g, out, |_, x, y, i| (f(x, y, i), 0));
 }
 
 /// [`per_receiver`] for a pass that casts rays: `f` gives a receiver's visibility and the number of rays
-/// it cast (none where the light is below its horizon). Returns the rays cast over the whole image.
+/// it cast (none where the light is below its horizon), tracing them after the row's last blocker (see
+/// [`SceneBvh::occluded_after`]). Returns the rays cast over the whole image.
 pub fn per_receiver_casting(
     g: &GBuffer,
     out: &mut Image<f32>,
-    f: impl Fn(u32, u32, usize) -> (f32, u64) + Sync,
+    f: impl Fn(&mut LastBlocker, u32, u32, usize) -> (f32, u64) + Sync,
 ) -> u64 {
     let w = g.width() as usize;
     out.data_mut()
         .par_chunks_mut(w)
         .enumerate()
         .map(|(y, row)| {
-            let mut rays = 0;
+            let (mut rays, mut last) = (0, LastBlocker::default());
             for (x, v) in row.iter_mut().enumerate() {
                 let i = y * w + x;
                 *v = if g.receiver.data()[i] {
-                    let (visibility, cast) = f(x as u32, y as u32, i);
+                    let (visibility, cast) = f(&mut last, x as u32, y as u32, i);
                     rays += cast;
                     visibility
                 } else {

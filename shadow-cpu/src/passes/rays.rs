@@ -7,7 +7,7 @@ use shadow_core::glam::Vec3;
 use shadow_core::scene::LightKind;
 use shadow_core::technique::TechniqueError;
 
-use crate::bvh::SceneBvh;
+use crate::bvh::{LastBlocker, SceneBvh};
 use crate::context::CpuContext;
 use crate::gbuffer::GBuffer;
 
@@ -87,4 +87,12 @@ pub fn shadow_rays(g: &GBuffer, frame: &FrameInputs, epsilon: f32) -> Vec<Shadow
             (n.dot(dir) > 0.0).then_some((origin, dir, far))
         })
         .collect()
+}
+
+/// How many of `rays` some triangle blocks, traced in order on this thread, each after the last blocker
+/// of those before it (as a technique traces a row of pixels: [`SceneBvh::occluded_after`]).
+#[must_use]
+pub fn count_blocked(bvh: &SceneBvh, rays: &[ShadowRay]) -> usize {
+    let mut last = LastBlocker::default();
+    rays.iter().filter(|&&(origin, dir, far)| bvh.occluded_after(&mut last, origin, dir, far)).count()
 }
