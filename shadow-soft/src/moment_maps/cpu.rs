@@ -4,7 +4,7 @@
 use shadow_core::Image;
 use shadow_core::glam::Vec2;
 use shadow_core::light::LightProjection;
-use shadow_core::lookup::{floor_f32, floor_vec2, on_map};
+use shadow_core::lookup::on_map;
 use shadow_core::technique::{DebugView, LightPass, ShadowTechnique, TechniqueError};
 use shadow_cpu::passes::maps::{map_position, render_depth_maps};
 use shadow_cpu::passes::per_receiver;
@@ -86,7 +86,7 @@ pub fn moment_mips(depth: &Image<f32>, proj: &LightProjection, kind: MomentKind,
 /// Bilinear moments of `level` at `uv`, between texel centres, clamped to the edge (twin: `bilinear`).
 fn bilinear(level: &MomentImage, uv: Vec2) -> [f32; 4] {
     let p = uv * Vec2::new(level.width() as f32, level.height() as f32) - 0.5;
-    let i = floor_vec2(p);
+    let i = p.floor();
     let f = p - i;
     let (x, y) = (i.x as i32, i.y as i32);
     let at = |dx, dy| *level.get_clamped(x + dx, y + dy);
@@ -105,7 +105,7 @@ pub const GRID: usize = 4;
 fn trilinear(mips: &[MomentImage], uv: Vec2, footprint: f32) -> [f32; 4] {
     let top = (mips.len() - 1) as f32;
     let level = (footprint * mips[0].width() as f32).max(1.0).log2().min(top);
-    let l0 = floor_f32(level);
+    let l0 = level.floor();
     let a = bilinear(&mips[l0 as usize], uv);
     if level == l0 {
         return a;
