@@ -149,8 +149,8 @@ impl DepthStencil {
 }
 
 /// A fragment handed to the closure.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Fragment {
+#[derive(Clone, Copy, Debug)]
+pub struct Fragment<'t> {
     /// Pixel column.
     pub x: u32,
     /// Pixel row.
@@ -161,8 +161,35 @@ pub struct Fragment {
     pub prim: u32,
     /// Front-facing (after the source's flip).
     pub front_facing: bool,
-    /// Perspective-correct barycentrics in the source triangle (before clipping).
-    pub bary: [f32; 3],
+    /// Where the barycentrics come from.
+    weights: Weights<'t>,
+}
+
+/// What [`Fragment::bary`] works from: the pixel's edge functions in the triangle's setup, or nothing
+/// (a flat draw's closure is asked once per primitive, about no pixel).
+#[derive(Clone, Copy, Debug)]
+enum Weights<'t> {
+    Centroid,
+    At { edges: [i64; 3], setup: &'t Setup },
+}
+
+impl Fragment<'_> {
+    /// Perspective-correct barycentrics in the source triangle (before clipping); the centroid's for the
+    /// fragment a flat draw asks about. Worked out when asked: most closures never read them, and a dozen
+    /// multiplies and a division at every fragment is a large share of a draw whose closure is cheap.
+    #[must_use]
+    #[inline]
+    pub fn bary(&self) -> [f32; 3] {
+        match self.weights {
+            Weights::Centroid => [1.0 / 3.0; 3],
+            Weights::At { edges, setup: t } => {
+                // Perspective-correct weights of the clipped corners, then of the source triangle.
+                let q = [0, 1, 2].map(|k| edges[k] as f32 * t.inv_area * t.inv_w[k]);
+                let s = 1.0 / (q[0] + q[1] + q[2]);
+                [0, 1, 2].map(|k| (q[0] * t.bary[0][k] + q[1] * t.bary[1][k] + q[2] * t.bary[2][k]) * s)
+            }
+        }
+    }
 }
 
 /// Rasterizes `src` into `ds` and `color`. The closure gives the colour of a fragment or `None` to
@@ -442,11 +469,11 @@ enum Path<'a> {
     Peel { compare: CompareFn, epsilon: f32, under: &'a [f32] },
 }
 
-impl Fragment {
+impl Fragment<'_> {
     /// The fragment a flat draw's closure is asked about: only `prim` and `front_facing` are the
     /// triangle's.
     fn of_primitive(t: &Setup) -> Self {
-        Self { x: 0, y: 0, depth: 0.0, prim: t.prim, front_facing: t.front, bary: [1.0 / 3.0; 3] }
+        Self { x: 0, y: 0, depth: 0.0, prim: t.prim, front_facing: t.front, weights: Weights::Centroid }
     }
 }
 
@@ -633,12 +660,13 @@ fn row_general<T, F, B>(
             *e += s;
         }
         c.fragments += 1;
-        let frag = || {
-            // Perspective-correct weights of the clipped corners, then of the source triangle.
-            let q = [0, 1, 2].map(|k| here[k] as f32 * t.inv_area * t.inv_w[k]);
-            let s = 1.0 / (q[0] + q[1] + q[2]);
-            let bary = [0, 1, 2].map(|k| (q[0] * t.bary[0][k] + q[1] * t.bary[1][k] + q[2] * t.bary[2][k]) * s);
-            Fragment { x: x as u32, y: y as u32, depth, prim: t.prim, front_facing: t.front, bary }
+        let frag = || Fragment {
+            x: x as u32,
+            y: y as u32,
+            depth,
+            prim: t.prim,
+            front_facing: t.front,
+            weights: Weights::At { edges: here, setup: t },
         };
         let i = row + x as usize;
         let mut value = None;

@@ -108,7 +108,14 @@ fn barycentrics_are_perspective_correct() {
     let mut ds = DepthStencil::new(32, 32, 1.0, 0);
     let mut out = Image::new(32, 32, [f32::NAN; 3]);
     let st = RasterState { depth: None, ..RasterState::default() };
-    draw(&mut ds, &mut out, &Soup { triangles: &[v], prim_base: 0, flip: false }, &st, |f| Some(f.bary), |d, s| *d = s);
+    draw(
+        &mut ds,
+        &mut out,
+        &Soup { triangles: &[v], prim_base: 0, flip: false },
+        &st,
+        |f| Some(f.bary()),
+        |d, s| *d = s,
+    );
     let mut checked = 0;
     for y in 0..32 {
         for x in 0..32 {

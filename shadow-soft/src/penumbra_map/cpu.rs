@@ -51,7 +51,7 @@ pub fn render_penumbra(
         &state,
         |f| {
             let t = &triangles[f.prim as usize];
-            let z_v = t.vertex_depth.iter().zip(f.bary).map(|(z, b)| z * b).sum::<f32>();
+            let z_v = t.vertex_depth.iter().zip(f.bary()).map(|(z, b)| z * b).sum::<f32>();
             let z_f = proj.linear_depth(*map.get(f.x, f.y));
             penumbra_value(proj.linear_depth(f.depth), z_v, z_f)
         },
