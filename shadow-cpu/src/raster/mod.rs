@@ -391,6 +391,69 @@ fn depth_at(t: &Setup, z_row: f32, x: i32, clamp: bool) -> f32 {
     if clamp { z.clamp(0.0, 1.0) } else { z }
 }
 
+/// [`depth_at`] along one row, in a form a row loop runs without a branch per fragment: the clamp as
+/// bounds that are infinite when it is off (the same value as `f32::clamp`, NaN and -0 included).
+#[derive(Clone, Copy)]
+struct RowDepth {
+    z_row: f32,
+    dzdx: f32,
+    lo: f32,
+    hi: f32,
+}
+
+impl RowDepth {
+    #[inline(always)]
+    fn new(t: &Setup, row: RowStart) -> Self {
+        let (lo, hi) = if row.clamp { (0.0, 1.0) } else { (f32::NEG_INFINITY, f32::INFINITY) };
+        Self { z_row: row.z_row, dzdx: t.dzdx, lo, hi }
+    }
+
+    /// [`depth_at`] column `x`.
+    #[inline(always)]
+    fn at(&self, x: i32) -> f32 {
+        let z = self.z_row + self.dzdx * x as f32;
+        if z < self.lo {
+            self.lo
+        } else if z > self.hi {
+            self.hi
+        } else {
+            z
+        }
+    }
+}
+
+/// Runs `$body` with `$test` bound to `$compare`'s test (`CompareFn::test` on f32) as a closure of its own
+/// for each of the orderings depth tests use, so that a row loop in the body has no match per fragment
+/// and the compiler vectorizes it; the body is compiled once per ordering. The loops count passes in a
+/// u32 (a row is at most [`MAX_TARGET_SIDE`](crate::context::MAX_TARGET_SIDE) wide): a 64-bit count would
+/// halve the lanes.
+macro_rules! with_depth_test {
+    ($compare:expr, |$test:ident| $body:expr) => {
+        match $compare {
+            CompareFn::Less => {
+                let $test = |new: f32, stored: f32| new < stored;
+                $body
+            }
+            CompareFn::LessEqual => {
+                let $test = |new: f32, stored: f32| new <= stored;
+                $body
+            }
+            CompareFn::Greater => {
+                let $test = |new: f32, stored: f32| new > stored;
+                $body
+            }
+            CompareFn::GreaterEqual => {
+                let $test = |new: f32, stored: f32| new >= stored;
+                $body
+            }
+            other => {
+                let $test = move |new: f32, stored: f32| other.test(new, stored);
+                $body
+            }
+        }
+    };
+}
+
 /// The depth of a row at the centre of column 0, bias included: the one place depth is interpolated, so
 /// every draw of a triangle gives it bit-identical depths. `py` is the row's centre in fixed point.
 #[inline(always)]
@@ -491,17 +554,20 @@ fn row_flat<T>(
 ) where
     T: Copy,
 {
-    let RowStart { z_row, clamp, xs } = row;
-    let mut passed = 0u64;
-    for (i, (d, col)) in depth.iter_mut().zip(color).enumerate() {
-        let z = depth_at(t, z_row, xs + i as i32, clamp);
-        let pass = compare.test(z, *d);
-        *d = if pass { z } else { *d };
-        *col = if pass { value } else { *col };
-        passed += u64::from(pass);
-    }
+    let z = RowDepth::new(t, row);
+    let passed = with_depth_test!(compare, |test| {
+        let mut passed = 0u32;
+        for (i, (d, col)) in depth.iter_mut().zip(&mut *color).enumerate() {
+            let z = z.at(row.xs + i as i32);
+            let pass = test(z, *d);
+            *d = if pass { z } else { *d };
+            *col = if pass { value } else { *col };
+            passed += u32::from(pass);
+        }
+        passed
+    });
     c.fragments += depth.len() as u64;
-    c.passed += passed;
+    c.passed += u64::from(passed);
 }
 
 /// One row of a peeling draw ([`draw_depth_peeled`]): a fragment passes when it lies more than
@@ -516,71 +582,62 @@ fn row_peel(
     under: &[f32],
     c: &mut RasterCounters,
 ) {
-    let RowStart { z_row, clamp, xs } = row;
-    let mut passed = 0u64;
-    for (i, (d, u)) in depth.iter_mut().zip(under).enumerate() {
-        let z = depth_at(t, z_row, xs + i as i32, clamp);
-        let pass = z > *u + epsilon && compare.test(z, *d);
-        *d = if pass { z } else { *d };
-        passed += u64::from(pass);
-    }
+    let z = RowDepth::new(t, row);
+    let passed = with_depth_test!(compare, |test| {
+        let mut passed = 0u32;
+        for (i, (d, u)) in depth.iter_mut().zip(under).enumerate() {
+            let z = z.at(row.xs + i as i32);
+            let pass = (z > *u + epsilon) & test(z, *d);
+            *d = if pass { z } else { *d };
+            passed += u32::from(pass);
+        }
+        passed
+    });
     c.fragments += depth.len() as u64;
-    c.passed += passed;
+    c.passed += u64::from(passed);
 }
 
 /// One row of a depth-only draw with a fast kernel. Branch-free, so the compiler can vectorize it.
 #[inline(always)]
 fn row_fast(t: &Setup, k: DepthKernel, row: RowStart, depth: &mut [f32], stencil: &mut [u8], c: &mut RasterCounters) {
-    let RowStart { z_row, clamp, xs } = row;
-    #[inline(always)]
-    fn go(
-        t: &Setup,
-        z_row: f32,
-        clamp: bool,
-        xs: i32,
-        depth: &mut [f32],
-        mut f: impl FnMut(usize, f32, f32) -> bool,
-    ) -> u64 {
-        let mut passed = 0u64;
-        for (i, d) in depth.iter().enumerate() {
-            let z = depth_at(t, z_row, xs + i as i32, clamp);
-            passed += u64::from(f(i, z, *d));
-        }
-        passed
-    }
+    let z = RowDepth::new(t, row);
     let n = depth.len() as u64;
     c.fragments += n;
     let passed = match k {
-        DepthKernel::Depth { compare, write: true } => {
-            let mut passed = 0u64;
+        DepthKernel::Depth { compare, write: true } => with_depth_test!(compare, |test| {
+            let mut passed = 0u32;
             for (i, d) in depth.iter_mut().enumerate() {
-                let z = depth_at(t, z_row, xs + i as i32, clamp);
-                let pass = compare.test(z, *d);
+                let z = z.at(row.xs + i as i32);
+                let pass = test(z, *d);
                 *d = if pass { z } else { *d };
-                passed += u64::from(pass);
+                passed += u32::from(pass);
             }
             passed
-        }
-        DepthKernel::Depth { compare, write: false } => go(t, z_row, clamp, xs, depth, |_, z, d| compare.test(z, d)),
+        }),
+        DepthKernel::Depth { compare, write: false } => with_depth_test!(compare, |test| {
+            let mut passed = 0u32;
+            for (i, d) in depth.iter().enumerate() {
+                passed += u32::from(test(z.at(row.xs + i as i32), *d));
+            }
+            passed
+        }),
         DepthKernel::Count { compare, front, back } => {
             let (dp, df) = if t.front { front } else { back };
-            let passed = match compare {
-                CompareFn::Less => go(t, z_row, clamp, xs, depth, |i, z, d| {
-                    let pass = z < d;
-                    stencil[i] = stencil[i].wrapping_add(if pass { dp } else { df });
-                    pass
-                }),
-                cmp => go(t, z_row, clamp, xs, depth, |i, z, d| {
-                    let pass = cmp.test(z, d);
-                    stencil[i] = stencil[i].wrapping_add(if pass { dp } else { df });
-                    pass
-                }),
-            };
-            c.stencil_updates += if dp != 0 { passed } else { 0 } + if df != 0 { n - passed } else { 0 };
+            let passed = with_depth_test!(compare, |test| {
+                let mut passed = 0u32;
+                for (i, (d, s)) in depth.iter().zip(&mut *stencil).enumerate() {
+                    let pass = test(z.at(row.xs + i as i32), *d);
+                    *s = s.wrapping_add(if pass { dp } else { df });
+                    passed += u32::from(pass);
+                }
+                passed
+            });
+            let counted = u64::from(passed);
+            c.stencil_updates += if dp != 0 { counted } else { 0 } + if df != 0 { n - counted } else { 0 };
             passed
         }
     };
-    c.passed += passed;
+    c.passed += u64::from(passed);
 }
 
 #[inline(always)]
