@@ -178,36 +178,54 @@ impl Image<Rgb8> {
 ///
 /// By table, not by `powf` per channel (a shaded frame encodes three channels per pixel): the code is the
 /// number of code boundaries at or below `v`, each boundary the linear value where the curve crosses the
-/// midpoint between two codes, computed once in f64. A coarse table of codes gives a lower bound; at most
-/// a step or two up from it finds the code.
+/// midpoint between two codes, computed once in f64. A table of codes at the starts of bins finer than
+/// the closest two boundaries gives the code at `v`'s bin start, and one comparison with the next
+/// boundary finds it.
 #[must_use]
 #[inline]
 pub fn linear_to_srgb8(v: f32) -> u8 {
-    let t = srgb8_table();
-    let v = v.clamp(0.0, 1.0);
-    // NaN survives the clamp, indexes 0 and passes no boundary.
-    let mut code = usize::from(t.lower_bound[(v * SRGB8_BINS as f32) as usize]);
-    while code < 255 && v >= t.boundaries[code] {
-        code += 1;
-    }
-    code as u8
+    srgb8_table().encode(v)
 }
 
-/// Bins of [`Srgb8Table::lower_bound`] over [0, 1]: the curve's steepest part, 12.92 x 255 codes per unit
-/// near black, then crosses under one code per bin.
+/// A linear colour to sRGB8, each channel as [`linear_to_srgb8`] encodes it (the table fetched once).
+#[must_use]
+#[inline]
+pub fn linear_rgb_to_srgb8(c: glam::Vec3) -> Rgb8 {
+    let t = srgb8_table();
+    [t.encode(c.x), t.encode(c.y), t.encode(c.z)]
+}
+
+/// Bins of [`Srgb8Table::lower_bound`] over [0, 1]: finer than the curve's steepest part (12.92 x 255, some
+/// 3300 codes per unit near black), so no bin holds two code boundaries.
 const SRGB8_BINS: usize = 4096;
 
 struct Srgb8Table {
-    /// `boundaries[k]`: the least f32 encoded as code `k + 1`.
-    boundaries: [f32; 255],
+    /// `boundaries[k]`: the least f32 encoded as code `k + 1`; infinity past code 255.
+    boundaries: [f32; 256],
     /// The code of each bin's start (and one past the end for 1.0).
     lower_bound: [u8; SRGB8_BINS + 1],
 }
 
+impl Srgb8Table {
+    /// [`linear_to_srgb8`].
+    #[inline(always)]
+    fn encode(&self, v: f32) -> u8 {
+        let v = v.clamp(0.0, 1.0);
+        // NaN survives the clamp, indexes 0 and passes no boundary. Scaling by a power of two is exact, so
+        // `v` lies in the bin it indexes, at or past its start's code and short of the boundary after next.
+        let code = self.lower_bound[(v * SRGB8_BINS as f32) as usize];
+        code + u8::from(v >= self.boundaries[usize::from(code)])
+    }
+}
+
+#[inline]
 fn srgb8_table() -> &'static Srgb8Table {
     static TABLE: std::sync::LazyLock<Srgb8Table> = std::sync::LazyLock::new(|| {
         let decode = |s: f64| if s <= 0.040_45 { s / 12.92 } else { ((s + 0.055) / 1.055).powf(2.4) };
-        let boundaries: [f32; 255] = std::array::from_fn(|k| {
+        let boundaries: [f32; 256] = std::array::from_fn(|k| {
+            if k == 255 {
+                return f32::INFINITY;
+            }
             let exact = decode((k as f64 + 0.5) / 255.0);
             // The least f32 at or above the exact crossing.
             let f = exact as f32;
@@ -372,6 +390,18 @@ mod tests {
         }
         for (v, code) in [(-1.0, 0), (0.0, 0), (2.0, 255), (f32::NAN, 0), (f32::INFINITY, 255)] {
             assert_eq!(linear_to_srgb8(v), code, "{v}");
+        }
+    }
+
+    #[test]
+    fn srgb_encoding_steps_at_each_boundary_and_no_bin_holds_two() {
+        let t = srgb8_table();
+        for (k, &b) in t.boundaries[..255].iter().enumerate() {
+            assert_eq!(usize::from(linear_to_srgb8(b)), k + 1, "at boundary {b}");
+            assert_eq!(usize::from(linear_to_srgb8(b.next_down())), k, "just below boundary {b}");
+        }
+        for (i, pair) in t.lower_bound.windows(2).enumerate() {
+            assert!(pair[1] - pair[0] <= 1, "bin {i} holds {} boundaries", pair[1] - pair[0]);
         }
     }
 

@@ -106,7 +106,11 @@ impl LightTerms {
     #[must_use]
     #[inline]
     pub fn direct(&self, p: Vec3, n: Vec3) -> Vec3 {
-        let term = self.radiance * n.dot(self.light.to_light(p)).max(0.0) * self.falloff(p);
+        let l = self.light.to_light(p);
+        // A spot's apex is the light's position, so the unit vector from it to `p` is `-l`, to the bit:
+        // [`Self::falloff`] without normalizing the same vector again.
+        let falloff = self.cone.map_or(1.0, |c| smoothstep(c.outer, c.inner, (-l).dot(c.axis)));
+        let term = self.radiance * n.dot(l).max(0.0) * falloff;
         if self.light.range.is_some() { term * range_window(&self.light, p) } else { term }
     }
 }
@@ -146,5 +150,26 @@ mod tests {
         assert_eq!(direct(&ranged, below(3.0), n), Vec3::ZERO);
         let near = direct(&ranged, below(1.0), n);
         assert!((near - direct(&Light::point(at), below(1.0), n) * (15.0 / 16.0)).length() < 1e-6, "{near}");
+    }
+
+    #[test]
+    fn the_direct_term_falls_off_as_the_cone_does_to_the_bit() {
+        let spot = Light::spot(Vec3::new(0.3, 4.0, -0.7), Vec3::new(0.7, 0.0, 0.1), 50.0);
+        let terms = LightTerms::new(&spot);
+        let n = Vec3::new(0.2, 0.9, 0.1).normalize();
+        let apex = spot.position().expect("a spot has a position");
+        // A grid through and beyond the cone, its edge included, the apex itself and points next to it.
+        let mut points: Vec<Vec3> = (0..41 * 41)
+            .map(|k| Vec3::new((k % 41) as f32 * 0.25 - 5.0, 0.01 * (k / 41) as f32, (k / 41) as f32 * 0.25 - 5.0))
+            .collect();
+        points.extend([apex, apex + Vec3::splat(1e-6), apex - Vec3::X * 1e-30, apex + Vec3::Y * 1e30]);
+        let mut inside = 0;
+        for p in points {
+            let l = spot.to_light(p);
+            let expected = spot.color * spot.intensity * n.dot(l).max(0.0) * terms.falloff(p);
+            assert_eq!(terms.direct(p, n).to_array().map(f32::to_bits), expected.to_array().map(f32::to_bits), "{p}");
+            inside += usize::from(terms.falloff(p) > 0.0 && terms.falloff(p) < 1.0);
+        }
+        assert!(inside > 0, "some points on the cone's soft edge");
     }
 }
