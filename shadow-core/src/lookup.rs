@@ -101,6 +101,7 @@ pub fn floor(v: f32) -> i64 {
 
 /// Comparison against the texel holding `uv` (WGSL twin: `compare_nearest`).
 #[must_use]
+#[inline]
 pub fn compare_nearest(map: &Image<f32>, uv: Vec2, depth: f32) -> f32 {
     let n = map.width() as f32;
     let t = floor_vec2(uv * n);
@@ -110,6 +111,7 @@ pub fn compare_nearest(map: &Image<f32>, uv: Vec2, depth: f32) -> f32 {
 /// Bilinearly weighted comparisons of the 2x2 texels around `uv - half a texel`: what a hardware
 /// comparison sampler with linear filtering returns (WGSL: `textureSampleCompareLevel`).
 #[must_use]
+#[inline]
 pub fn compare_bilinear(map: &Image<f32>, uv: Vec2, depth: f32) -> f32 {
     bilinear(map.width(), uv, |x, y| compare_texel(map, x, y, depth))
 }
@@ -278,6 +280,7 @@ pub const EDGE_MARGIN: f32 = 1e-5;
 /// Visibility from a shadow map with a filter (WGSL twin: `shadow_lookup`). `radius` is the kernel radius
 /// in texels for the jittered and Poisson filters; `pixel` seeds their per-pixel rotation or jitter.
 #[must_use]
+#[inline]
 pub fn shadow_lookup(map: &Image<f32>, uv: Vec2, depth: f32, filter: Filter, radius: f32, pixel: (u32, u32)) -> f32 {
     if !on_map(uv) {
         return 1.0;

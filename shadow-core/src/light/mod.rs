@@ -290,6 +290,7 @@ impl LightView {
 
     /// For cascades, the cascade `p` reads and the next one it fades into.
     #[must_use]
+    #[inline]
     pub fn cascade_pick(&self, p: Vec3) -> Option<CascadePick> {
         self.cascades.as_ref().map(|c| c.pick(c.depth(p)))
     }

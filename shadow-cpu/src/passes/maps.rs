@@ -151,6 +151,7 @@ pub struct MapPosition {
 /// Where a receiver at `p` looks into the light's maps, after moving it `receiver_offset` towards the
 /// light (`bias=world`).
 #[must_use]
+#[inline]
 pub fn map_position(light: &LightView, mut p: Vec3, receiver_offset: f32) -> MapPosition {
     if receiver_offset != 0.0 {
         p += light.light.to_light(p) * receiver_offset;
