@@ -6,7 +6,7 @@
 //! The clip-space vertices of every instance are kept: shadow-volume near caps are drawn from exactly
 //! these, so a lit surface and its cap have bit-identical depths.
 
-use glam::{Mat3, Mat4, Vec3, Vec4};
+use glam::{BVec4A, Mat3, Mat4, Vec3, Vec4};
 use rayon::prelude::*;
 use shadow_core::scene::Camera;
 use shadow_core::{FrameInputs, Image};
@@ -208,16 +208,23 @@ struct EyeRays {
     height: u32,
 }
 
-/// Where the eye ray through pixel `(x, y)` meets triangle `t` of instance `inst`: the world point, the
+impl EyeRays {
+    /// The direction (not normalized) of the ray through pixel `(x, y)`'s centre.
+    #[inline]
+    fn dir(&self, x: usize, y: usize) -> Vec3 {
+        let ndc = glam::Vec2::new(
+            (x as f32 + 0.5) / self.width as f32 * 2.0 - 1.0,
+            1.0 - (y as f32 + 0.5) / self.height as f32 * 2.0,
+        );
+        self.world_from_clip.project_point3(ndc.extend(0.5)) - self.eye
+    }
+}
+
+/// Where the eye ray along `dir` meets triangle `t` of instance `inst`: the world point, the
 /// interpolated shading normal and the face normal, both turned to the side that is seen (the shading
 /// normal only for two-sided materials).
 #[inline]
-fn surface(t: &Triangle, inst: &shadow_core::Instance, rays: &EyeRays, (x, y): (usize, usize)) -> (Vec3, Vec3, Vec3) {
-    let ndc = glam::Vec2::new(
-        (x as f32 + 0.5) / rays.width as f32 * 2.0 - 1.0,
-        1.0 - (y as f32 + 0.5) / rays.height as f32 * 2.0,
-    );
-    let dir = rays.world_from_clip.project_point3(ndc.extend(0.5)) - rays.eye;
+fn surface(t: &Triangle, inst: &shadow_core::Instance, rays: &EyeRays, dir: Vec3) -> (Vec3, Vec3, Vec3) {
     let (world, b) = ray_triangle(rays.eye, dir, t.corners);
     let interp = t.normals[0] * b[0] + t.normals[1] * b[1] + t.normals[2] * b[2];
     let mut shading = (t.normal_from_local * interp).normalize_or(Vec3::Y);
@@ -234,6 +241,127 @@ fn surface(t: &Triangle, inst: &shadow_core::Instance, rays: &EyeRays, (x, y): (
     (world, shading, geometric)
 }
 
+/// Four vectors, one a lane: the operands of [`surface_x4`].
+#[derive(Clone, Copy)]
+struct Lanes3 {
+    x: Vec4,
+    y: Vec4,
+    z: Vec4,
+}
+
+impl Lanes3 {
+    fn of(v: [Vec3; 4]) -> Self {
+        Self { x: Vec4::from(v.map(|v| v.x)), y: Vec4::from(v.map(|v| v.y)), z: Vec4::from(v.map(|v| v.z)) }
+    }
+
+    fn splat(v: Vec3) -> Self {
+        Self { x: Vec4::splat(v.x), y: Vec4::splat(v.y), z: Vec4::splat(v.z) }
+    }
+
+    fn lane(&self, k: usize) -> Vec3 {
+        Vec3::new(self.x[k], self.y[k], self.z[k])
+    }
+
+    /// `Vec3::dot`'s sum, in its order.
+    fn dot(self, o: Self) -> Vec4 {
+        self.x * o.x + self.y * o.y + self.z * o.z
+    }
+
+    /// `Vec3::cross`'s terms, in its order.
+    fn cross(self, o: Self) -> Self {
+        Self { x: self.y * o.z - o.y * self.z, y: self.z * o.x - o.z * self.x, z: self.x * o.y - o.x * self.y }
+    }
+
+    /// `Mat3 * Vec3` as glam sums it: column by column.
+    fn transformed(self, m: &Mat3) -> Self {
+        let (c0, c1, c2) = (Self::splat(m.x_axis), Self::splat(m.y_axis), Self::splat(m.z_axis));
+        c0 * self.x + c1 * self.y + c2 * self.z
+    }
+
+    /// `Vec3::normalize_or`: times the reciprocal length where that is finite and positive.
+    fn normalize_or(self, fallback: Vec3) -> Self {
+        let rcp = Vec4::ONE / self.dot(self).sqrt();
+        let ok = rcp.cmpgt(Vec4::ZERO) & rcp.is_finite_mask();
+        (self * rcp).select(ok, Self::splat(fallback))
+    }
+
+    /// `self` in the lanes of `mask`, `other` elsewhere.
+    fn select(self, mask: BVec4A, other: Self) -> Self {
+        Self {
+            x: Vec4::select(mask, self.x, other.x),
+            y: Vec4::select(mask, self.y, other.y),
+            z: Vec4::select(mask, self.z, other.z),
+        }
+    }
+}
+
+impl std::ops::Add for Lanes3 {
+    type Output = Self;
+    fn add(self, o: Self) -> Self {
+        Self { x: self.x + o.x, y: self.y + o.y, z: self.z + o.z }
+    }
+}
+
+impl std::ops::Sub for Lanes3 {
+    type Output = Self;
+    fn sub(self, o: Self) -> Self {
+        Self { x: self.x - o.x, y: self.y - o.y, z: self.z - o.z }
+    }
+}
+
+impl std::ops::Neg for Lanes3 {
+    type Output = Self;
+    fn neg(self) -> Self {
+        Self { x: -self.x, y: -self.y, z: -self.z }
+    }
+}
+
+/// Each lane times its own scalar.
+impl std::ops::Mul<Vec4> for Lanes3 {
+    type Output = Self;
+    fn mul(self, s: Vec4) -> Self {
+        Self { x: self.x * s, y: self.y * s, z: self.z * s }
+    }
+}
+
+/// [`surface`] for four rays into the same triangle: each lane the same operations in the same order, so
+/// the same bits (a test holds them equal), with four pixels' divisions and roots in one instruction
+/// each and four chains of them in flight.
+fn surface_x4(t: &Triangle, inst: &shadow_core::Instance, eye: Vec3, dirs: [Vec3; 4]) -> [(Vec3, Vec3, Vec3); 4] {
+    let c = t.corners;
+    let dir = Lanes3::of(dirs);
+    // ray_triangle, lane by lane.
+    let (e1, e2) = (c[1] - c[0], c[2] - c[0]);
+    let h = dir.cross(Lanes3::splat(e2));
+    let det = Lanes3::splat(e1).dot(h);
+    let s = eye - c[0];
+    let u = Lanes3::splat(s).dot(h) / det;
+    let v = dir.dot(Lanes3::splat(s.cross(e1))) / det;
+    let hit = Lanes3::splat(c[0]) + Lanes3::splat(e1) * u + Lanes3::splat(e2) * v;
+    let edge_on = det.abs().cmple(Vec4::splat(f32::MIN_POSITIVE));
+    let world = Lanes3::splat((c[0] + c[1] + c[2]) / 3.0).select(edge_on, hit);
+    let third = Vec4::splat(1.0 / 3.0);
+    let b = [
+        Vec4::select(edge_on, third, Vec4::ONE - u - v),
+        Vec4::select(edge_on, third, u),
+        Vec4::select(edge_on, third, v),
+    ];
+    // The rest of surface.
+    let n = t.normals.map(Lanes3::splat);
+    let interp = n[0] * b[0] + n[1] * b[1] + n[2] * b[2];
+    let mut shading = interp.transformed(&t.normal_from_local).normalize_or(Vec3::Y);
+    let mut geometric = t.face.map_or(shading, Lanes3::splat);
+    if inst.mirrored {
+        geometric = -geometric;
+    }
+    let away = geometric.dot(Lanes3::splat(eye) - world).cmplt(Vec4::ZERO);
+    geometric = (-geometric).select(away, geometric);
+    if inst.two_sided {
+        shading = (-shading).select(away, shading);
+    }
+    std::array::from_fn(|k| (world.lane(k), shading.lane(k), geometric.lane(k)))
+}
+
 /// The surface attributes of every pixel, row after row.
 struct Surfaces {
     position: Vec<Vec3>,
@@ -247,7 +375,7 @@ struct Surfaces {
 /// Resolves each pixel's visible primitive (its id in `all`, [`NO_INSTANCE`] for none) to the surface
 /// attributes, writing every pixel of every image in one pass (the background's too: the buffers are not
 /// cleared first). The triangle's world corners and face normal are those of the pixel before on most
-/// pixels of a row.
+/// pixels of a row, and four pixels in a row on one triangle are resolved together ([`surface_x4`]).
 fn resolve(frame: &FrameInputs, all: &Batch<'_>, visible: &[u32], eye_rays: &EyeRays, s: &mut Surfaces) {
     let normal_from_local: Vec<Mat3> =
         frame.instances.iter().map(|i| shadow_core::affine::normal_matrix(i.world_from_local)).collect();
@@ -261,12 +389,19 @@ fn resolve(frame: &FrameInputs, all: &Batch<'_>, visible: &[u32], eye_rays: &Eye
         .zip(s.instance.par_chunks_mut(w))
         .zip(visible.par_chunks(w))
         .enumerate()
-        .for_each(|(y, ((((((pos, nrm), geo), alb), rec), ins), vis))| {
+        .for_each_init(Vec::new, |dirs, (y, ((((((pos, nrm), geo), alb), rec), ins), vis))| {
+            // The row's ray directions first, in a loop of their own: the surface work after them is a
+            // long chain of dependent divisions and roots, and short loops keep more pixels in flight.
+            dirs.clear();
+            dirs.extend((0..w).map(|x| eye_rays.dir(x, y)));
             let mut last: Option<(u32, Triangle)> = None;
-            for (x, &prim) in vis.iter().enumerate() {
+            let mut x = 0;
+            while x < w {
+                let prim = vis[x];
                 if prim == NO_INSTANCE {
                     (pos[x], nrm[x], geo[x], alb[x], rec[x], ins[x]) =
                         (Vec3::ZERO, Vec3::Y, Vec3::Y, Vec3::ZERO, false, NO_INSTANCE);
+                    x += 1;
                     continue;
                 }
                 let t = match last {
@@ -279,9 +414,21 @@ fn resolve(frame: &FrameInputs, all: &Batch<'_>, visible: &[u32], eye_rays: &Eye
                     }
                 };
                 let inst = &frame.instances[t.instance];
-                let (world, shading, geometric) = surface(&t, inst, eye_rays, (x, y));
-                (pos[x], nrm[x], geo[x], alb[x], rec[x], ins[x]) =
-                    (world, shading, geometric, inst.base_color, inst.receives_shadow, t.instance as u32);
+                let mut put = |x: usize, (world, shading, geometric): (Vec3, Vec3, Vec3)| {
+                    (pos[x], nrm[x], geo[x], alb[x], rec[x], ins[x]) =
+                        (world, shading, geometric, inst.base_color, inst.receives_shadow, t.instance as u32);
+                };
+                // Four pixels at once where the next four show this triangle, else this one.
+                if vis.get(x..x + 4).is_some_and(|four| four.iter().all(|&p| p == prim)) {
+                    let four = surface_x4(&t, inst, eye_rays.eye, std::array::from_fn(|k| dirs[x + k]));
+                    for (k, surface) in four.into_iter().enumerate() {
+                        put(x + k, surface);
+                    }
+                    x += 4;
+                } else {
+                    put(x, surface(&t, inst, eye_rays, dirs[x]));
+                    x += 1;
+                }
             }
         });
 }
@@ -364,6 +511,59 @@ mod tests {
         let scene = scenes::build(name, &SceneParams::default()).expect("built-in scene");
         let camera = scene.cameras().next().expect("a camera").0;
         FrameInputs::from_scene(&scene, camera).expect("a valid frame")
+    }
+
+    /// Four rays at once give the bits one ray at a time gives: over random triangles and rays, a
+    /// degenerate triangle, one seen edge-on, zero and overflowing normals, mirrored and two-sided
+    /// instances, rays from either side.
+    #[test]
+    fn four_rays_at_once_are_four_rays_one_at_a_time() {
+        let f = frame("primitives");
+        let seed = std::cell::Cell::new(0x9e37_79b9u32);
+        let next = || {
+            let mut x = seed.get();
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            seed.set(x);
+            (x >> 8) as f32 / (1 << 24) as f32 * 4.0 - 2.0
+        };
+        let v3 = || Vec3::new(next(), next(), next());
+        let mut checked = 0;
+        for case in 0..400 {
+            let mut inst = f.instances[0].clone();
+            (inst.mirrored, inst.two_sided) = (case % 2 == 1, case % 4 >= 2);
+            let mut corners = [v3(), v3(), v3()];
+            match case % 25 {
+                0 => corners[2] = corners[0] + (corners[1] - corners[0]) * 0.5,
+                1 => corners = [Vec3::ZERO, Vec3::X, Vec3::Y],
+                _ => {}
+            }
+            let normals = match case % 25 {
+                2 => [Vec3::ZERO; 3],
+                // Lengths past f32's range: the reciprocal length is 0.
+                3 => [Vec3::splat(3e38); 3],
+                _ => [v3(), v3(), v3()],
+            };
+            let face = (corners[1] - corners[0]).cross(corners[2] - corners[0]).try_normalize();
+            let normal_from_local = Mat3::from_cols(v3(), v3(), v3());
+            let t = Triangle { instance: 0, corners, normals, normal_from_local, face };
+            let eye = v3() * 3.0;
+            // Rays towards points of the triangle's plane, and along it for the one seen edge-on.
+            let dirs: [Vec3; 4] = std::array::from_fn(|_| {
+                if case % 25 == 1 { Vec3::new(next(), next(), 0.0) - eye.with_z(0.0) } else { corners[0] + v3() - eye }
+            });
+            let eye = if case % 25 == 1 { eye.with_z(0.0) } else { eye };
+            let rays = EyeRays { eye, world_from_clip: Mat4::IDENTITY, width: 1, height: 1 };
+            let four = surface_x4(&t, &inst, eye, dirs);
+            for (k, &dir) in dirs.iter().enumerate() {
+                let one = surface(&t, &inst, &rays, dir);
+                let bits = |(a, b, c): (Vec3, Vec3, Vec3)| [a, b, c].map(|v| v.to_array().map(f32::to_bits));
+                assert_eq!(bits(four[k]), bits(one), "case {case}, lane {k}");
+                checked += 1;
+            }
+        }
+        assert_eq!(checked, 1600);
     }
 
     /// The buffers of a recycled G-buffer are overwritten, not cleared: whatever another scene left in
