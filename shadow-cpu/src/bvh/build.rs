@@ -179,12 +179,19 @@ impl Binning {
     /// The bin of a centre along one axis.
     fn bin(&self, centre: Vec3A, axis: usize) -> usize {
         let at = |v: Vec3A| v.to_array()[axis];
-        (((at(centre) - at(self.lo)) * at(self.scale)) as usize).min(self.count - 1)
+        self.clamped((at(centre) - at(self.lo)) * at(self.scale))
     }
 
     /// The bin of a centre on each axis.
     fn bins(&self, centre: Vec3A) -> [usize; 3] {
-        ((centre - self.lo) * self.scale).to_array().map(|t| (t as usize).min(self.count - 1))
+        ((centre - self.lo) * self.scale).to_array().map(|t| self.clamped(t))
+    }
+
+    /// The bin at `t` bins past the lowest centre: `t` is not negative (no centre lies below the lowest),
+    /// so the conversion through i32 (a shorter one than to usize) floors it, NaN to 0.
+    #[inline]
+    fn clamped(&self, t: f32) -> usize {
+        (t as i32).min(self.count as i32 - 1) as usize
     }
 
     fn fill(&self, prims: &[Prim], order: &[u32]) -> Bins {
