@@ -79,6 +79,14 @@ struct Cone {
     inner: f32,
 }
 
+impl Cone {
+    /// The falloff along the unit direction `d` from the apex.
+    #[inline]
+    fn falloff_along(&self, d: Vec3) -> f32 {
+        smoothstep(self.outer, self.inner, d.dot(self.axis))
+    }
+}
+
 impl LightTerms {
     /// The terms of `light`.
     #[must_use]
@@ -99,7 +107,7 @@ impl LightTerms {
     #[must_use]
     #[inline]
     pub fn falloff(&self, p: Vec3) -> f32 {
-        self.cone.map_or(1.0, |c| smoothstep(c.outer, c.inner, (p - c.apex).normalize_or_zero().dot(c.axis)))
+        self.cone.map_or(1.0, |c| c.falloff_along((p - c.apex).normalize_or_zero()))
     }
 
     /// [`direct`] at `p` with unit normal `n`.
@@ -109,7 +117,7 @@ impl LightTerms {
         let l = self.light.to_light(p);
         // A spot's apex is the light's position, so the unit vector from it to `p` is `-l`, to the bit:
         // [`Self::falloff`] without normalizing the same vector again.
-        let falloff = self.cone.map_or(1.0, |c| smoothstep(c.outer, c.inner, (-l).dot(c.axis)));
+        let falloff = self.cone.map_or(1.0, |c| c.falloff_along(-l));
         let term = self.radiance * n.dot(l).max(0.0) * falloff;
         if self.light.range.is_some() { term * range_window(&self.light, p) } else { term }
     }

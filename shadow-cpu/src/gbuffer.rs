@@ -220,19 +220,19 @@ impl EyeRays {
     }
 }
 
-/// Where the eye ray along `dir` meets triangle `t` of instance `inst`: the world point, the
+/// Where the ray from `eye` along `dir` meets triangle `t` of instance `inst`: the world point, the
 /// interpolated shading normal and the face normal, both turned to the side that is seen (the shading
 /// normal only for two-sided materials).
 #[inline]
-fn surface(t: &Triangle, inst: &shadow_core::Instance, rays: &EyeRays, dir: Vec3) -> (Vec3, Vec3, Vec3) {
-    let (world, b) = ray_triangle(rays.eye, dir, t.corners);
+fn surface(t: &Triangle, inst: &shadow_core::Instance, eye: Vec3, dir: Vec3) -> (Vec3, Vec3, Vec3) {
+    let (world, b) = ray_triangle(eye, dir, t.corners);
     let interp = t.normals[0] * b[0] + t.normals[1] * b[1] + t.normals[2] * b[2];
     let mut shading = (t.normal_from_local * interp).normalize_or(Vec3::Y);
     let mut geometric = t.face.unwrap_or(shading);
     if inst.mirrored {
         geometric = -geometric;
     }
-    if geometric.dot(rays.eye - world) < 0.0 {
+    if geometric.dot(eye - world) < 0.0 {
         geometric = -geometric;
         if inst.two_sided {
             shading = -shading;
@@ -426,7 +426,7 @@ fn resolve(frame: &FrameInputs, all: &Batch<'_>, visible: &[u32], eye_rays: &Eye
                     }
                     x += 4;
                 } else {
-                    put(x, surface(&t, inst, eye_rays, dirs[x]));
+                    put(x, surface(&t, inst, eye_rays.eye, dirs[x]));
                     x += 1;
                 }
             }
@@ -554,10 +554,9 @@ mod tests {
                 if case % 25 == 1 { Vec3::new(next(), next(), 0.0) - eye.with_z(0.0) } else { corners[0] + v3() - eye }
             });
             let eye = if case % 25 == 1 { eye.with_z(0.0) } else { eye };
-            let rays = EyeRays { eye, world_from_clip: Mat4::IDENTITY, width: 1, height: 1 };
             let four = surface_x4(&t, &inst, eye, dirs);
             for (k, &dir) in dirs.iter().enumerate() {
-                let one = surface(&t, &inst, &rays, dir);
+                let one = surface(&t, &inst, eye, dir);
                 let bits = |(a, b, c): (Vec3, Vec3, Vec3)| [a, b, c].map(|v| v.to_array().map(f32::to_bits));
                 assert_eq!(bits(four[k]), bits(one), "case {case}, lane {k}");
                 checked += 1;

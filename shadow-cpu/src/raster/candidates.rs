@@ -8,7 +8,7 @@ use super::{ONE, Setup, depth_origin, row_depth};
 /// edge functions (top-left rule included) and depth plane, with what is the same for every pixel hoisted.
 /// In f64 the edge functions' integer terms (far under 2^53) are exact, with no 64-bit integer multiplies;
 /// `py - fy0` is an exact integer rounded to f32 as the walk's i64 is, so the depth is `row_base` and
-/// `depth_at`'s f32 arithmetic, bit for bit.
+/// `RowDepth::at`'s f32 arithmetic, bit for bit.
 pub(super) struct CandidateTest<'a, P> {
     t: &'a Setup,
     edge: [(f64, f64, f64); 3],

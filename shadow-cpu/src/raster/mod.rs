@@ -384,15 +384,11 @@ struct BandRows<'a, T> {
     width: usize,
 }
 
-/// Depth at pixel column `x` of a row whose depth at column 0's centre is `z_row` (clamped when asked).
-#[inline(always)]
-fn depth_at(t: &Setup, z_row: f32, x: i32, clamp: bool) -> f32 {
-    let z = z_row + t.dzdx * x as f32;
-    if clamp { z.clamp(0.0, 1.0) } else { z }
-}
-
-/// [`depth_at`] along one row, in a form a row loop runs without a branch per fragment: the clamp as
-/// bounds that are infinite when it is off (the same value as `f32::clamp`, NaN and -0 included).
+/// The depths along one row: at column `x`, `z_row + dzdx x` (`z_row` the depth at column 0's centre),
+/// clamped to [0, 1] when asked. In a form a row loop runs without a branch per fragment: the clamp as
+/// bounds that are infinite when it is off (the same value as `f32::clamp`, NaN and -0 included). The
+/// loops that vectorize count passes in a u32 (a row is at most
+/// [`MAX_TARGET_SIDE`](crate::context::MAX_TARGET_SIDE) wide): a 64-bit count would halve the lanes.
 #[derive(Clone, Copy)]
 struct RowDepth {
     z_row: f32,
@@ -408,7 +404,7 @@ impl RowDepth {
         Self { z_row: row.z_row, dzdx: t.dzdx, lo, hi }
     }
 
-    /// [`depth_at`] column `x`.
+    /// The depth at column `x`.
     #[inline(always)]
     fn at(&self, x: i32) -> f32 {
         let z = self.z_row + self.dzdx * x as f32;
@@ -420,38 +416,6 @@ impl RowDepth {
             z
         }
     }
-}
-
-/// Runs `$body` with `$test` bound to `$compare`'s test (`CompareFn::test` on f32) as a closure of its own
-/// for each of the orderings depth tests use, so that a row loop in the body has no match per fragment
-/// and the compiler vectorizes it; the body is compiled once per ordering. The loops count passes in a
-/// u32 (a row is at most [`MAX_TARGET_SIDE`](crate::context::MAX_TARGET_SIDE) wide): a 64-bit count would
-/// halve the lanes.
-macro_rules! with_depth_test {
-    ($compare:expr, |$test:ident| $body:expr) => {
-        match $compare {
-            CompareFn::Less => {
-                let $test = |new: f32, stored: f32| new < stored;
-                $body
-            }
-            CompareFn::LessEqual => {
-                let $test = |new: f32, stored: f32| new <= stored;
-                $body
-            }
-            CompareFn::Greater => {
-                let $test = |new: f32, stored: f32| new > stored;
-                $body
-            }
-            CompareFn::GreaterEqual => {
-                let $test = |new: f32, stored: f32| new >= stored;
-                $body
-            }
-            other => {
-                let $test = move |new: f32, stored: f32| other.test(new, stored);
-                $body
-            }
-        }
-    };
 }
 
 /// The depth of a row at the centre of column 0, bias included: the one place depth is interpolated, so
@@ -555,7 +519,7 @@ fn row_flat<T>(
     T: Copy,
 {
     let z = RowDepth::new(t, row);
-    let passed = with_depth_test!(compare, |test| {
+    let passed = with_depth_test!(compare, test => {
         let mut passed = 0u32;
         for (i, (d, col)) in depth.iter_mut().zip(&mut *color).enumerate() {
             let z = z.at(row.xs + i as i32);
@@ -583,7 +547,7 @@ fn row_peel(
     c: &mut RasterCounters,
 ) {
     let z = RowDepth::new(t, row);
-    let passed = with_depth_test!(compare, |test| {
+    let passed = with_depth_test!(compare, test => {
         let mut passed = 0u32;
         for (i, (d, u)) in depth.iter_mut().zip(under).enumerate() {
             let z = z.at(row.xs + i as i32);
@@ -604,7 +568,7 @@ fn row_fast(t: &Setup, k: DepthKernel, row: RowStart, depth: &mut [f32], stencil
     let n = depth.len() as u64;
     c.fragments += n;
     let passed = match k {
-        DepthKernel::Depth { compare, write: true } => with_depth_test!(compare, |test| {
+        DepthKernel::Depth { compare, write: true } => with_depth_test!(compare, test => {
             let mut passed = 0u32;
             for (i, d) in depth.iter_mut().enumerate() {
                 let z = z.at(row.xs + i as i32);
@@ -614,7 +578,7 @@ fn row_fast(t: &Setup, k: DepthKernel, row: RowStart, depth: &mut [f32], stencil
             }
             passed
         }),
-        DepthKernel::Depth { compare, write: false } => with_depth_test!(compare, |test| {
+        DepthKernel::Depth { compare, write: false } => with_depth_test!(compare, test => {
             let mut passed = 0u32;
             for (i, d) in depth.iter().enumerate() {
                 passed += u32::from(test(z.at(row.xs + i as i32), *d));
@@ -623,7 +587,7 @@ fn row_fast(t: &Setup, k: DepthKernel, row: RowStart, depth: &mut [f32], stencil
         }),
         DepthKernel::Count { compare, front, back } => {
             let (dp, df) = if t.front { front } else { back };
-            let passed = with_depth_test!(compare, |test| {
+            let passed = with_depth_test!(compare, test => {
                 let mut passed = 0u32;
                 for (i, (d, s)) in depth.iter().zip(&mut *stencil).enumerate() {
                     let pass = test(z.at(row.xs + i as i32), *d);
@@ -682,7 +646,7 @@ fn raster_band<T, F, B>(
                         row_flat(t, compare, start, &mut rows.depth[lo..hi], &mut rows.color[lo..hi], v, c);
                     }
                 }
-                _ => row_general(t, rows, st, (y, py, row), (a, b, z_row, clamp), (shader, blend), c),
+                _ => row_general(t, rows, st, (y, py, row), (start, b), (shader, blend), c),
             }
         };
         match mask {
@@ -692,26 +656,27 @@ fn raster_band<T, F, B>(
     }
 }
 
-/// Columns `a..=b` of row `y` (`py` its centre in fixed point, `row` its first index in the band) through
-/// the general per-fragment path.
+/// Columns `start.xs..=xe` of row `y` (`py` its centre in fixed point, `row` its first index in the band)
+/// through the general per-fragment path.
 #[inline(always)]
 fn row_general<T, F, B>(
     t: &Setup,
     rows: &mut BandRows<'_, T>,
     st: &RasterState,
     (y, py, row): (i32, i64, usize),
-    (xs, xe, z_row, clamp): (i32, i32, f32, bool),
+    (start, xe): (RowStart, i32),
     (shader, blend): (&F, &B),
     c: &mut RasterCounters,
 ) where
     F: Fn(&Fragment) -> Option<T>,
     B: Fn(&mut T, T),
 {
+    let (xs, z) = (start.xs, RowDepth::new(t, start));
     let px0 = i64::from(xs) * ONE + HALF;
     let mut e: [i64; 3] = std::array::from_fn(|k| t.a[k] * px0 + t.b[k] * py + t.c[k]);
     let step: [i64; 3] = t.a.map(|a| a * ONE);
     for x in xs..=xe {
-        let depth = depth_at(t, z_row, x, clamp);
+        let depth = z.at(x);
         let here = e;
         for (e, s) in e.iter_mut().zip(step) {
             *e += s;
