@@ -39,6 +39,11 @@ impl Aabb {
         Self { lo: self.lo.min(p), hi: self.hi.max(p) }
     }
 
+    /// The centre: where a triangle's box is binned.
+    fn centre(self) -> Vec3A {
+        (self.lo + self.hi) * 0.5
+    }
+
     /// Half the surface area (the heuristic only compares areas).
     fn half_area(self) -> f32 {
         let d = (self.hi - self.lo).max(Vec3A::ZERO);
@@ -46,19 +51,12 @@ impl Aabb {
     }
 }
 
-/// A triangle's box and its centre.
-#[derive(Clone, Copy)]
-struct Prim {
-    bounds: Aabb,
-    centre: Vec3A,
-}
-
 /// The binary tree: leaves are runs of the reordered triangle indices. An inner node knows how many
 /// wide nodes and leaves it is written as (when it heads a wide node), so every subtree's
 /// place in the output is known before any is written and they are written in parallel.
 enum Node2 {
     Leaf { bounds: Aabb, start: usize, count: usize },
-    Inner { bounds: Aabb, halves: Box<[Node2; 2]>, size: Size },
+    Inner { bounds: Aabb, area: f32, halves: Box<[Node2; 2]>, size: Size },
 }
 
 /// Wide nodes and leaves a subtree is written as.
@@ -76,12 +74,20 @@ impl Node2 {
             size.nodes += s.nodes;
             size.leaves += s.leaves;
         }
-        Self::Inner { bounds, halves: Box::new(halves), size }
+        Self::Inner { bounds, area: bounds.half_area(), halves: Box::new(halves), size }
     }
 
     fn bounds(&self) -> Aabb {
         match self {
             Self::Leaf { bounds, .. } | Self::Inner { bounds, .. } => *bounds,
+        }
+    }
+
+    /// The half area of an inner node (which a wide node may open); `None` for a leaf.
+    fn inner_area(&self) -> Option<f32> {
+        match self {
+            Self::Leaf { .. } => None,
+            Self::Inner { area, .. } => Some(*area),
         }
     }
 
@@ -96,20 +102,19 @@ impl Node2 {
 
 /// The wide tree over `tris`: its nodes (the root first) and its leaves.
 ///
-/// The builder sorts a list of triangle indices, not the triangles' boxes: partitioning 4-byte indices
-/// in place measured faster here than moving the boxes, though the passes over a node then read its
-/// boxes out of order.
+/// The builder moves the triangles' boxes as it sorts their indices, so the passes over a node read
+/// its boxes in memory order.
 pub fn build(tris: &[[Vec3A; 3]]) -> (Vec<Node8>, Vec<Tri8>) {
-    let prims: Vec<Prim> = tris
+    // The triangles' boxes. A box's centre is worked out where it is needed, not stored: every pass
+    // streams the boxes through, and the partition moves them.
+    let mut prims: Vec<Aabb> = tris
         .par_iter()
         .with_min_len(4096)
-        .map(|&[a, b, c]| {
-            let bounds = Aabb { lo: a.min(b).min(c), hi: a.max(b).max(c) };
-            Prim { bounds, centre: (bounds.lo + bounds.hi) * 0.5 }
-        })
+        .map(|&[a, b, c]| Aabb { lo: a.min(b).min(c), hi: a.max(b).max(c) })
         .collect();
     let mut order: Vec<u32> = (0..tris.len() as u32).collect();
-    let root = split(&prims, &mut order, 0, 0);
+    let bounds = bounds_of(&prims);
+    let root = split(&mut prims, &mut order, 0, 0, bounds, &mut Box::new(Bins::EMPTY));
     // The root is always a wide node: over the widened halves of an inner root, or over a root
     // that is a single leaf.
     let (kids, size) = match &root {
@@ -123,17 +128,14 @@ pub fn build(tris: &[[Vec3A; 3]]) -> (Vec<Node8>, Vec<Tri8>) {
 }
 
 /// The bounds of the triangles `order` lists, and of their centres.
-fn bounds_of(prims: &[Prim], order: &[u32]) -> (Aabb, Aabb) {
-    let of = |ids: &[u32]| {
-        ids.iter().fold((Aabb::EMPTY, Aabb::EMPTY), |(b, c), &i| {
-            let p = prims[i as usize];
-            (b.grow(p.bounds), c.grow_point(p.centre))
-        })
+fn bounds_of(prims: &[Aabb]) -> (Aabb, Aabb) {
+    let of = |boxes: &[Aabb]| {
+        boxes.iter().fold((Aabb::EMPTY, Aabb::EMPTY), |(b, c), &p| (b.grow(p), c.grow_point(p.centre())))
     };
-    if order.len() < PARALLEL {
-        of(order)
+    if prims.len() < PARALLEL {
+        of(prims)
     } else {
-        order.par_chunks(4096).map(of).reduce(|| (Aabb::EMPTY, Aabb::EMPTY), |a, b| (a.0.grow(b.0), a.1.grow(b.1)))
+        prims.par_chunks(4096).map(of).reduce(|| (Aabb::EMPTY, Aabb::EMPTY), |a, b| (a.0.grow(b.0), a.1.grow(b.1)))
     }
 }
 
@@ -176,112 +178,174 @@ impl Binning {
         Self { lo: centres.lo, scale, count }
     }
 
-    /// The bin of a centre along one axis.
-    fn bin(&self, centre: Vec3A, axis: usize) -> usize {
-        let at = |v: Vec3A| v.to_array()[axis];
-        self.clamped((at(centre) - at(self.lo)) * at(self.scale))
-    }
-
-    /// The bin of a centre on each axis.
-    fn bins(&self, centre: Vec3A) -> [usize; 3] {
-        ((centre - self.lo) * self.scale).to_array().map(|t| self.clamped(t))
-    }
-
-    /// The bin at `t` bins past the lowest centre: `t` is not negative (no centre lies below the lowest),
-    /// so the conversion through i32 (a shorter one than to usize) floors it, NaN to 0.
+    /// The bin of a centre on each axis: the whole bins it lies past the lowest centre, at most the
+    /// last. The offset is never negative (no centre lies below the lowest); it is NaN where an
+    /// infinite extent made the scale 0, and that centre goes to bin 0.
+    #[cfg(target_arch = "x86_64")]
     #[inline]
-    fn clamped(&self, t: f32) -> usize {
-        (t as i32).min(self.count as i32 - 1) as usize
+    fn bins(&self, centre: Vec3A) -> [usize; 3] {
+        use std::arch::x86_64::{_mm_cvttps_epi32, _mm_max_ps, _mm_min_ps, _mm_set1_ps, _mm_setzero_ps};
+        let t = ((centre - self.lo) * self.scale).into();
+        // Clamped before the conversion, all three axes at once: `maxps` answers its second operand
+        // when either is NaN, so NaN becomes 0. In range, the truncation is the floor: the very bins
+        // the portable conversion below finds, without its checks for NaN and overflow per axis.
+        // SAFETY: the intrinsics need SSE and SSE2, which every x86_64 processor has.
+        #[allow(unsafe_code)]
+        let b = unsafe {
+            let last = _mm_set1_ps((self.count - 1) as f32);
+            _mm_cvttps_epi32(_mm_min_ps(_mm_max_ps(t, _mm_setzero_ps()), last))
+        };
+        let b: [i32; 4] = bytemuck::cast(b);
+        [b[0] as usize, b[1] as usize, b[2] as usize]
     }
 
-    fn fill(&self, prims: &[Prim], order: &[u32]) -> Bins {
-        let of = |ids: &[u32]| {
-            let mut bins = Bins::EMPTY;
-            for &i in ids {
-                let p = prims[i as usize];
-                for (axis, b) in self.bins(p.centre).into_iter().enumerate() {
+    #[cfg(not(target_arch = "x86_64"))]
+    #[inline]
+    fn bins(&self, centre: Vec3A) -> [usize; 3] {
+        // The saturating conversion floors a non-negative offset and sends NaN to 0.
+        ((centre - self.lo) * self.scale).to_array().map(|t| (t as i32).min(self.count as i32 - 1) as usize)
+    }
+
+    /// Counts the centres of `prims` in each bin in use, and bounds their boxes, into `bins` (whose
+    /// bins past the count are left as they were: the cut looks at none of them).
+    fn fill(&self, prims: &[Aabb], bins: &mut Bins) {
+        let add = |bins: &mut Bins, prims: &[Aabb]| {
+            for &p in prims {
+                for (axis, b) in self.bins(p.centre()).into_iter().enumerate() {
                     bins.count[axis][b] += 1;
-                    bins.bounds[axis][b] = bins.bounds[axis][b].grow(p.bounds);
+                    bins.bounds[axis][b] = bins.bounds[axis][b].grow(p);
                 }
             }
-            bins
         };
-        if order.len() < PARALLEL {
-            of(order)
+        if prims.len() < PARALLEL {
+            for axis in 0..3 {
+                bins.count[axis][..self.count].fill(0);
+                bins.bounds[axis][..self.count].fill(Aabb::EMPTY);
+            }
+            add(bins, prims);
         } else {
-            order.par_chunks(4096).map(of).reduce(|| Bins::EMPTY, |a, b| a.merge(&b))
+            *bins = prims
+                .par_chunks(4096)
+                .map(|chunk| {
+                    let mut bins = Bins::EMPTY;
+                    add(&mut bins, chunk);
+                    bins
+                })
+                .reduce(|| Bins::EMPTY, |a, b| a.merge(&b));
         }
     }
 }
 
-/// The binary tree over the triangles `order` lists (which it reorders so each leaf's are a run),
-/// `start` being `order`'s offset in the whole list.
-fn split(prims: &[Prim], order: &mut [u32], start: usize, depth: u32) -> Node2 {
-    let (bounds, centres) = bounds_of(prims, order);
+/// The binary tree over the triangles `order` lists, whose boxes are `prims` (both reordered alike, so
+/// each leaf's triangles are a run), `start` being `order`'s offset in the whole list, given the
+/// bounds of those triangles and of their centres. A binned cut hands each half its bounds: the union
+/// of its bins' boxes, and its centres' bounds gathered as the cut moves them, so no node passes over
+/// its triangles for them again. `bins` is the thread's room for the binning.
+fn split(
+    prims: &mut [Aabb],
+    order: &mut [u32],
+    start: usize,
+    depth: u32,
+    (bounds, centres): (Aabb, Aabb),
+    bins: &mut Bins,
+) -> Node2 {
     let n = order.len();
     if n <= LEAF_SIZE {
         return Node2::Leaf { bounds, start, count: n };
     }
     let binning = Binning::new(centres, n);
-    let cut = if depth < SAH_DEPTH { best_cut(&binning.fill(prims, order), binning.count, n) } else { None };
-    let mid = match cut {
-        Some((axis, bin)) => partition(order, |i| binning.bin(prims[i as usize].centre, axis) < bin),
+    let cut = (depth < SAH_DEPTH)
+        .then(|| {
+            binning.fill(prims, bins);
+            best_cut(bins, binning.count, n)
+        })
+        .flatten();
+    let (mid, below, above) = match cut {
+        Some((axis, bin)) => {
+            let (mid, centres_below, centres_above) = partition(prims, order, |c| binning.bins(c)[axis] < bin);
+            let union = |bins: &[Aabb]| bins.iter().fold(Aabb::EMPTY, |b, &bin| b.grow(bin));
+            let boxes = &bins.bounds[axis][..binning.count];
+            (mid, (union(&boxes[..bin]), centres_below), (union(&boxes[bin..]), centres_above))
+        }
         None => {
             // No cut separates the centres (they coincide), or the tree is deep: halve at the median
             // centre along the longest axis.
             let axis = (centres.hi - centres.lo).max_position();
-            order.select_nth_unstable_by(n / 2, |&a, &b| {
-                prims[a as usize].centre[axis].total_cmp(&prims[b as usize].centre[axis])
-            });
-            n / 2
+            let mut both: Vec<(Aabb, u32)> = prims.iter().copied().zip(order.iter().copied()).collect();
+            both.select_nth_unstable_by(n / 2, |a, b| a.0.centre()[axis].total_cmp(&b.0.centre()[axis]));
+            for (k, (p, i)) in both.into_iter().enumerate() {
+                (prims[k], order[k]) = (p, i);
+            }
+            let (left, right) = prims.split_at(n / 2);
+            (n / 2, bounds_of(left), bounds_of(right))
         }
     };
     let (left, right) = order.split_at_mut(mid);
+    let (prims_left, prims_right) = prims.split_at_mut(mid);
     let halves = if n >= PARALLEL {
-        rayon::join(|| split(prims, left, start, depth + 1), || split(prims, right, start + mid, depth + 1))
+        rayon::join(
+            || split(prims_left, left, start, depth + 1, below, bins),
+            || split(prims_right, right, start + mid, depth + 1, above, &mut Box::new(Bins::EMPTY)),
+        )
     } else {
-        (split(prims, left, start, depth + 1), split(prims, right, start + mid, depth + 1))
+        (
+            split(prims_left, left, start, depth + 1, below, bins),
+            split(prims_right, right, start + mid, depth + 1, above, bins),
+        )
     };
     Node2::inner(bounds, [halves.0, halves.1])
 }
 
 /// The cut of least surface-area cost among the first `used` bins: an axis and the first bin on its
-/// upper side. `None` when every centre is in one bin on every axis.
+/// upper side, the lowest axis and then the highest bin among equal costs. A cut with every centre on
+/// one side splits nothing: its cost is infinite, and the answer is `None` when every cut's is.
 fn best_cut(bins: &Bins, used: usize, n: usize) -> Option<(usize, usize)> {
-    let mut best: Option<(f32, usize, usize)> = None;
-    for axis in 0..3 {
-        // The cost of the lower side of each cut, swept from below; then the upper side's from above.
-        // A cut with every centre on one side splits nothing: its cost is infinite.
-        let mut below = [0.0f32; BINS];
-        let (mut b, mut count) = (Aabb::EMPTY, 0);
-        for (bin, cost) in below.iter_mut().enumerate().take(used).skip(1) {
-            b = b.grow(bins.bounds[axis][bin - 1]);
-            count += bins.count[axis][bin - 1];
-            *cost = if count == 0 || count as usize == n { f32::INFINITY } else { b.half_area() * count as f32 };
+    // The cost of the lower side of each cut, swept from below; then the whole cost, the upper side's
+    // swept from above. The three axes take each step together: their sweeps are independent chains.
+    let mut below = [[0.0f32; BINS]; 3];
+    let (mut b, mut count) = ([Aabb::EMPTY; 3], [0u32; 3]);
+    for bin in 1..used {
+        for (axis, below) in below.iter_mut().enumerate() {
+            b[axis] = b[axis].grow(bins.bounds[axis][bin - 1]);
+            count[axis] += bins.count[axis][bin - 1];
+            let lower = b[axis].half_area() * count[axis] as f32;
+            below[bin] = if count[axis] == 0 || count[axis] as usize == n { f32::INFINITY } else { lower };
         }
-        let (mut b, mut count) = (Aabb::EMPTY, 0);
-        for bin in (1..used).rev() {
-            b = b.grow(bins.bounds[axis][bin]);
-            count += bins.count[axis][bin];
-            let cost = below[bin] + b.half_area() * count as f32;
-            if cost.is_finite() && best.is_none_or(|(c, ..)| cost < c) {
-                best = Some((cost, axis, bin));
+    }
+    let (mut b, mut count) = ([Aabb::EMPTY; 3], [0u32; 3]);
+    // Each axis's cheapest finite cost (a NaN is never less) and its bin, the highest among equals.
+    let mut best = [(f32::INFINITY, 0); 3];
+    for bin in (1..used).rev() {
+        for axis in 0..3 {
+            b[axis] = b[axis].grow(bins.bounds[axis][bin]);
+            count[axis] += bins.count[axis][bin];
+            let cost = below[axis][bin] + b[axis].half_area() * count[axis] as f32;
+            if cost < best[axis].0 {
+                best[axis] = (cost, bin);
             }
         }
     }
-    best.map(|(_, axis, bin)| (axis, bin))
+    let (axis, &(cost, bin)) =
+        best.iter().enumerate().reduce(|low, next| if next.1.0 < low.1.0 { next } else { low })?;
+    (cost < f32::INFINITY).then_some((axis, bin))
 }
 
-/// Moves the indices for which `lower` holds to the front; returns how many there are.
-fn partition(order: &mut [u32], lower: impl Fn(u32) -> bool) -> usize {
-    let mut mid = 0;
+/// Moves the indices of the triangles whose centres `lower` holds for to the front; returns how many
+/// there are, and the bounds of the centres on each side.
+fn partition(prims: &mut [Aabb], order: &mut [u32], lower: impl Fn(Vec3A) -> bool) -> (usize, Aabb, Aabb) {
+    let (mut mid, mut below, mut above) = (0, Aabb::EMPTY, Aabb::EMPTY);
     for i in 0..order.len() {
-        if lower(order[i]) {
+        let centre = prims[i].centre();
+        if lower(centre) {
+            prims.swap(i, mid);
             order.swap(i, mid);
             mid += 1;
+            below = below.grow_point(centre);
+        } else {
+            above = above.grow_point(centre);
         }
     }
-    mid
+    (mid, below, above)
 }
 
 /// Up to [`LANES`] children of a wide node.
@@ -303,10 +367,9 @@ fn widen(halves: &[Node2; 2]) -> Kids<'_> {
     let mut kids = Kids { kid: [&halves[1]; LANES], len: 2 };
     kids.kid[0] = &halves[0];
     while kids.len < LANES {
-        let open = (0..kids.len)
-            .filter(|&i| matches!(kids.kid[i], Node2::Inner { .. }))
-            .max_by(|&a, &b| kids.kid[a].bounds().half_area().total_cmp(&kids.kid[b].bounds().half_area()));
-        let Some(i) = open else { break };
+        let open =
+            (0..kids.len).filter_map(|i| Some((i, kids.kid[i].inner_area()?))).max_by(|(_, a), (_, b)| a.total_cmp(b));
+        let Some((i, _)) = open else { break };
         let Node2::Inner { halves, .. } = kids.kid[i] else { unreachable!("only inner kids are opened") };
         kids.kid[i] = &halves[0];
         kids.kid[kids.len] = &halves[1];

@@ -243,4 +243,51 @@ mod tests {
         }
         assert!(blocked > 0 && blocked < cast, "{blocked} of {cast} rays blocked: both answers are checked");
     }
+
+    /// A tree over triangles whose centres coincide (no binned cut separates them: the builder halves
+    /// them at the median), among a cloud of scattered ones and a degenerate one, answers every ray as
+    /// testing every triangle does.
+    #[test]
+    fn triangles_sharing_a_centre_are_all_found() {
+        let mut rng = scenes::Rng::new(7);
+        let mut rand = move || rng.unit();
+        let mut tris = Vec::new();
+        // Eighty triangles through the origin, turned about the z axis and growing: each spans -p..p,
+        // its third corner inside that box, so every box is symmetric about the origin and every
+        // centre is the origin.
+        for k in 0..80 {
+            let (s, c) = (k as f32 * 0.078).sin_cos();
+            let p = Vec3A::new(c, s, 0.1) * (0.2 + 0.02 * k as f32);
+            tris.push([p, -p, p * Vec3A::new(0.3, -0.6, 0.5)]);
+        }
+        for _ in 0..300 {
+            let centre = Vec3A::new(rand() * 4.0 - 2.0, rand() * 4.0 - 2.0, rand() * 4.0 - 2.0);
+            let corner = |rand: &mut dyn FnMut() -> f32| centre + Vec3A::new(rand(), rand(), rand()) * 0.3;
+            tris.push([corner(&mut rand), corner(&mut rand), corner(&mut rand)]);
+        }
+        tris.push([Vec3A::ONE; 3]);
+        let (nodes, leaves) = build::build(&tris);
+        let bvh = SceneBvh { nodes, leaves, triangles: tris.len(), avx2: avx2() };
+        let (mut cast, mut blocked) = (0, 0);
+        for _ in 0..8000 {
+            let origin = Vec3::new(rand() * 6.0 - 3.0, rand() * 6.0 - 3.0, rand() * 6.0 - 3.0);
+            // Aimed at a point of a triangle (most often one through the origin), and stopping short
+            // of it a third of the time.
+            let [a, b, c] = tris[if cast % 4 == 0 { 80 + (rand() * 300.0) as usize } else { (rand() * 79.9) as usize }];
+            let (u, v) = (rand(), rand());
+            let (u, v) = if u + v > 1.0 { (1.0 - u, 1.0 - v) } else { (u, v) };
+            let target = Vec3::from(a + (b - a) * u + (c - a) * v);
+            let dir = (target - origin).normalize();
+            let tmax = (target - origin).length() * 1.5 * rand();
+            let ray = Ray::new(origin.into(), dir.into(), 0.0, tmax);
+            let any = tris.iter().any(|&[v0, v1, v2]| Triangle { v0, v1, v2 }.intersect(&ray) < tmax);
+            assert_eq!(bvh.occluded(origin, dir, tmax), any, "{origin} towards {dir}, to {tmax}");
+            cast += 1;
+            blocked += usize::from(any);
+        }
+        assert!(
+            blocked > cast / 4 && blocked < cast * 3 / 4,
+            "{blocked} of {cast} rays blocked: both answers are checked"
+        );
+    }
 }
