@@ -166,16 +166,16 @@ fn avx2() -> bool {
 
 /// Every casting triangle of the frame, in world space.
 fn casting_triangles(frame: &FrameInputs) -> Vec<[Vec3A; 3]> {
-    frame
-        .instances
-        .par_iter()
-        .filter(|i| i.casts_shadow)
-        .flat_map_iter(|inst| {
-            let m = inst.world_from_local;
-            let world: Vec<Vec3A> = inst.mesh.positions().iter().map(|&p| Vec3A::from(m.transform_point3(p))).collect();
-            inst.mesh.triangles().iter().map(move |t| t.map(|v| world[v as usize])).collect::<Vec<_>>()
-        })
-        .collect()
+    // Instance by instance, each one's vertices and triangles split among the threads: a scene is
+    // often one large mesh and a few small ones.
+    let mut tris = Vec::new();
+    for inst in frame.instances.iter().filter(|i| i.casts_shadow) {
+        let m = inst.world_from_local;
+        let world: Vec<Vec3A> =
+            inst.mesh.positions().par_iter().with_min_len(4096).map(|&p| m.transform_point3(p).into()).collect();
+        tris.par_extend(inst.mesh.triangles().par_iter().with_min_len(4096).map(|t| t.map(|v| world[v as usize])));
+    }
+    tris
 }
 
 #[cfg(test)]
