@@ -16,7 +16,7 @@ use shadow_core::technique::LightKinds;
 use shadow_core::technique::LightPass;
 use shadow_core::technique::settings::{SettingKey, SettingsError, Values};
 use shadow_core::technique::{ShadowTechnique, TechniqueError};
-use shadow_cpu::bvh::{LastBlocker, SceneBvh};
+use shadow_cpu::bvh::{SceneBvh, Walker};
 use shadow_cpu::passes::per_receiver_casting;
 use shadow_cpu::passes::rays::{RayOrigins, State as RayState};
 use shadow_cpu::{CpuBackend, CpuContext, CpuError, GBuffer};
@@ -75,12 +75,12 @@ pub struct Sphere {
 /// The fraction of `light` visible from `origin` (already off the surface) on a surface of unit normal
 /// `n`, and the number of rays cast for it: `samples` stratified directions (a square number) uniform in
 /// the cone the sphere subtends, each below the surface's horizon counted blocked without a ray, the
-/// others tested up to where they enter the sphere (each after `last`, the last blocker of the rays
-/// before it); `seed` picks the jitter. A receiver inside the sphere sees all of it.
+/// others tested up to where they enter the sphere (each after the last blocker `walker` saw: see
+/// [`SceneBvh::occluded_after`]); `seed` picks the jitter. A receiver inside the sphere sees all of it.
 #[must_use]
 pub fn sphere_visibility(
     bvh: &SceneBvh,
-    last: &mut LastBlocker,
+    walker: &mut Walker,
     origin: Vec3,
     n: Vec3,
     light: Sphere,
@@ -115,7 +115,7 @@ pub fn sphere_visibility(
             let miss2 = (to_centre.length_squared() - along * along).max(0.0);
             let tmax = along - (light.radius * light.radius - miss2).max(0.0).sqrt();
             cast += 1;
-            if !bvh.occluded_after(last, origin, dir, tmax) {
+            if !bvh.occluded_after(walker, origin, dir, tmax) {
                 seen += 1;
             }
         }
@@ -158,9 +158,9 @@ impl ShadowTechnique<CpuBackend> for AreaLightReference {
         };
         let sphere = Sphere { centre, radius: light.light.radius };
         let origins = RayOrigins::new(g, frame, self.epsilon);
-        let rays = per_receiver_casting(g, out, |last, x, y, i| {
+        let rays = per_receiver_casting(g, out, |walker, x, y, i| {
             let (origin, n) = origins.at(i);
-            let (visible, cast) = sphere_visibility(bvh, last, origin, n, sphere, self.samples, pixel_hash(x, y));
+            let (visible, cast) = sphere_visibility(bvh, walker, origin, n, sphere, self.samples, pixel_hash(x, y));
             (visible, u64::from(cast))
         });
         stats.counters.extra.insert("rays_cast".into(), rays as f64);
@@ -207,14 +207,14 @@ mod tests {
     fn visibility_is_the_unblocked_fraction_of_the_sphere() {
         let up = Vec3::Y;
         let fraction = |bvh: &SceneBvh, origin: Vec3, n: Vec3, light: Sphere, samples: u32| {
-            sphere_visibility(bvh, &mut LastBlocker::default(), origin, n, light, samples, 7).0
+            sphere_visibility(bvh, &mut Walker::default(), origin, n, light, samples, 7).0
         };
         // Far off to the side: nothing in the way, and every sample cast.
         let clear = occluder_from(50.0);
-        assert_eq!(sphere_visibility(&clear, &mut LastBlocker::default(), Vec3::ZERO, up, LIGHT, 256, 7), (1.0, 256));
+        assert_eq!(sphere_visibility(&clear, &mut Walker::default(), Vec3::ZERO, up, LIGHT, 256, 7), (1.0, 256));
         // Under the middle of the square: every ray blocked.
         let covered = occluder_from(-2.0);
-        assert_eq!(sphere_visibility(&covered, &mut LastBlocker::default(), Vec3::ZERO, up, LIGHT, 256, 7), (0.0, 256));
+        assert_eq!(sphere_visibility(&covered, &mut Walker::default(), Vec3::ZERO, up, LIGHT, 256, 7), (0.0, 256));
         // The square's edge right over the receiver, under the light's centre: half the cone, by symmetry
         // (stratified, so within a stratum row's worth).
         let half = occluder_from(0.0);
@@ -223,7 +223,7 @@ mod tests {
         // A receiver whose horizon passes through the light's centre sees the upper half of it, and casts
         // rays only there.
         let (v, cast) =
-            sphere_visibility(&clear, &mut LastBlocker::default(), Vec3::new(0.0, 2.0, 3.0), Vec3::Y, LIGHT, 256, 7);
+            sphere_visibility(&clear, &mut Walker::default(), Vec3::new(0.0, 2.0, 3.0), Vec3::Y, LIGHT, 256, 7);
         assert!((v - 0.5).abs() < 0.04, "half below the horizon: {v}");
         assert_eq!(cast as f32, v * 256.0, "rays cast over the horizon");
         // A point light is all or nothing, and the receiver inside the sphere sees it all without a ray.
@@ -231,7 +231,7 @@ mod tests {
         assert_eq!(fraction(&half, Vec3::new(-0.01, 0.0, 0.0), up, point, 16), 1.0);
         assert_eq!(fraction(&half, Vec3::new(0.01, 0.0, 0.0), up, point, 16), 0.0);
         assert_eq!(
-            sphere_visibility(&covered, &mut LastBlocker::default(), Vec3::new(0.0, 1.9, 0.0), up, LIGHT, 16, 7),
+            sphere_visibility(&covered, &mut Walker::default(), Vec3::new(0.0, 1.9, 0.0), up, LIGHT, 16, 7),
             (1.0, 0)
         );
     }
@@ -247,16 +247,7 @@ mod tests {
             let v: Vec<f32> = xs
                 .iter()
                 .map(|&x| {
-                    sphere_visibility(
-                        &half,
-                        &mut LastBlocker::default(),
-                        Vec3::new(x, 0.0, 0.0),
-                        Vec3::Y,
-                        light,
-                        256,
-                        3,
-                    )
-                    .0
+                    sphere_visibility(&half, &mut Walker::default(), Vec3::new(x, 0.0, 0.0), Vec3::Y, light, 256, 3).0
                 })
                 .collect();
             let first = |t: f32| xs[v.iter().position(|&v| v < t).unwrap()];

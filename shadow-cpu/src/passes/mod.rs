@@ -16,9 +16,9 @@ pub mod volumes;
 use rayon::prelude::*;
 use shadow_core::Image;
 
-use crate::bvh::LastBlocker;
 #[cfg(doc)]
 use crate::bvh::SceneBvh;
+use crate::bvh::Walker;
 use crate::gbuffer::GBuffer;
 
 /// Fills `out` with `f(x, y, i)` at every receiver pixel (i the pixel index) and 1 elsewhere.
@@ -32,18 +32,18 @@ pub fn per_receiver(g: &GBuffer, out: &mut Image<f32>, f: impl Fn(u32, u32, usiz
 pub fn per_receiver_casting(
     g: &GBuffer,
     out: &mut Image<f32>,
-    f: impl Fn(&mut LastBlocker, u32, u32, usize) -> (f32, u64) + Sync,
+    f: impl Fn(&mut Walker, u32, u32, usize) -> (f32, u64) + Sync,
 ) -> u64 {
     let w = g.width() as usize;
     out.data_mut()
         .par_chunks_mut(w)
         .enumerate()
         .map(|(y, row)| {
-            let (mut rays, mut last) = (0, LastBlocker::default());
+            let (mut rays, mut walker) = (0, Walker::default());
             for (x, v) in row.iter_mut().enumerate() {
                 let i = y * w + x;
                 *v = if g.receiver.data()[i] {
-                    let (visibility, cast) = f(&mut last, x as u32, y as u32, i);
+                    let (visibility, cast) = f(&mut walker, x as u32, y as u32, i);
                     rays += cast;
                     visibility
                 } else {

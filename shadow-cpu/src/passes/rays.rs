@@ -7,7 +7,7 @@ use shadow_core::glam::Vec3;
 use shadow_core::scene::LightKind;
 use shadow_core::technique::TechniqueError;
 
-use crate::bvh::{LastBlocker, SceneBvh};
+use crate::bvh::{SceneBvh, Walker};
 use crate::context::CpuContext;
 use crate::gbuffer::GBuffer;
 
@@ -93,6 +93,6 @@ pub fn shadow_rays(g: &GBuffer, frame: &FrameInputs, epsilon: f32) -> Vec<Shadow
 /// of those before it (as a technique traces a row of pixels: [`SceneBvh::occluded_after`]).
 #[must_use]
 pub fn count_blocked(bvh: &SceneBvh, rays: &[ShadowRay]) -> usize {
-    let mut last = LastBlocker::default();
-    rays.iter().filter(|&&(origin, dir, far)| bvh.occluded_after(&mut last, origin, dir, far)).count()
+    let mut walker = Walker::default();
+    rays.iter().filter(|&&(origin, dir, far)| bvh.occluded_after(&mut walker, origin, dir, far)).count()
 }

@@ -37,14 +37,14 @@ impl ShadowTechnique<CpuBackend> for RayTraced {
         let LightPass { frame, light, stats, .. } = pass;
         let bvh = state.bvh(Self::NAME)?;
         let origins = RayOrigins::new(g, frame, self.epsilon);
-        let rays = per_receiver_casting(g, out, |last, _, _, i| {
+        let rays = per_receiver_casting(g, out, |walker, _, _, i| {
             let (origin, n) = origins.at(i);
             let (dir, tmax) = towards(&light.light.kind, origin);
             // The light below the receiver's horizon: shadowed, and no ray to cast.
             if n.dot(dir) <= 0.0 {
                 (0.0, 0)
             } else {
-                (if bvh.occluded_after(last, origin, dir, tmax) { 0.0 } else { 1.0 }, 1)
+                (if bvh.occluded_after(walker, origin, dir, tmax) { 0.0 } else { 1.0 }, 1)
             }
         });
         stats.counters.extra.insert("rays_cast".into(), rays as f64);
