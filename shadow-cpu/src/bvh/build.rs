@@ -330,8 +330,8 @@ fn best_cut(bins: &Bins, used: usize, n: usize) -> Option<(usize, usize)> {
     (cost < f32::INFINITY).then_some((axis, bin))
 }
 
-/// Moves the indices of the triangles whose centres `lower` holds for to the front; returns how many
-/// there are, and the bounds of the centres on each side.
+/// Moves the triangles (their indices and boxes alike) whose centres `lower` holds for to the front;
+/// returns how many there are, and the bounds of the centres on each side.
 fn partition(prims: &mut [Aabb], order: &mut [u32], lower: impl Fn(Vec3A) -> bool) -> (usize, Aabb, Aabb) {
     let (mut mid, mut below, mut above) = (0, Aabb::EMPTY, Aabb::EMPTY);
     for i in 0..order.len() {
