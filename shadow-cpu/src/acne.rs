@@ -7,7 +7,7 @@ use glam::Vec3;
 use shadow_core::light::LightView;
 use shadow_core::{FrameInputs, Image};
 
-use crate::bvh::SceneBvh;
+use crate::bvh::{SceneBvh, Walker};
 use crate::gbuffer::GBuffer;
 
 /// World size of one texel of a `res`-texel map of projection `k` around world point `p`, and the map's
@@ -47,6 +47,8 @@ impl AcneProbe<'_> {
         let (g, light) = (self.gbuffer, self.light);
         let eps = 5e-7 * self.frame.bounds.size().length();
         let (mut n, mut acne) = (0u64, 0u64);
+        // The probes of neighbouring pixels, traced one after another (see [`SceneBvh::occluded_after`]).
+        let mut walker = Walker::default();
         for i in 0..self.mask.data().len() {
             if !self.mask.data()[i] {
                 continue;
@@ -71,7 +73,7 @@ impl AcneProbe<'_> {
                         Some(l) => ((l - q).normalize(), (l - q).length()),
                         None => (light.light.to_light(q), f32::INFINITY),
                     };
-                    !self.bvh.occluded(q, dir, tmax)
+                    !self.bvh.occluded_after(&mut walker, q, dir, tmax)
                 })
             });
             acne += u64::from(all_lit);

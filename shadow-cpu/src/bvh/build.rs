@@ -55,8 +55,18 @@ impl Aabb {
 /// wide nodes and leaves it is written as (when it heads a wide node), so every subtree's
 /// place in the output is known before any is written and they are written in parallel.
 enum Node2 {
-    Leaf { bounds: Aabb, start: usize, count: usize },
-    Inner { bounds: Aabb, area: f32, halves: Box<[Node2; 2]>, size: Size },
+    Leaf {
+        bounds: Aabb,
+        start: usize,
+        count: usize,
+    },
+    Inner {
+        bounds: Aabb,
+        /// The half area of `bounds`, kept: every widening that meets the node compares it.
+        area: f32,
+        halves: Box<[Node2; 2]>,
+        size: Size,
+    },
 }
 
 /// Wide nodes and leaves a subtree is written as.
@@ -127,7 +137,7 @@ pub fn build(tris: &[[Vec3A; 3]]) -> (Vec<Node8>, Vec<Tri8>) {
     (nodes, leaves)
 }
 
-/// The bounds of the triangles `order` lists, and of their centres.
+/// The bounds of the boxes `prims`, and of their centres.
 fn bounds_of(prims: &[Aabb]) -> (Aabb, Aabb) {
     let of = |boxes: &[Aabb]| {
         boxes.iter().fold((Aabb::EMPTY, Aabb::EMPTY), |(b, c), &p| (b.grow(p), c.grow_point(p.centre())))
