@@ -1,24 +1,28 @@
-//! Building the tree: a binary tree by the surface area heuristic over binned centroids (Wald, "On fast
-//! Construction of SAH-based Bounding Volume Hierarchies", 2007), on every core, then collapsed into
-//! eight-wide nodes whose leaves hold up to eight triangles.
+//! Building the tree by the surface area heuristic over binned centroids (Wald, "On fast Construction of
+//! SAH-based Bounding Volume Hierarchies", 2007), on every core, into eight-wide nodes whose leaves hold
+//! up to eight triangles. A wide node's children come from cutting its triangles in two, then cutting
+//! the child of largest area again while there is room: the tree a binary SAH tree collapses into, with
+//! no binary tree ever built.
 
 use glam::Vec3A;
 use rayon::prelude::*;
 
-use super::wide::{Child, LANES, LEAF, Node8, Tri8};
+use super::wide::{Child, LANES, LEAF, NONE, Node8, Tri8};
 
 /// Bins per axis a node's centroids are sorted into, at most: a node of fewer triangles gets one bin
 /// per triangle, which finds its cuts as well and sweeps fewer bins.
 const BINS: usize = 16;
 /// Triangles a leaf holds at most: one [`Tri8`].
 const LEAF_SIZE: usize = LANES;
-/// Nodes with at least this many triangles are binned, and their halves built, in parallel.
+/// Nodes with at least this many triangles are binned, and their children's subtrees built, in parallel.
 const PARALLEL: usize = 1 << 13;
-/// Below this depth the split is the best binned one; deeper, it is the median, so the binary tree is at
-/// most this deep plus log2 of the triangle count, and a traversal stack of [`STACK`] never overflows.
+/// Fewer cuts than this down from the root, a piece is cut at its best binned cut; deeper, at the
+/// median, so no leaf lies more than this many cuts plus log2 of the triangle count down, and a
+/// traversal stack of [`STACK`] never overflows.
 const SAH_DEPTH: u32 = 48;
 /// Entries a traversal stack holds: a wide node pushes at most `LANES - 1` more entries than it pops,
-/// and the wide tree is no deeper than the binary one (at most [`SAH_DEPTH`] + 32).
+/// and each wide node lies at least one cut below its parent, so the tree is at most [`SAH_DEPTH`] + 32
+/// nodes deep.
 pub const STACK: usize = (LANES - 1) * (SAH_DEPTH as usize + 32) + 1;
 
 /// An axis-aligned box.
@@ -51,65 +55,6 @@ impl Aabb {
     }
 }
 
-/// The binary tree: leaves are runs of the reordered triangle indices. An inner node knows how many
-/// wide nodes and leaves it is written as (when it heads a wide node), so every subtree's
-/// place in the output is known before any is written and they are written in parallel.
-enum Node2 {
-    Leaf {
-        bounds: Aabb,
-        start: usize,
-        count: usize,
-    },
-    Inner {
-        bounds: Aabb,
-        /// The half area of `bounds`, kept: every widening that meets the node compares it.
-        area: f32,
-        halves: Box<[Node2; 2]>,
-        size: Size,
-    },
-}
-
-/// Wide nodes and leaves a subtree is written as.
-#[derive(Clone, Copy, Default)]
-struct Size {
-    nodes: usize,
-    leaves: usize,
-}
-
-impl Node2 {
-    fn inner(bounds: Aabb, halves: [Node2; 2]) -> Self {
-        let mut size = Size { nodes: 1, leaves: 0 };
-        for kid in widen(&halves).iter() {
-            let s = kid.size();
-            size.nodes += s.nodes;
-            size.leaves += s.leaves;
-        }
-        Self::Inner { bounds, area: bounds.half_area(), halves: Box::new(halves), size }
-    }
-
-    fn bounds(&self) -> Aabb {
-        match self {
-            Self::Leaf { bounds, .. } | Self::Inner { bounds, .. } => *bounds,
-        }
-    }
-
-    /// The half area of an inner node (which a wide node may open); `None` for a leaf.
-    fn inner_area(&self) -> Option<f32> {
-        match self {
-            Self::Leaf { .. } => None,
-            Self::Inner { area, .. } => Some(*area),
-        }
-    }
-
-    /// What the node is written as when it is a wide node's child.
-    fn size(&self) -> Size {
-        match self {
-            Self::Leaf { .. } => Size { nodes: 0, leaves: 1 },
-            Self::Inner { size, .. } => *size,
-        }
-    }
-}
-
 /// The wide tree over `tris`: its nodes (the root first) and its leaves.
 ///
 /// The builder moves the triangles' boxes as it sorts their indices, so the passes over a node read
@@ -123,17 +68,19 @@ pub fn build(tris: &[[Vec3A; 3]]) -> (Vec<Node8>, Vec<Tri8>) {
         .map(|&[a, b, c]| Aabb { lo: a.min(b).min(c), hi: a.max(b).max(c) })
         .collect();
     let mut order: Vec<u32> = (0..tris.len() as u32).collect();
-    let bounds = bounds_of(&prims);
-    let root = split(&mut prims, &mut order, 0, 0, bounds, &mut Box::new(Bins::EMPTY));
-    // The root is always a wide node: over the widened halves of an inner root, or over a root
-    // that is a single leaf.
-    let (kids, size) = match &root {
-        Node2::Inner { halves, size, .. } => (widen(halves), *size),
-        leaf => (Kids { kid: [leaf; LANES], len: 1 }, Size { nodes: 1, leaves: 1 }),
-    };
+    let (bounds, centres) = bounds_of(&prims);
+    let root = Piece { prims: &mut prims, order: &mut order, depth: 0, bounds, centres };
+    if root.is_leaf() {
+        // The root is always a wide node, here over a single leaf.
+        let mut node = Node8::EMPTY;
+        node.set(0, LEAF, bounds.lo, bounds.hi);
+        return (vec![node], vec![Tri8::new(root.order.len(), |i| tris[root.order[i] as usize])]);
+    }
+    let built = subtree(root, &mut Box::new(Bins::EMPTY));
+    let size = built.size();
     let mut nodes = vec![Node8::EMPTY; size.nodes];
     let mut leaves = vec![Tri8::EMPTY; size.leaves];
-    Out { tris, order: &order }.write(kids, &mut nodes, 0, &mut leaves, 0);
+    built.write(tris, &mut nodes, 0, &mut leaves, 0);
     (nodes, leaves)
 }
 
@@ -246,64 +193,86 @@ impl Binning {
     }
 }
 
-/// The binary tree over the triangles `order` lists, whose boxes are `prims` (both reordered alike, so
-/// each leaf's triangles are a run), `start` being `order`'s offset in the whole list, given the
-/// bounds of those triangles and of their centres. A binned cut hands each half its bounds: the union
-/// of its bins' boxes, and its centres' bounds gathered as the cut moves them, so no node passes over
-/// its triangles for them again. `bins` is the thread's room for the binning.
-fn split(
-    prims: &mut [Aabb],
-    order: &mut [u32],
-    start: usize,
+/// Triangles not yet in a leaf: their boxes and indices (reordered alike, so each leaf's triangles are
+/// a run), how many cuts down from the root they lie, and the bounds of their boxes and of their
+/// centres.
+struct Piece<'a> {
+    prims: &'a mut [Aabb],
+    order: &'a mut [u32],
     depth: u32,
-    (bounds, centres): (Aabb, Aabb),
-    bins: &mut Bins,
-) -> Node2 {
-    let n = order.len();
-    if n <= LEAF_SIZE {
-        return Node2::Leaf { bounds, start, count: n };
+    bounds: Aabb,
+    centres: Aabb,
+}
+
+impl<'a> Piece<'a> {
+    fn is_leaf(&self) -> bool {
+        self.order.len() <= LEAF_SIZE
     }
-    let binning = Binning::new(centres, n);
-    let cut = (depth < SAH_DEPTH)
-        .then(|| {
-            binning.fill(prims, bins);
-            best_cut(bins, binning.count, n)
-        })
-        .flatten();
-    let (mid, below, above) = match cut {
-        Some((axis, bin)) => {
-            let (mid, centres_below, centres_above) = partition(prims, order, |c| binning.bins(c)[axis] < bin);
-            let union = |bins: &[Aabb]| bins.iter().fold(Aabb::EMPTY, |b, &bin| b.grow(bin));
-            let boxes = &bins.bounds[axis][..binning.count];
-            (mid, (union(&boxes[..bin]), centres_below), (union(&boxes[bin..]), centres_above))
-        }
-        None => {
-            // No cut separates the centres (they coincide), or the tree is deep: halve at the median
-            // centre along the longest axis.
-            let axis = (centres.hi - centres.lo).max_position();
-            let mut both: Vec<(Aabb, u32)> = prims.iter().copied().zip(order.iter().copied()).collect();
-            both.select_nth_unstable_by(n / 2, |a, b| a.0.centre()[axis].total_cmp(&b.0.centre()[axis]));
-            for (k, (p, i)) in both.into_iter().enumerate() {
-                (prims[k], order[k]) = (p, i);
+
+    /// Cuts the piece (more than a leaf's triangles) in two, the lower half first: by the cheapest
+    /// binned cut, or at the median. A binned cut hands each half its bounds: the union of its bins'
+    /// boxes, and its centres' bounds gathered as the cut moves them, so no piece passes over its
+    /// triangles for them again. `bins` is the thread's room for the binning.
+    fn cut(self, bins: &mut Bins) -> [Piece<'a>; 2] {
+        let Piece { prims, order, depth, centres, .. } = self;
+        let n = order.len();
+        let binning = Binning::new(centres, n);
+        let cut = (depth < SAH_DEPTH)
+            .then(|| {
+                binning.fill(prims, bins);
+                best_cut(bins, binning.count, n)
+            })
+            .flatten();
+        let (mid, below, above) = match cut {
+            Some((axis, bin)) => {
+                let (mid, centres_below, centres_above) = partition(prims, order, |c| binning.bins(c)[axis] < bin);
+                let union = |bins: &[Aabb]| bins.iter().fold(Aabb::EMPTY, |b, &bin| b.grow(bin));
+                let boxes = &bins.bounds[axis][..binning.count];
+                (mid, (union(&boxes[..bin]), centres_below), (union(&boxes[bin..]), centres_above))
             }
-            let (left, right) = prims.split_at(n / 2);
-            (n / 2, bounds_of(left), bounds_of(right))
+            None => {
+                // No cut separates the centres (they coincide), or the tree is deep: halve at the
+                // median centre along the longest axis.
+                let axis = (centres.hi - centres.lo).max_position();
+                let mut both: Vec<(Aabb, u32)> = prims.iter().copied().zip(order.iter().copied()).collect();
+                both.select_nth_unstable_by(n / 2, |a, b| a.0.centre()[axis].total_cmp(&b.0.centre()[axis]));
+                for (k, (p, i)) in both.into_iter().enumerate() {
+                    (prims[k], order[k]) = (p, i);
+                }
+                let (left, right) = prims.split_at(n / 2);
+                (n / 2, bounds_of(left), bounds_of(right))
+            }
+        };
+        let (prims_low, prims_high) = prims.split_at_mut(mid);
+        let (order_low, order_high) = order.split_at_mut(mid);
+        let depth = depth + 1;
+        [
+            Piece { prims: prims_low, order: order_low, depth, bounds: below.0, centres: below.1 },
+            Piece { prims: prims_high, order: order_high, depth, bounds: above.0, centres: above.1 },
+        ]
+    }
+
+    /// The children of the wide node over the piece (more than a leaf's triangles): its halves, and
+    /// while there is room the child of largest area that is not a leaf cut in two in its place, its
+    /// upper half last. Then in order of their centres along the axis they spread most on, so a ray
+    /// can open them nearest first; that axis comes with them.
+    fn open(self, bins: &mut Bins) -> (Vec<Piece<'a>>, u32) {
+        let mut kids = Vec::with_capacity(LANES);
+        kids.extend(self.cut(bins));
+        while kids.len() < LANES {
+            // `max_by` answers the last of equal areas.
+            let widest = kids.iter().enumerate().filter(|(_, k)| !k.is_leaf()).map(|(i, k)| (i, k.bounds.half_area()));
+            let Some((i, _)) = widest.max_by(|(_, a), (_, b)| a.total_cmp(b)) else { break };
+            let [low, high] = kids.remove(i).cut(bins);
+            kids.insert(i, low);
+            kids.push(high);
         }
-    };
-    let (left, right) = order.split_at_mut(mid);
-    let (prims_left, prims_right) = prims.split_at_mut(mid);
-    let halves = if n >= PARALLEL {
-        rayon::join(
-            || split(prims_left, left, start, depth + 1, below, bins),
-            || split(prims_right, right, start + mid, depth + 1, above, &mut Box::new(Bins::EMPTY)),
-        )
-    } else {
-        (
-            split(prims_left, left, start, depth + 1, below, bins),
-            split(prims_right, right, start + mid, depth + 1, above, bins),
-        )
-    };
-    Node2::inner(bounds, [halves.0, halves.1])
+        let centre = |k: &Piece<'_>| k.bounds.lo + k.bounds.hi;
+        let spread = kids.iter().fold(Aabb::EMPTY, |b, k| b.grow_point(centre(k)));
+        let axis = (spread.hi - spread.lo).max_position();
+        kids.sort_by(|a, b| centre(a)[axis].total_cmp(&centre(b)[axis]));
+        (kids, axis as u32)
+    }
 }
 
 /// The cut of least surface-area cost among the first `used` bins: an axis and the first bin on its
@@ -358,94 +327,127 @@ fn partition(prims: &mut [Aabb], order: &mut [u32], lower: impl Fn(Vec3A) -> boo
     (mid, below, above)
 }
 
-/// Up to [`LANES`] children of a wide node.
-#[derive(Clone, Copy)]
-struct Kids<'a> {
-    kid: [&'a Node2; LANES],
-    len: usize,
-}
-
-impl<'a> Kids<'a> {
-    fn iter(&self) -> impl Iterator<Item = &'a Node2> + '_ {
-        self.kid[..self.len].iter().copied()
+/// The subtree of the wide node over `piece` (more than a leaf's triangles). A piece of at least
+/// [`PARALLEL`] triangles builds its children's subtrees in parallel, each with a [`Bins`] of its own;
+/// a smaller one is built whole on this thread, which keeps a thread on one piece of work long enough
+/// to be worth waking.
+fn subtree<'a>(piece: Piece<'a>, bins: &mut Bins) -> Built<'a> {
+    if piece.order.len() < PARALLEL {
+        let mut tree = Tree { nodes: Vec::new(), leaves: Vec::new() };
+        grow(piece, bins, &mut tree);
+        return Built::Alone(tree);
     }
+    let (kids, axis) = piece.open(bins);
+    let kids = kids
+        .into_par_iter()
+        .map(|kid| {
+            let bounds = kid.bounds;
+            (bounds, if kid.is_leaf() { Built::Leaf(kid.order) } else { subtree(kid, &mut Box::new(Bins::EMPTY)) })
+        })
+        .collect();
+    Built::Node { axis, kids }
 }
 
-/// The children of a wide node over the binary node with `halves`: the inner child of largest
-/// area is opened into its own halves while there is room.
-fn widen(halves: &[Node2; 2]) -> Kids<'_> {
-    let mut kids = Kids { kid: [&halves[1]; LANES], len: 2 };
-    kids.kid[0] = &halves[0];
-    while kids.len < LANES {
-        let open =
-            (0..kids.len).filter_map(|i| Some((i, kids.kid[i].inner_area()?))).max_by(|(_, a), (_, b)| a.total_cmp(b));
-        let Some((i, _)) = open else { break };
-        let Node2::Inner { halves, .. } = kids.kid[i] else { unreachable!("only inner kids are opened") };
-        kids.kid[i] = &halves[0];
-        kids.kid[kids.len] = &halves[1];
-        kids.len += 1;
-    }
-    kids
-}
-
-/// Writes the wide tree, depth first: a node, then each child's subtree in turn.
-struct Out<'a> {
-    tris: &'a [[Vec3A; 3]],
-    order: &'a [u32],
-}
-
-impl Out<'_> {
-    /// Writes a node over `kids` at `nodes[0]` (index `node_at` in the whole tree) and its subtrees
-    /// after it, their leaves into `leaves` (from index `leaf_at`). Each subtree's slices are cut by
-    /// its size, so a node with many leaves below writes its subtrees in parallel.
-    fn write(&self, mut kids: Kids<'_>, nodes: &mut [Node8], node_at: usize, leaves: &mut [Tri8], leaf_at: usize) {
-        let parallel = leaves.len() >= PARALLEL / LEAF_SIZE;
-        // A subtree's slice holds its own node first: every inner size counts itself.
-        let (node, mut nodes_rest) = nodes.split_first_mut().expect("a slot for the node");
-        // The children in order along the axis their centres spread most on.
-        let centre = |n: &Node2| n.bounds().lo + n.bounds().hi;
-        let spread = kids.iter().fold(Aabb::EMPTY, |b, k| b.grow_point(centre(k)));
-        let axis = (spread.hi - spread.lo).max_position();
-        kids.kid[..kids.len].sort_by(|a, b| centre(a)[axis].total_cmp(&centre(b)[axis]));
-        node.axis = axis as u32;
-        let mut leaves_rest = leaves;
-        let (mut next_node, mut next_leaf) = (node_at + 1, leaf_at);
-        let mut below: [Option<Subtree<'_, '_>>; LANES] = std::array::from_fn(|_| None);
-        for (k, kid) in kids.iter().enumerate() {
-            let size = kid.size();
-            let (kid_nodes, more_nodes) = std::mem::take(&mut nodes_rest).split_at_mut(size.nodes);
-            let (kid_leaves, more_leaves) = std::mem::take(&mut leaves_rest).split_at_mut(size.leaves);
-            (nodes_rest, leaves_rest) = (more_nodes, more_leaves);
-            let child = match kid {
-                Node2::Leaf { start, count, .. } => {
-                    let ids = &self.order[*start..start + count];
-                    kid_leaves[0] = Tri8::new(ids.len(), |i| self.tris[ids[i] as usize]);
-                    LEAF | next_leaf as Child
-                }
-                Node2::Inner { halves, .. } => {
-                    below[k] = Some((widen(halves), kid_nodes, next_node, kid_leaves, next_leaf));
-                    next_node as Child
-                }
-            };
-            let b = kid.bounds();
-            node.set(k, child, b.lo, b.hi);
-            next_node += size.nodes;
-            next_leaf += size.leaves;
-        }
-        let below = below.into_iter().flatten();
-        if parallel {
-            rayon::scope(|scope| {
-                for (kids, nodes, at, leaves, leaf_at) in below {
-                    scope.spawn(move |_| self.write(kids, nodes, at, leaves, leaf_at));
-                }
-            });
+/// Appends the wide node over `piece` (more than a leaf's triangles) to `tree`, then each child's
+/// leaf or subtree in turn; answers the node's index.
+fn grow<'a>(piece: Piece<'a>, bins: &mut Bins, tree: &mut Tree<'a>) -> Child {
+    let (kids, axis) = piece.open(bins);
+    let at = tree.nodes.len();
+    tree.nodes.push(Node8 { axis, ..Node8::EMPTY });
+    for (k, kid) in kids.into_iter().enumerate() {
+        let bounds = kid.bounds;
+        let child = if kid.is_leaf() {
+            tree.leaves.push(kid.order);
+            LEAF | (tree.leaves.len() - 1) as Child
         } else {
-            for (kids, nodes, at, leaves, leaf_at) in below {
-                self.write(kids, nodes, at, leaves, leaf_at);
+            grow(kid, bins, tree)
+        };
+        tree.nodes[at].set(k, child, bounds.lo, bounds.hi);
+    }
+    at as Child
+}
+
+/// A subtree's wide nodes (its root first, each node's children's subtrees after it in turn) and its
+/// leaves' triangles (in the order a depth-first walk meets them), numbered from 0 within it.
+struct Tree<'a> {
+    nodes: Vec<Node8>,
+    leaves: Vec<&'a [u32]>,
+}
+
+/// A subtree as its threads built it.
+enum Built<'a> {
+    /// The triangles of a leaf child of a node built in parallel.
+    Leaf(&'a [u32]),
+    /// A subtree built on one thread.
+    Alone(Tree<'a>),
+    /// A node whose children's subtrees were built in parallel: the axis of its children's order, and
+    /// their boxes and subtrees.
+    Node { axis: u32, kids: Vec<(Aabb, Built<'a>)> },
+}
+
+/// Wide nodes and leaves a subtree is written as.
+#[derive(Clone, Copy)]
+struct Size {
+    nodes: usize,
+    leaves: usize,
+}
+
+impl Built<'_> {
+    fn size(&self) -> Size {
+        match self {
+            Self::Leaf(_) => Size { nodes: 0, leaves: 1 },
+            Self::Alone(tree) => Size { nodes: tree.nodes.len(), leaves: tree.leaves.len() },
+            Self::Node { kids, .. } => {
+                kids.iter().map(|(_, kid)| kid.size()).fold(Size { nodes: 1, leaves: 0 }, |a, b| Size {
+                    nodes: a.nodes + b.nodes,
+                    leaves: a.leaves + b.leaves,
+                })
+            }
+        }
+    }
+
+    /// Writes the subtree into the whole tree's `nodes` (from index `node_at`) and `leaves` (from
+    /// `leaf_at`), slices cut to its size; a node built in parallel writes its children in parallel.
+    fn write(self, tris: &[[Vec3A; 3]], nodes: &mut [Node8], node_at: usize, leaves: &mut [Tri8], leaf_at: usize) {
+        let leaf = |ids: &[u32]| Tri8::new(ids.len(), |i| tris[ids[i] as usize]);
+        match self {
+            Self::Leaf(ids) => leaves[0] = leaf(ids),
+            Self::Alone(tree) => {
+                // Its numbers start at 0: every child moves by where the subtree starts.
+                for (to, mut node) in nodes.iter_mut().zip(tree.nodes) {
+                    for child in node.child.iter_mut().filter(|c| **c != NONE) {
+                        *child += if *child & LEAF != 0 { leaf_at } else { node_at } as Child;
+                    }
+                    *to = node;
+                }
+                for (to, ids) in leaves.iter_mut().zip(tree.leaves) {
+                    *to = leaf(ids);
+                }
+            }
+            Self::Node { axis, kids } => {
+                let (node, mut nodes_rest) = nodes.split_first_mut().expect("a slot for the node");
+                let mut leaves_rest = leaves;
+                node.axis = axis;
+                let (mut next_node, mut next_leaf) = (node_at + 1, leaf_at);
+                let mut parts = Vec::with_capacity(kids.len());
+                for (k, (b, kid)) in kids.into_iter().enumerate() {
+                    let size = kid.size();
+                    let child = match kid {
+                        Self::Leaf(_) => LEAF | next_leaf as Child,
+                        _ => next_node as Child,
+                    };
+                    node.set(k, child, b.lo, b.hi);
+                    let (kid_nodes, more_nodes) = std::mem::take(&mut nodes_rest).split_at_mut(size.nodes);
+                    let (kid_leaves, more_leaves) = std::mem::take(&mut leaves_rest).split_at_mut(size.leaves);
+                    (nodes_rest, leaves_rest) = (more_nodes, more_leaves);
+                    parts.push((kid, kid_nodes, next_node, kid_leaves, next_leaf));
+                    next_node += size.nodes;
+                    next_leaf += size.leaves;
+                }
+                parts.into_par_iter().for_each(|(kid, nodes, node_at, leaves, leaf_at)| {
+                    kid.write(tris, nodes, node_at, leaves, leaf_at)
+                });
             }
         }
     }
 }
-
-/// A subtree still to be written: its root's children, its slices and where they start in the tree.
-type Subtree<'k, 's> = (Kids<'k>, &'s mut [Node8], usize, &'s mut [Tri8], usize);
