@@ -133,6 +133,21 @@ pub fn timed<R>(f: impl FnOnce() -> R) -> (R, f64) {
     (r, ms(t.elapsed()))
 }
 
+/// Keeps every thread of rayon's pool busy for `busy`, so a timing on all threads that follows measures
+/// the threads and not the waking of a core. Between such timings the other threads idle (while one
+/// thread works alone, say), and on a virtual machine a core that has idled for tens of milliseconds can
+/// run its first tens of milliseconds of work slow: on the 2-core machine this was measured on, the
+/// second thread of a trace that followed one-thread work was busy 40% longer than the rays it traced
+/// took on one thread, and not at all longer when both had been busy just before.
+pub fn wake_every_thread(busy: Duration) {
+    let start = Instant::now();
+    rayon::broadcast(|_| {
+        while start.elapsed() < busy {
+            std::hint::spin_loop();
+        }
+    });
+}
+
 /// Median, minimum and maximum of a series of samples.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Summary {

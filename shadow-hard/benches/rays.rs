@@ -7,15 +7,15 @@
 //! drifts in speed. A development measurement: Embree is never a dependency of the library.
 //! `cargo bench -p shadow-hard --bench rays`.
 
-use std::hint::{black_box, spin_loop};
+use std::hint::black_box;
 use std::path::Path;
 use std::process::Command;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use rayon::prelude::*;
 use shadow_core::FrameInputs;
 use shadow_core::scenes::{self, SceneParams};
-use shadow_core::stats::{Summary, timed};
+use shadow_core::stats::{Summary, timed, wake_every_thread};
 use shadow_core::technique::TechniqueSettings;
 use shadow_cpu::bvh::SceneBvh;
 use shadow_cpu::gbuffer;
@@ -26,7 +26,7 @@ use shadow_hard::RayTraced;
 const RUNS: usize = 5;
 /// BVH builds in a row per run, on each side (`BUILDS` in `embree_rays.py`); the median counts.
 const BUILDS: usize = 3;
-/// How long every thread spins before the rays are traced on all of them.
+/// How long every thread spins before the rays are traced on all of them ([`wake_every_thread`]).
 const WAKE: Duration = Duration::from_millis(100);
 
 fn main() {
@@ -67,7 +67,7 @@ fn measure(name: &str, folder: &Path, embree: bool) {
         // caches) and keeps the median.
         build.push(median((0..BUILDS).map(|_| timed(|| black_box(SceneBvh::build(&frame))).1).collect()));
         one.push(timed(|| black_box(rays::count_blocked(&bvh, &rays))).1);
-        wake_every_core();
+        wake_every_thread(WAKE);
         all.push(timed(|| black_box(rays.par_chunks(4096).map(|c| rays::count_blocked(&bvh, c)).sum::<usize>())).1);
         if embree {
             theirs.extend(embree_once(name, folder));
@@ -97,21 +97,6 @@ fn measure(name: &str, folder: &Path, embree: bool) {
         ratio(rate(one), theirs.as_ref().map(|t| rate(t.0))),
         ratio(build, theirs.as_ref().map(|t| t.1)),
     );
-}
-
-/// Keeps every thread of the pool busy for [`WAKE`], so the trace on all threads measures the threads
-/// and not the waking of a core. The other threads idle while the one-thread trace runs, and on a
-/// virtual machine a core that has idled for tens of milliseconds can run its first tens of
-/// milliseconds of work slow: on the 2-core machine this was measured on, the second thread of a trace
-/// that followed one-thread work was busy 40% longer than the rays it traced took on one thread, and
-/// not at all longer when both had been busy just before.
-fn wake_every_core() {
-    let start = Instant::now();
-    rayon::broadcast(|_| {
-        while start.elapsed() < WAKE {
-            spin_loop();
-        }
-    });
 }
 
 /// The rays `ray-traced` casts over the frame's G-buffer at `w` x `h`.

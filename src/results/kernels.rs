@@ -5,6 +5,7 @@
 
 use std::fmt::Write as _;
 use std::hint::black_box;
+use std::time::Duration;
 
 use rayon::prelude::*;
 use shadow_core::geometry::LightSource;
@@ -13,7 +14,7 @@ use shadow_core::geometry::silhouette::{CastMode, silhouette};
 use shadow_core::geometry::volume::{Caps, extrude};
 use shadow_core::glam::Vec3;
 use shadow_core::procedural;
-use shadow_core::stats::{Summary, timed};
+use shadow_core::stats::{Summary, timed, wake_every_thread};
 use shadow_core::technique::TechniqueSettings;
 use shadow_cpu::bvh::SceneBvh;
 use shadow_cpu::gbuffer;
@@ -25,6 +26,8 @@ use crate::Error;
 
 /// Runs of each timing; the median is reported.
 const RUNS: usize = 11;
+/// How long every thread spins before the rays are traced on all of them.
+const WAKE: Duration = Duration::from_millis(100);
 /// The view the rays are cast over.
 const RAY_VIEW: (u32, u32) = (1024, 768);
 
@@ -75,12 +78,15 @@ pub fn run_kernels(progress: &mut impl FnMut(&str)) -> Result<KernelsReport, Err
             black_box(SceneBvh::build(&frame));
         });
         let bvh = SceneBvh::build(&frame);
-        let one = median(|| {
-            black_box(count_blocked(&bvh, &set));
-        });
-        let all = median(|| {
-            black_box(set.par_chunks(4096).map(|c| count_blocked(&bvh, c)).sum::<usize>());
-        });
+        // One thread and all take turns, run by run, so a drift of the machine's speed weighs on both
+        // alike; every thread is woken before each run on all of them.
+        let (mut one, mut all) = (Vec::new(), Vec::new());
+        for _ in 0..RUNS {
+            one.push(timed(|| black_box(count_blocked(&bvh, &set))).1);
+            wake_every_thread(WAKE);
+            all.push(timed(|| black_box(set.par_chunks(4096).map(|c| count_blocked(&bvh, c)).sum::<usize>())).1);
+        }
+        let (one, all) = (Summary::of(&one).median, Summary::of(&all).median);
         let rate = |ms: f64| set.len() as f64 / ms / 1e3;
         rays.push(RaysRow {
             scene,
@@ -118,9 +124,12 @@ pub fn markdown(s: &mut String, r: &KernelsReport) {
     let _ = writeln!(
         s,
         "\nShadow rays: the rays `ray-traced` casts over each scene's G-buffer at {}x{}, through the CPU \
-         backend's BVH (its build, on all threads, and the rays traced on one thread and on all). \
+         backend's BVH (its build, on all threads, and the rays traced on one thread and on all, the two \
+         taking turns run by run, every thread kept busy for {} ms before each run on all of them). \
          `cargo bench -p shadow-hard --bench rays` traces the same rays through Embree beside ours.\n",
-        RAY_VIEW.0, RAY_VIEW.1
+        RAY_VIEW.0,
+        RAY_VIEW.1,
+        WAKE.as_millis()
     );
     let _ = writeln!(
         s,
