@@ -55,7 +55,7 @@ impl Aabb {
     }
 }
 
-/// The wide tree over `tris`: its nodes (the root first) and its leaves.
+/// The wide tree over `tris` (at least one): its nodes (the root first) and its leaves.
 ///
 /// The builder moves the triangles' boxes as it sorts their indices, so the passes over a node read
 /// its boxes in memory order.

@@ -300,4 +300,21 @@ mod tests {
             "{blocked} of {cast} rays blocked: both answers are checked"
         );
     }
+
+    /// The build splits its work among the threads it has, and yet writes the same tree on any number
+    /// of them: node for node, leaf for leaf, in the same places.
+    #[test]
+    fn the_tree_is_the_same_on_any_number_of_threads() {
+        let scene = scenes::build("tree", &SceneParams::default()).expect("tree");
+        let frame = FrameInputs::from_first_camera(&scene).expect("frame");
+        let tris = casting_triangles(&frame);
+        let on = |threads| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("a pool");
+            pool.install(|| build::build(&tris))
+        };
+        let (one, three) = (on(1), on(3));
+        assert!(one.0.len() > 1000, "{} nodes: the build has pieces to share out", one.0.len());
+        assert!(one.0 == three.0, "the nodes differ");
+        assert!(one.1 == three.1, "the leaves differ");
+    }
 }

@@ -28,6 +28,7 @@ const FAR_SLACK: f32 = 1.0 + 2.0 * (3.0 * f32::EPSILON / 2.0) / (1.0 - 3.0 * f32
 /// Up to eight children's boxes: rows 0-2 the lower corner's x, y, z, rows 3-5 the upper corner's. The
 /// children are in order of their centres along `axis`, so a ray can open them nearest first.
 #[derive(Clone, Copy, Debug)]
+#[cfg_attr(test, derive(PartialEq))]
 #[repr(C, align(64))]
 pub struct Node8 {
     pub bounds: [[f32; LANES]; 6],
@@ -83,6 +84,7 @@ impl Node8 {
 /// Up to eight triangles, lane by lane: the first vertex, the edges `e1 = v0 - v1` and `e2 = v2 - v0`,
 /// and the normal `e1 x e2`, each as x, y, z rows. A leaf with fewer triangles repeats its last one.
 #[derive(Clone, Copy, Debug)]
+#[cfg_attr(test, derive(PartialEq))]
 #[repr(C, align(64))]
 pub struct Tri8 {
     v0: [[f32; LANES]; 3],
