@@ -133,16 +133,19 @@ pub fn timed<R>(f: impl FnOnce() -> R) -> (R, f64) {
     (r, ms(t.elapsed()))
 }
 
-/// Keeps every thread of rayon's pool busy for `busy`, so a timing on all threads that follows measures
+/// How long [`wake_every_thread`] keeps the threads busy.
+pub const WAKE: Duration = Duration::from_millis(100);
+
+/// Keeps every thread of rayon's pool busy for [`WAKE`], so a timing on all threads that follows measures
 /// the threads and not the waking of a core. Between such timings the other threads idle (while one
 /// thread works alone, say), and on a virtual machine a core that has idled for tens of milliseconds can
 /// run its first tens of milliseconds of work slow: on the 2-core machine this was measured on, the
 /// second thread of a trace that followed one-thread work was busy 40% longer than the rays it traced
 /// took on one thread, and not at all longer when both had been busy just before.
-pub fn wake_every_thread(busy: Duration) {
+pub fn wake_every_thread() {
     let start = Instant::now();
     rayon::broadcast(|_| {
-        while start.elapsed() < busy {
+        while start.elapsed() < WAKE {
             std::hint::spin_loop();
         }
     });

@@ -10,9 +10,7 @@
 use std::hint::black_box;
 use std::path::Path;
 use std::process::Command;
-use std::time::Duration;
 
-use rayon::prelude::*;
 use shadow_core::FrameInputs;
 use shadow_core::scenes::{self, SceneParams};
 use shadow_core::stats::{Summary, timed, wake_every_thread};
@@ -26,8 +24,6 @@ use shadow_hard::RayTraced;
 const RUNS: usize = 5;
 /// BVH builds in a row per run, on each side (`BUILDS` in `embree_rays.py`); the median counts.
 const BUILDS: usize = 3;
-/// How long every thread spins before the rays are traced on all of them ([`wake_every_thread`]).
-const WAKE: Duration = Duration::from_millis(100);
 
 fn main() {
     let folder = std::env::temp_dir().join("shadowlab-rays");
@@ -67,8 +63,8 @@ fn measure(name: &str, folder: &Path, embree: bool) {
         // caches) and keeps the median.
         build.push(median((0..BUILDS).map(|_| timed(|| black_box(SceneBvh::build(&frame))).1).collect()));
         one.push(timed(|| black_box(rays::count_blocked(&bvh, &rays))).1);
-        wake_every_thread(WAKE);
-        all.push(timed(|| black_box(rays.par_chunks(4096).map(|c| rays::count_blocked(&bvh, c)).sum::<usize>())).1);
+        wake_every_thread();
+        all.push(timed(|| black_box(rays::count_blocked_on_every_thread(&bvh, &rays))).1);
         if embree {
             theirs.extend(embree_once(name, folder));
         }

@@ -5,20 +5,18 @@
 
 use std::fmt::Write as _;
 use std::hint::black_box;
-use std::time::Duration;
 
-use rayon::prelude::*;
 use shadow_core::geometry::LightSource;
 use shadow_core::geometry::adjacency::Adjacency;
 use shadow_core::geometry::silhouette::{CastMode, silhouette};
 use shadow_core::geometry::volume::{Caps, extrude};
 use shadow_core::glam::Vec3;
 use shadow_core::procedural;
-use shadow_core::stats::{Summary, timed, wake_every_thread};
+use shadow_core::stats::{self, Summary, timed, wake_every_thread};
 use shadow_core::technique::TechniqueSettings;
 use shadow_cpu::bvh::SceneBvh;
 use shadow_cpu::gbuffer;
-use shadow_cpu::passes::rays::{count_blocked, shadow_rays};
+use shadow_cpu::passes::rays::{count_blocked, count_blocked_on_every_thread, shadow_rays};
 use shadow_hard::RayTraced;
 
 use super::scene_frame;
@@ -26,8 +24,6 @@ use crate::Error;
 
 /// Runs of each timing; the median is reported.
 const RUNS: usize = 11;
-/// How long every thread spins before the rays are traced on all of them.
-const WAKE: Duration = Duration::from_millis(100);
 /// The view the rays are cast over.
 const RAY_VIEW: (u32, u32) = (1024, 768);
 
@@ -83,8 +79,8 @@ pub fn run_kernels(progress: &mut impl FnMut(&str)) -> Result<KernelsReport, Err
         let (mut one, mut all) = (Vec::new(), Vec::new());
         for _ in 0..RUNS {
             one.push(timed(|| black_box(count_blocked(&bvh, &set))).1);
-            wake_every_thread(WAKE);
-            all.push(timed(|| black_box(set.par_chunks(4096).map(|c| count_blocked(&bvh, c)).sum::<usize>())).1);
+            wake_every_thread();
+            all.push(timed(|| black_box(count_blocked_on_every_thread(&bvh, &set))).1);
         }
         let (one, all) = (Summary::of(&one).median, Summary::of(&all).median);
         let rate = |ms: f64| set.len() as f64 / ms / 1e3;
@@ -129,7 +125,7 @@ pub fn markdown(s: &mut String, r: &KernelsReport) {
          `cargo bench -p shadow-hard --bench rays` traces the same rays through Embree beside ours.\n",
         RAY_VIEW.0,
         RAY_VIEW.1,
-        WAKE.as_millis()
+        stats::WAKE.as_millis()
     );
     let _ = writeln!(
         s,

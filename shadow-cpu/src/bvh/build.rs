@@ -425,6 +425,7 @@ impl Built<'_> {
                 }
             }
             Self::Node { axis, kids } => {
+                // A subtree's slice holds its own node first: a parallel node's size counts itself.
                 let (node, mut nodes_rest) = nodes.split_first_mut().expect("a slot for the node");
                 let mut leaves_rest = leaves;
                 node.axis = axis;

@@ -2,6 +2,7 @@
 //! shadow-soft): the scene BVH, built once per frame, and each receiver's ray origin, offset off the
 //! surface by a fraction of the scene's diagonal along the face normal turned towards the viewer.
 
+use rayon::prelude::*;
 use shadow_core::FrameInputs;
 use shadow_core::glam::Vec3;
 use shadow_core::scene::LightKind;
@@ -95,4 +96,10 @@ pub fn shadow_rays(g: &GBuffer, frame: &FrameInputs, epsilon: f32) -> Vec<Shadow
 pub fn count_blocked(bvh: &SceneBvh, rays: &[ShadowRay]) -> usize {
     let mut walker = Walker::default();
     rays.iter().filter(|&&(origin, dir, far)| bvh.occluded_after(&mut walker, origin, dir, far)).count()
+}
+
+/// [`count_blocked`] on every thread, each taking runs of neighbouring rays in turn.
+#[must_use]
+pub fn count_blocked_on_every_thread(bvh: &SceneBvh, rays: &[ShadowRay]) -> usize {
+    rays.par_chunks(4096).map(|run| count_blocked(bvh, run)).sum()
 }
