@@ -6,6 +6,7 @@ mod cli;
 mod depth_layers;
 mod extrusion;
 mod gpu_clock;
+mod head_on;
 mod host;
 mod hybrid;
 mod moment_maps;

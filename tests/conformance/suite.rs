@@ -176,8 +176,10 @@ fn counter_disagreements(spec: &TechniqueSpec, c: &Counters, w: &Counters, why: 
     // Relative tolerances: rasterized counts agree to rounding; silhouette_pixels counts per-pixel
     // depth comparisons, which flip where a corner sample ties the receiver to an ulp.
     // Hybrid counts its volume fragments under a mask made of silhouette pixels: a pixel that ties
-    // one way on one backend brings its whole overdraw along, so twice theirs.
-    let volume_tolerance = if spec.name == "hybrid" { 0.02 } else { 0.001 };
+    // one way on one backend brings its whole overdraw along, so twice theirs, and a few such pixels
+    // on top (on a small mask, as the point light's cube faces of the room give, a handful of tied
+    // pixels is a few percent of the count while the pictures agree exactly).
+    let (volume_tolerance, volume_slack) = if spec.name == "hybrid" { (0.02, 16.0) } else { (0.001, 2.0) };
     // Both backends' caster masks (on unless turned off) count each small caster only where its
     // shadow can be, but they choose the pieces counted that way differently (the CPU by triangles
     // times pixels, the GPU by triangles alone: primitives' sphere is listed on one and drawn through
@@ -186,22 +188,23 @@ fn counter_disagreements(spec: &TechniqueSpec, c: &Counters, w: &Counters, why: 
     // GPU's caster masks to their own whole mask's picture).
     let caster_masks = spec.name == "hybrid" && !spec.values.iter().any(|(k, v)| k == "caster_masks" && v == "off");
     let cpu_fragments = if caster_masks { None } else { c.volume_fragments };
-    for (name, a, b, tolerance) in [
-        ("covered_pixels", c.covered_pixels, w.covered_pixels, 0.001),
-        ("volume_fragments", cpu_fragments, w.volume_fragments, volume_tolerance),
-        ("cap_triangles", extra(c, "cap_triangles"), extra(w, "cap_triangles"), 0.0),
-        ("silhouette_edges", c.silhouette_edges, w.silhouette_edges, 0.0),
-        ("silhouette_pixels", c.silhouette_pixels, w.silhouette_pixels, 0.01),
-        ("silhouette_texels", extra(c, "silhouette_texels"), extra(w, "silhouette_texels"), 0.001),
+    for (name, a, b, tolerance, slack) in [
+        ("covered_pixels", c.covered_pixels, w.covered_pixels, 0.001, 2.0),
+        ("volume_fragments", cpu_fragments, w.volume_fragments, volume_tolerance, volume_slack),
+        ("cap_triangles", extra(c, "cap_triangles"), extra(w, "cap_triangles"), 0.0, 2.0),
+        ("silhouette_edges", c.silhouette_edges, w.silhouette_edges, 0.0, 2.0),
+        ("silhouette_pixels", c.silhouette_pixels, w.silhouette_pixels, 0.01, 2.0),
+        ("silhouette_texels", extra(c, "silhouette_texels"), extra(w, "silhouette_texels"), 0.001, 2.0),
         (
             "unmasked_volume_fragments",
             extra(c, "unmasked_volume_fragments"),
             extra(w, "unmasked_volume_fragments"),
             0.001,
+            2.0,
         ),
     ] {
         if let (Some(a), Some(b)) = (a, b) {
-            if (a as f64 - b as f64).abs() > tolerance * a.max(b) as f64 + 2.0 {
+            if (a as f64 - b as f64).abs() > tolerance * a.max(b) as f64 + slack {
                 why.push(format!("{name}: cpu {a}, wgpu {b}"));
             }
         } else if a.is_some() != b.is_some() && name == "covered_pixels" {

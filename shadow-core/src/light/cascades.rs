@@ -183,7 +183,7 @@ impl LightView {
         let light_from_world = look_to_mat4(Vec3::ZERO, dir, safe_up(dir));
         let scene = bounds.transformed(light_from_world);
         let pad = (scene.max.z - scene.min.z) * 0.01 + 1e-4;
-        let (z_near, z_far) = (-scene.max.z - pad, -scene.min.z + pad);
+        let (z_near, z_far) = super::orthographic_range(-scene.max.z - pad, -scene.min.z + pad);
         let tan_y = (camera.fov_y * 0.5).tan();
         let tan_x = tan_y * aspect;
         let res = fit.resolution.max(4) as f32;
@@ -294,9 +294,11 @@ mod tests {
             let p = &v.projections[1];
             // The world origin's map coordinates in texels, and the texel size in world units.
             let (uv, _) = p.uv_depth(Vec3::ZERO);
-            let size = (p.world_from_uv_depth(glam::Vec2::new(1.0 / 2048.0, 0.0), 0.5)
-                - p.world_from_uv_depth(glam::Vec2::ZERO, 0.5))
-            .length();
+            // Measured across the whole map, so the rounding of the two world points is a 2048th of it.
+            let size = (p.world_from_uv_depth(glam::Vec2::new(1.0, 0.0), 0.75)
+                - p.world_from_uv_depth(glam::Vec2::ZERO, 0.75))
+            .length()
+                / 2048.0;
             (uv * 2048.0, size)
         };
         let camera = Camera::look_at(Vec3::new(3.0, 1.7, 40.0), Vec3::new(-20.0, 1.0, -60.0), 60.0);

@@ -181,8 +181,9 @@ pub fn focused_uniform(direction: Vec3, body: &[Vec3], bounds: &Aabb) -> LightPr
     let (y0, y1) = padded_range(range(points.iter().map(|p| p.y)));
     let scene = bounds.transformed(light_from_world);
     let (z_lo, z_hi) = padded_range((scene.min.z, scene.max.z));
-    let proj = directx::orthographic(x0, x1, y0, y1, -z_hi, -z_lo);
-    LightProjection::new(light_from_world, proj, -z_hi, -z_lo, true)
+    let (near, far) = super::orthographic_range(-z_hi, -z_lo);
+    let proj = directx::orthographic(x0, x1, y0, y1, near, far);
+    LightProjection::new(light_from_world, proj, near, far, true)
 }
 
 /// The points transformed by `m`.

@@ -173,6 +173,23 @@ pub fn cube_face(d: Vec3) -> usize {
     }
 }
 
+/// The near and far planes of an orthographic view whose casters lie between distances `lo` and `hi`
+/// along the light (padded already): the casters fill the far half of the depth range, [0.5, 1].
+///
+/// The map's constant bias is counted in f32 steps of the depth it offsets (Vulkan's rule, DESIGN 4), but
+/// a depth is computed as a sum of terms, `clip_from_world`'s row times the world point, which are as
+/// large as the point's offset along the light over the depth range. In a range fitted tight, a caster
+/// on the near side (a roof or a card squarely facing an overhead sun) has a depth near 0 whose f32 step
+/// is a hundred times finer than the rounding of those terms: its receivers' depths then come out
+/// rounded above its stored depth in bands across it, and nothing else covers that, since a surface
+/// facing the light has no depth slope and so no slope bias. On [0.5, 1] every depth has the same f32
+/// step, that of the terms for a scene whose extent along the light reaches the origin, so the four
+/// steps of the default constant bias settle those ties everywhere. The price is one bit of depth
+/// resolution, far below any bias.
+pub(crate) fn orthographic_range(lo: f32, hi: f32) -> (f32, f32) {
+    (lo - (hi - lo), hi)
+}
+
 fn safe_up(dir: Vec3) -> Vec3 {
     if dir.cross(Vec3::Y).length_squared() < 1e-6 { Vec3::Z } else { Vec3::Y }
 }
@@ -228,7 +245,7 @@ impl LightView {
                 let mid = in_view.center().xy();
                 let (near, far) = (-in_view.max.z, -in_view.min.z);
                 let pad = (far - near) * 0.01 + 1e-4;
-                let (near, far) = (near - pad, far + pad);
+                let (near, far) = orthographic_range(near - pad, far + pad);
                 let proj = directx::orthographic(mid.x - half, mid.x + half, mid.y - half, mid.y + half, near, far);
                 vec![LightProjection::new(view, proj, near, far, true)]
             }

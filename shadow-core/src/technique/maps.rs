@@ -20,7 +20,7 @@ pub const BIAS: SettingKey = SettingKey::choice(
 /// `bias_constant`: Vulkan's constant depth-bias factor.
 pub const BIAS_CONSTANT: SettingKey = SettingKey::float(
     "bias_constant",
-    "4",
+    "16",
     0.0,
     1e9,
     "constant bias factor, in units of the f32 depth resolution at the primitive",
@@ -68,11 +68,14 @@ pub struct DepthMap {
     pub resolution: u32,
     /// Bias mode.
     pub bias: BiasMode,
-    /// Vulkan constant depth-bias factor. The default, 4 (four f32 ulps at the primitive's depth), is the
-    /// smallest that settles ties on surfaces squarely facing the light: there the stored and the looked-up
-    /// depths are equal up to rounding, and at 1 the GPU's interpolated positions lost the tie on a
-    /// table top seen through a cube face (0.5% acne on lavapipe, none on the CPU); 4 to 64 changed no
-    /// other error.
+    /// Vulkan constant depth-bias factor. The default, 16 (sixteen f32 steps of the primitive's depth),
+    /// settles the ties on surfaces squarely facing the light, which have no depth slope for the slope
+    /// term to cover: there the stored and the looked-up depths are equal up to rounding, and the GPU's
+    /// looked-up depth comes from a world position interpolated across the receiving triangle, a few
+    /// steps off along its diagonal. At 8 a card facing an axis-aligned sun still showed a line of false
+    /// shadow along its wall's diagonal on lavapipe, at 4 lines across 0.8% of it (the CPU was exact at
+    /// 4). Sixteen steps of a depth in [0.5, 1] are 1e-6 of the light's depth range, far below a texel's
+    /// slope bias.
     pub bias_constant: f32,
     /// Vulkan slope depth-bias factor.
     pub bias_slope: f32,

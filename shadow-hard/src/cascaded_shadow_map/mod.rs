@@ -148,7 +148,7 @@ mod tests {
     fn defaults_parse_and_print() {
         assert_eq!(
             CascadedShadowMap::defaults().settings_string(),
-            "res=2048,bias=slope,bias_constant=4,bias_slope=2,bias_world=0.05,filter=none,filter_radius=1.5,\
+            "res=2048,bias=slope,bias_constant=16,bias_slope=2,bias_world=0.05,filter=none,filter_radius=1.5,\
              cascades=4,lambda=0.75,blend=0.1,stabilize=snapped,distance=0"
         );
     }

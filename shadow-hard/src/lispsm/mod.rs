@@ -84,7 +84,7 @@ mod tests {
     fn defaults_parse_and_print() {
         assert_eq!(
             Lispsm::defaults().settings_string(),
-            "res=4096,bias=slope,bias_constant=4,bias_slope=4,bias_world=0.05,filter=none,filter_radius=1.5,n=0"
+            "res=4096,bias=slope,bias_constant=16,bias_slope=4,bias_world=0.05,filter=none,filter_radius=1.5,n=0"
         );
     }
 }

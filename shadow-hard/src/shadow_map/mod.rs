@@ -84,7 +84,7 @@ mod tests {
     fn defaults_parse_and_print() {
         assert_eq!(
             ShadowMap::defaults().settings_string(),
-            "res=2048,bias=slope,bias_constant=4,bias_slope=2,filter=none,filter_radius=1.5,bias_world=0.05"
+            "res=2048,bias=slope,bias_constant=16,bias_slope=2,filter=none,filter_radius=1.5,bias_world=0.05"
         );
     }
 

@@ -111,7 +111,7 @@ mod tests {
     fn defaults_parse_and_print() {
         assert_eq!(
             SilhouetteMap::defaults().settings_string(),
-            "res=1024,bias=slope,bias_constant=4,bias_slope=2,bias_world=0.05,corner_margin=0.01,\
+            "res=1024,bias=slope,bias_constant=16,bias_slope=2,bias_world=0.05,corner_margin=0.01,\
              corner_depth=receiver-plane,keep=nearest,cascades=0"
         );
     }

@@ -76,25 +76,42 @@ fn hom(p: Vec4) -> Vec3 {
     p.truncate() / p.w
 }
 
-/// Whether segment a-b crosses triangle t (Moller-Trumbore on the divided points).
-fn crosses(a: Vec3, b: Vec3, t: &HomTriangle) -> bool {
+/// Where segment a-b crosses triangle t (Moller-Trumbore on the divided points): the smallest of the
+/// crossing's barycentric coordinates, its distance from the triangle's border.
+fn crossing(a: Vec3, b: Vec3, t: &HomTriangle) -> Option<f32> {
     let (p0, p1, p2) = (hom(t[0]), hom(t[1]), hom(t[2]));
     let (e1, e2, d) = (p1 - p0, p2 - p0, b - a);
     let h = d.cross(e2);
     let det = e1.dot(h);
     if det.abs() < 1e-12 {
-        return false;
+        return None;
     }
     let s = a - p0;
     let u = s.dot(h) / det;
     let q = s.cross(e1);
     let v = d.dot(q) / det;
     let t = e2.dot(q) / det;
-    u >= 0.0 && v >= 0.0 && u + v <= 1.0 && t > 0.0 && t < 1.0
+    let border = u.min(v).min(1.0 - u - v);
+    (border >= 0.0 && t > 0.0 && t < 1.0).then_some(border)
 }
 
-fn parity(a: Vec3, b: Vec3, tris: &[HomTriangle]) -> bool {
-    tris.iter().filter(|t| crosses(a, b, t)).count() % 2 == 1
+fn crosses(a: Vec3, b: Vec3, t: &HomTriangle) -> bool {
+    crossing(a, b, t).is_some()
+}
+
+/// The parity of segment a-b's crossings of `tris`, or `None` where the segment passes within rounding
+/// of a triangle's border: there the two triangles sharing that edge both count it under this inclusive
+/// test, where the stencil's rasterization rule counts it once.
+fn parity(a: Vec3, b: Vec3, tris: &[HomTriangle]) -> Option<bool> {
+    let mut count = 0;
+    for t in tris {
+        match crossing(a, b, t) {
+            Some(border) if border < 1e-4 => return None,
+            Some(_) => count += 1,
+            None => {}
+        }
+    }
+    Some(count % 2 == 1)
 }
 
 /// Ground points on a grid, away from the shadow's edge by more than `band` (in world units).
@@ -251,8 +268,16 @@ fn parity_of_the_reconstructed_boundary_is_the_shadow() {
         let eye = Vec3::new(2.5, 3.0, 3.0);
         let texel = 4.2 / N as f32;
         let pts: Vec<Vec3> = ground_points(s.dir, 2.0 * texel).into_iter().filter(|&q| visible(eye, q)).collect();
-        let wrong = pts.iter().filter(|&&q| parity(eye, q, &rec.triangles) != shadowed(s.dir, q)).count();
-        assert_eq!(wrong, 0, "{wrong} of {} ground points (texel squares: {texel_squares})", pts.len());
+        let parities: Vec<(Vec3, bool)> =
+            pts.iter().filter_map(|&q| parity(eye, q, &rec.triangles).map(|p| (q, p))).collect();
+        assert!(
+            parities.len() * 100 > pts.len() * 99,
+            "{} of {} points on a border",
+            pts.len() - parities.len(),
+            pts.len()
+        );
+        let wrong = parities.iter().filter(|&&(q, p)| p != shadowed(s.dir, q)).count();
+        assert_eq!(wrong, 0, "{wrong} of {} ground points (texel squares: {texel_squares})", parities.len());
         assert!(pts.iter().filter(|&&q| shadowed(s.dir, q)).count() > 100);
     }
 }
@@ -296,7 +321,7 @@ fn cap_restores_parity(s: &Setup, texel_squares: bool) {
     let (mut uncapped, mut capped) = (0, 0);
     for &q in &pts {
         let f = near_point(q);
-        let p = parity(f, q, &rec.triangles);
+        let Some(p) = parity(f, q, &rec.triangles) else { continue };
         uncapped += usize::from(p != shadowed(s.dir, q));
         capped += usize::from((p != in_cap(f)) != shadowed(s.dir, q));
     }
