@@ -196,7 +196,7 @@ impl SceneSetup {
     /// # Errors
     /// Unknown scene, bad model file, or bad overrides.
     pub fn build(&self) -> Result<Scene, SetupError> {
-        let options = LoadOptions { file_access: self.file_access };
+        let options = LoadOptions { file_access: self.file_access, ..LoadOptions::default() };
         let mut scene = load_scene_with(&self.source, &self.params, self.ground, &options)?;
         if let Some(c) = &self.camera {
             let cam = parse_camera(c)?;

@@ -2,6 +2,7 @@
 
 use crate::bounds::Aabb;
 use crate::frame::FrameInputs;
+use crate::material::AlphaMode;
 use crate::scene::Scene;
 
 /// What `inspect` reports. Counts are after welding coincident positions, summed over drawn instances.
@@ -25,6 +26,40 @@ pub struct Inspection {
     pub bounds: Aabb,
     /// Silhouette edges of the casting instances from the scene's first light, `None` without a light.
     pub silhouette_edges: Option<usize>,
+    /// The scene's textures: name, level-0 size and bytes with the mip chain, in the order they were added.
+    pub textures: Vec<TextureStats>,
+    /// The scene's materials, in the order they were added.
+    pub materials: Vec<MaterialStats>,
+    /// Meshes drawn, each counted once however many instances draw it.
+    pub meshes: usize,
+    /// Of those, the meshes that carry texture coordinates.
+    pub meshes_with_uvs: usize,
+}
+
+/// One material as `inspect` reports it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MaterialStats {
+    /// Its name.
+    pub name: String,
+    /// How its alpha decides coverage.
+    pub alpha_mode: AlphaMode,
+    /// Whether both sides are drawn and lit.
+    pub double_sided: bool,
+    /// Its base-colour texture, as an index into [`Inspection::textures`].
+    pub texture: Option<usize>,
+}
+
+/// One texture as `inspect` reports it.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct TextureStats {
+    /// The image's name (its file, or where in the model it was).
+    pub name: String,
+    /// Level-0 width.
+    pub width: u32,
+    /// Level-0 height.
+    pub height: u32,
+    /// Bytes held, every level.
+    pub bytes: usize,
 }
 
 impl Inspection {
@@ -41,7 +76,37 @@ impl Inspection {
             inconsistent_edges: 0,
             bounds: scene.bounds(),
             silhouette_edges: None,
+            textures: Vec::new(),
+            materials: Vec::new(),
+            meshes: 0,
+            meshes_with_uvs: 0,
         };
+        let mut texture_index = std::collections::HashMap::new();
+        for (key, t) in scene.textures() {
+            texture_index.insert(key, out.textures.len());
+            out.textures.push(TextureStats {
+                name: t.name().to_string(),
+                width: t.width(),
+                height: t.height(),
+                bytes: t.memory_bytes(),
+            });
+        }
+        out.materials = scene
+            .materials()
+            .map(|(_, m)| MaterialStats {
+                name: m.name.clone(),
+                alpha_mode: m.alpha_mode,
+                double_sided: m.two_sided,
+                texture: m.base_color_texture.and_then(|r| texture_index.get(&r.texture).copied()),
+            })
+            .collect();
+        let mut seen = std::collections::HashSet::new();
+        for (_, _, mesh, _) in scene.drawables() {
+            if seen.insert(mesh) {
+                out.meshes += 1;
+                out.meshes_with_uvs += usize::from(scene.mesh(mesh).is_some_and(|m| m.uvs().is_some()));
+            }
+        }
         for (_, _, mesh, _) in scene.drawables() {
             let (Some(m), Some(adj)) = (scene.mesh(mesh), scene.adjacency(mesh)) else { continue };
             out.triangles += m.triangle_count();

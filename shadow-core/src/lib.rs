@@ -17,6 +17,7 @@ pub mod image;
 pub mod inspect;
 pub mod light;
 pub mod lookup;
+pub mod material;
 pub mod mesh;
 pub mod metrics;
 pub mod procedural;
@@ -35,5 +36,6 @@ pub use light::LightView;
 pub use mesh::{Mesh, MeshError};
 pub use scene::{
     Camera, CameraKey, Light, LightKey, LightKind, LightShadow, Material, MaterialKey, MeshKey, Node, NodeKey, Scene,
+    TextureKey,
 };
 pub mod shading;

@@ -1,11 +1,12 @@
-//! Triangle meshes: positions, per-vertex shading normals and counter-clockwise triangles.
+//! Triangle meshes: positions, per-vertex shading normals, optional texture coordinates and
+//! counter-clockwise triangles.
 //!
 //! A [`Mesh`] is valid by construction: every index is in range, every position and normal is finite,
 //! every coordinate within [`MAX_COORDINATE`], and at least one triangle has an area. Loaders and builders
 //! go through [`Mesh::new`] or [`Mesh::with_normals`], so no backend ever sees a mesh that would rasterize
 //! garbage.
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 use crate::bounds::Aabb;
 
@@ -35,7 +36,7 @@ pub enum MeshError {
     NonFinite {
         /// Vertex number.
         vertex: usize,
-        /// "position" or "normal".
+        /// "position", "normal" or "texture coordinate".
         what: &'static str,
         /// The offending value, printed.
         value: String,
@@ -59,16 +60,26 @@ pub enum MeshError {
         /// Number of positions.
         positions: usize,
     },
+    /// Texture coordinates given, but not one per vertex.
+    #[error("{uvs} texture coordinates for {positions} positions")]
+    UvCount {
+        /// Number of texture coordinates.
+        uvs: usize,
+        /// Number of positions.
+        positions: usize,
+    },
     /// More vertices than a `u32` index can name.
     #[error("{0} vertices is more than 32-bit indices can address")]
     TooManyVertices(usize),
 }
 
-/// An indexed triangle mesh with per-vertex normals. Front faces wind counter-clockwise.
+/// An indexed triangle mesh with per-vertex normals and, for textured materials, texture coordinates.
+/// Front faces wind counter-clockwise.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Mesh {
     positions: Vec<Vec3>,
     normals: Vec<Vec3>,
+    uvs: Option<Vec<Vec2>>,
     triangles: Vec<[u32; 3]>,
     /// The positions' bounds, kept with them: a frame reads them once per instance of the mesh.
     bounds: Aabb,
@@ -83,7 +94,7 @@ impl Mesh {
         Self::check(&positions, &triangles)?;
         let normals = vertex_normals(&positions, &triangles);
         let bounds = Aabb::from_points(positions.iter().copied());
-        Ok(Self { positions, normals, triangles, bounds })
+        Ok(Self { positions, normals, uvs: None, triangles, bounds })
     }
 
     /// A mesh with the given shading normals (normalized here; zero normals are replaced by computed ones).
@@ -101,7 +112,24 @@ impl Mesh {
         let computed = vertex_normals(&positions, &triangles);
         let normals = normals.iter().zip(&computed).map(|(n, c)| n.try_normalize().unwrap_or(*c)).collect();
         let bounds = Aabb::from_points(positions.iter().copied());
-        Ok(Self { positions, normals, triangles, bounds })
+        Ok(Self { positions, normals, uvs: None, triangles, bounds })
+    }
+
+    /// The mesh with texture coordinates, one per vertex (glTF's `TEXCOORD_n`: u to the right, v down
+    /// the image from its top).
+    ///
+    /// # Errors
+    /// [`MeshError::UvCount`] when there is not one per vertex, [`MeshError::NonFinite`] for NaN or
+    /// infinity.
+    pub fn with_uvs(mut self, uvs: Vec<Vec2>) -> Result<Self, MeshError> {
+        if uvs.len() != self.positions.len() {
+            return Err(MeshError::UvCount { uvs: uvs.len(), positions: self.positions.len() });
+        }
+        if let Some((vertex, uv)) = uvs.iter().enumerate().find(|(_, uv)| !uv.is_finite()) {
+            return Err(MeshError::NonFinite { vertex, what: "texture coordinate", value: format!("{uv}") });
+        }
+        self.uvs = Some(uvs);
+        Ok(self)
     }
 
     fn check(positions: &[Vec3], triangles: &[[u32; 3]]) -> Result<(), MeshError> {
@@ -141,6 +169,12 @@ impl Mesh {
         &self.normals
     }
 
+    /// Texture coordinates, one per vertex, where the mesh has them.
+    #[must_use]
+    pub fn uvs(&self) -> Option<&[Vec2]> {
+        self.uvs.as_deref()
+    }
+
     /// Triangles as vertex indices, counter-clockwise seen from the front.
     #[must_use]
     pub fn triangles(&self) -> &[[u32; 3]] {
@@ -176,6 +210,7 @@ impl Mesh {
             bounds: Aabb::from_points(positions.iter().copied()),
             positions,
             normals: self.normals.iter().map(|&n| (normal_m * n).normalize_or_zero()).collect(),
+            uvs: self.uvs.clone(),
             triangles: if mirror {
                 self.triangles.iter().map(|&[a, b, c]| [a, c, b]).collect()
             } else {
@@ -184,7 +219,8 @@ impl Mesh {
         }
     }
 
-    /// Appends another mesh's vertices and triangles.
+    /// Appends another mesh's vertices and triangles. Where only one of the two has texture
+    /// coordinates, the other's vertices get (0, 0).
     ///
     /// # Errors
     /// [`MeshError::TooManyVertices`] when the two together have more vertices than 32-bit indices can
@@ -193,6 +229,14 @@ impl Mesh {
         let base = appended_base(self.positions.len(), other.positions.len())?;
         self.positions.extend_from_slice(&other.positions);
         self.normals.extend_from_slice(&other.normals);
+        if self.uvs.is_some() || other.uvs.is_some() {
+            let (have, more) = (self.positions.len() - other.positions.len(), other.positions.len());
+            let uvs = self.uvs.get_or_insert_with(|| vec![Vec2::ZERO; have]);
+            match &other.uvs {
+                Some(o) => uvs.extend_from_slice(o),
+                None => uvs.resize(have + more, Vec2::ZERO),
+            }
+        }
         self.triangles.extend(other.triangles.iter().map(|t| t.map(|i| i + base)));
         self.bounds = self.bounds.union(other.bounds);
         Ok(())

@@ -87,7 +87,7 @@ fn gltf_buffers_stay_inside_the_model_folder() {
     }
 
     // Wider access is the user's choice: then `..` and absolute paths resolve, but a device still does not.
-    let wide = LoadOptions { file_access: FileAccess::Anywhere };
+    let wide = LoadOptions { file_access: FileAccess::Anywhere, ..LoadOptions::default() };
     let parent = dir.join("model/parent.gltf");
     assert_eq!(assets::load_with(&parent, &wide).expect("wide access loads ../").triangle_count(), 1);
     let device = dir.join("model/device.gltf");
@@ -138,7 +138,7 @@ fn obj_material_libraries_follow_the_same_rules() {
     assert_eq!(colour(&outside, &default), Vec3::splat(0.8), "a library outside the folder was read");
     let absolute = write(&dir.join("model/absolute.obj"), obj(&dir.join("outside.mtl").display().to_string()));
     assert_eq!(colour(&absolute, &default), Vec3::splat(0.8), "an absolute library path was read");
-    let wide = LoadOptions { file_access: FileAccess::Anywhere };
+    let wide = LoadOptions { file_access: FileAccess::Anywhere, ..LoadOptions::default() };
     assert_eq!(colour(&outside, &wide), Vec3::new(0.9, 0.1, 0.1));
 }
 

@@ -112,6 +112,7 @@ fn bad_inputs_give_one_line_and_the_right_status() {
             "not implemented on the wgpu backend",
         ),
         (&["export", "--scene", "cylinder", "-o", "/no/such/dir/x.glb"], 1, "cannot write /no/such/dir/x.glb"),
+        (&["export", "--scene", "cylinder", "-o", "cylinder.obj"], 2, "expected a .glb or .gltf file"),
     ];
     for (args, status, words) in cases {
         let (code, _, err) = shadowlab(args);
@@ -302,4 +303,73 @@ fn view_without_a_display_says_how_to_get_one() {
     assert_eq!(out.status.code(), Some(1), "{err}");
     assert_eq!(err.lines().count(), 1, "{err}");
     assert!(err.contains("no display") && err.contains("xvfb-run"), "{err}");
+}
+
+/// A 256-texel checkerboard card, masked at 0.5, written by `export` as `card.gltf` with `card.bin` and
+/// the image `card-0.png` beside it in `dir`.
+fn write_checkerboard_card(dir: &Path) -> std::path::PathBuf {
+    use glam::{Mat4, Vec2, Vec3};
+    use shadow_core::material::{AlphaMode, Filter, Sampler, Texture, TextureRef, UvTransform};
+    let texels =
+        (0..256 * 256).map(|i| if (i % 256 / 32 + i / 256 / 32) % 2 == 0 { [255; 4] } else { [0; 4] }).collect();
+    let mut scene = shadow_core::Scene::new();
+    let texture = scene.add_texture(Texture::from_rgba8("checker", 256, 256, texels).expect("a texture"));
+    let sampler = Sampler { mag: Filter::Nearest, ..Sampler::default() };
+    let material = scene.add_material(shadow_core::Material {
+        base_color_texture: Some(TextureRef { texture, sampler, transform: UvTransform::IDENTITY }),
+        alpha_mode: AlphaMode::Mask { cutoff: 0.5 },
+        two_sided: true,
+        ..shadow_core::Material::colored("checker", Vec3::ONE)
+    });
+    let corners = vec![
+        Vec3::new(-1.0, 0.0, 1.0),
+        Vec3::new(1.0, 0.0, 1.0),
+        Vec3::new(1.0, 0.0, -1.0),
+        Vec3::new(-1.0, 0.0, -1.0),
+    ];
+    let uvs = vec![Vec2::new(0.0, 1.0), Vec2::ONE, Vec2::new(1.0, 0.0), Vec2::ZERO];
+    let card =
+        shadow_core::Mesh::new(corners, vec![[0, 1, 2], [0, 2, 3]]).and_then(|m| m.with_uvs(uvs)).expect("a card");
+    let mesh = scene.add_mesh(card);
+    scene.add_instance("card", mesh, material, Mat4::IDENTITY).expect("an instance");
+    let path = dir.join("card.gltf");
+    shadow_core::assets::export::export(&scene, &path).expect("export");
+    path
+}
+
+#[test]
+fn inspect_lists_a_textured_cards_material_and_texture_and_names_a_bad_image() {
+    let dir = std::env::temp_dir().join(format!("shadowlab-cli-card-{}", std::process::id()));
+    let model = dir.join("model");
+    std::fs::create_dir_all(&model).unwrap();
+    let card = write_checkerboard_card(&model);
+    let card = card.to_str().unwrap();
+    let (code, out, err) = shadowlab(&["inspect", card, "--json"]);
+    assert_eq!((code, err.as_str()), (0, ""));
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let material = &v["materials"][0];
+    assert_eq!((&material["name"], &material["alpha_mode"]), (&"checker".into(), &"MASK".into()), "{v}");
+    assert_eq!((&material["alpha_cutoff"], &material["double_sided"]), (&0.5.into(), &true.into()), "{v}");
+    let texture = &v["textures"][material["base_color_texture"].as_u64().expect("a texture") as usize];
+    assert_eq!((&texture["width"], &texture["height"]), (&256.into(), &256.into()), "{v}");
+    assert_eq!(texture["bytes_with_mips"], 349_524, "{v}");
+    assert_eq!(v["meshes_with_texture_coordinates"], 1);
+    // Without its image the card still loads, untextured, with one warning naming model, material and image.
+    std::fs::rename(model.join("card-0.png"), dir.join("card-0.png")).unwrap();
+    let (code, out, err) = shadowlab(&["inspect", card]);
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("textures            0"), "{out}");
+    let lines: Vec<&str> = err.lines().collect();
+    assert_eq!(lines.len(), 1, "{err}");
+    assert!(lines[0].contains(card) && lines[0].contains("'card-0.png'") && lines[0].contains("material 'checker'"));
+    // Named outside the model's folder, it is refused, in one line naming the model and the path.
+    let text = std::fs::read_to_string(card).unwrap().replace("\"card-0.png\"", "\"../card-0.png\"");
+    std::fs::write(card, text).unwrap();
+    let (code, _, err) = shadowlab(&["inspect", card]);
+    assert_eq!(code, 1, "{err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(err.contains(card) && err.contains("'../card-0.png'"), "{err}");
+    let (code, _, err) = shadowlab(&["inspect", card, "--allow-outside-files"]);
+    assert_eq!((code, err.as_str()), (0, ""));
+    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -1,6 +1,9 @@
-//! Writing a scene as binary glTF (.glb): every drawn mesh (shared meshes written once), its material's
-//! base colour and sidedness, the node hierarchy flattened to world matrices, the cameras and the lights
-//! (KHR_lights_punctual), so it opens in Blender or any glTF viewer and loads back through [`super::load`].
+//! Writing a scene as glTF 2.0, binary (.glb) or JSON (.gltf with its buffer and images beside it):
+//! every drawn mesh (shared meshes written once) with its texture coordinates, its material's base colour
+//! and alpha, base-colour texture (level 0 as a PNG, with its sampler and `KHR_texture_transform`),
+//! alpha mode and cutoff and sidedness, the node hierarchy flattened to world matrices, the cameras and
+//! the lights (KHR_lights_punctual), so it opens in Blender or any glTF viewer and loads back through
+//! [`super::load`] with the same texels.
 
 use std::collections::HashMap;
 use std::io::Write;
@@ -9,8 +12,9 @@ use std::path::Path;
 use glam::{Mat4, Quat, Vec3};
 use serde_json::{Value, json};
 
+use crate::material::{AlphaMode, Filter, Sampler, TextureRef, Wrap};
 use crate::mesh::Mesh;
-use crate::scene::{Light, LightKind, Material, MeshKey, Scene};
+use crate::scene::{Light, LightKind, Material, MeshKey, Scene, TextureKey};
 use crate::shading;
 
 /// Why a scene could not be written.
@@ -44,17 +48,46 @@ fn pad4(v: &mut Vec<u8>, byte: u8) {
     }
 }
 
-/// The GLB bytes of a scene.
+/// A scene as glTF, before its buffer and images are placed: the document, the binary buffer, and each
+/// image's PNG bytes in the order of the document's `images`.
+struct Document {
+    doc: Value,
+    bin: Vec<u8>,
+    pngs: Vec<Vec<u8>>,
+}
+
+/// The GLB bytes of a scene: its images in the binary chunk after the meshes.
 #[must_use]
 pub fn glb_bytes(scene: &Scene) -> Vec<u8> {
+    let Document { mut doc, mut bin, pngs } = document(scene);
+    for (i, png) in pngs.iter().enumerate() {
+        pad4(&mut bin, 0);
+        let views = doc["bufferViews"].as_array_mut().expect("the document has buffer views");
+        views.push(json!({"buffer": 0, "byteOffset": bin.len(), "byteLength": png.len()}));
+        doc["images"][i]["bufferView"] = json!(views.len() - 1);
+        doc["images"][i]["mimeType"] = json!("image/png");
+        bin.extend_from_slice(png);
+    }
+    pad4(&mut bin, 0);
+    doc["buffers"] = json!([{"byteLength": bin.len()}]);
+    glb_container(doc.to_string().into_bytes(), &bin)
+}
+
+fn document(scene: &Scene) -> Document {
     let mut parts = MeshParts::default();
     let mut nodes = vec![];
     let mut mesh_index: HashMap<(MeshKey, String), usize> = HashMap::new();
     for (_, node, mesh_key, material) in scene.drawables() {
         let Some(mesh) = scene.mesh(mesh_key) else { continue };
-        let mi = *mesh_index.entry((mesh_key, material.name.clone())).or_insert_with(|| parts.mesh(mesh, material));
+        let mi =
+            *mesh_index.entry((mesh_key, material.name.clone())).or_insert_with(|| parts.mesh(scene, mesh, material));
         let m: Mat4 = node.world_transform();
-        nodes.push(json!({"name": node.name(), "mesh": mi, "matrix": m.to_cols_array()}));
+        let mut n = json!({"name": node.name(), "mesh": mi});
+        // glTF asks that the identity be left out rather than written.
+        if m != Mat4::IDENTITY {
+            n["matrix"] = json!(m.to_cols_array());
+        }
+        nodes.push(n);
     }
     let mut cameras = vec![];
     for (_, c) in scene.cameras() {
@@ -77,8 +110,8 @@ pub fn glb_bytes(scene: &Scene) -> Vec<u8> {
         }
         nodes.push(n);
     }
-    let MeshParts { mut bin, views, accessors, meshes, materials } = parts;
-    pad4(&mut bin, 0);
+    let MeshParts { bin, views, accessors, meshes, materials, images, textures, samplers, transformed, pngs, .. } =
+        parts;
     let mut doc = json!({
         "asset": {"version": "2.0", "generator": "shadowlab"},
         "scene": 0,
@@ -88,18 +121,29 @@ pub fn glb_bytes(scene: &Scene) -> Vec<u8> {
         "materials": materials,
         "accessors": accessors,
         "bufferViews": views,
-        "buffers": [{"byteLength": bin.len()}],
     });
     if let Some(o) = doc.as_object_mut() {
         if !cameras.is_empty() {
             o.insert("cameras".into(), json!(cameras));
         }
+        if !images.is_empty() {
+            o.insert("images".into(), json!(images));
+            o.insert("textures".into(), json!(textures));
+            o.insert("samplers".into(), json!(samplers));
+        }
+        let mut used = vec![];
         if !lights.is_empty() {
-            o.insert("extensionsUsed".into(), json!(["KHR_lights_punctual"]));
+            used.push("KHR_lights_punctual");
             o.insert("extensions".into(), json!({"KHR_lights_punctual": {"lights": lights}}));
         }
+        if transformed {
+            used.push("KHR_texture_transform");
+        }
+        if !used.is_empty() {
+            o.insert("extensionsUsed".into(), json!(used));
+        }
     }
-    glb_container(doc.to_string().into_bytes(), &bin)
+    Document { doc, bin, pngs }
 }
 
 /// The binary buffer and the glTF arrays describing the meshes written into it.
@@ -110,6 +154,17 @@ struct MeshParts {
     accessors: Vec<Value>,
     meshes: Vec<Value>,
     materials: Vec<Value>,
+    images: Vec<Value>,
+    textures: Vec<Value>,
+    samplers: Vec<Value>,
+    /// The PNG bytes of each image.
+    pngs: Vec<Vec<u8>>,
+    /// Image indices of the scene textures written so far.
+    image_index: HashMap<TextureKey, usize>,
+    /// Texture indices by image and sampler.
+    texture_index: HashMap<(usize, Sampler), usize>,
+    /// Some texture reference has a coordinate transform.
+    transformed: bool,
 }
 
 impl MeshParts {
@@ -121,8 +176,9 @@ impl MeshParts {
         self.views.len() - 1
     }
 
-    /// Writes a mesh with its material (positions, normals, indices, one primitive); returns its index.
-    fn mesh(&mut self, mesh: &Mesh, material: &Material) -> usize {
+    /// Writes a mesh with its material (positions, normals, texture coordinates, indices, one
+    /// primitive); returns its index.
+    fn mesh(&mut self, scene: &Scene, mesh: &Mesh, material: &Material) -> usize {
         let b = mesh.bounds();
         let idx: Vec<u32> = mesh.triangles().iter().flatten().copied().collect();
         let pv = self.view(bytemuck::cast_slice(mesh.positions()), 34962);
@@ -132,15 +188,97 @@ impl MeshParts {
         self.accessors.push(json!({"bufferView": pv, "componentType": 5126, "count": n, "type": "VEC3", "min": b.min.to_array(), "max": b.max.to_array()}));
         self.accessors.push(json!({"bufferView": nv, "componentType": 5126, "count": n, "type": "VEC3"}));
         self.accessors.push(json!({"bufferView": iv, "componentType": 5125, "count": idx.len(), "type": "SCALAR"}));
-        self.materials.push(json!({
-            "name": material.name,
-            "pbrMetallicRoughness": {"baseColorFactor": [material.base_color.x, material.base_color.y, material.base_color.z, 1.0], "metallicFactor": 0.0},
-            "doubleSided": material.two_sided,
-        }));
-        let a = self.accessors.len();
-        self.meshes.push(json!({"primitives": [{"attributes": {"POSITION": a - 3, "NORMAL": a - 2}, "indices": a - 1, "material": self.materials.len() - 1}]}));
+        let (position, normal, indices) =
+            (self.accessors.len() - 3, self.accessors.len() - 2, self.accessors.len() - 1);
+        let mut attributes = json!({"POSITION": position, "NORMAL": normal});
+        if let Some(uvs) = mesh.uvs() {
+            let tv = self.view(bytemuck::cast_slice(uvs), 34962);
+            self.accessors.push(json!({"bufferView": tv, "componentType": 5126, "count": n, "type": "VEC2"}));
+            attributes["TEXCOORD_0"] = json!(self.accessors.len() - 1);
+        }
+        let c = material.base_color;
+        let mut pbr = json!({"baseColorFactor": [c.x, c.y, c.z, material.alpha], "metallicFactor": 0.0});
+        // A texture is written only with the coordinates it reads.
+        if let (Some(r), Some(_)) = (&material.base_color_texture, mesh.uvs())
+            && let Some(info) = self.texture_info(scene, r)
+        {
+            pbr["baseColorTexture"] = info;
+        }
+        let mut m = json!({"name": material.name, "pbrMetallicRoughness": pbr, "doubleSided": material.two_sided});
+        match material.alpha_mode {
+            AlphaMode::Opaque => {}
+            AlphaMode::Mask { cutoff } => {
+                m["alphaMode"] = json!("MASK");
+                m["alphaCutoff"] = json!(cutoff);
+            }
+            AlphaMode::Blend => m["alphaMode"] = json!("BLEND"),
+        }
+        self.materials.push(m);
+        self.meshes.push(json!({"primitives": [{"attributes": attributes, "indices": indices, "material": self.materials.len() - 1}]}));
         self.meshes.len() - 1
     }
+
+    /// A material's texture reference as a glTF `textureInfo`, its image (as PNG), sampler and texture
+    /// written on first use. `None` for a key the scene does not hold.
+    fn texture_info(&mut self, scene: &Scene, r: &TextureRef) -> Option<Value> {
+        let image = match self.image_index.get(&r.texture) {
+            Some(&i) => i,
+            None => {
+                let texture = scene.texture(r.texture)?;
+                let level = &texture.levels()[0];
+                let mut png = Vec::new();
+                let raw: &[u8] = bytemuck::cast_slice(level.data());
+                image::ImageEncoder::write_image(
+                    image::codecs::png::PngEncoder::new(&mut png),
+                    raw,
+                    level.width(),
+                    level.height(),
+                    image::ExtendedColorType::Rgba8,
+                )
+                .ok()?;
+                self.pngs.push(png);
+                self.images.push(json!({"name": texture.name()}));
+                self.image_index.insert(r.texture, self.images.len() - 1);
+                self.images.len() - 1
+            }
+        };
+        let texture = *self.texture_index.entry((image, r.sampler)).or_insert_with(|| {
+            self.samplers.push(sampler_json(&r.sampler));
+            self.textures.push(json!({"source": image, "sampler": self.samplers.len() - 1}));
+            self.textures.len() - 1
+        });
+        let mut info = json!({"index": texture});
+        if !r.transform.is_identity() {
+            let t = r.transform;
+            info["extensions"] = json!({"KHR_texture_transform": {
+                "offset": t.offset.to_array(), "rotation": t.rotation, "scale": t.scale.to_array(),
+            }});
+            self.transformed = true;
+        }
+        Some(info)
+    }
+}
+
+/// A sampler as glTF writes it (the filter and wrap enums are OpenGL's).
+fn sampler_json(s: &Sampler) -> Value {
+    let wrap = |w: Wrap| match w {
+        Wrap::Repeat => 10497,
+        Wrap::ClampToEdge => 33071,
+        Wrap::MirroredRepeat => 33648,
+    };
+    let mag = match s.mag {
+        Filter::Nearest => 9728,
+        Filter::Linear => 9729,
+    };
+    let min = match (s.min, s.mipmap) {
+        (Filter::Nearest, None) => 9728,
+        (Filter::Linear, None) => 9729,
+        (Filter::Nearest, Some(Filter::Nearest)) => 9984,
+        (Filter::Linear, Some(Filter::Nearest)) => 9985,
+        (Filter::Nearest, Some(Filter::Linear)) => 9986,
+        (Filter::Linear, Some(Filter::Linear)) => 9987,
+    };
+    json!({"magFilter": mag, "minFilter": min, "wrapS": wrap(s.wrap_u), "wrapT": wrap(s.wrap_v)})
 }
 
 /// A light as KHR_lights_punctual has it, with the position and direction of its node.
@@ -187,10 +325,57 @@ fn glb_container(mut js: Vec<u8>, bin: &[u8]) -> Vec<u8> {
 /// # Errors
 /// When the file cannot be written.
 pub fn export_glb(scene: &Scene, path: impl AsRef<Path>) -> Result<(), ExportError> {
+    write(path.as_ref(), &glb_bytes(scene))
+}
+
+/// Writes a scene as a .gltf file with its buffer beside it as `STEM.bin` and each image as
+/// `STEM-N.png` (N from 0), `STEM` being the file's name without its extension.
+///
+/// # Errors
+/// When a file cannot be written; the first failure stops the export.
+pub fn export_gltf(scene: &Scene, path: impl AsRef<Path>) -> Result<(), ExportError> {
     let path = path.as_ref();
+    let stem = path.file_stem().map_or_else(|| "scene".into(), |s| s.to_string_lossy().into_owned());
+    let beside = |name: &str| path.with_file_name(name);
+    let Document { mut doc, bin, pngs } = document(scene);
+    let bin_name = format!("{stem}.bin");
+    write(&beside(&bin_name), &bin)?;
+    doc["buffers"] = json!([{"byteLength": bin.len(), "uri": uri_of(&bin_name)}]);
+    for (i, png) in pngs.iter().enumerate() {
+        let name = format!("{stem}-{i}.png");
+        write(&beside(&name), png)?;
+        doc["images"][i]["uri"] = json!(uri_of(&name));
+    }
+    let text = serde_json::to_vec_pretty(&doc).expect("a JSON value serializes");
+    write(path, &text)
+}
+
+/// Writes a scene as glTF, binary for a `.glb` path and JSON ([`export_gltf`]) for any other.
+///
+/// # Errors
+/// When a file cannot be written.
+pub fn export(scene: &Scene, path: impl AsRef<Path>) -> Result<(), ExportError> {
+    let path = path.as_ref();
+    let glb = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("glb"));
+    if glb { export_glb(scene, path) } else { export_gltf(scene, path) }
+}
+
+fn write(path: &Path, bytes: &[u8]) -> Result<(), ExportError> {
     let err = |source| ExportError { path: path.display().to_string(), source };
-    let mut f = std::fs::File::create(path).map_err(err)?;
-    f.write_all(&glb_bytes(scene)).map_err(err)
+    std::fs::File::create(path).and_then(|mut f| f.write_all(bytes)).map_err(err)
+}
+
+/// A file name as a relative URI: every byte outside RFC 3986's unreserved characters percent-encoded.
+fn uri_of(name: &str) -> String {
+    name.bytes()
+        .map(|b| {
+            if b.is_ascii_alphanumeric() || b"-._~".contains(&b) {
+                (b as char).to_string()
+            } else {
+                format!("%{b:02X}")
+            }
+        })
+        .collect()
 }
 
 #[cfg(test)]

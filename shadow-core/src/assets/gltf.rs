@@ -1,6 +1,8 @@
 //! glTF 2.0: `.gltf` with external or data-URI buffers, and `.glb`. The node hierarchy with matrices or
 //! TRS; every triangle primitive (lists, strips, fans) with u8, u16, u32 or no indices; the base colour
-//! factor and double-sidedness; perspective cameras and KHR_lights_punctual lights.
+//! factor and texture (PNG or JPEG, from a buffer view, a data URI or a file beside the model) with its
+//! sampler, texture coordinates and `KHR_texture_transform`; the alpha mode and cutoff;
+//! double-sidedness; perspective cameras and KHR_lights_punctual lights.
 //!
 //! The gltf crate parses and validates the JSON (index ranges, enum values). Everything that touches
 //! bytes is done here, with bounds checks: the GLB container, buffer sources, and accessor reads (offsets,
@@ -9,11 +11,13 @@
 use std::collections::HashMap;
 use std::path::Path;
 
-use glam::{Mat4, Vec3};
+use glam::{Mat4, Vec2, Vec3};
 use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::{Mode, Semantic};
 
-use super::{AssetError, AssetFault, LoadOptions, read_model, read_referenced};
+use super::images::{self, ImageSource};
+use super::{AssetError, AssetFault, IMAGE_FILE_LIMIT, LoadOptions, read_model, read_referenced};
+use crate::material::{AlphaMode, Filter, Sampler, TextureRef, UvTransform, Wrap};
 use crate::mesh::{MAX_COORDINATE, Mesh};
 use crate::scene::{Camera, Light, LightKind, Material, MaterialKey, MeshKey, NodeKey, Scene};
 
@@ -218,6 +222,22 @@ fn read_vec3(acc: &gltf::Accessor, buffers: &[Vec<u8>], what: &str) -> Result<Ve
     Ok(read_accessor(acc, buffers, what)?.iter().map(|e| Vec3::new(e[0] as f32, e[1] as f32, e[2] as f32)).collect())
 }
 
+/// Texture coordinates: float pairs, or normalized unsigned bytes or shorts (glTF 2.0 3.7.2.1).
+fn read_uvs(acc: &gltf::Accessor, buffers: &[Vec<u8>], what: &str) -> Result<Vec<Vec2>, Fault> {
+    let float = acc.data_type() == DataType::F32;
+    let normalized = acc.normalized() && matches!(acc.data_type(), DataType::U8 | DataType::U16);
+    if acc.dimensions() != Dimensions::Vec2 || !(float || normalized) {
+        return Err(Fault::WrongAccessor(format!(
+            "{what} accessor {} is {:?} of {:?}{}, expected Vec2 of F32 or of normalized U8 or U16",
+            acc.index(),
+            acc.dimensions(),
+            acc.data_type(),
+            if acc.normalized() { " (normalized)" } else { "" }
+        )));
+    }
+    Ok(read_accessor(acc, buffers, what)?.iter().map(|e| Vec2::new(e[0] as f32, e[1] as f32)).collect())
+}
+
 fn read_indices(acc: &gltf::Accessor, buffers: &[Vec<u8>]) -> Result<Vec<u32>, Fault> {
     if acc.dimensions() != Dimensions::Scalar
         || !matches!(acc.data_type(), DataType::U8 | DataType::U16 | DataType::U32)
@@ -262,24 +282,154 @@ fn check_required_extensions(root: &gltf::json::Root) -> Result<(), Fault> {
     Ok(())
 }
 
+/// A scene material and the texture-coordinate set its texture reads, if it has one.
+#[derive(Clone, Copy)]
+struct LoadedMaterial {
+    key: MaterialKey,
+    uv_set: Option<u32>,
+}
+
+/// A material's base-colour texture, waiting for its image to be decoded with all the others.
+struct PendingTexture {
+    material: MaterialKey,
+    image: usize,
+    sampler: Sampler,
+    transform: UvTransform,
+}
+
 struct Loader<'a> {
     buffers: Vec<Vec<u8>>,
     scene: Scene,
     meshes: HashMap<(usize, usize), (MeshKey, MaterialKey)>,
-    materials: HashMap<Option<usize>, MaterialKey>,
+    materials: HashMap<Option<usize>, LoadedMaterial>,
+    /// Textures of the materials made so far, in the order they were made.
+    pending: Vec<PendingTexture>,
     doc: &'a gltf::Document,
+    dir: &'a Path,
+    options: &'a LoadOptions,
     triangles: usize,
 }
 
 impl Loader<'_> {
-    fn material(&mut self, m: &gltf::Material) -> MaterialKey {
-        *self.materials.entry(m.index()).or_insert_with(|| {
-            let c = m.pbr_metallic_roughness().base_color_factor();
-            let name = m.name().unwrap_or("material");
-            self.scene.add_material(Material {
-                two_sided: m.double_sided(),
-                ..Material::colored(name, Vec3::new(c[0], c[1], c[2]))
-            })
+    fn material(&mut self, m: &gltf::Material) -> Result<LoadedMaterial, Fault> {
+        if let Some(&loaded) = self.materials.get(&m.index()) {
+            return Ok(loaded);
+        }
+        let pbr = m.pbr_metallic_roughness();
+        let c = pbr.base_color_factor();
+        let name =
+            m.name().map_or_else(|| m.index().map_or("default".into(), |i| format!("material {i}")), str::to_string);
+        let alpha_mode = match m.alpha_mode() {
+            gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
+            gltf::material::AlphaMode::Mask => {
+                AlphaMode::Mask { cutoff: m.alpha_cutoff().unwrap_or(AlphaMode::DEFAULT_CUTOFF) }
+            }
+            gltf::material::AlphaMode::Blend => AlphaMode::Blend,
+        };
+        if let AlphaMode::Mask { cutoff } = alpha_mode
+            && !(cutoff >= 0.0 && cutoff.is_finite())
+        {
+            return Err(Fault::Malformed(format!("material '{name}' has alphaCutoff {cutoff}, expected 0 or more")));
+        }
+        let key = self.scene.add_material(Material {
+            alpha: c[3],
+            alpha_mode,
+            two_sided: m.double_sided(),
+            ..Material::colored(&name, Vec3::new(c[0], c[1], c[2]))
+        });
+        let mut uv_set = None;
+        if let Some(info) = pbr.base_color_texture() {
+            let transform = info.texture_transform();
+            let texture = info.texture();
+            uv_set = Some(transform.as_ref().and_then(|t| t.tex_coord()).unwrap_or(info.tex_coord()));
+            self.pending.push(PendingTexture {
+                material: key,
+                image: texture.source().index(),
+                sampler: sampler(&texture.sampler()),
+                transform: transform.map_or(UvTransform::IDENTITY, |t| UvTransform {
+                    offset: Vec2::from(t.offset()),
+                    rotation: t.rotation(),
+                    scale: Vec2::from(t.scale()),
+                }),
+            });
+        }
+        let loaded = LoadedMaterial { key, uv_set };
+        self.materials.insert(m.index(), loaded);
+        Ok(loaded)
+    }
+
+    /// Decodes the images the materials read, each once and all in parallel, and gives each material
+    /// its texture. An image that cannot be used leaves its materials untextured, with one warning that
+    /// names the image, the materials and what is wrong.
+    fn finish_textures(&mut self) -> Result<(), Fault> {
+        let mut images: Vec<usize> = Vec::new();
+        for p in &self.pending {
+            if !images.contains(&p.image) {
+                images.push(p.image);
+            }
+        }
+        let doc_images: Vec<gltf::Image> = self.doc.images().collect();
+        let sources = images.iter().map(|&i| self.image_source(&doc_images[i])).collect::<Result<Vec<_>, Fault>>()?;
+        let labels: Vec<String> = sources.iter().map(|s| s.label.clone()).collect();
+        let decoded = images::decode_all(sources, &self.options.textures);
+        for ((image, label), texture) in images.iter().zip(labels).zip(decoded) {
+            let users = self.pending.iter().filter(|p| p.image == *image);
+            match texture {
+                Ok(texture) => {
+                    let key = self.scene.add_texture(texture);
+                    for p in users {
+                        let r = TextureRef { texture: key, sampler: p.sampler, transform: p.transform };
+                        if let Some(m) = self.scene.material_mut(p.material) {
+                            m.base_color_texture = Some(r);
+                        }
+                    }
+                }
+                Err(why) => {
+                    let names: Vec<String> = users
+                        .filter_map(|p| self.scene.material(p.material))
+                        .map(|m| format!("'{}'", m.name))
+                        .collect();
+                    let (noun, verb) = if names.len() == 1 { ("material", "is") } else { ("materials", "are") };
+                    let names = names.join(", ");
+                    self.scene.add_warning(format!("{label}: {why}; {noun} {names} {verb} drawn without it"));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// An image's bytes: from a buffer view, a data URI, or a file the model may read. A file it may not
+    /// read refuses the model, as a buffer would; one that cannot be read is a bad image like any other.
+    fn image_source(&self, image: &gltf::Image) -> Result<ImageSource, Fault> {
+        let what = format!("image {}", image.index());
+        Ok(match image.source() {
+            gltf::image::Source::View { view, .. } => {
+                let buffer = &self.buffers[view.buffer().index()];
+                let bytes = view.offset().checked_add(view.length()).and_then(|end| buffer.get(view.offset()..end));
+                let bytes = bytes.ok_or_else(|| {
+                    Fault::Truncated(format!("{what}: buffer view {} runs past the end of its buffer", view.index()))
+                })?;
+                ImageSource { label: what, bytes: Ok(bytes.to_vec()) }
+            }
+            gltf::image::Source::Uri { uri, .. } if uri.starts_with("data:") => {
+                let bytes = match uri.split_once(";base64,") {
+                    Some((_, payload)) => base64_decode(payload).map_err(|f| f.to_string()),
+                    None => Err("a data URI that is not base64".to_string()),
+                };
+                ImageSource { label: what, bytes }
+            }
+            gltf::image::Source::Uri { uri, .. } => {
+                let file = percent_decode(uri);
+                let bytes = match read_referenced(self.dir, &file, &what, Some(IMAGE_FILE_LIMIT), self.options) {
+                    Err(f @ (Fault::OutsideFolder(_) | Fault::Access(_))) => return Err(f),
+                    Err(f) => Err(f.to_string()),
+                    Ok(b) if b.len() as u64 >= IMAGE_FILE_LIMIT => {
+                        Err(format!("larger than the {} MiB an image file may have", IMAGE_FILE_LIMIT >> 20))
+                    }
+                    Ok(b) => Ok(b),
+                };
+                ImageSource { label: format!("{what} ('{file}')"), bytes }
+            }
         })
     }
 
@@ -312,9 +462,18 @@ impl Loader<'_> {
                 }
                 None => Mesh::new(positions, triangles),
             };
-            let m = mesh_result.map_err(|e| Fault::Mesh(what, e))?;
-            let mat = self.material(&prim.material());
-            let key = (self.scene.add_mesh(m), mat);
+            let mut m = mesh_result.map_err(|e| Fault::Mesh(what.clone(), e))?;
+            let mat = self.material(&prim.material())?;
+            if let Some(set) = mat.uv_set {
+                let acc = prim.get(&Semantic::TexCoords(set)).ok_or_else(|| {
+                    Fault::Malformed(format!(
+                        "{what}: its material's texture reads TEXCOORD_{set}, which it does not have"
+                    ))
+                })?;
+                let uvs = read_uvs(&acc, &self.buffers, &format!("TEXCOORD_{set}"))?;
+                m = m.with_uvs(uvs).map_err(|e| Fault::Mesh(what, e))?;
+            }
+            let key = (self.scene.add_mesh(m), mat.key);
             self.meshes.insert(id, key);
             out.push(key);
         }
@@ -440,6 +599,27 @@ impl Loader<'_> {
     }
 }
 
+/// A glTF sampler as ours. Without a minification filter glTF leaves the choice to the renderer:
+/// trilinear, as without a sampler.
+fn sampler(s: &gltf::texture::Sampler) -> Sampler {
+    use gltf::texture::{MagFilter, MinFilter, WrappingMode};
+    let wrap = |w| match w {
+        WrappingMode::ClampToEdge => Wrap::ClampToEdge,
+        WrappingMode::MirroredRepeat => Wrap::MirroredRepeat,
+        WrappingMode::Repeat => Wrap::Repeat,
+    };
+    let mag = if s.mag_filter() == Some(MagFilter::Nearest) { Filter::Nearest } else { Filter::Linear };
+    let (min, mipmap) = match s.min_filter() {
+        None | Some(MinFilter::LinearMipmapLinear) => (Filter::Linear, Some(Filter::Linear)),
+        Some(MinFilter::Nearest) => (Filter::Nearest, None),
+        Some(MinFilter::Linear) => (Filter::Linear, None),
+        Some(MinFilter::NearestMipmapNearest) => (Filter::Nearest, Some(Filter::Nearest)),
+        Some(MinFilter::LinearMipmapNearest) => (Filter::Linear, Some(Filter::Nearest)),
+        Some(MinFilter::NearestMipmapLinear) => (Filter::Nearest, Some(Filter::Linear)),
+    };
+    Sampler { mag, min, mipmap, wrap_u: wrap(s.wrap_s()), wrap_v: wrap(s.wrap_t()) }
+}
+
 /// Checks that a mesh placed by `world` stays inside f32 geometry and keeps some area: the mesh's own
 /// checks ran on its local positions, and a transform can overflow them (a huge translation, nested
 /// huge scales) or flatten every triangle (a zero scale). The corners of the local bounds bound the
@@ -521,7 +701,10 @@ fn parse(path: &Path, options: &LoadOptions) -> Result<Scene, Fault> {
         scene: Scene::new(),
         meshes: HashMap::new(),
         materials: HashMap::new(),
+        pending: Vec::new(),
         doc: &doc,
+        dir,
+        options,
         triangles: 0,
     };
     let roots: Vec<usize> = match doc.default_scene().or_else(|| doc.scenes().next()) {
@@ -539,6 +722,7 @@ fn parse(path: &Path, options: &LoadOptions) -> Result<Scene, Fault> {
         return Err(Fault::Cycle("every node is some node's child, so there is no root".into()));
     }
     loader.walk(&roots)?;
+    loader.finish_textures()?;
     if loader.triangles == 0 {
         let any_prims = doc.meshes().any(|m| m.primitives().len() > 0);
         return Err(if any_prims {

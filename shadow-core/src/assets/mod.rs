@@ -8,12 +8,15 @@
 
 pub mod export;
 mod gltf;
+mod images;
 mod obj;
 mod ply;
 
 use std::fmt;
 use std::io::Read;
 use std::path::Path;
+
+pub use images::TextureLimits;
 
 use crate::mesh::MeshError;
 use crate::scene::Scene;
@@ -106,6 +109,8 @@ pub enum FileAccess {
 pub struct LoadOptions {
     /// Which files the model may name.
     pub file_access: FileAccess,
+    /// How large its images may be, one by one and together.
+    pub textures: TextureLimits,
 }
 
 /// Loads a model file into a new scene (meshes, materials and nodes; cameras and lights where the format
@@ -137,8 +142,16 @@ pub fn load_with(path: impl AsRef<Path>, options: &LoadOptions) -> Result<Scene,
         "gz" if name.ends_with(".ply.gz") => ply::load(path),
         _ => Err(err(AssetFault::UnknownFormat(ext.to_string()))),
     });
-    result.unwrap_or_else(|_| Err(err(AssetFault::Malformed("the parser failed on this input".into()))))
+    let mut scene =
+        result.unwrap_or_else(|_| Err(err(AssetFault::Malformed("the parser failed on this input".into()))))?;
+    scene.prefix_warnings(&path.display().to_string());
+    Ok(scene)
 }
+
+/// The most bytes read of an image file a model names: 256 MiB. A longer (or endless) file stops there
+/// and its image is left out with a warning; the limits on texels, [`TextureLimits`], are checked on the
+/// header before decoding.
+pub const IMAGE_FILE_LIMIT: u64 = 256 << 20;
 
 /// Reads the model file itself. The user named it, so it is read whole, but only if it is a regular file:
 /// a FIFO or a device could block or never end.

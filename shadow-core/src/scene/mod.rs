@@ -9,16 +9,18 @@
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, OnceLock};
 
-use glam::{Mat4, Vec3};
+use glam::Mat4;
 use slotmap::{SecondaryMap, SlotMap};
 
 use crate::bounds::Aabb;
 use crate::geometry::adjacency::Adjacency;
+use crate::material::Texture;
 use crate::mesh::Mesh;
 
 mod camera;
 mod light;
 
+pub use crate::material::Material;
 pub use camera::Camera;
 pub use light::{Light, LightKind, LightShadow};
 
@@ -29,6 +31,8 @@ slotmap::new_key_type! {
     pub struct MeshKey;
     /// A material.
     pub struct MaterialKey;
+    /// A decoded texture, shared by any number of materials.
+    pub struct TextureKey;
     /// A light.
     pub struct LightKey;
     /// A camera.
@@ -58,41 +62,6 @@ pub enum SceneError {
     /// A light or camera with unusable parameters.
     #[error("{0}")]
     Invalid(String),
-}
-
-/// Surface appearance and shadow flags.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Material {
-    /// Name, for reports.
-    pub name: String,
-    /// Linear-RGB albedo.
-    pub base_color: Vec3,
-    /// Lit from both sides (the shading normal faces the viewer).
-    pub two_sided: bool,
-    /// Whether surfaces with this material block light.
-    pub casts_shadow: bool,
-    /// Whether shadows are computed on surfaces with this material.
-    pub receives_shadow: bool,
-}
-
-impl Default for Material {
-    fn default() -> Self {
-        Self {
-            name: "default".into(),
-            base_color: Vec3::splat(0.8),
-            two_sided: false,
-            casts_shadow: true,
-            receives_shadow: true,
-        }
-    }
-}
-
-impl Material {
-    /// A default material of the given colour.
-    #[must_use]
-    pub fn colored(name: &str, base_color: Vec3) -> Self {
-        Self { name: name.into(), base_color, ..Self::default() }
-    }
 }
 
 /// A node: a local transform, optionally a mesh with a material, and shadow flags.
@@ -164,6 +133,8 @@ pub struct Scene {
     roots: Vec<NodeKey>,
     meshes: SlotMap<MeshKey, MeshEntry>,
     materials: SlotMap<MaterialKey, Material>,
+    textures: SlotMap<TextureKey, Arc<Texture>>,
+    warnings: Vec<String>,
     lights: SlotMap<LightKey, Placed<Light>>,
     light_shadows: SecondaryMap<LightKey, LightShadow>,
     cameras: SlotMap<CameraKey, Placed<Camera>>,
@@ -244,9 +215,53 @@ impl Scene {
         self.materials.get(key)
     }
 
+    /// Every material.
+    pub fn materials(&self) -> impl Iterator<Item = (MaterialKey, &Material)> {
+        self.materials.iter()
+    }
+
     /// A material, to edit (materials hold no cached state).
     pub fn material_mut(&mut self, key: MaterialKey) -> Option<&mut Material> {
         self.materials.get_mut(key)
+    }
+
+    // ---- textures ----
+
+    /// Adds a texture; materials name it by the returned key.
+    pub fn add_texture(&mut self, texture: Texture) -> TextureKey {
+        self.textures.insert(Arc::new(texture))
+    }
+
+    /// A texture.
+    #[must_use]
+    pub fn texture(&self, key: TextureKey) -> Option<&Arc<Texture>> {
+        self.textures.get(key)
+    }
+
+    /// Every texture.
+    pub fn textures(&self) -> impl Iterator<Item = (TextureKey, &Arc<Texture>)> {
+        self.textures.iter()
+    }
+
+    // ---- warnings ----
+
+    /// Records something the scene's source got wrong that did not stop it loading (an image left out, a
+    /// setting ignored), one line each, for the tools to print.
+    pub fn add_warning(&mut self, warning: String) {
+        self.warnings.push(warning);
+    }
+
+    /// Puts `source: ` before every warning recorded so far (the file they came from).
+    pub(crate) fn prefix_warnings(&mut self, source: &str) {
+        for w in &mut self.warnings {
+            *w = format!("{source}: {w}");
+        }
+    }
+
+    /// The warnings recorded while the scene was built, oldest first.
+    #[must_use]
+    pub fn warnings(&self) -> &[String] {
+        &self.warnings
     }
 
     // ---- nodes ----
@@ -611,6 +626,7 @@ mod tests {
 
     use super::*;
     use crate::procedural;
+    use glam::Vec3;
 
     #[test]
     fn moving_a_node_updates_its_subtree_only() {

@@ -131,6 +131,7 @@ impl SceneArgs {
     pub(crate) fn frame(&self, view: &ViewArgs) -> Result<(FrameInputs, u32, u32), Error> {
         let (w, h) = view.size()?;
         let scene = self.setup().build()?;
+        print_warnings(&scene);
         Ok((FrameInputs::from_first_camera(&scene)?, w, h))
     }
 
@@ -279,11 +280,13 @@ pub(crate) enum Command {
         #[arg(long)]
         script: Option<String>,
     },
-    /// Write a scene (built-in or loaded) as .glb with its camera and lights.
+    /// Write a scene (built-in or loaded) as glTF (.glb or .gltf) with its materials, textures, camera
+    /// and lights.
     Export {
         #[command(flatten)]
         scene: SceneArgs,
-        /// The .glb to write.
+        /// The file to write: .glb (one binary file) or .gltf (JSON, with its buffer and PNG images
+        /// beside it).
         #[arg(long, short)]
         out: PathBuf,
     },
@@ -305,4 +308,11 @@ pub(crate) enum Command {
         #[arg(long)]
         out_dir: Option<PathBuf>,
     },
+}
+
+/// Prints what the scene's source got wrong without stopping it loading, one line each.
+pub(crate) fn print_warnings(scene: &shadow_core::Scene) {
+    for w in scene.warnings() {
+        eprintln!("warning: {w}");
+    }
 }

@@ -11,6 +11,7 @@ use serde_json::json;
 use shadow_core::FrameInputs;
 use shadow_core::assets::FileAccess;
 use shadow_core::inspect::Inspection;
+use shadow_core::material::AlphaMode;
 use shadow_core::scenes::{self, SceneParams};
 use shadow_core::technique::TechniqueSpec;
 use shadowlab::compare::{CompareJob, run_compare};
@@ -254,11 +255,15 @@ fn inspect(target: &str, json: bool, allow_outside_files: bool) -> Result<(), Er
     let file_access = if allow_outside_files { FileAccess::Anywhere } else { FileAccess::ModelFolder };
     let i = if is_file {
         // The file's own numbers; the silhouette from the default staged light.
-        let options = shadow_core::assets::LoadOptions { file_access };
+        let options = shadow_core::assets::LoadOptions { file_access, ..Default::default() };
         let raw = shadow_core::assets::load_with(path, &options)
             .map_err(|e| Error::Setup(shadowlab::SceneSourceError::Asset(e).into()))?;
-        let staged = SceneSetup { ground: false, file_access, ..SceneSetup::new(target) }.build()?;
-        Inspection { silhouette_edges: Inspection::of(&staged).silhouette_edges, ..Inspection::of(&raw) }
+        args::print_warnings(&raw);
+        let of_file = Inspection::of(&raw);
+        // Staged in place rather than loaded again: its images are decoded once.
+        let mut staged = raw;
+        scenes::stage_model(&mut staged, false);
+        Inspection { silhouette_edges: Inspection::of(&staged).silhouette_edges, ..of_file }
     } else {
         Inspection::of(&SceneSetup::new(target).build()?)
     };
@@ -273,6 +278,21 @@ fn inspect(target: &str, json: bool, allow_outside_files: bool) -> Result<(), Er
             "inconsistent_edges": i.inconsistent_edges,
             "bounds": {"min": i.bounds.min.to_array(), "max": i.bounds.max.to_array()},
             "silhouette_edges": i.silhouette_edges,
+            "meshes": i.meshes,
+            "meshes_with_texture_coordinates": i.meshes_with_uvs,
+            "materials": i.materials.iter().map(|m| {
+                let mut j = json!({
+                    "name": m.name, "alpha_mode": m.alpha_mode.name(), "double_sided": m.double_sided,
+                    "base_color_texture": m.texture,
+                });
+                if let AlphaMode::Mask { cutoff } = m.alpha_mode {
+                    j["alpha_cutoff"] = json!(cutoff);
+                }
+                j
+            }).collect::<Vec<_>>(),
+            "textures": i.textures.iter().map(|t| json!({
+                "name": t.name, "width": t.width, "height": t.height, "bytes_with_mips": t.bytes,
+            })).collect::<Vec<_>>(),
         }));
     }
     out!("{target}");
@@ -287,6 +307,30 @@ fn inspect(target: &str, json: bool, allow_outside_files: bool) -> Result<(), Er
     match i.silhouette_edges {
         Some(n) => out!("  silhouette edges    {n} (default light)"),
         None => out!("  silhouette edges    - (no light)"),
+    }
+    out!("  texture coordinates {} of {} meshes", i.meshes_with_uvs, i.meshes);
+    let count = |mode: &str| i.materials.iter().filter(|m| m.alpha_mode.name() == mode).count();
+    let sides = i.materials.iter().filter(|m| m.double_sided).count();
+    out!(
+        "  materials           {} ({} opaque, {} masked, {} blended; {sides} double-sided)",
+        i.materials.len(),
+        count("OPAQUE"),
+        count("MASK"),
+        count("BLEND")
+    );
+    for m in &i.materials {
+        let mode = match m.alpha_mode {
+            AlphaMode::Mask { cutoff } => format!("MASK {cutoff}"),
+            other => other.name().to_string(),
+        };
+        let texture = m.texture.map_or(String::new(), |t| format!("  texture {t}"));
+        let sides = if m.double_sided { "double-sided" } else { "single-sided" };
+        out!("    {:<20} {mode:<10} {sides}{texture}", m.name);
+    }
+    let bytes: usize = i.textures.iter().map(|t| t.bytes).sum();
+    out!("  textures            {} ({:.1} MiB with mip chains)", i.textures.len(), bytes as f64 / f64::from(1 << 20));
+    for (n, t) in i.textures.iter().enumerate() {
+        out!("    {n:<3} {} x {}  {}", t.width, t.height, t.name);
     }
     Ok(())
 }
@@ -730,9 +774,14 @@ fn bench_sweep(
 }
 
 fn export(args: &SceneArgs, out: &Path) -> Result<(), Error> {
+    let extension = out.extension().map(|e| e.to_string_lossy().to_ascii_lowercase());
+    if !matches!(extension.as_deref(), Some("glb" | "gltf")) {
+        return Err(Error::Usage(format!("--out {}: expected a .glb or .gltf file", out.display())));
+    }
     let scene = args.setup().build()?;
-    shadow_core::assets::export::export_glb(&scene, out)
-        .map_err(|e| Error::Write { path: out.to_path_buf(), why: e.source.to_string() })?;
+    args::print_warnings(&scene);
+    shadow_core::assets::export::export(&scene, out)
+        .map_err(|e| Error::Write { path: e.path.into(), why: e.source.to_string() })?;
     out!("wrote {} ({} triangles)", out.display(), scene.triangle_count());
     Ok(())
 }
