@@ -213,8 +213,15 @@ impl MeshParts {
             }
             AlphaMode::Blend => m["alphaMode"] = json!("BLEND"),
         }
-        self.materials.push(m);
-        self.meshes.push(json!({"primitives": [{"attributes": attributes, "indices": indices, "material": self.materials.len() - 1}]}));
+        // Meshes that share a material (by everything written of it) share its entry.
+        let material = match self.materials.iter().position(|written| *written == m) {
+            Some(i) => i,
+            None => {
+                self.materials.push(m);
+                self.materials.len() - 1
+            }
+        };
+        self.meshes.push(json!({"primitives": [{"attributes": attributes, "indices": indices, "material": material}]}));
         self.meshes.len() - 1
     }
 
@@ -411,5 +418,21 @@ mod tests {
             }
         }
         let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn meshes_sharing_a_material_share_its_entry() {
+        let mut s = Scene::new();
+        let white = s.add_material(Material::colored("white", Vec3::ONE));
+        let red = s.add_material(Material::colored("red", Vec3::X));
+        for (i, material) in [white, white, red].into_iter().enumerate() {
+            let box_mesh = s.add_mesh(crate::procedural::cuboid(Vec3::ONE * (i + 1) as f32).unwrap());
+            s.add_instance("box", box_mesh, material, Mat4::IDENTITY).unwrap();
+        }
+        let doc = document(&s).doc;
+        assert_eq!(doc["meshes"].as_array().unwrap().len(), 3);
+        let names: Vec<&str> =
+            doc["materials"].as_array().unwrap().iter().map(|m| m["name"].as_str().unwrap()).collect();
+        assert_eq!(names, ["white", "red"]);
     }
 }

@@ -159,8 +159,10 @@ impl Texture {
         limits.max_alloc = None;
         decoder.set_limits(limits).map_err(|e| TextureError::Decode(e.to_string()))?;
         let image = image::DynamicImage::from_decoder(decoder).map_err(|e| TextureError::Decode(e.to_string()))?;
-        let rgba = image.into_rgba8();
-        let texels = rgba.as_raw().chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect();
+        let bytes = image.into_rgba8().into_raw();
+        // The decoder's buffer becomes the texels without a copy where its capacity is whole texels.
+        let texels = bytemuck::allocation::try_cast_vec(bytes)
+            .unwrap_or_else(|(_, bytes)| bytes.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect());
         Self::from_rgba8_within(name, header.width, header.height, texels, max_side)
     }
 
