@@ -2,7 +2,7 @@
 
 use crate::bounds::Aabb;
 use crate::frame::FrameInputs;
-use crate::material::AlphaMode;
+use crate::material::{AlphaMode, Sampler};
 use crate::scene::Scene;
 
 /// What `inspect` reports. Counts are after welding coincident positions, summed over drawn instances.
@@ -47,6 +47,8 @@ pub struct MaterialStats {
     pub double_sided: bool,
     /// Its base-colour texture, as an index into [`Inspection::textures`].
     pub texture: Option<usize>,
+    /// How that texture is read.
+    pub sampler: Option<Sampler>,
 }
 
 /// One texture as `inspect` reports it.
@@ -98,6 +100,7 @@ impl Inspection {
                 alpha_mode: m.alpha_mode,
                 double_sided: m.two_sided,
                 texture: m.base_color_texture.and_then(|r| texture_index.get(&r.texture).copied()),
+                sampler: m.base_color_texture.map(|r| r.sampler),
             })
             .collect();
         let mut seen = std::collections::HashSet::new();

@@ -350,6 +350,8 @@ fn inspect_lists_a_textured_cards_material_and_texture_and_names_a_bad_image() {
     let material = &v["materials"][0];
     assert_eq!((&material["name"], &material["alpha_mode"]), (&"checker".into(), &"MASK".into()), "{v}");
     assert_eq!((&material["alpha_cutoff"], &material["double_sided"]), (&0.5.into(), &true.into()), "{v}");
+    let sampler = serde_json::json!({"mag": "nearest", "min": "linear", "mipmap": "linear", "wrap_u": "repeat", "wrap_v": "repeat"});
+    assert_eq!(material["sampler"], sampler, "{v}");
     let texture = &v["textures"][material["base_color_texture"].as_u64().expect("a texture") as usize];
     assert_eq!((&texture["width"], &texture["height"]), (&256.into(), &256.into()), "{v}");
     assert_eq!(texture["bytes_with_mips"], 349_524, "{v}");

@@ -401,7 +401,12 @@ impl Loader<'_> {
     /// An image's bytes: from a buffer view, a data URI, or a file the model may read. A file it may not
     /// read refuses the model, as a buffer would; one that cannot be read is a bad image like any other.
     fn image_source(&self, image: &gltf::Image) -> Result<ImageSource, Fault> {
+        // Told by its index, and by its name where the model gives one (a file also by its path).
         let what = format!("image {}", image.index());
+        let (label, name) = match image.name() {
+            Some(name) => (format!("{what} '{name}'"), name.to_string()),
+            None => (what.clone(), what.clone()),
+        };
         Ok(match image.source() {
             gltf::image::Source::View { view, .. } => {
                 let buffer = &self.buffers[view.buffer().index()];
@@ -409,14 +414,14 @@ impl Loader<'_> {
                 let bytes = bytes.ok_or_else(|| {
                     Fault::Truncated(format!("{what}: buffer view {} runs past the end of its buffer", view.index()))
                 })?;
-                ImageSource { label: what, bytes: Ok(bytes.to_vec()) }
+                ImageSource { label, name, bytes: Ok(bytes.to_vec()) }
             }
             gltf::image::Source::Uri { uri, .. } if uri.starts_with("data:") => {
                 let bytes = match uri.split_once(";base64,") {
                     Some((_, payload)) => base64_decode(payload).map_err(|f| f.to_string()),
                     None => Err("a data URI that is not base64".to_string()),
                 };
-                ImageSource { label: what, bytes }
+                ImageSource { label, name, bytes }
             }
             gltf::image::Source::Uri { uri, .. } => {
                 let file = percent_decode(uri);
@@ -428,7 +433,8 @@ impl Loader<'_> {
                     }
                     Ok(b) => Ok(b),
                 };
-                ImageSource { label: format!("{what} ('{file}')"), bytes }
+                let name = image.name().map_or_else(|| file.clone(), str::to_string);
+                ImageSource { label: format!("{label} ('{file}')"), name, bytes }
             }
         })
     }

@@ -28,10 +28,12 @@ impl Default for TextureLimits {
     }
 }
 
-/// One image to decode: a name for messages and its bytes, or why they could not be read.
+/// One image to decode: its names and its bytes, or why they could not be read.
 pub(super) struct ImageSource {
-    /// The image's name: its file, or where in the model it is.
+    /// Where in the model the image is, for messages.
     pub label: String,
+    /// The texture's name: the image's own name, or its file.
+    pub name: String,
     /// Its bytes, or what went wrong reading them.
     pub bytes: Result<Vec<u8>, String>,
 }
@@ -67,7 +69,7 @@ pub(super) fn decode_all(sources: Vec<ImageSource>, limits: &TextureLimits) -> V
         .map(|source| {
             let source = source?;
             let bytes = source.bytes.as_deref().unwrap_or_default();
-            Texture::decode_within(&source.label, bytes, limits.max_side).map_err(|e| e.to_string())
+            Texture::decode_within(&source.name, bytes, limits.max_side).map_err(|e| e.to_string())
         })
         .collect()
 }

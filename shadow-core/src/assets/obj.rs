@@ -140,7 +140,7 @@ impl Images {
                 }
                 Ok(b) => Ok(b),
             };
-            sources.push(ImageSource { label: file.clone(), bytes });
+            sources.push(ImageSource { label: file.clone(), name: file.clone(), bytes });
         }
         let decoded = files.into_iter().zip(images::decode_all(sources, &options.textures)).collect();
         Ok(Self { decoded, warned: HashSet::new(), keys: HashMap::new() })

@@ -11,7 +11,7 @@ use serde_json::json;
 use shadow_core::FrameInputs;
 use shadow_core::assets::FileAccess;
 use shadow_core::inspect::Inspection;
-use shadow_core::material::AlphaMode;
+use shadow_core::material::{AlphaMode, Filter, Wrap};
 use shadow_core::scenes::{self, SceneParams};
 use shadow_core::technique::TechniqueSpec;
 use shadowlab::compare::{CompareJob, run_compare};
@@ -280,16 +280,7 @@ fn inspect(target: &str, json: bool, allow_outside_files: bool) -> Result<(), Er
             "silhouette_edges": i.silhouette_edges,
             "meshes": i.meshes,
             "meshes_with_texture_coordinates": i.meshes_with_uvs,
-            "materials": i.materials.iter().map(|m| {
-                let mut j = json!({
-                    "name": m.name, "alpha_mode": m.alpha_mode.name(), "double_sided": m.double_sided,
-                    "base_color_texture": m.texture,
-                });
-                if let AlphaMode::Mask { cutoff } = m.alpha_mode {
-                    j["alpha_cutoff"] = json!(cutoff);
-                }
-                j
-            }).collect::<Vec<_>>(),
+            "materials": i.materials.iter().map(material_json).collect::<Vec<_>>(),
             "textures": i.textures.iter().map(|t| json!({
                 "name": t.name, "width": t.width, "height": t.height, "bytes_with_mips": t.bytes,
             })).collect::<Vec<_>>(),
@@ -333,6 +324,34 @@ fn inspect(target: &str, json: bool, allow_outside_files: bool) -> Result<(), Er
         out!("    {n:<3} {} x {}  {}", t.width, t.height, t.name);
     }
     Ok(())
+}
+
+/// A material as `inspect --json` lists it.
+fn material_json(m: &shadow_core::inspect::MaterialStats) -> serde_json::Value {
+    let mut j = json!({
+        "name": m.name, "alpha_mode": m.alpha_mode.name(), "double_sided": m.double_sided,
+        "base_color_texture": m.texture,
+    });
+    if let AlphaMode::Mask { cutoff } = m.alpha_mode {
+        j["alpha_cutoff"] = json!(cutoff);
+    }
+    if let Some(s) = m.sampler {
+        let filter = |f: Option<Filter>| match f {
+            None => "none",
+            Some(Filter::Nearest) => "nearest",
+            Some(Filter::Linear) => "linear",
+        };
+        let wrap = |w: Wrap| match w {
+            Wrap::Repeat => "repeat",
+            Wrap::ClampToEdge => "clamp_to_edge",
+            Wrap::MirroredRepeat => "mirrored_repeat",
+        };
+        j["sampler"] = json!({
+            "mag": filter(Some(s.mag)), "min": filter(Some(s.min)), "mipmap": filter(s.mipmap),
+            "wrap_u": wrap(s.wrap_u), "wrap_v": wrap(s.wrap_v),
+        });
+    }
+    j
 }
 
 /// Checks that every technique exists on the backends `choice` names, before any backend is opened, so
