@@ -16,6 +16,7 @@ use crate::geometry::silhouette::{CastMode, Silhouette, silhouette};
 use crate::geometry::volume::{Caps, ShadowVolume, extrude};
 use crate::image::Image;
 use crate::light::{LightView, LightViewError};
+use crate::material::{Material, Texture};
 use crate::mesh::Mesh;
 use crate::scene::{Camera, CameraKey, Light, LightShadow, MeshKey, NodeKey, Scene, SceneError};
 use crate::stats::Counters;
@@ -39,6 +40,10 @@ pub struct Instance {
     pub local_from_world: Mat4,
     /// The transform mirrors (negative determinant): front faces wind clockwise in world space.
     pub mirrored: bool,
+    /// The material it is drawn with (one mesh may be drawn with several).
+    pub material: Arc<Material>,
+    /// That material's base-colour texture, where it has one the scene holds.
+    pub base_color_texture: Option<Arc<Texture>>,
     /// Linear albedo.
     pub base_color: Vec3,
     /// Lit from both sides.
@@ -135,11 +140,13 @@ impl FrameInputs {
                     world_from_local: world,
                     local_from_world: crate::affine::inverse(world),
                     mirrored: world.determinant() < 0.0,
+                    base_color_texture: material.base_color_texture.and_then(|r| scene.texture(r.texture)).cloned(),
                     base_color: material.base_color,
                     two_sided: material.two_sided,
                     casts_shadow: n.casts_shadow() && material.casts_shadow,
                     receives_shadow: n.receives_shadow() && material.receives_shadow,
                     bounds: mesh.bounds().transformed(world),
+                    material: Arc::clone(material),
                     mesh,
                 })
             })
@@ -328,5 +335,34 @@ mod tests {
         let err = FrameInputs::new(&scene, camera, lights).expect_err("over the limit");
         assert_eq!(err, FrameError::TooManyTriangles { triangles: n * n });
         assert!(err.to_string().contains(&(n * n).to_string()), "{err}");
+    }
+
+    #[test]
+    fn an_instance_carries_its_material_and_texture_as_the_frame_found_them() {
+        use crate::material::{AlphaMode, Texture, TextureRef};
+        let mut scene = Scene::new();
+        let texture = scene.add_texture(Texture::from_rgba8("clear", 1, 1, vec![[0; 4]]).unwrap());
+        let masked = Material {
+            alpha_mode: AlphaMode::Mask { cutoff: 0.5 },
+            base_color_texture: Some(TextureRef {
+                texture,
+                sampler: Default::default(),
+                transform: Default::default(),
+            }),
+            ..Material::colored("card", Vec3::ONE)
+        };
+        let card = scene.add_material(masked);
+        let mesh = scene.add_mesh(grid(1, 1));
+        scene.add_instance("card", mesh, card, Mat4::IDENTITY).unwrap();
+        let camera = Camera::look_at(Vec3::new(0.5, 2.0, 0.5), Vec3::new(0.5, 0.0, 0.5), 45.0);
+        let frame = FrameInputs::new(&scene, camera, vec![]).unwrap();
+        let instance = &frame.instances[0];
+        assert_eq!(instance.material.alpha_mode, AlphaMode::Mask { cutoff: 0.5 });
+        let shared = instance.base_color_texture.as_ref().expect("the texture");
+        assert!(std::sync::Arc::ptr_eq(shared, scene.texture(texture).unwrap()), "one copy of the texture");
+        // Editing the scene's material afterwards leaves the frame's as it was.
+        scene.material_mut(card).unwrap().alpha_mode = AlphaMode::Opaque;
+        assert_eq!(instance.material.alpha_mode, AlphaMode::Mask { cutoff: 0.5 });
+        assert_eq!(scene.material(card).unwrap().alpha_mode, AlphaMode::Opaque);
     }
 }

@@ -132,7 +132,8 @@ pub struct Scene {
     nodes: SlotMap<NodeKey, Node>,
     roots: Vec<NodeKey>,
     meshes: SlotMap<MeshKey, MeshEntry>,
-    materials: SlotMap<MaterialKey, Material>,
+    /// Shared with the frames that draw them, so a frame carries its instances' materials uncopied.
+    materials: SlotMap<MaterialKey, Arc<Material>>,
     textures: SlotMap<TextureKey, Arc<Texture>>,
     warnings: Vec<String>,
     lights: SlotMap<LightKey, Placed<Light>>,
@@ -206,23 +207,23 @@ impl Scene {
 
     /// Adds a material.
     pub fn add_material(&mut self, material: Material) -> MaterialKey {
-        self.materials.insert(material)
+        self.materials.insert(Arc::new(material))
     }
 
     /// A material.
     #[must_use]
     pub fn material(&self, key: MaterialKey) -> Option<&Material> {
-        self.materials.get(key)
+        self.materials.get(key).map(Arc::as_ref)
     }
 
     /// Every material.
     pub fn materials(&self) -> impl Iterator<Item = (MaterialKey, &Material)> {
-        self.materials.iter()
+        self.materials.iter().map(|(k, m)| (k, m.as_ref()))
     }
 
-    /// A material, to edit (materials hold no cached state).
+    /// A material, to edit (materials hold no cached state; a frame made before keeps the old one).
     pub fn material_mut(&mut self, key: MaterialKey) -> Option<&mut Material> {
-        self.materials.get_mut(key)
+        self.materials.get_mut(key).map(Arc::make_mut)
     }
 
     // ---- textures ----
@@ -470,7 +471,7 @@ impl Scene {
     }
 
     /// Nodes that draw a mesh, depth-first, with the mesh and the material.
-    pub fn drawables(&self) -> impl Iterator<Item = (NodeKey, &Node, MeshKey, &Material)> {
+    pub fn drawables(&self) -> impl Iterator<Item = (NodeKey, &Node, MeshKey, &Arc<Material>)> {
         self.depth_first().into_iter().filter_map(move |k| {
             let n = &self.nodes[k];
             let (m, mat) = n.mesh?;
