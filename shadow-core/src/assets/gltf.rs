@@ -16,7 +16,7 @@ use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::{Mode, Semantic};
 
 use super::images::{self, ImageSource};
-use super::{AssetError, AssetFault, IMAGE_FILE_LIMIT, LoadOptions, read_model, read_referenced};
+use super::{AssetError, AssetFault, LoadOptions, read_model, read_referenced};
 use crate::material::{AlphaMode, Filter, Sampler, TextureRef, UvTransform, Wrap};
 use crate::mesh::{MAX_COORDINATE, Mesh};
 use crate::scene::{Camera, Light, LightKind, Material, MaterialKey, MeshKey, NodeKey, Scene};
@@ -425,14 +425,7 @@ impl Loader<'_> {
             }
             gltf::image::Source::Uri { uri, .. } => {
                 let file = percent_decode(uri);
-                let bytes = match read_referenced(self.dir, &file, &what, Some(IMAGE_FILE_LIMIT), self.options) {
-                    Err(f @ (Fault::OutsideFolder(_) | Fault::Access(_))) => return Err(f),
-                    Err(f) => Err(f.to_string()),
-                    Ok(b) if b.len() as u64 >= IMAGE_FILE_LIMIT => {
-                        Err(format!("larger than the {} MiB an image file may have", IMAGE_FILE_LIMIT >> 20))
-                    }
-                    Ok(b) => Ok(b),
-                };
+                let bytes = images::read_image_file(self.dir, &file, &what, self.options)?;
                 let name = image.name().map_or_else(|| file.clone(), str::to_string);
                 ImageSource { label: format!("{label} ('{file}')"), name, bytes }
             }

@@ -6,8 +6,11 @@
 //! refuse the model: the loaders leave its materials untextured and say so in one warning line. Only a
 //! file the model may not read at all is refused, by the loader, before it gets here.
 
+use std::path::Path;
+
 use rayon::prelude::*;
 
+use super::{AssetFault, IMAGE_FILE_LIMIT, LoadOptions, read_referenced};
 use crate::material::texture::{ImageHeader, chain_bytes};
 use crate::material::{MAX_TEXTURE_SIDE, Texture};
 
@@ -36,6 +39,25 @@ pub(super) struct ImageSource {
     pub name: String,
     /// Its bytes, or what went wrong reading them.
     pub bytes: Result<Vec<u8>, String>,
+}
+
+/// An image file a model names, `file` relative to its `folder`: its bytes, or why they cannot be used
+/// (missing, unreadable, longer than [`IMAGE_FILE_LIMIT`]). A file the model may not read at all refuses
+/// the model, as a buffer would.
+pub(super) fn read_image_file(
+    folder: &Path,
+    file: &str,
+    what: &str,
+    options: &LoadOptions,
+) -> Result<Result<Vec<u8>, String>, AssetFault> {
+    match read_referenced(folder, file, what, Some(IMAGE_FILE_LIMIT), options) {
+        Err(f @ (AssetFault::OutsideFolder(_) | AssetFault::Access(_))) => Err(f),
+        Err(f) => Ok(Err(f.to_string())),
+        Ok(b) if b.len() as u64 >= IMAGE_FILE_LIMIT => {
+            Ok(Err(format!("larger than the {} MiB an image file may have", IMAGE_FILE_LIMIT >> 20)))
+        }
+        Ok(b) => Ok(Ok(b)),
+    }
 }
 
 /// Decodes every source, in parallel, after checking all the headers against `limits` in order. The

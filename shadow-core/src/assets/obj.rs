@@ -18,7 +18,7 @@ use std::path::Path;
 use glam::{Mat4, Vec2, Vec3};
 
 use super::images::{self, ImageSource};
-use super::{AssetError, AssetFault, IMAGE_FILE_LIMIT, LoadOptions, read_model, read_referenced};
+use super::{AssetError, AssetFault, LoadOptions, read_model, read_referenced};
 use crate::material::{AlphaMode, Sampler, Texture, TextureRef, UvTransform, Wrap};
 use crate::mesh::Mesh;
 use crate::scene::{Material, Scene, TextureKey};
@@ -132,14 +132,7 @@ impl Images {
         }
         let mut sources = Vec::with_capacity(files.len());
         for file in &files {
-            let bytes = match read_referenced(folder, file, "a material library", Some(IMAGE_FILE_LIMIT), options) {
-                Err(f @ (AssetFault::OutsideFolder(_) | AssetFault::Access(_))) => return Err(f),
-                Err(f) => Err(f.to_string()),
-                Ok(b) if b.len() as u64 >= IMAGE_FILE_LIMIT => {
-                    Err(format!("larger than the {} MiB an image file may have", IMAGE_FILE_LIMIT >> 20))
-                }
-                Ok(b) => Ok(b),
-            };
+            let bytes = images::read_image_file(folder, file, "a material library", options)?;
             sources.push(ImageSource { label: file.clone(), name: file.clone(), bytes });
         }
         let decoded = files.into_iter().zip(images::decode_all(sources, &options.textures)).collect();

@@ -9,13 +9,10 @@ use std::process::ExitCode;
 use clap::Parser;
 use serde_json::json;
 use shadow_core::FrameInputs;
-use shadow_core::assets::FileAccess;
-use shadow_core::inspect::Inspection;
-use shadow_core::material::{AlphaMode, Filter, Wrap};
 use shadow_core::scenes::{self, SceneParams};
 use shadow_core::technique::TechniqueSpec;
 use shadowlab::compare::{CompareJob, run_compare};
-use shadowlab::setup::{OptionError, SceneSetup, parse_size};
+use shadowlab::setup::{OptionError, parse_size};
 use shadowlab::{BackendChoice, Error, Renderer, TechniqueRegistry};
 
 mod args;
@@ -43,6 +40,8 @@ macro_rules! out_raw {
         }
     }};
 }
+
+mod inspect;
 
 fn stdout_error(e: &std::io::Error) -> Error {
     if e.kind() == std::io::ErrorKind::BrokenPipe {
@@ -112,7 +111,7 @@ fn run(cli: Cli) -> Result<(), Error> {
     match cli.command {
         Command::Scenes { json } => list_scenes(json),
         Command::Techniques { json } => list_techniques(json),
-        Command::Inspect { target, json, allow_outside_files } => inspect(&target, json, allow_outside_files),
+        Command::Inspect { target, json, allow_outside_files } => inspect::inspect(&target, json, allow_outside_files),
         Command::Render { scene, view, technique, backend, out } => render(&scene, &view, &technique, &backend, &out),
         Command::Compare { scene, view, choice, reference, out_dir } => {
             compare(&scene, &view, &choice, reference.as_deref(), out_dir)
@@ -247,111 +246,6 @@ fn list_techniques(json: bool) -> Result<(), Error> {
         }
     }
     Ok(())
-}
-
-fn inspect(target: &str, json: bool, allow_outside_files: bool) -> Result<(), Error> {
-    let path = Path::new(target);
-    let is_file = shadow_core::assets::is_model_path(path) || path.exists();
-    let file_access = if allow_outside_files { FileAccess::Anywhere } else { FileAccess::ModelFolder };
-    let i = if is_file {
-        // The file's own numbers; the silhouette from the default staged light.
-        let options = shadow_core::assets::LoadOptions { file_access, ..Default::default() };
-        let raw = shadow_core::assets::load_with(path, &options)
-            .map_err(|e| Error::Setup(shadowlab::SceneSourceError::Asset(e).into()))?;
-        args::print_warnings(&raw);
-        let of_file = Inspection::of(&raw);
-        // Staged in place rather than loaded again: its images are decoded once.
-        let mut staged = raw;
-        scenes::stage_model(&mut staged, false);
-        Inspection { silhouette_edges: Inspection::of(&staged).silhouette_edges, ..of_file }
-    } else {
-        Inspection::of(&SceneSetup::new(target).build()?)
-    };
-    if json {
-        return print_json(&json!({
-            "triangles": i.triangles,
-            "vertices": i.vertices,
-            "closed": i.closed,
-            "components": i.components,
-            "boundary_edges": i.boundary_edges,
-            "non_manifold_edges": i.non_manifold_edges,
-            "inconsistent_edges": i.inconsistent_edges,
-            "bounds": {"min": i.bounds.min.to_array(), "max": i.bounds.max.to_array()},
-            "silhouette_edges": i.silhouette_edges,
-            "meshes": i.meshes,
-            "meshes_with_texture_coordinates": i.meshes_with_uvs,
-            "materials": i.materials.iter().map(material_json).collect::<Vec<_>>(),
-            "textures": i.textures.iter().map(|t| json!({
-                "name": t.name, "width": t.width, "height": t.height, "bytes_with_mips": t.bytes,
-            })).collect::<Vec<_>>(),
-        }));
-    }
-    out!("{target}");
-    out!("  triangles           {}", i.triangles);
-    out!("  vertices (welded)   {}", i.vertices);
-    out!("  closed              {}", i.closed);
-    out!("  components          {}", i.components);
-    out!("  boundary edges      {}", i.boundary_edges);
-    out!("  non-manifold edges  {}", i.non_manifold_edges);
-    out!("  inconsistent edges  {}", i.inconsistent_edges);
-    out!("  bounds              {} .. {}", i.bounds.min, i.bounds.max);
-    match i.silhouette_edges {
-        Some(n) => out!("  silhouette edges    {n} (default light)"),
-        None => out!("  silhouette edges    - (no light)"),
-    }
-    out!("  texture coordinates {} of {} meshes", i.meshes_with_uvs, i.meshes);
-    let count = |mode: &str| i.materials.iter().filter(|m| m.alpha_mode.name() == mode).count();
-    let sides = i.materials.iter().filter(|m| m.double_sided).count();
-    out!(
-        "  materials           {} ({} opaque, {} masked, {} blended; {sides} double-sided)",
-        i.materials.len(),
-        count("OPAQUE"),
-        count("MASK"),
-        count("BLEND")
-    );
-    for m in &i.materials {
-        let mode = match m.alpha_mode {
-            AlphaMode::Mask { cutoff } => format!("MASK {cutoff}"),
-            other => other.name().to_string(),
-        };
-        let texture = m.texture.map_or(String::new(), |t| format!("  texture {t}"));
-        let sides = if m.double_sided { "double-sided" } else { "single-sided" };
-        out!("    {:<20} {mode:<10} {sides}{texture}", m.name);
-    }
-    let bytes: usize = i.textures.iter().map(|t| t.bytes).sum();
-    out!("  textures            {} ({:.1} MiB with mip chains)", i.textures.len(), bytes as f64 / f64::from(1 << 20));
-    for (n, t) in i.textures.iter().enumerate() {
-        out!("    {n:<3} {} x {}  {}", t.width, t.height, t.name);
-    }
-    Ok(())
-}
-
-/// A material as `inspect --json` lists it.
-fn material_json(m: &shadow_core::inspect::MaterialStats) -> serde_json::Value {
-    let mut j = json!({
-        "name": m.name, "alpha_mode": m.alpha_mode.name(), "double_sided": m.double_sided,
-        "base_color_texture": m.texture,
-    });
-    if let AlphaMode::Mask { cutoff } = m.alpha_mode {
-        j["alpha_cutoff"] = json!(cutoff);
-    }
-    if let Some(s) = m.sampler {
-        let filter = |f: Option<Filter>| match f {
-            None => "none",
-            Some(Filter::Nearest) => "nearest",
-            Some(Filter::Linear) => "linear",
-        };
-        let wrap = |w: Wrap| match w {
-            Wrap::Repeat => "repeat",
-            Wrap::ClampToEdge => "clamp_to_edge",
-            Wrap::MirroredRepeat => "mirrored_repeat",
-        };
-        j["sampler"] = json!({
-            "mag": filter(Some(s.mag)), "min": filter(Some(s.min)), "mipmap": filter(s.mipmap),
-            "wrap_u": wrap(s.wrap_u), "wrap_v": wrap(s.wrap_v),
-        });
-    }
-    j
 }
 
 /// Checks that every technique exists on the backends `choice` names, before any backend is opened, so
