@@ -154,6 +154,15 @@ impl View {
         }
     }
 
+    /// [`Self::memory`] once the device has finished every submitted frame, so the staging buffers of
+    /// writes still in flight are freed and not counted: what a script's `memory` step reports.
+    #[must_use]
+    pub fn settled_memory(&self) -> GpuMemory {
+        // A device that cannot wait (lost, or mid-recording) is read as it stands.
+        let _ = self.shadows.context().wait();
+        self.memory()
+    }
+
     /// Times the wgpu frames on the GPU (where the adapter has timestamps); see [`Self::gpu_times`].
     pub fn time_frames(&mut self) -> bool {
         self.shadows.time_frames(true)

@@ -132,7 +132,7 @@ impl Viewer {
             Step::Screenshot(path) => self.screenshot = Some(path),
             Step::Command => println!("{}", self.command()),
             Step::Memory => {
-                let m = self.view.memory();
+                let m = self.view.settled_memory();
                 println!(
                     "gpu memory: {} buffers, {} buffer bytes, {} texture bytes",
                     m.buffers, m.buffer_bytes, m.texture_bytes
