@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 use shadow_core::image::{Rgb8, error_map_over, visibility_to_rgb};
+use shadow_core::material::AlphaMode;
 use shadow_core::metrics::{
     VisibilityMetrics, back_false_light, compare_visibility, flip_mean, light_bleeding, measured_pixels, min_median,
     near_field, texel_density,
@@ -105,6 +106,28 @@ pub struct CompareReport {
     pub cross_backend: Vec<CrossEntry>,
     /// The reference, as its spec reads.
     pub reference: String,
+    /// What the reader must know of the scene to read the figures: which content every technique and
+    /// the reference take in a simpler way alike.
+    pub notes: Vec<String>,
+}
+
+/// The notes of a report on `frame` ([`CompareReport::notes`]).
+#[must_use]
+pub fn scene_notes(frame: &FrameInputs) -> Vec<String> {
+    let mut blended: Vec<&str> = Vec::new();
+    for inst in frame.instances.iter().filter(|i| i.casts_shadow && i.material.alpha_mode == AlphaMode::Blend) {
+        if !blended.contains(&inst.material.name.as_str()) {
+            blended.push(&inst.material.name);
+        }
+    }
+    let mut notes = Vec::new();
+    if !blended.is_empty() {
+        notes.push(format!(
+            "blended casters cast as opaque ones, in every technique and in the reference alike (materials: {})",
+            blended.join(", ")
+        ));
+    }
+    notes
 }
 
 /// The reference for `techniques`: `area-light-reference` when they are all soft, `ray-traced` otherwise
@@ -535,6 +558,7 @@ pub fn run_compare(
         results: runs.iter().map(|m| m.entry.clone()).collect(),
         cross_backend: cross_backend(&runs, &refs.cpu().mask)?,
         reference: job.reference.to_string(),
+        notes: scene_notes(job.frame),
     };
     if let Some(dir) = &job.out_dir {
         write_reports(dir, job, &refs, (&sheet, &runs), &report)?;
@@ -554,6 +578,9 @@ pub fn report_markdown(r: &CompareReport) -> String {
          techniques built on depth maps.\n\n",
         r.scene, r.width, r.height
     );
+    for note in &r.notes {
+        s.push_str(&format!("Note: {note}.\n\n"));
+    }
     s.push_str("| technique | backend | reference | mismatch | edge band | interior | near field | false shadow | false light | RMSE | FLIP | texels/px | total ms | picture |\n");
     s.push_str("|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|\n");
     for e in &r.results {
@@ -604,4 +631,25 @@ pub fn report_markdown(r: &CompareReport) -> String {
         s.push_str(&format!("- `{}` ({}): {}\n", e.technique, e.backend, c.join(", ")));
     }
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use shadow_core::scenes::{self, SceneParams};
+
+    use super::*;
+
+    /// A report on a scene with blended casters says they cast as opaque ones, naming their materials;
+    /// one with none says nothing.
+    #[test]
+    fn blended_casters_are_noted() {
+        let mut scene = scenes::build("cutout", &SceneParams::default()).expect("cutout");
+        let notes = |scene: &shadow_core::Scene| scene_notes(&FrameInputs::from_first_camera(scene).expect("frame"));
+        assert!(notes(&scene).is_empty());
+        let card = scene.materials().find(|(_, m)| m.name == "checkerboard").expect("the card").0;
+        scene.material_mut(card).expect("material").alpha_mode = AlphaMode::Blend;
+        let notes = notes(&scene);
+        assert_eq!(notes.len(), 1);
+        assert!(notes[0].contains("cast as opaque") && notes[0].contains("checkerboard"), "{}", notes[0]);
+    }
 }

@@ -36,6 +36,23 @@ pub enum RegistryError {
     Settings(#[from] SettingsError),
 }
 
+/// A technique [`TechniqueRegistry::measurable`] leaves out of a frame, and why.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LeftOut {
+    /// The technique.
+    pub name: &'static str,
+    /// Why, as a clause: "as ...".
+    pub why: &'static str,
+}
+
+impl LeftOut {
+    /// It or its reference takes none of the frame's kinds of light.
+    pub const LIGHTS: &'static str = "as they or their reference take no light of this scene's kinds";
+    /// It extrudes silhouettes, and the frame has casters cut out by their texture.
+    pub const CUTOUTS: &'static str =
+        "as they extrude silhouettes and this scene's casters are cut out by their textures, which have none";
+}
+
 /// Every technique, by name.
 #[derive(Clone, Default)]
 pub struct TechniqueRegistry {
@@ -76,17 +93,25 @@ impl TechniqueRegistry {
     }
 
     /// The techniques `compare` and `results` measure on `frame` when none is named: every one that is
-    /// not a reference and that takes every light of the frame, as do the references of its kind (hard or
-    /// soft), in registration order; and the names of those left out.
+    /// not a reference, that takes every light of the frame, as do the references of its kind (hard or
+    /// soft), and that takes its casters (a frame with casters cut out by their texture leaves out the
+    /// techniques that extrude silhouettes), in registration order; and those left out, each with why.
     #[must_use]
-    pub fn measurable(&self, frame: &FrameInputs) -> (Vec<TechniqueSpec>, Vec<&'static str>) {
+    pub fn measurable(&self, frame: &FrameInputs) -> (Vec<TechniqueSpec>, Vec<LeftOut>) {
         let lit = |e: &TechniqueEntry| frame.lights.iter().all(|l| e.lights.takes(l));
-        let (taken, left): (Vec<_>, Vec<_>) = self
-            .entries
-            .iter()
-            .filter(|e| !e.reference)
-            .partition(|e| lit(e) && self.entries.iter().filter(|r| r.reference && r.soft == e.soft).all(lit));
-        (taken.iter().map(|e| TechniqueSpec::named(e.name)).collect(), left.iter().map(|e| e.name).collect())
+        let cutouts = frame.has_cutout_casters();
+        let mut taken = Vec::new();
+        let mut left = Vec::new();
+        for e in self.entries.iter().filter(|e| !e.reference) {
+            if !(lit(e) && self.entries.iter().filter(|r| r.reference && r.soft == e.soft).all(lit)) {
+                left.push(LeftOut { name: e.name, why: LeftOut::LIGHTS });
+            } else if cutouts && !e.cutouts {
+                left.push(LeftOut { name: e.name, why: LeftOut::CUTOUTS });
+            } else {
+                taken.push(TechniqueSpec::named(e.name));
+            }
+        }
+        (taken, left)
     }
 
     /// Adds (or replaces) a technique.
@@ -138,5 +163,36 @@ impl TechniqueRegistry {
         let e = self.get(&spec.name)?;
         let make = e.cpu.ok_or_else(|| RegistryError::NotOnBackend { name: spec.name.clone(), backend: "cpu" })?;
         Ok(make(spec)?)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use shadow_core::material::AlphaMode;
+    use shadow_core::scenes::{self, SceneParams};
+
+    use super::*;
+
+    /// On a scene whose card is cut out by its texture, the techniques that extrude silhouettes are left
+    /// out, each saying why; the same card made opaque or blended leaves none out for it.
+    #[test]
+    fn cutouts_leave_out_the_techniques_that_extrude_silhouettes() {
+        let registry = TechniqueRegistry::builtin();
+        let mut scene = scenes::build("cutout", &SceneParams::default()).expect("cutout");
+        let left_for_cutouts = |scene: &shadow_core::Scene| {
+            let frame = FrameInputs::from_first_camera(scene).expect("frame");
+            let (taken, left) = registry.measurable(&frame);
+            assert!(taken.iter().any(|t| t.name == "shadow-map"), "the map techniques are measured");
+            left.iter().filter(|l| l.why == LeftOut::CUTOUTS).map(|l| l.name).collect::<Vec<_>>()
+        };
+        let extruding: Vec<&str> = registry.entries().iter().filter(|e| !e.cutouts).map(|e| e.name).collect();
+        assert_eq!(extruding, ["hybrid", "penumbra-wedges", "shadow-volume-zpass", "shadow-volume-zfail"]);
+        // Penumbra wedges take no directional light, which leaves them out first.
+        assert_eq!(left_for_cutouts(&scene), ["hybrid", "shadow-volume-zpass", "shadow-volume-zfail"]);
+        let card = scene.materials().find(|(_, m)| m.name == "checkerboard").expect("the card").0;
+        for mode in [AlphaMode::Opaque, AlphaMode::Blend] {
+            scene.material_mut(card).expect("material").alpha_mode = mode;
+            assert!(left_for_cutouts(&scene).is_empty(), "{mode:?}");
+        }
     }
 }

@@ -16,7 +16,7 @@ use crate::geometry::silhouette::{CastMode, Silhouette, silhouette};
 use crate::geometry::volume::{Caps, ShadowVolume, extrude};
 use crate::image::Image;
 use crate::light::{LightView, LightViewError};
-use crate::material::{Material, Texture};
+use crate::material::{AlphaMode, Footprint, Material, Texture};
 use crate::mesh::Mesh;
 use crate::scene::{Camera, CameraKey, Light, LightShadow, MeshKey, NodeKey, Scene, SceneError};
 use crate::stats::Counters;
@@ -54,6 +54,39 @@ pub struct Instance {
     pub receives_shadow: bool,
     /// World-space bounds.
     pub bounds: Aabb,
+}
+
+/// How much of an instance's surface is there to block light or to be seen: its material's alpha test.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Coverage {
+    /// All of it: opaque and blended materials (a blended surface blocks as an opaque one for now), and
+    /// masked ones whose alpha passes with no texture to read.
+    Solid,
+    /// Where its texels pass the alpha test: a masked material with a texture, on a mesh with texture
+    /// coordinates.
+    Cutout,
+    /// None: a masked material whose alpha fails with no texture to read.
+    Absent,
+}
+
+impl Instance {
+    /// How much of the surface is there ([`Coverage`]).
+    #[must_use]
+    pub fn coverage(&self) -> Coverage {
+        let material = &self.material;
+        if !matches!(material.alpha_mode, AlphaMode::Mask { .. }) {
+            return Coverage::Solid;
+        }
+        let textured =
+            material.base_color_texture.is_some() && self.base_color_texture.is_some() && self.mesh.uvs().is_some();
+        if textured {
+            Coverage::Cutout
+        } else if material.passes(None, None, Footprint::POINT) {
+            Coverage::Solid
+        } else {
+            Coverage::Absent
+        }
+    }
 }
 
 /// The shadow volume of one casting instance, in that instance's mesh space.
@@ -188,6 +221,12 @@ impl FrameInputs {
     #[must_use]
     pub fn shadow(&self, k: usize) -> LightShadow {
         self.shadows.get(k).cloned().unwrap_or_default()
+    }
+
+    /// True when some casting instance is alpha-tested ([`Coverage::Cutout`]).
+    #[must_use]
+    pub fn has_cutout_casters(&self) -> bool {
+        self.instances.iter().any(|i| i.casts_shadow && i.coverage() == Coverage::Cutout)
     }
 
     /// Total triangles drawn.

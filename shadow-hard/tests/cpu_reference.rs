@@ -160,3 +160,29 @@ fn volumes_are_exact_at_every_scale_the_loaders_accept() {
         }
     }
 }
+
+/// The reference through `cutout`'s checkerboard card lights half of the ground under it, as the board
+/// is half clear; the same card made opaque shadows all of it.
+#[test]
+fn the_reference_sees_through_clear_texels() {
+    use shadow_core::material::AlphaMode;
+    use shadow_core::scenes::cutouts::card_shadow_lit_share;
+    let lit_share = |scene: &Scene| {
+        let mut reference = Stateful::<CpuBackend, _>::new(RayTraced::defaults(), String::new());
+        let r = render_frame(&mut CpuContext::new(), &frame(scene), SIZE, SIZE, &mut reference).expect("reference");
+        let g = &r.gbuffer;
+        let pixels = (g.position.data().iter().zip(g.receiver.data()))
+            .zip(r.visibility[0].data())
+            .filter(|((_, receiver), _)| **receiver)
+            .map(|((&p, _), &v)| (p, v));
+        card_shadow_lit_share(pixels)
+    };
+    let mut scene = scenes::build("cutout", &SceneParams::default()).expect("cutout");
+    let (share, pixels) = lit_share(&scene);
+    assert!(pixels > 20_000, "{pixels} pixels under the card");
+    assert!((share - 0.5).abs() <= 0.005, "the reference lights {:.2}% of the card's shadow", share * 100.0);
+    let card = scene.materials().find(|(_, m)| m.name == "checkerboard").expect("the card's material").0;
+    scene.material_mut(card).expect("material").alpha_mode = AlphaMode::Opaque;
+    let (solid, _) = lit_share(&scene);
+    assert!(solid < 0.001, "an opaque card's shadow is {:.2}% lit", solid * 100.0);
+}

@@ -11,17 +11,17 @@ use crate::procedural;
 use crate::scene::{Camera, Light, Material, MeshKey, Scene};
 
 /// A scene under construction.
-struct Stage {
-    scene: Scene,
+pub(super) struct Stage {
+    pub(super) scene: Scene,
 }
 
 impl Stage {
-    fn new() -> Self {
+    pub(super) fn new() -> Self {
         Self { scene: Scene::new() }
     }
 
     /// Adds a mesh instance with a colour. The builders only pass finite transforms of their own meshes.
-    fn add(&mut self, name: &str, mesh: Mesh, color: Vec3, transform: Mat4) {
+    pub(super) fn add(&mut self, name: &str, mesh: Mesh, color: Vec3, transform: Mat4) {
         let m = self.mesh(mesh);
         self.place(name, m, color, transform);
     }
@@ -39,12 +39,12 @@ impl Stage {
         }
     }
 
-    fn ground(mut self, size: f32) -> Self {
+    pub(super) fn ground(mut self, size: f32) -> Self {
         self.add("ground", built(procedural::plane(size, size)), Vec3::splat(0.75), Mat4::IDENTITY);
         self
     }
 
-    fn finish(mut self, camera: Camera, light: Light) -> Scene {
+    pub(super) fn finish(mut self, camera: Camera, light: Light) -> Scene {
         self.scene.add_camera(camera);
         self.scene.add_light(light);
         self.scene

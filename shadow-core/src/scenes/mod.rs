@@ -5,6 +5,7 @@
 //! plane with the default spotlight and camera of DESIGN 11.
 
 mod builders;
+pub mod cutouts;
 
 use glam::{Mat4, Vec3};
 
@@ -145,9 +146,20 @@ pub const OUTDOOR: &[SceneInfo] = &[
     },
 ];
 
-/// Every built-in scene: the papers' ([`ALL`]), then the outdoor ones ([`OUTDOOR`]).
+/// The scenes of alpha-tested casters (glTF `MASK`), whose textures cut their cards out: the light passes
+/// must discard clear texels, and the references test them. Apart from [`ALL`], as the techniques that
+/// extrude silhouettes leave them out.
+pub const CUTOUT: &[SceneInfo] = &[SceneInfo {
+    name: "cutout",
+    after: "alpha testing",
+    description: "a checkerboard card cut out by its alpha under a sun straight above: half its shadow is lit",
+    build: cutouts::cutout,
+}];
+
+/// Every built-in scene: the papers' ([`ALL`]), the outdoor ones ([`OUTDOOR`]), then those of cutouts
+/// ([`CUTOUT`]).
 pub fn every() -> impl Iterator<Item = &'static SceneInfo> {
-    ALL.iter().chain(OUTDOOR)
+    ALL.iter().chain(OUTDOOR).chain(CUTOUT)
 }
 
 /// Why a scene could not be built.
@@ -161,7 +173,7 @@ pub fn names() -> Vec<&'static str> {
     ALL.iter().map(|s| s.name).collect()
 }
 
-/// The description of a built-in scene (of [`ALL`] or [`OUTDOOR`]).
+/// The description of a built-in scene (of [`every`]).
 #[must_use]
 pub fn info(name: &str) -> Option<&'static SceneInfo> {
     every().find(|s| s.name == name)
@@ -170,7 +182,7 @@ pub fn info(name: &str) -> Option<&'static SceneInfo> {
 /// Builds a built-in scene: its meshes, one camera and one light.
 ///
 /// # Errors
-/// [`UnknownScene`] for a name not in [`ALL`] or [`OUTDOOR`].
+/// [`UnknownScene`] for a name not in [`every`].
 pub fn build(name: &str, params: &SceneParams) -> Result<Scene, UnknownScene> {
     let info = info(name).ok_or_else(|| UnknownScene(name.into()))?;
     let mut scene = (info.build)(params);

@@ -91,6 +91,9 @@ pub struct Entry<C: Backend, G: Backend> {
     pub wgsl: fn() -> Vec<(&'static str, String)>,
     /// For a technique built on depth maps, where its texels fall ([`MapLayout`]).
     pub layout: Option<Layout>,
+    /// Whether it takes casters that their texture cuts out ([`crate::frame::Coverage::Cutout`]); one
+    /// that extrudes silhouettes cannot, as a cutout has none to extrude.
+    pub cutouts: bool,
 }
 
 /// No WGSL of its own.
@@ -128,6 +131,7 @@ impl<C: Backend, G: Backend> Entry<C, G> {
             wgpu,
             wgsl: no_wgsl,
             layout: None,
+            cutouts: true,
         }
     }
 
@@ -166,6 +170,13 @@ impl<C: Backend, G: Backend> Entry<C, G> {
     #[must_use]
     pub fn with_layout<S: TechniqueSettings + MapLayout>(self) -> Self {
         Self { layout: Some(layout::<S>), ..self }
+    }
+
+    /// The same entry, for a technique that extrudes the casters' silhouettes, so takes no casters
+    /// cut out by their texture.
+    #[must_use]
+    pub fn without_cutouts(self) -> Self {
+        Self { cutouts: false, ..self }
     }
 
     /// The same entry, for a reference.

@@ -55,11 +55,13 @@ impl Aabb {
     }
 }
 
-/// The wide tree over `tris` (at least one): its nodes (the root first) and its leaves.
+/// The wide tree over `tris` (at least one): its nodes (the root first), its leaves, and each leaf's
+/// triangles as indices into `tris`, lane by lane (a leaf of fewer than eight repeats its last one, as
+/// its [`Tri8`] does).
 ///
 /// The builder moves the triangles' boxes as it sorts their indices, so the passes over a node read
 /// its boxes in memory order.
-pub fn build(tris: &[[Vec3A; 3]]) -> (Vec<Node8>, Vec<Tri8>) {
+pub fn build(tris: &[[Vec3A; 3]]) -> (Vec<Node8>, Vec<Tri8>, Vec<Members>) {
     // The triangles' boxes. A box's centre is worked out where it is needed, not stored: every pass
     // streams the boxes through, and the partition moves them.
     let mut prims: Vec<Aabb> = tris
@@ -74,14 +76,27 @@ pub fn build(tris: &[[Vec3A; 3]]) -> (Vec<Node8>, Vec<Tri8>) {
         // The root is always a wide node, here over a single leaf.
         let mut node = Node8::EMPTY;
         node.set(0, LEAF, bounds.lo, bounds.hi);
-        return (vec![node], vec![Tri8::new(root.order.len(), |i| tris[root.order[i] as usize])]);
+        return (
+            vec![node],
+            vec![Tri8::new(root.order.len(), |i| tris[root.order[i] as usize])],
+            vec![members(root.order)],
+        );
     }
     let built = subtree(root, &mut Box::new(Bins::EMPTY));
     let size = built.size();
     let mut nodes = vec![Node8::EMPTY; size.nodes];
     let mut leaves = vec![Tri8::EMPTY; size.leaves];
-    built.write(tris, &mut nodes, 0, &mut leaves, 0);
-    (nodes, leaves)
+    let mut lanes = vec![[0; LANES]; size.leaves];
+    built.write(tris, &mut nodes, 0, (&mut leaves, &mut lanes), 0);
+    (nodes, leaves, lanes)
+}
+
+/// A leaf's triangles, lane by lane.
+pub type Members = [u32; LANES];
+
+/// The lanes of a leaf of the triangles `ids` (one to eight), the last repeated.
+fn members(ids: &[u32]) -> Members {
+    std::array::from_fn(|k| ids[k.min(ids.len() - 1)])
 }
 
 /// The bounds of the boxes `prims`, and of their centres.
@@ -406,12 +421,20 @@ impl Built<'_> {
         }
     }
 
-    /// Writes the subtree into the whole tree's `nodes` (from index `node_at`) and `leaves` (from
-    /// `leaf_at`), slices cut to its size; a node built in parallel writes its children in parallel.
-    fn write(self, tris: &[[Vec3A; 3]], nodes: &mut [Node8], node_at: usize, leaves: &mut [Tri8], leaf_at: usize) {
+    /// Writes the subtree into the whole tree's `nodes` (from index `node_at`) and leaves with their
+    /// members (from `leaf_at`), slices cut to its size; a node built in parallel writes its children
+    /// in parallel.
+    fn write(
+        self,
+        tris: &[[Vec3A; 3]],
+        nodes: &mut [Node8],
+        node_at: usize,
+        (leaves, lanes): (&mut [Tri8], &mut [Members]),
+        leaf_at: usize,
+    ) {
         let leaf = |ids: &[u32]| Tri8::new(ids.len(), |i| tris[ids[i] as usize]);
         match self {
-            Self::Leaf(ids) => leaves[0] = leaf(ids),
+            Self::Leaf(ids) => (leaves[0], lanes[0]) = (leaf(ids), members(ids)),
             Self::Alone(tree) => {
                 // Its numbers start at 0: every child moves by where the subtree starts.
                 for (to, mut node) in nodes.iter_mut().zip(tree.nodes) {
@@ -420,14 +443,14 @@ impl Built<'_> {
                     }
                     *to = node;
                 }
-                for (to, ids) in leaves.iter_mut().zip(tree.leaves) {
-                    *to = leaf(ids);
+                for ((to, lanes), ids) in leaves.iter_mut().zip(lanes.iter_mut()).zip(tree.leaves) {
+                    (*to, *lanes) = (leaf(ids), members(ids));
                 }
             }
             Self::Node { axis, kids } => {
                 // A subtree's slice holds its own node first: a parallel node's size counts itself.
                 let (node, mut nodes_rest) = nodes.split_first_mut().expect("a slot for the node");
-                let mut leaves_rest = leaves;
+                let (mut leaves_rest, mut lanes_rest) = (leaves, lanes);
                 node.axis = axis;
                 let (mut next_node, mut next_leaf) = (node_at + 1, leaf_at);
                 let mut parts = Vec::with_capacity(kids.len());
@@ -440,8 +463,9 @@ impl Built<'_> {
                     node.set(k, child, b.lo, b.hi);
                     let (kid_nodes, more_nodes) = std::mem::take(&mut nodes_rest).split_at_mut(size.nodes);
                     let (kid_leaves, more_leaves) = std::mem::take(&mut leaves_rest).split_at_mut(size.leaves);
-                    (nodes_rest, leaves_rest) = (more_nodes, more_leaves);
-                    parts.push((kid, kid_nodes, next_node, kid_leaves, next_leaf));
+                    let (kid_lanes, more_lanes) = std::mem::take(&mut lanes_rest).split_at_mut(size.leaves);
+                    (nodes_rest, leaves_rest, lanes_rest) = (more_nodes, more_leaves, more_lanes);
+                    parts.push((kid, kid_nodes, next_node, (kid_leaves, kid_lanes), next_leaf));
                     next_node += size.nodes;
                     next_leaf += size.leaves;
                 }

@@ -1,8 +1,10 @@
 //! Ray casting for the exact reference: an eight-wide BVH over every casting triangle in world space,
 //! built by the surface area heuristic on every core ([`build`]) and traversed for any hit, eight boxes
-//! or eight triangles per step ([`wide`]).
+//! or eight triangles per step ([`wide`]). A hit on an alpha-tested triangle counts only where its texel
+//! passes ([`cutout`]); the walk goes on past a clear one.
 
 mod build;
+pub mod cutout;
 mod wide;
 
 use std::hash::{Hash, Hasher};
@@ -12,7 +14,9 @@ use rayon::prelude::*;
 use shadow_core::FrameInputs;
 
 use self::build::STACK;
+use self::cutout::{Cutouts, Table};
 use self::wide::{Child, LEAF, NONE, Node8, Ray, Tri8};
+use shadow_core::frame::Coverage;
 
 /// The casters of a frame, ready for shadow rays.
 pub struct SceneBvh {
@@ -20,6 +24,8 @@ pub struct SceneBvh {
     nodes: Vec<Node8>,
     /// The leaves, in the order a depth-first walk meets them.
     leaves: Vec<Tri8>,
+    /// The leaves' alpha-tested triangles, where the frame casts any.
+    cutouts: Option<Cutouts>,
     triangles: usize,
     /// Whether this CPU runs AVX2 (and the bit scans the walk uses).
     #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
@@ -27,7 +33,7 @@ pub struct SceneBvh {
 }
 
 impl SceneBvh {
-    /// A key that changes when any caster's mesh or transform does.
+    /// A key that changes when any caster's mesh, transform or alpha test does.
     #[must_use]
     pub fn key(frame: &FrameInputs) -> u64 {
         let mut h = std::collections::hash_map::DefaultHasher::new();
@@ -36,6 +42,7 @@ impl SceneBvh {
             for v in inst.world_from_local.to_cols_array() {
                 v.to_bits().hash(&mut h);
             }
+            cutout::hash_alpha_test(inst, &mut h);
         }
         h.finish()
     }
@@ -43,15 +50,17 @@ impl SceneBvh {
     /// Builds the BVH of every casting triangle in world space.
     #[must_use]
     pub fn build(frame: &FrameInputs) -> Self {
-        let tris = casting_triangles(frame);
+        let Casters { tris, cutout, table } = casting_triangles(frame);
         if tris.is_empty() {
-            return Self { nodes: Vec::new(), leaves: Vec::new(), triangles: 0, avx2: false };
+            return Self { nodes: Vec::new(), leaves: Vec::new(), cutouts: None, triangles: 0, avx2: false };
         }
-        let (nodes, leaves) = build::build(&tris);
-        Self { nodes, leaves, triangles: tris.len(), avx2: avx2() }
+        let (nodes, leaves, members) = build::build(&tris);
+        let cutouts = (!table.is_empty()).then(|| Cutouts::new(&members, &cutout, table));
+        Self { nodes, leaves, cutouts, triangles: tris.len(), avx2: avx2() }
     }
 
-    /// Number of triangles.
+    /// Number of triangles (those of masked casters with no texture to read and an alpha below the
+    /// cutoff left out: they are nowhere).
     #[must_use]
     pub fn triangle_count(&self) -> usize {
         self.triangles
@@ -82,9 +91,19 @@ impl SceneBvh {
                 // SAFETY: `avx2` is set only where `is_x86_feature_detected!` found every feature
                 // `walk_avx2` enables (see [`avx2`]).
                 #[allow(unsafe_code)]
-                break 'walk unsafe { self.walk_avx2(&ray, walker.last, &mut walker.stack) };
+                break 'walk unsafe {
+                    if self.cutouts.is_some() {
+                        self.walk_avx2::<true>(&ray, walker.last, &mut walker.stack)
+                    } else {
+                        self.walk_avx2::<false>(&ray, walker.last, &mut walker.stack)
+                    }
+                };
             }
-            self.walk(&ray, walker.last, &mut walker.stack)
+            if self.cutouts.is_some() {
+                self.walk::<true>(&ray, walker.last, &mut walker.stack)
+            } else {
+                self.walk::<false>(&ray, walker.last, &mut walker.stack)
+            }
         };
         if blocker.is_some() {
             walker.last = blocker;
@@ -96,16 +115,22 @@ impl SceneBvh {
     /// 128-bit ones. The operations and their order are the same, so the answers are too.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,bmi1,bmi2,lzcnt")]
-    fn walk_avx2(&self, ray: &Ray, first: Option<Child>, stack: &mut [Child; STACK]) -> Option<Child> {
-        self.walk(ray, first, stack)
+    fn walk_avx2<const CUTOUTS: bool>(
+        &self,
+        ray: &Ray,
+        first: Option<Child>,
+        stack: &mut [Child; STACK],
+    ) -> Option<Child> {
+        self.walk::<CUTOUTS>(ray, first, stack)
     }
 
     /// The leaf that blocks `ray`, trying leaf `first` before walking the tree (whose walk then passes it
-    /// by); `None` when none does. The walk's stack is `stack`.
+    /// by); `None` when none does. The walk's stack is `stack`. `CUTOUTS` says whether the tree has
+    /// alpha-tested triangles: a tree without walks as if the alpha test did not exist.
     #[inline(always)]
-    fn walk(&self, ray: &Ray, first: Option<Child>, stack: &mut [Child; STACK]) -> Option<Child> {
+    fn walk<const CUTOUTS: bool>(&self, ray: &Ray, first: Option<Child>, stack: &mut [Child; STACK]) -> Option<Child> {
         let first = first.unwrap_or(NONE);
-        if first != NONE && self.leaves[first as usize].hit(ray) {
+        if first != NONE && self.blocks::<CUTOUTS>(first, ray) {
             return Some(first);
         }
         let mut top = 0;
@@ -113,7 +138,7 @@ impl SceneBvh {
         loop {
             if at & LEAF != 0 {
                 let leaf = at & !LEAF;
-                if leaf != first && self.leaves[leaf as usize].hit(ray) {
+                if leaf != first && self.blocks::<CUTOUTS>(leaf, ray) {
                     return Some(leaf);
                 }
             } else {
@@ -141,6 +166,17 @@ impl SceneBvh {
             }
             top -= 1;
             at = stack[top];
+        }
+    }
+
+    /// Whether leaf `leaf` blocks `ray`: one of its triangles meets it, and where that one is
+    /// alpha-tested, its texel there passes.
+    #[inline(always)]
+    fn blocks<const CUTOUTS: bool>(&self, leaf: Child, ray: &Ray) -> bool {
+        let tris = &self.leaves[leaf as usize];
+        match &self.cutouts {
+            Some(cutouts) if CUTOUTS => cutouts.blocks(leaf as usize, || tris.hit(ray), || tris.hits(ray)),
+            _ => tris.hit(ray),
         }
     }
 }
@@ -174,29 +210,75 @@ fn avx2() -> bool {
     false
 }
 
-/// Every casting triangle of the frame, in world space.
-fn casting_triangles(frame: &FrameInputs) -> Vec<[Vec3A; 3]> {
+/// The casting triangles of a frame.
+struct Casters {
+    /// Each one in world space.
+    tris: Vec<[Vec3A; 3]>,
+    /// Where the frame casts alpha-tested triangles: each one's index in `table`, `u32::MAX` for a solid
+    /// one. Empty when it casts none.
+    cutout: Vec<u32>,
+    /// The alpha-tested triangles.
+    table: Table,
+}
+
+/// Every triangle of the frame that can block light, in world space, and the alpha-tested ones among them.
+fn casting_triangles(frame: &FrameInputs) -> Casters {
+    let casters: Vec<(&shadow_core::Instance, Coverage)> = frame
+        .instances
+        .iter()
+        .filter(|i| i.casts_shadow)
+        .map(|i| (i, i.coverage()))
+        .filter(|(_, c)| *c != Coverage::Absent)
+        .collect();
+    let any_cutout = casters.iter().any(|(_, c)| *c == Coverage::Cutout);
+    let mut out = Casters { tris: Vec::new(), cutout: Vec::new(), table: Table::default() };
     // Instance by instance, each one's vertices and triangles split among the threads: a scene is
     // often one large mesh and a few small ones.
-    let mut tris = Vec::new();
-    for inst in frame.instances.iter().filter(|i| i.casts_shadow) {
+    for (inst, coverage) in casters {
         let m = inst.world_from_local;
         let world: Vec<Vec3A> =
             inst.mesh.positions().par_iter().with_min_len(4096).map(|&p| m.transform_point3(p).into()).collect();
-        tris.par_extend(inst.mesh.triangles().par_iter().with_min_len(4096).map(|t| t.map(|v| world[v as usize])));
+        let triangles = inst.mesh.triangles();
+        out.tris.par_extend(triangles.par_iter().with_min_len(4096).map(|t| t.map(|v| world[v as usize])));
+        if any_cutout {
+            let ids = match coverage {
+                Coverage::Cutout => {
+                    let first = out.table.add(inst);
+                    (first..first + triangles.len() as u32).collect()
+                }
+                _ => vec![u32::MAX; triangles.len()],
+            };
+            out.cutout.extend(ids);
+        }
     }
-    tris
+    out
 }
 
 #[cfg(test)]
 mod tests {
-    use glam::Vec3;
+    use glam::{Vec2, Vec3};
     use shadow_core::scenes::{self, LightType, SceneParams};
 
     use obvhs::ray::Ray;
     use obvhs::triangle::Triangle;
 
     use super::*;
+
+    /// Asserts that a tree and the same tree walked without AVX2 both answer a ray `expected`, from the
+    /// root and after the last blocker each one's walker saw (which must change no answer).
+    fn assert_answer(
+        (bvh, portable): (&SceneBvh, &SceneBvh),
+        walkers: &mut (Walker, Walker),
+        (origin, dir, tmax): (Vec3, Vec3, f32),
+        expected: bool,
+        what: &str,
+    ) {
+        let ray = format!("{what} {origin} towards {dir}, to {tmax}");
+        assert_eq!(bvh.occluded(origin, dir, tmax), expected, "{ray}");
+        assert_eq!(portable.occluded(origin, dir, tmax), expected, "{ray}, without AVX2");
+        assert_eq!(bvh.occluded_after(&mut walkers.0, origin, dir, tmax), expected, "{ray}, after the last blocker");
+        assert_eq!(portable.occluded_after(&mut walkers.1, origin, dir, tmax), expected, "{ray}, after, without AVX2");
+    }
 
     #[test]
     fn negative_zero_directions_still_hit() {
@@ -224,13 +306,13 @@ mod tests {
         let bvh = SceneBvh::build(&frame);
         // The same tree walked without AVX2, as CPUs without it walk it.
         let portable = SceneBvh { avx2: false, ..SceneBvh::build(&frame) };
-        let tris = casting_triangles(&frame);
+        let tris = casting_triangles(&frame).tris;
         let g = crate::gbuffer::render(&frame, 48, 36).unwrap();
         // The offset `ray-traced` uses by default (shadow-hard's `epsilon`).
         let origins = crate::passes::rays::RayOrigins::new(&g, &frame, 5e-7);
         let light = &frame.lights[0].kind;
         let (mut cast, mut blocked) = (0, 0);
-        let (mut walker, mut walker_portable) = (Walker::default(), Walker::default());
+        let mut walkers = (Walker::default(), Walker::default());
         for i in (0..g.receiver.data().len()).filter(|&i| g.receiver.data()[i]) {
             let (origin, n) = origins.at(i);
             let (dir, tmax) = crate::passes::rays::towards(light, origin);
@@ -239,15 +321,7 @@ mod tests {
             }
             let ray = Ray::new(origin.into(), dir.map(|c| if c == 0.0 { 0.0 } else { c }).into(), 0.0, tmax);
             let any = tris.iter().any(|&[v0, v1, v2]| Triangle { v0, v1, v2 }.intersect(&ray) < tmax);
-            assert_eq!(bvh.occluded(origin, dir, tmax), any, "pixel {i}: {origin} towards {dir}");
-            assert_eq!(portable.occluded(origin, dir, tmax), any, "pixel {i} without AVX2");
-            // Trying first the leaf that blocked the last blocked ray changes no answer.
-            assert_eq!(bvh.occluded_after(&mut walker, origin, dir, tmax), any, "pixel {i} after the last blocker");
-            assert_eq!(
-                portable.occluded_after(&mut walker_portable, origin, dir, tmax),
-                any,
-                "pixel {i} after, portable"
-            );
+            assert_answer((&bvh, &portable), &mut walkers, (origin, dir, tmax), any, &format!("pixel {i}"));
             cast += 1;
             blocked += usize::from(any);
         }
@@ -276,8 +350,8 @@ mod tests {
             tris.push([corner(&mut rand), corner(&mut rand), corner(&mut rand)]);
         }
         tris.push([Vec3A::ONE; 3]);
-        let (nodes, leaves) = build::build(&tris);
-        let bvh = SceneBvh { nodes, leaves, triangles: tris.len(), avx2: avx2() };
+        let (nodes, leaves, _) = build::build(&tris);
+        let bvh = SceneBvh { nodes, leaves, cutouts: None, triangles: tris.len(), avx2: avx2() };
         let (mut cast, mut blocked) = (0, 0);
         for _ in 0..8000 {
             let origin = Vec3::new(rand() * 6.0 - 3.0, rand() * 6.0 - 3.0, rand() * 6.0 - 3.0);
@@ -301,13 +375,136 @@ mod tests {
         );
     }
 
+    /// A lane reports where the ray meets its triangle as `(1 - u - v) v0 + u v1 + v v2`, the weights the
+    /// alpha test interpolates texture coordinates with.
+    #[test]
+    fn a_hit_says_where_it_meets_the_triangle() {
+        let corners = [Vec3A::new(0.3, -0.2, 1.0), Vec3A::new(1.4, 0.1, 0.8), Vec3A::new(0.2, 1.3, 1.2)];
+        let block = Tri8::new(1, |_| corners);
+        let mut rng = scenes::Rng::new(3);
+        for _ in 0..200 {
+            let (u, v) = (rng.unit(), rng.unit());
+            let (u, v) = if u + v > 1.0 { (1.0 - u, 1.0 - v) } else { (u, v) };
+            let target = corners[0] * (1.0 - u - v) + corners[1] * u + corners[2] * v;
+            let origin = Vec3A::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), -2.0);
+            let hits = block.hits(&wide::Ray::new(origin, (target - origin).normalize(), 0.0, 10.0));
+            assert_eq!(hits.lanes, 0xff, "every lane holds the one triangle");
+            assert!(
+                (hits.u[0] - u).abs() < 1e-4 && (hits.v[0] - v).abs() < 1e-4,
+                "{u} {v}: {} {}",
+                hits.u[0],
+                hits.v[0]
+            );
+        }
+    }
+
+    /// Cards of random alpha textures (read through both filters, every wrap and a turned, scaled
+    /// coordinate transform) among opaque ones: every ray is blocked exactly when testing every triangle,
+    /// each hit's texel included, says so, with or without the last blocker tried first, with or without
+    /// AVX2; and a fair share of the rays meet triangles only where their texels are clear.
+    #[test]
+    fn alpha_tested_rays_are_answered_as_all_triangles_answer_them() {
+        let scene = cards(11, 200);
+        let frame = FrameInputs::from_first_camera(&scene).unwrap();
+        let bvh = SceneBvh::build(&frame);
+        let portable = SceneBvh { avx2: false, ..SceneBvh::build(&frame) };
+        let Casters { tris, cutout, table } = casting_triangles(&frame);
+        assert!(bvh.cutouts.is_some() && !table.is_empty());
+        // Testing every triangle: each one alone in a block, its texel read where it is met.
+        let every = |ray: &wide::Ray| {
+            let (mut met, mut blocked) = (false, false);
+            for (i, &corners) in tris.iter().enumerate() {
+                let hits = Tri8::new(1, |_| corners).hits(ray);
+                if hits.lanes != 0 {
+                    met = true;
+                    blocked |= cutout[i] == u32::MAX || table.passes(cutout[i], hits.u[0], hits.v[0]);
+                }
+            }
+            (met, blocked)
+        };
+        let mut rng = scenes::Rng::new(5);
+        let mut walkers = (Walker::default(), Walker::default());
+        let (mut cast, mut blocked, mut only_clear) = (0, 0, 0);
+        for _ in 0..20_000 {
+            let origin = Vec3::new(rng.range(-3.0, 3.0), rng.range(-3.0, 3.0), rng.range(-3.0, 3.0));
+            let [a, b, c] = tris[(rng.unit() * tris.len() as f32) as usize % tris.len()];
+            let (u, v) = (rng.unit(), rng.unit());
+            let (u, v) = if u + v > 1.0 { (1.0 - u, 1.0 - v) } else { (u, v) };
+            let target = Vec3::from(a + (b - a) * u + (c - a) * v);
+            let dir = (target - origin).normalize();
+            let tmax = (target - origin).length() * rng.range(0.6, 1.6);
+            let (met, any) = every(&wide::Ray::new(origin.into(), dir.into(), 0.0, tmax));
+            assert_answer((&bvh, &portable), &mut walkers, (origin, dir, tmax), any, "");
+            cast += 1;
+            blocked += usize::from(any);
+            only_clear += usize::from(met && !any);
+        }
+        assert!(blocked > cast / 5 && blocked < cast * 4 / 5, "{blocked} of {cast} rays blocked");
+        assert!(only_clear > cast / 20, "{only_clear} of {cast} rays met only clear texels");
+    }
+
+    /// A scene of `count` square cards scattered through a 5 m cube, most of them alpha-tested with one of
+    /// four random alpha textures, read in turn through each filter and wrap and a coordinate transform.
+    fn cards(seed: u64, count: usize) -> shadow_core::Scene {
+        use shadow_core::material::{AlphaMode, Filter, Material, Sampler, Texture, TextureRef, UvTransform, Wrap};
+        let mut rng = scenes::Rng::new(seed);
+        let mut scene = shadow_core::Scene::new();
+        let textures: Vec<_> = (0..4)
+            .map(|k| {
+                let texels = (0..16 * 16).map(|_| [200, 200, 200, (rng.unit() * 255.0) as u8]).collect();
+                scene.add_texture(Texture::from_rgba8(&format!("noise {k}"), 16, 16, texels).unwrap())
+            })
+            .collect();
+        let wraps = [Wrap::Repeat, Wrap::MirroredRepeat, Wrap::ClampToEdge];
+        let materials: Vec<_> = (0..8)
+            .map(|k| {
+                let filter = if k % 2 == 0 { Filter::Nearest } else { Filter::Linear };
+                let sampler = Sampler {
+                    mag: filter,
+                    min: filter,
+                    mipmap: None,
+                    wrap_u: wraps[k % 3],
+                    wrap_v: wraps[(k + 1) % 3],
+                };
+                let transform = if k < 4 {
+                    UvTransform::IDENTITY
+                } else {
+                    UvTransform { offset: Vec2::new(0.3, -0.1), rotation: 0.4, scale: Vec2::new(1.5, 0.8) }
+                };
+                scene.add_material(Material {
+                    base_color_texture: Some(TextureRef { texture: textures[k % 4], sampler, transform }),
+                    alpha: if k == 7 { 0.9 } else { 1.0 },
+                    alpha_mode: AlphaMode::Mask { cutoff: 0.3 + 0.1 * (k % 4) as f32 },
+                    two_sided: true,
+                    ..Material::default()
+                })
+            })
+            .collect();
+        let opaque = scene.add_material(Material::default());
+        for i in 0..count {
+            let centre = Vec3::new(rng.range(-2.5, 2.5), rng.range(-2.5, 2.5), rng.range(-2.5, 2.5));
+            let random =
+                |rng: &mut scenes::Rng| Vec3::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(-1.0, 1.0));
+            let (e1, e2) = (random(&mut rng) * 0.3, random(&mut rng) * 0.3);
+            let positions = vec![centre - e1 - e2, centre + e1 - e2, centre + e1 + e2, centre - e1 + e2];
+            let s = rng.range(0.5, 3.0);
+            let uvs = vec![Vec2::ZERO, Vec2::new(s, 0.0), Vec2::new(s, s), Vec2::new(0.0, s)];
+            let mesh = shadow_core::Mesh::new(positions, vec![[0, 1, 2], [0, 2, 3]]).unwrap().with_uvs(uvs).unwrap();
+            let mesh = scene.add_mesh(mesh);
+            let material = if i % 5 == 0 { opaque } else { materials[i % 8] };
+            scene.add_instance(&format!("card {i}"), mesh, material, glam::Mat4::IDENTITY).unwrap();
+        }
+        scene.add_camera(shadow_core::scene::Camera::look_at(Vec3::new(0.0, 0.0, 8.0), Vec3::ZERO, 45.0));
+        scene
+    }
+
     /// The build splits its work among the threads it has, and yet writes the same tree on any number
     /// of them: node for node, leaf for leaf, in the same places.
     #[test]
     fn the_tree_is_the_same_on_any_number_of_threads() {
         let scene = scenes::build("tree", &SceneParams::default()).expect("tree");
         let frame = FrameInputs::from_first_camera(&scene).expect("frame");
-        let tris = casting_triangles(&frame);
+        let tris = casting_triangles(&frame).tris;
         let on = |threads| {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("a pool");
             pool.install(|| build::build(&tris))

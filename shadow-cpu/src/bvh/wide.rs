@@ -125,22 +125,49 @@ impl Tri8 {
     /// (zero determinant) never hits.
     #[inline(always)]
     pub fn hit(&self, ray: &Ray) -> bool {
-        let d = ray.dir;
         let mut any = false;
         for k in 0..LANES {
-            let c = [self.v0[0][k] - ray.origin[0], self.v0[1][k] - ray.origin[1], self.v0[2][k] - ray.origin[2]];
-            let r = [d[1] * c[2] - c[1] * d[2], d[2] * c[0] - c[2] * d[0], d[0] * c[1] - c[0] * d[1]];
-            let n = [self.n[0][k], self.n[1][k], self.n[2][k]];
-            let inv_det = 1.0 / dot(n, d);
-            let u = dot(r, [self.e2[0][k], self.e2[1][k], self.e2[2][k]]) * inv_det;
-            let v = dot(r, [self.e1[0][k], self.e1[1][k], self.e1[2][k]]) * inv_det;
-            let w = 1.0 - u - v;
-            let inside = (u.to_bits() | v.to_bits() | w.to_bits()) & 0x8000_0000 == 0;
-            let t = dot(n, c) * inv_det;
-            any |= inv_det != 0.0 && inside && t >= ray.tmin && t < ray.tmax;
+            any |= self.lane(ray, k).0;
         }
         any
     }
+
+    /// The lanes [`Self::hit`] finds the ray meets, as bits, and where on each: its barycentric
+    /// coordinates `u` and `v`, the point being `(1 - u - v) v0 + u v1 + v v2` of the corners the block
+    /// was made from.
+    #[inline(always)]
+    pub fn hits(&self, ray: &Ray) -> Hits {
+        let mut hits = Hits { lanes: 0, u: [0.0; LANES], v: [0.0; LANES] };
+        for k in 0..LANES {
+            let (hit, u, v) = self.lane(ray, k);
+            hits.lanes |= u32::from(hit) << k;
+            (hits.u[k], hits.v[k]) = (u, v);
+        }
+        hits
+    }
+
+    /// Lane `k`'s test: whether the ray meets its triangle, and where (see [`Self::hits`]).
+    #[inline(always)]
+    fn lane(&self, ray: &Ray, k: usize) -> (bool, f32, f32) {
+        let d = ray.dir;
+        let c = [self.v0[0][k] - ray.origin[0], self.v0[1][k] - ray.origin[1], self.v0[2][k] - ray.origin[2]];
+        let r = [d[1] * c[2] - c[1] * d[2], d[2] * c[0] - c[2] * d[0], d[0] * c[1] - c[0] * d[1]];
+        let n = [self.n[0][k], self.n[1][k], self.n[2][k]];
+        let inv_det = 1.0 / dot(n, d);
+        let u = dot(r, [self.e2[0][k], self.e2[1][k], self.e2[2][k]]) * inv_det;
+        let v = dot(r, [self.e1[0][k], self.e1[1][k], self.e1[2][k]]) * inv_det;
+        let w = 1.0 - u - v;
+        let inside = (u.to_bits() | v.to_bits() | w.to_bits()) & 0x8000_0000 == 0;
+        let t = dot(n, c) * inv_det;
+        (inv_det != 0.0 && inside && t >= ray.tmin && t < ray.tmax, u, v)
+    }
+}
+
+/// The lanes of a [`Tri8`] a ray meets (bit `k` for lane `k`), and each one's barycentric coordinates.
+pub struct Hits {
+    pub lanes: u32,
+    pub u: [f32; LANES],
+    pub v: [f32; LANES],
 }
 
 /// A shadow ray, set up for box tests: for each axis, the bounds rows its slab is entered and left

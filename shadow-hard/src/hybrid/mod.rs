@@ -175,4 +175,5 @@ pub fn entry() -> Entry {
         "Chan 2004 (thesis, chapter 3)",
     )
     .wgsl(gpu::shaders::all)
+    .without_cutouts()
 }

@@ -127,6 +127,7 @@ pub fn zpass_entry() -> Entry {
         "stencil shadow volumes counted from the eye: wrong when the eye is in shadow",
         "Crow 1977; Heidmann 1991",
     )
+    .without_cutouts()
 }
 
 /// The registry entry of z-fail volumes.
@@ -137,6 +138,7 @@ pub fn zfail_entry() -> Entry {
         "stencil shadow volumes counted from infinity, capped: right with the eye in shadow",
         "Everitt-Kilgard 2002",
     )
+    .without_cutouts()
 }
 
 #[cfg(test)]

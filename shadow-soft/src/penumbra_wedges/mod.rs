@@ -114,4 +114,5 @@ pub fn entry() -> Entry {
     )
     .wgsl(gpu::shaders)
     .soft()
+    .without_cutouts()
 }

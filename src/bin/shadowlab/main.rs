@@ -12,6 +12,7 @@ use shadow_core::FrameInputs;
 use shadow_core::scenes::{self, SceneParams};
 use shadow_core::technique::TechniqueSpec;
 use shadowlab::compare::{CompareJob, run_compare};
+use shadowlab::registry::LeftOut;
 use shadowlab::setup::{OptionError, parse_size};
 use shadowlab::{BackendChoice, Error, Renderer, TechniqueRegistry};
 
@@ -434,6 +435,9 @@ fn compare(
             out!("{:<24} {:>19.3}% {:>7.4} {:>7.4}", c.technique, c.mismatch * 100.0, c.rmse, c.flip_mean);
         }
     }
+    for note in &report.notes {
+        out!("note: {note}");
+    }
     out!("wrote {}/contact.png, report.md, report.json", out.display());
     Ok(())
 }
@@ -445,7 +449,7 @@ fn technique_specs(
     technique: &[String],
     techniques: Option<&str>,
     frame: &FrameInputs,
-) -> Result<(Vec<TechniqueSpec>, Vec<&'static str>), Error> {
+) -> Result<(Vec<TechniqueSpec>, Vec<LeftOut>), Error> {
     let mut specs: Vec<TechniqueSpec> = technique.iter().map(|t| TechniqueSpec::parse(t)).collect::<Result<_, _>>()?;
     let mut left = Vec::new();
     let mut all = || {
@@ -464,14 +468,29 @@ fn technique_specs(
     for s in &specs {
         renderer.registry().canonical(s)?;
     }
+    if frame.has_cutout_casters() {
+        for s in specs.iter().filter(|s| renderer.registry().get(&s.name).is_ok_and(|e| !e.cutouts)) {
+            eprintln!(
+                "warning: {} extrudes silhouettes: the casters this scene's textures cut out shadow as solid in it",
+                s.name
+            );
+        }
+    }
     Ok((specs, left))
 }
 
-/// Names the techniques a run leaves out for the scene's lights, once every input has been checked (a
-/// refused run says one line, its error).
-fn say_left_out(left: &[&str]) {
-    if !left.is_empty() {
-        eprintln!("left out, as they or their reference take no light of this scene's kinds: {}", left.join(", "));
+/// Names the techniques a run leaves out and why, a line for each reason, once every input has been
+/// checked (a refused run says one line, its error).
+fn say_left_out(left: &[LeftOut]) {
+    let mut reasons: Vec<&str> = Vec::new();
+    for l in left {
+        if !reasons.contains(&l.why) {
+            reasons.push(l.why);
+        }
+    }
+    for why in reasons {
+        let names: Vec<&str> = left.iter().filter(|l| l.why == why).map(|l| l.name).collect();
+        eprintln!("left out, {why}: {}", names.join(", "));
     }
 }
 
