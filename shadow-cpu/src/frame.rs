@@ -25,6 +25,19 @@ pub struct CpuFrame {
     pub stats: FrameStats,
 }
 
+impl CpuFrame {
+    /// Each receiver pixel's world position and its visibility under light `light`, in pixel order.
+    ///
+    /// # Panics
+    /// For a light the frame does not have.
+    pub fn receiver_points(&self, light: usize) -> impl Iterator<Item = (shadow_core::glam::Vec3, f32)> + '_ {
+        let g = &self.gbuffer;
+        (g.position.data().iter().zip(g.receiver.data()).zip(self.visibility[light].data()))
+            .filter(|((_, receiver), _)| **receiver)
+            .map(|((&p, _), &v)| (p, v))
+    }
+}
+
 /// Renders a frame, each light shadowed by the frame's technique or its own (`techniques`; a single
 /// technique converts into them).
 ///

@@ -6,13 +6,15 @@
 //! The clip-space vertices of every instance are kept: shadow-volume near caps are drawn from exactly
 //! these, so a lit surface and its cap have bit-identical depths.
 
-use glam::{BVec4A, Mat3, Mat4, Vec3, Vec4};
+use glam::{BVec4A, Mat3, Mat4, Vec2, Vec3, Vec4};
 use rayon::prelude::*;
+use shadow_core::material::Footprint;
 use shadow_core::scene::Camera;
 use shadow_core::{FrameInputs, Image};
 
+use crate::alpha_test::{Cutout, Drawn, draw_alpha_tested};
 use crate::context::{CpuError, check_size};
-use crate::raster::{Batch, DepthStencil, Indexed, RasterState, draw_flat};
+use crate::raster::{Batch, DepthStencil, Fragment, Indexed, RasterState, draw_flat};
 
 /// No instance at this pixel.
 pub const NO_INSTANCE: u32 = u32::MAX;
@@ -154,6 +156,8 @@ struct Triangle {
     normal_from_local: Mat3,
     /// Unit world-space face normal, `None` for a degenerate triangle.
     face: Option<Vec3>,
+    /// The corners' texture coordinates, where the instance's base colour has a texture to read.
+    uvs: Option<[Vec2; 3]>,
 }
 
 impl Triangle {
@@ -161,13 +165,30 @@ impl Triangle {
         let inst = &frame.instances[instance];
         let t = inst.mesh.triangles()[triangle];
         let (p, nn) = (inst.mesh.positions(), inst.mesh.normals());
+        let textured = inst.material.base_color_texture.is_some() && inst.base_color_texture.is_some();
         Self {
             instance,
             corners: t.map(|k| inst.world_from_local.transform_point3(p[k as usize])),
             normals: t.map(|k| nn[k as usize]),
             normal_from_local,
             face: (normal_from_local * shadow_core::mesh::face_normal(t.map(|k| p[k as usize]))).try_normalize(),
+            uvs: inst.mesh.uvs().filter(|_| textured).map(|uv| t.map(|k| uv[k as usize])),
         }
+    }
+
+    /// The albedo where the ray from `eye` along `dir` meets the triangle: the material's base colour
+    /// times its texture's, read at the point's texture coordinates over the footprint of the pixel
+    /// (how they change to where the rays `right` and `down` of the pixels beside it meet the
+    /// triangle's plane). `None` for an untextured triangle, whose albedo is the instance's.
+    fn albedo(&self, inst: &shadow_core::Instance, eye: Vec3, [dir, right, down]: [Vec3; 3]) -> Option<Vec3> {
+        let uvs = self.uvs?;
+        let uv = |dir: Vec3| {
+            let b = ray_triangle(eye, dir, self.corners).1;
+            uvs[0] * b[0] + uvs[1] * b[1] + uvs[2] * b[2]
+        };
+        let at = uv(dir);
+        let footprint = Footprint { dx: uv(right) - at, dy: uv(down) - at };
+        Some(inst.material.base_color_at(inst.base_color_texture.as_deref(), Some(at), footprint).truncate())
     }
 }
 
@@ -419,16 +440,23 @@ fn resolve(frame: &FrameInputs, all: &Batch<'_>, visible: &[u32], eye_rays: &Eye
                         (world, shading, geometric, inst.base_color, inst.receives_shadow, t.instance as u32);
                 };
                 // Four pixels at once where the next four show this triangle, else this one.
-                if vis.get(x..x + 4).is_some_and(|four| four.iter().all(|&p| p == prim)) {
+                let next = if vis.get(x..x + 4).is_some_and(|four| four.iter().all(|&p| p == prim)) {
                     let four = surface_x4(&t, inst, eye_rays.eye, std::array::from_fn(|k| dirs[x + k]));
                     for (k, surface) in four.into_iter().enumerate() {
                         put(x + k, surface);
                     }
-                    x += 4;
+                    x + 4
                 } else {
                     put(x, surface(&t, inst, eye_rays.eye, dirs[x]));
-                    x += 1;
+                    x + 1
+                };
+                if t.uvs.is_some() {
+                    for x in x..next {
+                        let beside = [dirs[x], eye_rays.dir(x + 1, y), eye_rays.dir(x, y + 1)];
+                        alb[x] = t.albedo(inst, eye_rays.eye, beside).unwrap_or(alb[x]);
+                    }
                 }
+                x = next;
             }
         });
 }
@@ -470,7 +498,24 @@ pub fn render_reusing(
     // of its primitive in the batch.
     let all =
         Batch::new(frame.instances.iter().zip(&clip).map(|(inst, clip)| Indexed::instance(inst, clip)).collect())?;
-    draw_flat(&mut ds, &mut visible, &all, &RasterState::default(), |prim| prim);
+    let drawn = Drawn::sort(frame, |_| true);
+    if drawn.solid.len() == frame.instances.len() {
+        draw_flat(&mut ds, &mut visible, &all, &RasterState::default(), |prim| prim);
+    } else {
+        // The solid instances in one draw, then the cut-out ones through their alpha test, each pixel
+        // left with its primitive's id in `all`.
+        let part = |k: usize| Indexed::instance(&frame.instances[k], &clip[k]);
+        let solid = Batch::new(drawn.solid.iter().map(|&k| part(k)).collect())?;
+        let in_all = |list: &[usize], batch: &Batch<'_>, prim: u32| {
+            let (part, triangle) = batch.part_of(prim);
+            all.start(list[part]) + triangle
+        };
+        draw_flat(&mut ds, &mut visible, &solid, &RasterState::default(), |p| in_all(&drawn.solid, &solid, p));
+        let cutout = Batch::new(drawn.cutout.iter().map(|&k| part(k)).collect())?;
+        let tests: Vec<Cutout<'_>> = drawn.cutout.iter().filter_map(|&k| Cutout::of(&frame.instances[k])).collect();
+        let value = |f: &Fragment| Some(in_all(&drawn.cutout, &cutout, f.prim));
+        draw_alpha_tested(&mut ds, &mut visible, (&cutout, &tests), &RasterState::default(), value);
+    }
 
     let eye_rays = EyeRays { eye: camera.eye, world_from_clip: clip_from_world.inverse(), width, height };
     let mut surfaces = Surfaces {
@@ -547,7 +592,7 @@ mod tests {
             };
             let face = (corners[1] - corners[0]).cross(corners[2] - corners[0]).try_normalize();
             let normal_from_local = Mat3::from_cols(v3(), v3(), v3());
-            let t = Triangle { instance: 0, corners, normals, normal_from_local, face };
+            let t = Triangle { instance: 0, corners, normals, normal_from_local, face, uvs: None };
             let eye = v3() * 3.0;
             // Rays towards points of the triangle's plane, and along it for the one seen edge-on.
             let dirs: [Vec3; 4] = std::array::from_fn(|_| {
@@ -563,6 +608,48 @@ mod tests {
             }
         }
         assert_eq!(checked, 1600);
+    }
+
+    /// Through the clear squares of `cutout`'s checkerboard card the camera sees the ground; on its
+    /// opaque ones, the card in the texture's colour.
+    #[test]
+    fn clear_texels_show_what_lies_behind_them() {
+        use shadow_core::scenes::cutouts::{CARD_HEIGHT, CARD_SIDE, CHECKER_SQUARES};
+        let f = frame("cutout");
+        let card = f.instances.iter().position(|i| i.material.name == "checkerboard").expect("the card");
+        let (w, h) = (320, 240);
+        let g = render(&f, w, h).expect("G-buffer");
+        let eye = f.camera.eye;
+        let world_from_clip = g.clip_from_world.inverse();
+        let rays = EyeRays { eye, world_from_clip, width: w, height: h };
+        // Each pixel's ray through the card's plane, where it meets the card: the square it crosses, and
+        // whether it lies a hundredth of a square or more from the square's sides.
+        let crossing = |x: usize, y: usize| {
+            let dir = rays.dir(x, y);
+            let p = eye + dir * ((CARD_HEIGHT - eye.y) / dir.y);
+            let uv = (Vec2::new(p.x, p.z) / CARD_SIDE + 0.5) * CHECKER_SQUARES as f32;
+            let inside = uv.cmpge(Vec2::ZERO).all() && uv.cmplt(Vec2::splat(CHECKER_SQUARES as f32)).all();
+            let clear_of_sides = (uv - uv.round()).abs().min_element() > 0.01;
+            inside.then(|| ((uv.x.floor() + uv.y.floor()) as u32 % 2 == 0, clear_of_sides))
+        };
+        let colour = shadow_core::material::sampler::decode([224, 150, 80, 255]).truncate();
+        let (mut opaque, mut clear) = (0, 0);
+        for y in 0..h as usize {
+            for x in 0..w as usize {
+                let Some((solid, true)) = crossing(x, y) else { continue };
+                let shows = *g.instance.get(x as u32, y as u32);
+                if solid {
+                    assert_eq!(shows, card as u32, "pixel {x}, {y} on an opaque square");
+                    assert!((*g.albedo.get(x as u32, y as u32) - colour).abs().max_element() < 1e-6);
+                    opaque += 1;
+                } else {
+                    assert_ne!(shows, card as u32, "pixel {x}, {y} on a clear square");
+                    assert!(g.position.get(x as u32, y as u32).y.abs() < 1e-4, "the ground through a clear square");
+                    clear += 1;
+                }
+            }
+        }
+        assert!(opaque > 1000 && clear > 1000, "{opaque} pixels on opaque squares, {clear} on clear ones");
     }
 
     /// The buffers of a recycled G-buffer are overwritten, not cleared: whatever another scene left in

@@ -2,9 +2,11 @@
 //!
 //! A software rasterizer that follows DESIGN 4 exactly ([`raster`]), BVH ray casting for the exact
 //! reference ([`bvh`]), the G-buffer ([`gbuffer`]), shading ([`shade`]) and frame assembly ([`frame`]),
-//! and the passes techniques are built from ([`passes`]).
+//! and the passes techniques are built from ([`passes`]); the rasterized passes cut out what a masked
+//! material's texture clears ([`alpha_test`]).
 
 pub mod acne;
+pub mod alpha_test;
 pub mod bvh;
 pub mod context;
 pub mod frame;

@@ -170,12 +170,7 @@ fn the_reference_sees_through_clear_texels() {
     let lit_share = |scene: &Scene| {
         let mut reference = Stateful::<CpuBackend, _>::new(RayTraced::defaults(), String::new());
         let r = render_frame(&mut CpuContext::new(), &frame(scene), SIZE, SIZE, &mut reference).expect("reference");
-        let g = &r.gbuffer;
-        let pixels = (g.position.data().iter().zip(g.receiver.data()))
-            .zip(r.visibility[0].data())
-            .filter(|((_, receiver), _)| **receiver)
-            .map(|((&p, _), &v)| (p, v));
-        card_shadow_lit_share(pixels)
+        card_shadow_lit_share(r.receiver_points(0))
     };
     let mut scene = scenes::build("cutout", &SceneParams::default()).expect("cutout");
     let (share, pixels) = lit_share(&scene);

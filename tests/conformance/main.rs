@@ -3,6 +3,7 @@
 
 mod cache;
 mod cli;
+mod cutouts;
 mod depth_layers;
 mod extrusion;
 mod gpu_clock;

@@ -183,10 +183,45 @@ impl Material {
     /// pixel or map texel.
     #[must_use]
     pub fn passes(&self, texture: Option<&Texture>, uv: Option<Vec2>, footprint: Footprint) -> bool {
-        match self.alpha_mode {
-            AlphaMode::Opaque | AlphaMode::Blend => true,
-            AlphaMode::Mask { cutoff } => self.base_color_at(texture, uv, footprint).w >= cutoff,
-        }
+        self.alpha_test(texture).is_none_or(|test| test.passes(uv, footprint))
+    }
+
+    /// The alpha test of a masked material ([`Self::passes`]) made ready for many reads, `texture` the
+    /// one [`Self::base_color_texture`] names; `None` for an opaque or blended one, which is everywhere.
+    #[must_use]
+    pub fn alpha_test<'a>(&'a self, texture: Option<&'a Texture>) -> Option<AlphaTest<'a>> {
+        let AlphaMode::Mask { cutoff } = self.alpha_mode else { return None };
+        let read = self.base_color_texture.as_ref().zip(texture).map(|(r, t)| (r.sampler, t, r.transform.matrix()));
+        Some(AlphaTest { cutoff, alpha: self.alpha, read })
+    }
+}
+
+/// A masked material's alpha test ([`Material::alpha_test`]): its texture-coordinate transform worked out
+/// once and the alpha channel alone read, with the answers of [`Material::passes`] to the bit.
+#[derive(Clone, Copy, Debug)]
+pub struct AlphaTest<'a> {
+    cutoff: f32,
+    /// The base colour's alpha factor.
+    alpha: f32,
+    /// The texture: its sampler, its texels and the transform into it.
+    read: Option<(Sampler, &'a Texture, Mat3)>,
+}
+
+impl AlphaTest<'_> {
+    /// Whether the surface is there at mesh coordinate `uv` over `footprint` (see [`Material::passes`]).
+    #[must_use]
+    #[inline]
+    pub fn passes(&self, uv: Option<Vec2>, footprint: Footprint) -> bool {
+        let alpha = match (self.read, uv) {
+            // As `TextureRef::sample` moves the point and the footprint.
+            (Some((sampler, texture, m)), Some(uv)) => {
+                let footprint =
+                    Footprint { dx: m.transform_vector2(footprint.dx), dy: m.transform_vector2(footprint.dy) };
+                self.alpha * sampler.sample_alpha(texture, m.transform_point2(uv), footprint)
+            }
+            _ => self.alpha,
+        };
+        alpha >= self.cutoff
     }
 }
 
@@ -299,5 +334,53 @@ pub(crate) mod tests {
         // Without its texture, or without coordinates, a masked material is its factor.
         assert!(card(0.5).passes(None, Some(clear), Footprint::POINT));
         assert!(!faded.passes(Some(&t), None, Footprint::POINT));
+    }
+
+    /// The alpha test reads the alpha alone and answers as the full colour's alpha against the cutoff
+    /// does, to the bit: over random points, footprints from magnified to the top level, every filter and
+    /// wrap, a turned and scaled transform, and cutoffs at, just under and just over the alpha read.
+    #[test]
+    fn the_alpha_test_is_the_colours_alpha_to_the_bit() {
+        let mut rng = crate::scenes::Rng::new(9);
+        let texels = (0..24 * 20).map(|_| [0, 0, 0, (rng.unit() * 256.0) as u8]).collect();
+        let t = Texture::from_rgba8("noise", 24, 20, texels).unwrap();
+        let (mut checked, mut at_the_cutoff) = (0, 0);
+        for k in 0..4000 {
+            let filter = |bit: usize| if (k >> bit) & 1 == 0 { Filter::Nearest } else { Filter::Linear };
+            let wraps = [Wrap::Repeat, Wrap::MirroredRepeat, Wrap::ClampToEdge];
+            let sampler = Sampler {
+                mag: filter(0),
+                min: filter(1),
+                mipmap: [None, Some(Filter::Nearest), Some(Filter::Linear)][k % 3],
+                wrap_u: wraps[k % 3],
+                wrap_v: wraps[(k / 3) % 3],
+            };
+            let transform = if k % 2 == 0 {
+                UvTransform::IDENTITY
+            } else {
+                UvTransform { offset: Vec2::new(0.2, -0.7), rotation: 0.9, scale: Vec2::new(1.7, 0.6) }
+            };
+            let r = TextureRef { texture: TextureKey::default(), sampler, transform };
+            let uv = Vec2::new(rng.range(-2.0, 3.0), rng.range(-2.0, 3.0));
+            let size = 2f32.powf(rng.range(-3.0, 6.0)) / 24.0;
+            let footprint = Footprint { dx: Vec2::new(size, rng.range(-size, size)), dy: Vec2::new(0.0, size) };
+            let factor = if k % 5 == 0 { 0.7 } else { 1.0 };
+            let alpha = Material { base_color_texture: Some(r), alpha: factor, ..Material::default() }
+                .base_color_at(Some(&t), Some(uv), footprint)
+                .w;
+            for cutoff in [alpha, alpha.next_down(), alpha.next_up(), 0.5] {
+                let m = Material {
+                    base_color_texture: Some(r),
+                    alpha: factor,
+                    alpha_mode: AlphaMode::Mask { cutoff },
+                    ..Material::default()
+                };
+                let test = m.alpha_test(Some(&t)).expect("a masked material");
+                assert_eq!(test.passes(Some(uv), footprint), alpha >= cutoff, "{k}: {uv} {footprint:?} {cutoff}");
+                checked += 1;
+            }
+            at_the_cutoff += usize::from(alpha > 0.0 && alpha < 1.0);
+        }
+        assert!(checked == 16_000 && at_the_cutoff > 2000, "{at_the_cutoff}");
     }
 }

@@ -156,12 +156,28 @@ impl Sampler {
     /// The texture's colour at `uv` over `footprint`: linear RGB and alpha.
     #[must_use]
     pub fn sample(&self, texture: &Texture, uv: Vec2, footprint: Footprint) -> Vec4 {
+        self.filtered(texture, uv, footprint, decode)
+    }
+
+    /// The alpha of [`Self::sample`], to the bit, without decoding the colour: what an alpha test reads.
+    #[must_use]
+    pub fn sample_alpha(&self, texture: &Texture, uv: Vec2, footprint: Footprint) -> f32 {
+        self.filtered(texture, uv, footprint, |t| f32::from(t[3]) / 255.0)
+    }
+
+    /// The texels' values `read` gives, filtered at `uv` over `footprint`.
+    fn filtered<T: Filtered>(&self, texture: &Texture, uv: Vec2, footprint: Footprint, read: fn([u8; 4]) -> T) -> T {
         let chain = texture.levels();
         let choice = self.levels(footprint.rho_squared(texture.width(), texture.height()), chain.len());
         let filter = if choice.magnified { self.mag } else { self.min };
-        let mut out = self.sample_level(&chain[choice.first.0], uv, filter) * choice.first.1;
+        let level = |k: usize| {
+            let level = &chain[k];
+            let texels = self.texels(level, uv, filter);
+            texels.iter().filter(|(_, w)| *w > 0.0).fold(T::ZERO, |sum, &((x, y), w)| sum + read(*level.get(x, y)) * w)
+        };
+        let mut out = level(choice.first.0) * choice.first.1;
         if let Some((k, w)) = choice.second {
-            out += self.sample_level(&chain[k], uv, filter) * w;
+            out = out + level(k) * w;
         }
         out
     }
@@ -192,14 +208,20 @@ impl Sampler {
             }
         }
     }
+}
 
-    fn sample_level(&self, level: &TextureLevel, uv: Vec2, filter: Filter) -> Vec4 {
-        self.texels(level, uv, filter)
-            .iter()
-            .filter(|(_, w)| *w > 0.0)
-            .map(|&((x, y), w)| decode(*level.get(x, y)) * w)
-            .sum()
-    }
+/// What a sampler filters: weighted sums of texel values, lane by lane in the same operations whether
+/// it is a colour or its alpha alone.
+trait Filtered: Copy + std::ops::Add<Output = Self> + std::ops::Mul<f32, Output = Self> {
+    const ZERO: Self;
+}
+
+impl Filtered for f32 {
+    const ZERO: Self = 0.0;
+}
+
+impl Filtered for Vec4 {
+    const ZERO: Self = Vec4::ZERO;
 }
 
 /// An RGBA8 texel as linear colour and alpha.

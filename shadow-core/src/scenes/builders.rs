@@ -264,10 +264,20 @@ pub(super) fn cage(p: &SceneParams) -> Scene {
     )
 }
 
-fn branch(rng: &mut Rng, base: Vec3, dir: Vec3, length: f32, radius: f32, depth: u32, out: &mut Vec<Mesh>) {
+/// A branch of `length` from `base` along `dir`, and below `depth` more levels three branches from its tip,
+/// each shorter and thinner, their meshes pushed to `out`. The twigs (the last level) are pushed to `twigs`
+/// as their base and tip.
+pub(super) fn branch(
+    rng: &mut Rng,
+    (base, dir): (Vec3, Vec3),
+    (length, radius): (f32, f32),
+    depth: u32,
+    (out, twigs): (&mut Vec<Mesh>, &mut Vec<(Vec3, Vec3)>),
+) {
     let rot = Quat::from_rotation_arc(Vec3::Y, dir);
     out.push(built(procedural::cylinder(radius, length, 9)).transformed(Mat4::from_rotation_translation(rot, base)));
     if depth == 0 {
+        twigs.push((base, base + dir * length));
         return;
     }
     let tip = base + dir * length;
@@ -279,7 +289,7 @@ fn branch(rng: &mut Rng, base: Vec3, dir: Vec3, length: f32, radius: f32, depth:
         let child = (dir * tilt.cos() + side * tilt.sin() + Vec3::Y * 0.15).normalize();
         let start = tip - dir * radius;
         let child_length = length * rng.range(0.68, 0.8);
-        branch(rng, start, child, child_length, radius * 0.62, depth - 1, out);
+        branch(rng, (start, child), (child_length, radius * 0.62), depth - 1, (&mut *out, &mut *twigs));
     }
 }
 
@@ -287,7 +297,7 @@ pub(super) fn tree(p: &SceneParams) -> Scene {
     let mut rng = Rng::new(p.seed);
     let mut s = Stage::new().ground(12.0);
     let mut parts = Vec::new();
-    branch(&mut rng, Vec3::ZERO, Vec3::Y, 0.9, 0.09, 6, &mut parts);
+    branch(&mut rng, (Vec3::ZERO, Vec3::Y), (0.9, 0.09), 6, (&mut parts, &mut Vec::new()));
     s.add(
         "tree",
         Mesh::merged(&parts).unwrap_or_else(|e| panic!("tree: {e}")),
@@ -341,10 +351,10 @@ enum Sun {
 }
 
 /// The sun's elevation above the horizon, in degrees: low, so shadows are long.
-const SUN_ELEVATION: f32 = 20.0;
+pub(super) const SUN_ELEVATION: f32 = 20.0;
 
 /// Half the outdoor ground's side, in metres.
-const OUTDOOR_HALF: f32 = 100.0;
+pub(super) const OUTDOOR_HALF: f32 = 100.0;
 
 /// The outdoor scene of the perspective-aliasing work (Stamminger-Drettakis, the Nealen survey's Fig. 10):
 /// a 200 x 200 m ground under a low sun and a few thousand casters of every size (buildings, lamp poles,
@@ -388,7 +398,7 @@ fn outdoor_with(p: &SceneParams, sun: Sun) -> Scene {
         .map(|_| {
             let mut parts = Vec::new();
             let height = rng.range(1.2, 1.8);
-            branch(&mut rng, Vec3::ZERO, Vec3::Y, height, 0.1, 4, &mut parts);
+            branch(&mut rng, (Vec3::ZERO, Vec3::Y), (height, 0.1), 4, (&mut parts, &mut Vec::new()));
             s.mesh(Mesh::merged(&parts).unwrap_or_else(|e| panic!("outdoor tree: {e}")))
         })
         .collect();

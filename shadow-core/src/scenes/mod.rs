@@ -149,12 +149,26 @@ pub const OUTDOOR: &[SceneInfo] = &[
 /// The scenes of alpha-tested casters (glTF `MASK`), whose textures cut their cards out: the light passes
 /// must discard clear texels, and the references test them. Apart from [`ALL`], as the techniques that
 /// extrude silhouettes leave them out.
-pub const CUTOUT: &[SceneInfo] = &[SceneInfo {
-    name: "cutout",
-    after: "alpha testing",
-    description: "a checkerboard card cut out by its alpha under a sun straight above: half its shadow is lit",
-    build: cutouts::cutout,
-}];
+pub const CUTOUT: &[SceneInfo] = &[
+    SceneInfo {
+        name: "cutout",
+        after: "alpha testing",
+        description: "a checkerboard card cut out by its alpha under a sun straight above: half its shadow is lit",
+        build: cutouts::cutout,
+    },
+    SceneInfo {
+        name: "foliage",
+        after: "Chan Tree, in leaves",
+        description: "a tree of 2916 alpha-masked leaf cards on bare branches, spotlight",
+        build: cutouts::foliage,
+    },
+    SceneInfo {
+        name: "fence",
+        after: "Nealen Fig. 10, fenced",
+        description: "picket-fence cards along a 200 m street at head height, low sun across it",
+        build: cutouts::fence,
+    },
+];
 
 /// Every built-in scene: the papers' ([`ALL`]), the outdoor ones ([`OUTDOOR`]), then those of cutouts
 /// ([`CUTOUT`]).
@@ -361,6 +375,20 @@ mod tests {
         };
         let (side, behind, facing) = (sun("outdoor"), sun("outdoor-behind"), sun("outdoor-facing"));
         assert!(behind > 0.9 && facing < -0.9 && side.abs() < 0.8, "{side} {behind} {facing}");
+    }
+
+    /// Each scene of cut-out casters casts through its texture: its frame has cut-out casters, and
+    /// `foliage` thousands of leaf cards.
+    #[test]
+    fn the_cutout_scenes_have_cut_out_casters() {
+        for info in CUTOUT {
+            let s = build(info.name, &SceneParams::default()).unwrap();
+            let frame = crate::FrameInputs::from_first_camera(&s).unwrap();
+            assert!(frame.has_cutout_casters(), "{}", info.name);
+        }
+        let foliage = build("foliage", &SceneParams::default()).unwrap();
+        let leaves = foliage.drawables().find(|(_, n, _, _)| n.name() == "leaves").expect("the leaves").2;
+        assert_eq!(foliage.mesh(leaves).unwrap().triangle_count(), 2 * 2916);
     }
 
     #[test]

@@ -1,6 +1,7 @@
 //! Light depth maps on the CPU (twin: shadow-wgpu's `passes::maps`): rendered with Vulkan's depth bias,
 //! one per light projection (a point light's six cube faces), optionally with McCool's object-ID channel;
-//! looked up per receiver through `shadow_core::lookup::shadow_lookup` with each filter.
+//! looked up per receiver through `shadow_core::lookup::shadow_lookup` with each filter. Casters cut out
+//! by their texture discard the fragments of clear texels, each read over the footprint of one map texel.
 
 use shadow_core::frame::FrameError;
 use shadow_core::glam::{Vec2, Vec3, Vec4};
@@ -11,10 +12,11 @@ use shadow_core::technique::settings::{DepthBias, Filter};
 use shadow_core::{FrameInputs, Image};
 
 use super::per_receiver;
+use crate::alpha_test::{Cutout, Drawn, draw_alpha_tested};
 use crate::context::{CpuError, MAX_MAP_TEXELS, check_size};
 use crate::gbuffer::{GBuffer, clip_vertices};
 use crate::raster::{
-    Batch, CullMode, DepthState, DepthStencil, Indexed, RasterCounters, RasterState, draw_depth, draw_flat,
+    Batch, CullMode, DepthState, DepthStencil, Fragment, Indexed, RasterCounters, RasterState, draw_depth, draw_flat,
 };
 
 /// Refuses a set of `count` square maps of side `res` before anything is allocated.
@@ -36,7 +38,8 @@ pub fn check_maps(res: u32, count: usize) -> Result<(), CpuError> {
 }
 
 /// Renders the depth of every casting instance from one light projection into a `res x res` map, in the
-/// storage of `reuse` when given (last frame's map: its pages are already mapped).
+/// storage of `reuse` when given (last frame's map: its pages are already mapped). Casters cut out by
+/// their texture are drawn after the others, through their alpha test ([`crate::alpha_test`]).
 ///
 /// # Errors
 /// [`FrameError::TooManyTriangles`] for casters of more triangles than a draw can number.
@@ -55,32 +58,56 @@ pub fn render_depth_map(
     let mut ds = DepthStencil::from_parts(res, res, depth, vec![0; n]);
     let state =
         RasterState { cull, depth: Some(DepthState { bias, ..DepthState::LESS_WRITE }), ..RasterState::default() };
-    let (casters, clip) = casters_clipped(frame, proj);
-    let counters = draw_depth(&mut ds, &casters_batch(frame, &casters, &clip)?, &state);
+    let casters = Casters::new(frame, proj);
+    let mut counters = draw_depth(&mut ds, &casters.solid()?, &state);
+    if !casters.drawn.cutout.is_empty() {
+        let mut none = Image::new(res, res, ());
+        counters += draw_alpha_tested(&mut ds, &mut none, (&casters.cutout()?, &casters.tests()), &state, |_| Some(()));
+    }
     Ok((ds.into_depth_image(), counters))
 }
 
-/// The shadow casters of `frame` (indices into its instances) and their vertices in the clip space of
-/// `proj`.
-fn casters_clipped(frame: &FrameInputs, proj: &LightProjection) -> (Vec<usize>, Vec<Vec<Vec4>>) {
-    let casters: Vec<usize> = (0..frame.instances.len()).filter(|&k| frame.instances[k].casts_shadow).collect();
-    let clip = casters
-        .iter()
-        .map(|&k| {
-            let inst = &frame.instances[k];
-            clip_vertices(inst.mesh.positions(), proj.clip_from_world * inst.world_from_local)
-        })
-        .collect();
-    (casters, clip)
+/// The shadow casters of a frame, sorted by their coverage (in frame order within each kind), with their
+/// vertices in the clip space of one light projection.
+struct Casters<'a> {
+    frame: &'a FrameInputs,
+    drawn: Drawn,
+    /// The clip-space vertices of each of `drawn.solid`, then of each of `drawn.cutout`.
+    clip: Vec<Vec<Vec4>>,
 }
 
-/// The casters of [`casters_clipped`] as one draw; its parts are in the order of `casters`.
-fn casters_batch<'a>(
-    frame: &'a FrameInputs,
-    casters: &[usize],
-    clip: &'a [Vec<Vec4>],
-) -> Result<Batch<'a>, FrameError> {
-    Batch::new(casters.iter().zip(clip).map(|(&k, clip)| Indexed::instance(&frame.instances[k], clip)).collect())
+impl<'a> Casters<'a> {
+    fn new(frame: &'a FrameInputs, proj: &LightProjection) -> Self {
+        let drawn = Drawn::sort(frame, |i| i.casts_shadow);
+        let clip = (drawn.solid.iter().chain(&drawn.cutout))
+            .map(|&k| {
+                let inst = &frame.instances[k];
+                clip_vertices(inst.mesh.positions(), proj.clip_from_world * inst.world_from_local)
+            })
+            .collect();
+        Self { frame, drawn, clip }
+    }
+
+    /// The instances `list` (whose clip-space vertices start at `clip[first]`) as one draw, in order.
+    fn batch<'b>(&'b self, list: &[usize], first: usize) -> Result<Batch<'b>, FrameError> {
+        let part = |(&k, clip): (&usize, &'b Vec<Vec4>)| Indexed::instance(&self.frame.instances[k], clip);
+        Batch::new(list.iter().zip(&self.clip[first..]).map(part).collect())
+    }
+
+    /// The solid casters as one draw; its parts are in the order of `drawn.solid`.
+    fn solid(&self) -> Result<Batch<'_>, FrameError> {
+        self.batch(&self.drawn.solid, 0)
+    }
+
+    /// The cut-out casters as one draw; its parts are in the order of `drawn.cutout`.
+    fn cutout(&self) -> Result<Batch<'_>, FrameError> {
+        self.batch(&self.drawn.cutout, self.drawn.solid.len())
+    }
+
+    /// The alpha tests of the cut-out casters, in the order of `drawn.cutout`.
+    fn tests(&self) -> Vec<Cutout<'a>> {
+        self.drawn.cutout.iter().filter_map(|&k| Cutout::of(&self.frame.instances[k])).collect()
+    }
 }
 
 /// Renders one depth map per projection of `light` (after checking their size), each in the storage of the
@@ -126,9 +153,14 @@ pub fn render_depth_and_id_maps(
     for p in &light.projections {
         let mut ds = DepthStencil::new(res, res, 1.0, 0);
         let mut id = Image::new(res, res, 0u32);
-        let (casters, clip) = casters_clipped(frame, p);
-        let all = casters_batch(frame, &casters, &clip)?;
-        draw_flat(&mut ds, &mut id, &all, &state, |prim| casters[all.part_of(prim).0] as u32 + 1);
+        let casters = Casters::new(frame, p);
+        let (solid, list) = (casters.solid()?, &casters.drawn.solid);
+        draw_flat(&mut ds, &mut id, &solid, &state, |prim| list[solid.part_of(prim).0] as u32 + 1);
+        if !casters.drawn.cutout.is_empty() {
+            let (cutout, list) = (casters.cutout()?, &casters.drawn.cutout);
+            let id_of = |f: &Fragment| Some(list[cutout.part_of(f.prim).0] as u32 + 1);
+            draw_alpha_tested(&mut ds, &mut id, (&cutout, &casters.tests()), &state, id_of);
+        }
         maps.push(ds.into_depth_image());
         ids.push(id);
     }

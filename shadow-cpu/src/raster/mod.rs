@@ -182,14 +182,34 @@ impl Fragment<'_> {
     pub fn bary(&self) -> [f32; 3] {
         match self.weights {
             Weights::Centroid => [1.0 / 3.0; 3],
-            Weights::At { edges, setup: t } => {
-                // Perspective-correct weights of the clipped corners, then of the source triangle.
-                let q = [0, 1, 2].map(|k| edges[k] as f32 * t.inv_area * t.inv_w[k]);
-                let s = 1.0 / (q[0] + q[1] + q[2]);
-                [0, 1, 2].map(|k| (q[0] * t.bary[0][k] + q[1] * t.bary[1][k] + q[2] * t.bary[2][k]) * s)
-            }
+            Weights::At { edges, setup: t } => bary_at(edges, t),
         }
     }
+
+    /// [`Self::bary`] at the centres of the pixels one to the right and one down, on the triangle's
+    /// plane whether or not they lie inside it: what the triangle interpolates changes by the difference
+    /// from the fragment's own across one pixel, the pixel's footprint in it. The centroid's for a flat
+    /// draw's fragment.
+    #[must_use]
+    #[inline]
+    pub fn bary_beside(&self) -> [[f32; 3]; 2] {
+        match self.weights {
+            Weights::Centroid => [[1.0 / 3.0; 3]; 2],
+            Weights::At { edges, setup: t } => [
+                bary_at(std::array::from_fn(|k| edges[k] + t.a[k] * ONE), t),
+                bary_at(std::array::from_fn(|k| edges[k] + t.b[k] * ONE), t),
+            ],
+        }
+    }
+}
+
+/// The perspective-correct barycentrics in the source triangle of the point whose edge functions in the
+/// setup `t` are `edges`: the weights of the clipped corners, then of the source triangle's.
+#[inline]
+fn bary_at(edges: [i64; 3], t: &Setup) -> [f32; 3] {
+    let q = [0, 1, 2].map(|k| edges[k] as f32 * t.inv_area * t.inv_w[k]);
+    let s = 1.0 / (q[0] + q[1] + q[2]);
+    [0, 1, 2].map(|k| (q[0] * t.bary[0][k] + q[1] * t.bary[1][k] + q[2] * t.bary[2][k]) * s)
 }
 
 /// Rasterizes `src` into `ds` and `color`. The closure gives the colour of a fragment or `None` to

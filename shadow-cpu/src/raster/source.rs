@@ -93,6 +93,12 @@ impl<'a> Batch<'a> {
         Ok(Self { parts, starts })
     }
 
+    /// The primitive id of part `part`'s first triangle.
+    #[must_use]
+    pub fn start(&self, part: usize) -> u32 {
+        self.starts[part]
+    }
+
     /// The part a primitive id of this source is in, and its triangle there.
     #[must_use]
     pub fn part_of(&self, prim: u32) -> (usize, u32) {

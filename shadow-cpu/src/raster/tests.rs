@@ -136,6 +136,40 @@ fn barycentrics_are_perspective_correct() {
     assert!(checked > 100);
 }
 
+/// The barycentrics beside a fragment are those of the fragments one to the right and one down, and
+/// past the triangle's edge they go on along its plane (the footprint of a pixel on an edge).
+#[test]
+fn barycentrics_beside_a_fragment_are_its_neighbours() {
+    let v = [Vec4::new(-1.0, -1.0, 0.1, 1.0), Vec4::new(3.0, -3.0, 1.5, 3.0), Vec4::new(-0.5, 2.0, 1.0, 2.0)];
+    let mut ds = DepthStencil::new(32, 32, 1.0, 0);
+    let mut out = Image::new(32, 32, [[f32::NAN; 3]; 3]);
+    let st = RasterState { depth: None, ..RasterState::default() };
+    let soup = Soup { triangles: &[v], prim_base: 0, flip: false };
+    draw(&mut ds, &mut out, &soup, &st, |f| Some([f.bary(), f.bary_beside()[0], f.bary_beside()[1]]), |d, s| *d = s);
+    let (mut neighbours, mut past_the_edge) = (0, 0);
+    let close = |a: [f32; 3], b: [f32; 3]| a.iter().zip(b).all(|(a, b)| (a - b).abs() < 1e-5);
+    for y in 0..31 {
+        for x in 0..31 {
+            let [_, right, down] = *out.get(x, y);
+            if right[0].is_nan() {
+                continue;
+            }
+            for (beside, (bx, by)) in [(right, (x + 1, y)), (down, (x, y + 1))] {
+                let theirs = out.get(bx, by)[0];
+                if theirs[0].is_nan() {
+                    // Outside the triangle: a point of its plane, one weight negative.
+                    assert!(beside.iter().any(|&w| w < 0.0) && (beside.iter().sum::<f32>() - 1.0).abs() < 1e-5);
+                    past_the_edge += 1;
+                } else {
+                    assert!(close(beside, theirs), "({x}, {y}) beside ({bx}, {by}): {beside:?} {theirs:?}");
+                    neighbours += 1;
+                }
+            }
+        }
+    }
+    assert!(neighbours > 100 && past_the_edge > 10, "{neighbours} {past_the_edge}");
+}
+
 #[test]
 fn depth_test_keeps_the_nearest_and_bias_follows_vulkan() {
     let quad = |z: f32| [[Vec4::new(-1.0, -1.0, z, 1.0), Vec4::new(3.0, -1.0, z, 1.0), Vec4::new(-1.0, 3.0, z, 1.0)]];

@@ -17,10 +17,14 @@ use shadow_core::technique::LightPass;
 use shadow_core::technique::{DebugView, ShadowTechnique, TechniqueError};
 use shadow_core::{FrameInputs, Image};
 
+use shadow_core::frame::Coverage;
+use shadow_cpu::alpha_test::{Cutout, draw_alpha_tested};
 use shadow_cpu::gbuffer::{GBuffer, clip_vertices};
 use shadow_cpu::passes::maps::check_maps;
 use shadow_cpu::passes::maps::{depth_views, query_maps};
-use shadow_cpu::raster::{CullMode, DepthState, DepthStencil, Indexed, RasterState, draw_depth, draw_depth_peeled};
+use shadow_cpu::raster::{
+    Batch, CullMode, DepthState, DepthStencil, Fragment, Indexed, RasterState, draw_depth, draw_depth_peeled,
+};
 use shadow_cpu::{CpuBackend, CpuContext, CpuError};
 
 /// The layers and the combined map of the last build, one of each per light projection.
@@ -31,32 +35,42 @@ pub struct State {
     maps: Vec<Image<f32>>,
 }
 
-/// One light pass: the nearest depth, or with `first` the nearest depth behind it (depth peeling).
+/// One light pass: the nearest depth, or with `first` the nearest depth behind it (depth peeling). A
+/// caster cut out by its texture leaves no depth where its texel is clear, in either pass.
+///
+/// # Errors
+/// [`FrameError::TooManyTriangles`](shadow_core::frame::FrameError) for a caster a draw cannot number.
 fn layer_pass(
     frame: &FrameInputs,
     proj: &LightProjection,
     res: u32,
     culling: LayerCulling,
     first: Option<(&Image<f32>, f32)>,
-) -> Image<f32> {
+) -> Result<Image<f32>, CpuError> {
     let mut ds = DepthStencil::new(res, res, 1.0, 0);
-    for inst in frame.instances.iter().filter(|i| i.casts_shadow) {
+    for inst in frame.instances.iter().filter(|i| i.casts_shadow && i.coverage() != Coverage::Absent) {
         let cull =
             if culling == LayerCulling::Auto && inst.adjacency.closed() { CullMode::Back } else { CullMode::None };
         let clip = clip_vertices(inst.mesh.positions(), proj.clip_from_world * inst.world_from_local);
         let src = Indexed { positions: &clip, triangles: inst.mesh.triangles(), prim_base: 0, flip: inst.mirrored };
-        match first {
-            None => {
-                let state = RasterState { cull, depth: Some(DepthState::LESS_WRITE), ..RasterState::default() };
+        let state = RasterState { cull, depth: Some(DepthState::LESS_WRITE), ..RasterState::default() };
+        match (Cutout::of(inst), first) {
+            (None, None) => {
                 draw_depth(&mut ds, &src, &state);
             }
-            Some((z1, eps)) => {
-                let state = RasterState { cull, depth: Some(DepthState::LESS_WRITE), ..RasterState::default() };
+            (None, Some((z1, eps))) => {
                 draw_depth_peeled(&mut ds, &src, &state, z1, eps);
+            }
+            (Some(test), first) => {
+                // The peel's discard (see `draw_depth_peeled`) after the alpha test's.
+                let behind = |f: &Fragment| first.is_none_or(|(z1, eps)| f.depth > *z1.get(f.x, f.y) + eps);
+                let mut none = Image::new(res, res, ());
+                let batch = Batch::new(vec![src])?;
+                draw_alpha_tested(&mut ds, &mut none, (&batch, &[test]), &state, |f| behind(f).then_some(()));
             }
         }
     }
-    ds.into_depth_image()
+    Ok(ds.into_depth_image())
 }
 
 impl ShadowTechnique<CpuBackend> for DepthLayers {
@@ -79,8 +93,8 @@ impl ShadowTechnique<CpuBackend> for DepthLayers {
         state.z2.clear();
         state.maps.clear();
         for proj in &light.projections {
-            let z1 = layer_pass(frame, proj, self.resolution, self.culling, None);
-            let z2 = layer_pass(frame, proj, self.resolution, self.culling, Some((&z1, self.peel_epsilon)));
+            let z1 = layer_pass(frame, proj, self.resolution, self.culling, None)?;
+            let z2 = layer_pass(frame, proj, self.resolution, self.culling, Some((&z1, self.peel_epsilon)))?;
             // Where the first layer is missing (the far plane) no caster is: the map stays at the far plane.
             let mut combined = Image::new(self.resolution, self.resolution, 1.0f32);
             combined.data_mut().par_iter_mut().zip(z1.data()).zip(z2.data()).with_min_len(4096).for_each(
