@@ -249,7 +249,7 @@ impl FrameInputs {
     fn silhouettes(&self, light: &LightView) -> impl IndexedParallelIterator<Item = (usize, LightSource, Silhouette)> {
         let world_light = light.source();
         self.instances.par_iter().enumerate().map(move |(i, inst)| {
-            if !inst.casts_shadow {
+            if !inst.casts_shadow || inst.coverage() == Coverage::Absent {
                 return (i, world_light, Silhouette::default());
             }
             let local_light = world_light.transformed(inst.local_from_world);
@@ -296,11 +296,16 @@ impl FrameInputs {
     }
 
     /// The silhouette edges of every casting instance for the light, in world space, in instance order
-    /// (what silhouette maps rasterize; the edges' weights do not matter there).
+    /// (what silhouette maps rasterize; the edges' weights do not matter there). A caster its texture cuts
+    /// out has none here: its mesh's outline is not its shadow's edge, which only the map of its depths,
+    /// cut out alike, knows.
     #[must_use]
     pub fn silhouette_segments(&self, light: &LightView) -> Vec<[Vec3; 2]> {
-        let per_instance: Vec<Vec<[Vec3; 2]>> =
-            self.silhouettes(light).map(|(i, _, sil)| self.world_segments(i, &sil)).collect();
+        let per_instance: Vec<Vec<[Vec3; 2]>> = self
+            .silhouettes(light)
+            .filter(|(i, ..)| self.instances[*i].coverage() != Coverage::Cutout)
+            .map(|(i, _, sil)| self.world_segments(i, &sil))
+            .collect();
         per_instance.concat()
     }
 

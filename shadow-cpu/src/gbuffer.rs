@@ -630,7 +630,7 @@ mod tests {
             let uv = (Vec2::new(p.x, p.z) / CARD_SIDE + 0.5) * CHECKER_SQUARES as f32;
             let inside = uv.cmpge(Vec2::ZERO).all() && uv.cmplt(Vec2::splat(CHECKER_SQUARES as f32)).all();
             let clear_of_sides = (uv - uv.round()).abs().min_element() > 0.01;
-            inside.then(|| ((uv.x.floor() + uv.y.floor()) as u32 % 2 == 0, clear_of_sides))
+            inside.then(|| (((uv.x.floor() + uv.y.floor()) as u32).is_multiple_of(2), clear_of_sides))
         };
         let colour = shadow_core::material::sampler::decode([224, 150, 80, 255]).truncate();
         let (mut opaque, mut clear) = (0, 0);
