@@ -342,6 +342,7 @@ mod tests {
     use glam::{Mat4, Vec3};
 
     use super::{FrameError, FrameInputs, MAX_FRAME_TRIANGLES};
+    use crate::material::AlphaMode;
     use crate::{Camera, Light, Material, Mesh, Scene};
 
     /// A flat grid of `2 * columns * rows` triangles.
@@ -408,5 +409,22 @@ mod tests {
         scene.material_mut(card).unwrap().alpha_mode = AlphaMode::Opaque;
         assert_eq!(instance.material.alpha_mode, AlphaMode::Mask { cutoff: 0.5 });
         assert_eq!(scene.material(card).unwrap().alpha_mode, AlphaMode::Opaque);
+    }
+
+    /// A caster its texture cuts out gives silhouette maps no edges, though its mesh has an outline; made
+    /// opaque, it does.
+    #[test]
+    fn cut_out_casters_give_silhouette_maps_no_edges() {
+        let mut scene = crate::scenes::build("cutout", &crate::scenes::SceneParams::default()).expect("cutout");
+        let edges = |scene: &Scene| {
+            let frame = FrameInputs::from_first_camera(scene).expect("frame");
+            let light = frame.light_view(&frame.lights[0]).expect("light view");
+            // The card's, a metre over the ground's outline.
+            frame.silhouette_segments(&light).iter().filter(|[a, b]| a.y > 0.5 && b.y > 0.5).count()
+        };
+        assert_eq!(edges(&scene), 0, "the cut-out card");
+        let card = scene.materials().find(|(_, m)| m.name == "checkerboard").expect("the card").0;
+        scene.material_mut(card).expect("material").alpha_mode = AlphaMode::Opaque;
+        assert_eq!(edges(&scene), 4, "the opaque card's outline");
     }
 }
