@@ -16,24 +16,31 @@ use shadow_core::{FrameInputs, Image};
 use crate::raster::{Batch, DepthStencil, Fragment, RasterCounters, RasterState, draw};
 
 /// A frame's instances for a rasterized pass, sorted by their coverage, each list in frame order.
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
-pub struct Drawn {
+#[derive(Default)]
+pub struct Drawn<'a> {
     /// Drawn whole.
     pub solid: Vec<usize>,
     /// Drawn through the alpha test.
     pub cutout: Vec<usize>,
+    /// The alpha test of each of `cutout`, in its order.
+    pub tests: Vec<Cutout<'a>>,
 }
 
-impl Drawn {
+impl<'a> Drawn<'a> {
     /// The instances of `frame` that `keep` takes (every one for the camera, the casters for a light),
     /// sorted.
     #[must_use]
-    pub fn sort(frame: &FrameInputs, keep: impl Fn(&Instance) -> bool) -> Self {
+    pub fn sort(frame: &'a FrameInputs, keep: impl Fn(&Instance) -> bool) -> Self {
         let mut drawn = Self::default();
         for (k, inst) in frame.instances.iter().enumerate().filter(|(_, i)| keep(i)) {
             match inst.coverage() {
                 Coverage::Solid => drawn.solid.push(k),
-                Coverage::Cutout => drawn.cutout.push(k),
+                Coverage::Cutout => {
+                    if let Some(test) = Cutout::of(inst) {
+                        drawn.cutout.push(k);
+                        drawn.tests.push(test);
+                    }
+                }
                 Coverage::Absent => {}
             }
         }

@@ -12,7 +12,7 @@ use shadow_core::material::Footprint;
 use shadow_core::scene::Camera;
 use shadow_core::{FrameInputs, Image};
 
-use crate::alpha_test::{Cutout, Drawn, draw_alpha_tested};
+use crate::alpha_test::{Drawn, draw_alpha_tested};
 use crate::context::{CpuError, check_size};
 use crate::raster::{Batch, DepthStencil, Fragment, Indexed, RasterState, draw_flat};
 
@@ -512,9 +512,8 @@ pub fn render_reusing(
         };
         draw_flat(&mut ds, &mut visible, &solid, &RasterState::default(), |p| in_all(&drawn.solid, &solid, p));
         let cutout = Batch::new(drawn.cutout.iter().map(|&k| part(k)).collect())?;
-        let tests: Vec<Cutout<'_>> = drawn.cutout.iter().filter_map(|&k| Cutout::of(&frame.instances[k])).collect();
         let value = |f: &Fragment| Some(in_all(&drawn.cutout, &cutout, f.prim));
-        draw_alpha_tested(&mut ds, &mut visible, (&cutout, &tests), &RasterState::default(), value);
+        draw_alpha_tested(&mut ds, &mut visible, (&cutout, &drawn.tests), &RasterState::default(), value);
     }
 
     let eye_rays = EyeRays { eye: camera.eye, world_from_clip: clip_from_world.inverse(), width, height };

@@ -12,7 +12,7 @@ use shadow_core::technique::settings::{DepthBias, Filter};
 use shadow_core::{FrameInputs, Image};
 
 use super::per_receiver;
-use crate::alpha_test::{Cutout, Drawn, draw_alpha_tested};
+use crate::alpha_test::{Drawn, draw_alpha_tested};
 use crate::context::{CpuError, MAX_MAP_TEXELS, check_size};
 use crate::gbuffer::{GBuffer, clip_vertices};
 use crate::raster::{
@@ -62,7 +62,8 @@ pub fn render_depth_map(
     let mut counters = draw_depth(&mut ds, &casters.solid()?, &state);
     if !casters.drawn.cutout.is_empty() {
         let mut none = Image::new(res, res, ());
-        counters += draw_alpha_tested(&mut ds, &mut none, (&casters.cutout()?, &casters.tests()), &state, |_| Some(()));
+        counters +=
+            draw_alpha_tested(&mut ds, &mut none, (&casters.cutout()?, &casters.drawn.tests), &state, |_| Some(()));
     }
     Ok((ds.into_depth_image(), counters))
 }
@@ -71,7 +72,7 @@ pub fn render_depth_map(
 /// vertices in the clip space of one light projection.
 struct Casters<'a> {
     frame: &'a FrameInputs,
-    drawn: Drawn,
+    drawn: Drawn<'a>,
     /// The clip-space vertices of each of `drawn.solid`, then of each of `drawn.cutout`.
     clip: Vec<Vec<Vec4>>,
 }
@@ -102,11 +103,6 @@ impl<'a> Casters<'a> {
     /// The cut-out casters as one draw; its parts are in the order of `drawn.cutout`.
     fn cutout(&self) -> Result<Batch<'_>, FrameError> {
         self.batch(&self.drawn.cutout, self.drawn.solid.len())
-    }
-
-    /// The alpha tests of the cut-out casters, in the order of `drawn.cutout`.
-    fn tests(&self) -> Vec<Cutout<'a>> {
-        self.drawn.cutout.iter().filter_map(|&k| Cutout::of(&self.frame.instances[k])).collect()
     }
 }
 
@@ -159,7 +155,7 @@ pub fn render_depth_and_id_maps(
         if !casters.drawn.cutout.is_empty() {
             let (cutout, list) = (casters.cutout()?, &casters.drawn.cutout);
             let id_of = |f: &Fragment| Some(list[cutout.part_of(f.prim).0] as u32 + 1);
-            draw_alpha_tested(&mut ds, &mut id, (&cutout, &casters.tests()), &state, id_of);
+            draw_alpha_tested(&mut ds, &mut id, (&cutout, &casters.drawn.tests), &state, id_of);
         }
         maps.push(ds.into_depth_image());
         ids.push(id);
