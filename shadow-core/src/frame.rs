@@ -289,10 +289,15 @@ impl FrameInputs {
 
     /// The silhouette of every casting instance for the light, in instance order: its index in
     /// `instances` and its edges in the welded vertices of the instance's adjacency
-    /// (`adjacency.positions()`, mesh space), oriented as [`silhouette`] orients them.
+    /// (`adjacency.positions()`, mesh space), oriented as [`silhouette`] orients them. A caster its texture
+    /// cuts out has none, as in [`Self::silhouette_segments`]: the penumbrae built on silhouettes
+    /// (smoothies, penumbra maps) would otherwise soften the outline of a card where it casts no shadow.
     #[must_use]
     pub fn caster_silhouettes(&self, light: &LightView) -> Vec<(usize, Silhouette)> {
-        self.silhouettes(light).filter(|(i, ..)| self.instances[*i].casts_shadow).map(|(i, _, s)| (i, s)).collect()
+        self.silhouettes(light)
+            .filter(|(i, ..)| self.instances[*i].casts_shadow && self.instances[*i].coverage() != Coverage::Cutout)
+            .map(|(i, _, s)| (i, s))
+            .collect()
     }
 
     /// The silhouette edges of every casting instance for the light, in world space, in instance order
@@ -411,20 +416,25 @@ mod tests {
         assert_eq!(scene.material(card).unwrap().alpha_mode, AlphaMode::Opaque);
     }
 
-    /// A caster its texture cuts out gives silhouette maps no edges, though its mesh has an outline; made
-    /// opaque, it does.
+    /// A caster its texture cuts out gives silhouette maps and the penumbrae built on silhouettes no
+    /// edges, though its mesh has an outline; made opaque, it does.
     #[test]
-    fn cut_out_casters_give_silhouette_maps_no_edges() {
+    fn cut_out_casters_give_silhouette_techniques_no_edges() {
         let mut scene = crate::scenes::build("cutout", &crate::scenes::SceneParams::default()).expect("cutout");
+        // The card's edges (it is the one caster a metre over the ground) in the world segments and in
+        // the per-caster silhouettes.
         let edges = |scene: &Scene| {
             let frame = FrameInputs::from_first_camera(scene).expect("frame");
             let light = frame.light_view(&frame.lights[0]).expect("light view");
-            // The card's, a metre over the ground's outline.
-            frame.silhouette_segments(&light).iter().filter(|[a, b]| a.y > 0.5 && b.y > 0.5).count()
+            let segments = frame.silhouette_segments(&light).iter().filter(|[a, b]| a.y > 0.5 && b.y > 0.5).count();
+            let card = |i: usize| frame.instances[i].bounds.min.y > 0.5;
+            let silhouettes: usize =
+                frame.caster_silhouettes(&light).iter().filter(|(i, _)| card(*i)).map(|(_, s)| s.edges.len()).sum();
+            (segments, silhouettes)
         };
-        assert_eq!(edges(&scene), 0, "the cut-out card");
+        assert_eq!(edges(&scene), (0, 0), "the cut-out card");
         let card = scene.materials().find(|(_, m)| m.name == "checkerboard").expect("the card").0;
         scene.material_mut(card).expect("material").alpha_mode = AlphaMode::Opaque;
-        assert_eq!(edges(&scene), 4, "the opaque card's outline");
+        assert_eq!(edges(&scene), (4, 4), "the opaque card's outline");
     }
 }
