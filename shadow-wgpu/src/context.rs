@@ -68,6 +68,18 @@ pub enum WgpuError {
         /// The device's limit.
         most: u64,
     },
+    /// A material's texture larger than the device takes.
+    #[error("texture '{texture}' of {width}x{height} texels is over the device's limit of {most} a side")]
+    TextureTooLarge {
+        /// The texture's name (its file, or where in the model it is).
+        texture: String,
+        /// Width of level 0.
+        width: u32,
+        /// Height of level 0.
+        height: u32,
+        /// The device's largest side.
+        most: u32,
+    },
     /// A wait for the GPU or a read-back inside a frame recorded into a host's encoder, which is only
     /// submitted once the recording is done.
     #[error("{what} needs the GPU's results, which a frame recorded into a host's encoder does not wait for")]

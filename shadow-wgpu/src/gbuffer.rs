@@ -233,6 +233,7 @@ fn fill(
     // A frame begins with its G-buffer: its transient data starts over.
     cx.begin_transient();
     cx.upload_meshes(frame);
+    cx.upload_textures(frame)?;
     let instances = cx.instances(frame);
     let targets = match cx.gbuffer_targets.take() {
         Some(t) if (t.width, t.height) == (width, height) => t,

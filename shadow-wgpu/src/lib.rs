@@ -3,7 +3,7 @@
 //! A context on its own device or the host application's ([`context`]), scene upload cached per mesh
 //! ([`upload`]), the G-buffer ([`gbuffer`]), the instrumented frame with shading and read-backs
 //! ([`frame`]), the frame recorded into a host's encoder ([`record`]), pipelines and WGSL every technique
-//! uses ([`pipelines`], [`shaders`]), the passes techniques are built from ([`passes`]), and where
+//! uses ([`pipelines`], [`shaders`]), materials' textures ([`textures`]), the passes techniques are built from ([`passes`]), and where
 //! buffers and textures come from ([`resources`]).
 
 pub mod clock;
@@ -17,6 +17,7 @@ pub mod readback;
 pub mod record;
 pub mod resources;
 pub mod shaders;
+pub mod textures;
 pub mod timer;
 pub mod upload;
 

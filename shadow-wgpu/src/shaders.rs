@@ -32,6 +32,9 @@ fn poisson_constant() -> String {
     s
 }
 
+/// The texel rule (`texel.wgsl`): how a material's texture is read, for the shaders that read one.
+pub const TEXEL: &str = include_str!("shaders/texel.wgsl");
+
 /// G-buffer pass.
 #[must_use]
 pub fn gbuffer() -> String {
@@ -86,5 +89,6 @@ pub fn all() -> Vec<(&'static str, String)> {
         ("shadow_map", shadow_map()),
         ("shadow_volume", shadow_volume()),
         ("extrusion", extrusion()),
+        ("texel", TEXEL.to_string()),
     ]
 }

@@ -1,7 +1,7 @@
 //! Scene upload, cached: vertex and index buffers per [`MeshKey`] (refreshed when the mesh's version
-//! changes), the adjacency the GPU's shadow-volume extrusion reads (per mesh, on first use), and the
-//! per-instance data of a frame (rewritten in place when an instance changes, made anew only when their
-//! number does).
+//! changes), the adjacency the GPU's shadow-volume extrusion reads (per mesh, on first use), the
+//! materials' textures ([`crate::textures`]), and the per-instance data of a frame (rewritten in place
+//! when an instance changes, made anew only when their number does).
 
 use std::collections::HashMap;
 
@@ -10,7 +10,8 @@ use glam::Mat4;
 use shadow_core::geometry::adjacency::{Adjacency, FaceUse};
 use shadow_core::{FrameInputs, MeshKey};
 
-use crate::context::WgpuContext;
+use crate::context::{WgpuContext, WgpuError};
+use crate::textures::DeviceTextures;
 
 /// A mesh on the GPU.
 pub struct MeshGpu {
@@ -123,6 +124,8 @@ pub struct SceneCache {
     adjacency: HashMap<MeshKey, AdjacencyGpu>,
     /// The instance buffers, one per frame that may be in flight, each with what it holds.
     instances: Vec<(Vec<InstanceRaw>, wgpu::Buffer)>,
+    /// The materials' textures.
+    pub textures: DeviceTextures,
 }
 
 impl SceneCache {
@@ -219,6 +222,18 @@ impl WgpuContext {
         let mut cache = std::mem::take(&mut self.cache);
         cache.upload_adjacency(self, frame);
         self.cache = cache;
+    }
+
+    /// Uploads the textures `frame`'s materials read that are not on the device yet, and lets go of those
+    /// it reads no more ([`DeviceTextures::upload`]).
+    ///
+    /// # Errors
+    /// A texture over the device's limit.
+    pub fn upload_textures(&mut self, frame: &FrameInputs) -> Result<(), WgpuError> {
+        let mut cache = std::mem::take(&mut self.cache);
+        let done = cache.textures.upload(self, frame);
+        self.cache = cache;
+        done
     }
 
     /// The frame's instance data, written where it changed ([`SceneCache::instances`]).

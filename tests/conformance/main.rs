@@ -25,6 +25,7 @@ mod planar;
 mod recorded;
 mod scale;
 mod suite;
+mod texel_rule;
 mod view_fitted;
 mod viewer;
 mod volume_reconstruction;
