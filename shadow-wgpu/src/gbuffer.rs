@@ -1,13 +1,14 @@
 //! The camera G-buffer on the GPU: the context's depth-stencil format plus world position (w: receives shadow),
 //! shading normal and albedo (w: covered), all f32 so shading matches the CPU's.
 
-use shadow_core::frame::Surfaces;
+use shadow_core::frame::{Coverage, Surfaces};
 use shadow_core::glam::Vec3;
 use shadow_core::scene::Camera;
 use shadow_core::{FrameInputs, Image};
 
 use crate::context::{WgpuContext, WgpuError};
 use crate::pipelines::{ATTRIBUTE, ViewRaw};
+use crate::textures::read_texture;
 
 /// The camera view of a frame, on the GPU.
 pub struct GpuGBuffer {
@@ -103,7 +104,9 @@ impl GBufferTargets {
 pub fn render(cx: &mut WgpuContext, frame: &FrameInputs, width: u32, height: u32) -> Result<GpuGBuffer, WgpuError> {
     fill(cx, frame, (width, height), "the G-buffer pass", |cx, pass| {
         pass.set_pipeline(&cx.shared.gbuffer);
-        draw_instances(cx, pass, frame, |_| true, true);
+        draw_instances(cx, pass, frame, |i| read_texture(i).is_none() && i.coverage() != Coverage::Absent, true);
+        pass.set_pipeline(&cx.shared.gbuffer_textured);
+        draw_textured(cx, pass, frame, |_| true, true);
     })
 }
 
@@ -291,6 +294,25 @@ fn fill(
     })
 }
 
+/// Draws every instance whose material reads a texture ([`read_texture`]) and that passes `keep`, with
+/// its own mesh, its texture coordinates in the slot after the positions (and the normals, with
+/// `normals`) and its texture's group as group 2 (instance index = frame instance index).
+pub fn draw_textured(
+    cx: &WgpuContext,
+    pass: &mut wgpu::RenderPass<'_>,
+    frame: &FrameInputs,
+    keep: impl Fn(&shadow_core::Instance) -> bool,
+    normals: bool,
+) {
+    for (i, inst) in frame.instances.iter().enumerate().filter(|(_, i)| keep(i)) {
+        let Some(texture) = read_texture(inst).and_then(|t| cx.cache.textures.get(t)) else { continue };
+        let Some((m, uvs)) = cx.cache.mesh(inst.mesh_key).and_then(|m| Some((m, m.uvs.as_ref()?))) else { continue };
+        pass.set_bind_group(2, &texture.group, &[]);
+        pass.set_vertex_buffer(if normals { 2 } else { 1 }, uvs.slice(..));
+        draw_mesh(pass, m, i, normals);
+    }
+}
+
 /// Draws every instance that passes `keep` with its own mesh (instance index = frame instance index).
 pub fn draw_instances(
     cx: &WgpuContext,
@@ -301,11 +323,16 @@ pub fn draw_instances(
 ) {
     for (i, inst) in frame.instances.iter().enumerate().filter(|(_, i)| keep(i)) {
         let Some(m) = cx.cache.mesh(inst.mesh_key) else { continue };
-        pass.set_vertex_buffer(0, m.positions.slice(..));
-        if normals {
-            pass.set_vertex_buffer(1, m.normals.slice(..));
-        }
-        pass.set_index_buffer(m.indices.slice(..), wgpu::IndexFormat::Uint32);
-        pass.draw_indexed(0..m.index_count, 0, i as u32..i as u32 + 1);
+        draw_mesh(pass, m, i, normals);
     }
+}
+
+/// Draws mesh `m` as instance `i`: its positions in slot 0 (and its normals in slot 1, with `normals`).
+fn draw_mesh(pass: &mut wgpu::RenderPass<'_>, m: &crate::upload::MeshGpu, i: usize, normals: bool) {
+    pass.set_vertex_buffer(0, m.positions.slice(..));
+    if normals {
+        pass.set_vertex_buffer(1, m.normals.slice(..));
+    }
+    pass.set_index_buffer(m.indices.slice(..), wgpu::IndexFormat::Uint32);
+    pass.draw_indexed(0..m.index_count, 0, i as u32..i as u32 + 1);
 }

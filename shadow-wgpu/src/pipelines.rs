@@ -86,6 +86,19 @@ pub const NORMAL_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferL
     attributes: &wgpu::vertex_attr_array![1 => Float32x4],
 };
 
+/// Vertex layout of texture coordinates, `vec2<f32>` (location 2, whichever slot holds them).
+pub const UV_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
+    array_stride: 8,
+    step_mode: wgpu::VertexStepMode::Vertex,
+    attributes: &wgpu::vertex_attr_array![2 => Float32x2],
+};
+
+/// A material's texture (`textures::TEXTURE_FORMAT`), read by index with `textureLoad` in the fragment stage.
+#[must_use]
+pub fn material_texture_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    texture_entry(binding, wgpu::TextureSampleType::Float { filterable: false }, wgpu::TextureViewDimension::D2)
+}
+
 fn texture_entry(
     binding: u32,
     sample_type: wgpu::TextureSampleType,
@@ -143,8 +156,13 @@ pub fn buffer_entry(
 pub struct Shared {
     /// Group 0: view uniform and instance data.
     pub frame_layout: wgpu::BindGroupLayout,
+    /// A material's base-colour texture, as every pass that reads one binds it (group 2, binding 0).
+    pub material_layout: wgpu::BindGroupLayout,
     /// The G-buffer pipeline.
     pub gbuffer: wgpu::RenderPipeline,
+    /// The G-buffer pipeline of instances whose material reads a texture (group 2: the texture), with
+    /// their texture coordinates in vertex slot 2.
+    pub gbuffer_textured: wgpu::RenderPipeline,
     /// Group 1 of the shading pass.
     pub shade_layout: wgpu::BindGroupLayout,
     /// The shading pipeline.
@@ -165,37 +183,51 @@ impl Shared {
                 buffer_entry(1, wgpu::BufferBindingType::Storage { read_only: true }, all),
             ],
         );
+        let material_layout = pipelines.group_layout("material texture", &[material_texture_entry(0)]);
         let gmod = pipelines.module("gbuffer", shaders::gbuffer());
-        let glayout = pipelines.layout("gbuffer", &[Some(&frame_layout)]);
-        let target =
-            Some(wgpu::ColorTargetState { format: ATTRIBUTE, blend: None, write_mask: wgpu::ColorWrites::ALL });
-        let gbuffer = pipelines.render(&wgpu::RenderPipelineDescriptor {
-            label: Some("gbuffer"),
-            layout: Some(&glayout),
-            vertex: wgpu::VertexState {
-                module: &gmod,
-                entry_point: Some("vs_gbuffer"),
-                compilation_options: Default::default(),
-                buffers: &[Some(POSITION_LAYOUT), Some(NORMAL_LAYOUT)],
-            },
-            primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: depth_stencil,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Less),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &gmod,
-                entry_point: Some("fs_gbuffer"),
-                compilation_options: Default::default(),
-                targets: &[target.clone(), target.clone(), target.clone(), target],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let gbuffer_pipeline = |label, groups: &[Option<&wgpu::BindGroupLayout>], buffers: &[_], entries: [&str; 2]| {
+            let target =
+                Some(wgpu::ColorTargetState { format: ATTRIBUTE, blend: None, write_mask: wgpu::ColorWrites::ALL });
+            pipelines.render(&wgpu::RenderPipelineDescriptor {
+                label: Some(label),
+                layout: Some(&pipelines.layout(label, groups)),
+                vertex: wgpu::VertexState {
+                    module: &gmod,
+                    entry_point: Some(entries[0]),
+                    compilation_options: Default::default(),
+                    buffers,
+                },
+                primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+                depth_stencil: Some(wgpu::DepthStencilState {
+                    format: depth_stencil,
+                    depth_write_enabled: Some(true),
+                    depth_compare: Some(wgpu::CompareFunction::Less),
+                    stencil: Default::default(),
+                    bias: Default::default(),
+                }),
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &gmod,
+                    entry_point: Some(entries[1]),
+                    compilation_options: Default::default(),
+                    targets: &[target.clone(), target.clone(), target.clone(), target],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        let gbuffer = gbuffer_pipeline(
+            "gbuffer",
+            &[Some(&frame_layout)],
+            &[Some(POSITION_LAYOUT), Some(NORMAL_LAYOUT)],
+            ["vs_gbuffer", "fs_gbuffer"],
+        );
+        let gbuffer_textured = gbuffer_pipeline(
+            "gbuffer textured",
+            &[Some(&frame_layout), None, Some(&material_layout)],
+            &[Some(POSITION_LAYOUT), Some(NORMAL_LAYOUT), Some(UV_LAYOUT)],
+            ["vs_gbuffer_textured", "fs_gbuffer_textured"],
+        );
         let shade_layout = pipelines.group_layout(
             "shade",
             &[
@@ -229,7 +261,7 @@ impl Shared {
             Some(COLOR),
             None,
         );
-        Self { frame_layout, gbuffer, shade_layout, shade, receivers }
+        Self { frame_layout, material_layout, gbuffer, gbuffer_textured, shade_layout, shade, receivers }
     }
 
     /// A group-0 bind group for a view (camera or light) over a frame's instances, the view in this frame's

@@ -35,10 +35,10 @@ fn poisson_constant() -> String {
 /// The texel rule (`texel.wgsl`): how a material's texture is read, for the shaders that read one.
 pub const TEXEL: &str = include_str!("shaders/texel.wgsl");
 
-/// G-buffer pass.
+/// G-buffer pass, with the texel rule for textured surfaces.
 #[must_use]
 pub fn gbuffer() -> String {
-    with_common(include_str!("shaders/gbuffer.wgsl"))
+    with_common(&format!("{TEXEL}\n{}", include_str!("shaders/gbuffer.wgsl")))
 }
 
 /// The G-buffer from a host's depth and normals.
@@ -53,10 +53,18 @@ pub fn shade() -> String {
     with_common(include_str!("shaders/shade.wgsl"))
 }
 
-/// Shadow-map light pass and query.
+/// `common.wgsl`, the texel rule and the light-pass stages of casters a texture cuts out
+/// (`cutout_casters.wgsl`: `vs_light_cutout` and `caster_there`, the texture in group 2) + `body`: for a
+/// shader of light passes that draw casters.
+#[must_use]
+pub fn with_cutout_casters(body: &str) -> String {
+    with_common(&format!("{TEXEL}\n{}\n{body}", include_str!("shaders/cutout_casters.wgsl")))
+}
+
+/// Shadow-map light pass (casters a texture cuts out included) and query.
 #[must_use]
 pub fn shadow_map() -> String {
-    with_common(&format!("{}{}", poisson_constant(), include_str!("shaders/shadow_map.wgsl")))
+    with_cutout_casters(&format!("{}{}", poisson_constant(), include_str!("shaders/shadow_map.wgsl")))
 }
 
 /// The shadow-map shader followed by `query`: a query written against `MapQuery`'s bindings and the

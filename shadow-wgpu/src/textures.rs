@@ -80,6 +80,8 @@ pub struct TextureGpu {
     pub texture: wgpu::Texture,
     /// A view of every level.
     pub view: wgpu::TextureView,
+    /// The view bound as the passes that read a material's texture bind it (`Shared::material_layout`).
+    pub group: wgpu::BindGroup,
 }
 
 impl TextureGpu {
@@ -122,7 +124,12 @@ impl TextureGpu {
             );
         }
         let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
-        Ok(Self { source: source.clone(), texture, view })
+        let group = cx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some(source.name()),
+            layout: &cx.shared.material_layout,
+            entries: &[wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&view) }],
+        });
+        Ok(Self { source: source.clone(), texture, view, group })
     }
 
     /// The texture it was made from.

@@ -11,7 +11,7 @@ use shadow_core::geometry::adjacency::{Adjacency, FaceUse};
 use shadow_core::{FrameInputs, MeshKey};
 
 use crate::context::{WgpuContext, WgpuError};
-use crate::textures::DeviceTextures;
+use crate::textures::{DeviceTextures, TexelRuleRaw, read_texture};
 
 /// A mesh on the GPU.
 pub struct MeshGpu {
@@ -20,6 +20,8 @@ pub struct MeshGpu {
     pub positions: wgpu::Buffer,
     /// Normals, one `vec4<f32>` per vertex.
     pub normals: wgpu::Buffer,
+    /// Texture coordinates, one `vec2<f32>` per vertex, where the mesh has them.
+    pub uvs: Option<wgpu::Buffer>,
     /// Triangle indices (also bound as storage: the extrusion copies casting faces' indices into its cap
     /// lists).
     pub indices: wgpu::Buffer,
@@ -35,16 +37,19 @@ pub struct InstanceRaw {
     normal_from_local: [[f32; 4]; 4],
     color: [f32; 4],
     flags: [u32; 4],
+    texel: TexelRuleRaw,
 }
 
 impl InstanceRaw {
     fn of(inst: &shadow_core::Instance) -> Self {
         let n = Mat4::from_mat3(shadow_core::affine::normal_matrix(inst.world_from_local));
+        let texel = read_texture(inst).and_then(|_| TexelRuleRaw::of(&inst.material)).unwrap_or_default();
         Self {
             world_from_local: inst.world_from_local.to_cols_array_2d(),
             normal_from_local: n.to_cols_array_2d(),
             color: inst.base_color.extend(if inst.two_sided { 1.0 } else { 0.0 }).to_array(),
             flags: [u32::from(inst.receives_shadow), u32::from(inst.mirrored), 0, 0],
+            texel,
         }
     }
 }
@@ -148,6 +153,7 @@ impl SceneCache {
                     version: inst.mesh_version,
                     positions: make("positions", bytemuck::cast_slice(&positions), wgpu::BufferUsages::VERTEX),
                     normals: make("normals", bytemuck::cast_slice(&normals), wgpu::BufferUsages::VERTEX),
+                    uvs: m.uvs().map(|uvs| make("uvs", bytemuck::cast_slice(uvs), wgpu::BufferUsages::VERTEX)),
                     indices: make(
                         "indices",
                         bytemuck::cast_slice(&indices),

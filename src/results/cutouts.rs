@@ -1,9 +1,9 @@
 //! The cut-out casters' part of the results: the scenes whose textures cut their casters out
-//! ([`scenes::CUTOUT`]) on the CPU backend, every technique that takes such casters against its
-//! reference. How much of `cutout`'s checkerboard shadow each lights (half is right), under the scene's
-//! sun and under a spot light in its place; each one's error on `foliage` beside its error on `tree` (the
-//! same branches, bare), and on `fence` beside `outdoor` (the same street's scale and sun); and the
-//! contact sheet of `foliage`.
+//! ([`scenes::CUTOUT`]) on each backend, every technique that takes such casters against its reference.
+//! How much of `cutout`'s checkerboard shadow each lights (half is right), under the scene's sun and under
+//! a spot light in its place; each one's error on `foliage` beside its error on `tree` (the same branches,
+//! bare), and on `fence` beside `outdoor` (the same street's scale and sun), with the two backends'
+//! mismatch on the scenes of cut-out casters; and the contact sheet of `foliage`.
 
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -11,6 +11,7 @@ use std::path::PathBuf;
 use shadow_core::FrameInputs;
 use shadow_core::scenes::cutouts::card_shadow_lit_share;
 use shadow_core::scenes::{self, LightType, SceneParams};
+use shadow_core::technique::TechniqueSpec;
 
 use super::scene_frame;
 use crate::Error;
@@ -24,22 +25,50 @@ const PAIRS: [(&str, &str); 2] = [("foliage", "tree"), ("fence", "outdoor")];
 pub struct CutoutJob {
     /// View size.
     pub size: (u32, u32),
+    /// The backends to measure (the references run on the CPU, at each backend's pixels).
+    pub backends: Vec<BackendKind>,
     /// The folder the pictures go to, beside the results page.
     pub pictures: PathBuf,
 }
 
+/// The lit shares of one technique: per backend of the job, under the sun and under a spot light (`None`
+/// where it takes no such light or does not run on that backend).
+type LitShares = (String, Vec<[Option<f64>; 2]>);
+
 /// The measurements.
 pub struct CutoutReport {
-    /// Each technique's lit share of the card's shadow under the sun and under a spot light (`None`
-    /// where it takes no such light), references first.
-    lit_shares: Vec<(String, [Option<f64>; 2])>,
+    /// Each technique's lit shares of the card's shadow, references first.
+    lit_shares: Vec<LitShares>,
     /// The reports of the scenes of [`PAIRS`], each with its partner's.
     pairs: Vec<(CompareReport, CompareReport)>,
+    backends: Vec<BackendKind>,
     size: (u32, u32),
 }
 
-/// Measures the scenes of cut-out casters and their partners on the CPU; copies the contact sheet of
-/// `foliage` into `job.pictures`.
+/// How much of `cutout`'s card shadow `spec` lights on `backend` at `width x height` (the mean visibility
+/// over the ground under the card, at the backend's own pixels), and over how many pixels.
+///
+/// # Errors
+/// A rendering failure, or no wgpu adapter for `BackendKind::Wgpu`.
+pub fn card_lit_share(
+    renderer: &mut Renderer,
+    backend: BackendKind,
+    frame: &FrameInputs,
+    spec: &TechniqueSpec,
+    (width, height): (u32, u32),
+) -> Result<(f64, usize), Error> {
+    if backend == BackendKind::Cpu {
+        let (f, _) = renderer.run_cpu_frame(frame, width, height, spec)?;
+        return Ok(card_shadow_lit_share(f.receiver_points(0)));
+    }
+    let run = renderer.run(backend, frame, width, height, spec)?;
+    let surfaces = shadow_wgpu::gbuffer::read(renderer.wgpu_context()?, frame, width, height)?;
+    let pixels = surfaces.position.data().iter().zip(surfaces.receiver.data()).zip(run.visibility[0].data());
+    Ok(card_shadow_lit_share(pixels.filter(|((_, receiver), _)| **receiver).map(|((&p, _), &v)| (p, v))))
+}
+
+/// Measures the scenes of cut-out casters and their partners on the job's backends; copies the contact
+/// sheet of `foliage` into `job.pictures`.
 ///
 /// # Errors
 /// A scene that cannot be built, a rendering failure, or a picture that cannot be written.
@@ -49,23 +78,34 @@ pub fn run_cutouts(
     mut progress: impl FnMut(&str),
 ) -> Result<CutoutReport, Error> {
     let (w, h) = job.size;
-    let mut lit_shares: Vec<(String, [Option<f64>; 2])> = Vec::new();
+    let mut lit_shares: Vec<LitShares> = Vec::new();
     for (k, light) in [None, Some(LightType::Spot)].into_iter().enumerate() {
         let scene = scenes::build("cutout", &SceneParams { light, ..SceneParams::default() })
             .map_err(|e| Error::Usage(format!("cutout: {e}")))?;
         let frame = FrameInputs::from_first_camera(&scene)?;
         let (taken, _) = renderer.registry().measurable(&frame);
         let (reference, soft_reference) = references_for(renderer.registry(), &taken);
+        let references = 1 + usize::from(soft_reference.is_some());
         let mut specs = vec![reference];
         specs.extend(soft_reference);
         specs.extend(taken);
-        for spec in specs {
-            progress(&format!("cutout: lit share of {spec}"));
-            let (f, _) = renderer.run_cpu_frame(&frame, w, h, &spec)?;
-            let share = card_shadow_lit_share(f.receiver_points(0)).0;
-            match lit_shares.iter_mut().find(|(name, _)| *name == spec.name) {
-                Some((_, shares)) => shares[k] = Some(share),
-                None => lit_shares.push((spec.name.clone(), std::array::from_fn(|i| (i == k).then_some(share)))),
+        for (i, spec) in specs.iter().enumerate() {
+            let on_wgpu = renderer.registry().get(&spec.name)?.wgpu.is_some();
+            let runs = |b: &BackendKind| match b {
+                // The references at the CPU's pixels only: the wgpu rows measure the techniques.
+                BackendKind::Cpu => true,
+                BackendKind::Wgpu => i >= references && on_wgpu,
+            };
+            let slot = match lit_shares.iter().position(|(name, _)| *name == spec.name) {
+                Some(slot) => slot,
+                None => {
+                    lit_shares.push((spec.name.clone(), vec![[None; 2]; job.backends.len()]));
+                    lit_shares.len() - 1
+                }
+            };
+            for (b, backend) in job.backends.iter().enumerate().filter(|(_, b)| runs(b)) {
+                progress(&format!("cutout: lit share of {spec} on {}", backend.name()));
+                lit_shares[slot].1[b][k] = Some(card_lit_share(renderer, *backend, &frame, spec, job.size)?.0);
             }
         }
     }
@@ -84,7 +124,7 @@ pub fn run_cutouts(
                 techniques,
                 reference,
                 soft_reference,
-                backends: vec![BackendKind::Cpu],
+                backends: job.backends.clone(),
                 out_dir: Some(scratch.clone()),
             };
             let report = run_compare(renderer, &compare, |m| progress(&format!("{name}: {m}")))?;
@@ -100,7 +140,7 @@ pub fn run_cutouts(
         let without = measure(renderer, partner, &mut progress)?;
         pairs.push((with, without));
     }
-    Ok(CutoutReport { lit_shares, pairs, size: job.size })
+    Ok(CutoutReport { lit_shares, pairs, backends: job.backends.clone(), size: job.size })
 }
 
 /// A result's error: the mismatch for a hard technique (as a percentage), the RMSE for a soft one.
@@ -114,53 +154,67 @@ fn error(e: &ResultEntry) -> (f64, String) {
 
 /// The markdown section.
 pub fn markdown(s: &mut String, r: &CutoutReport) {
-    let _ = writeln!(s, "\n## Cut-out casters (CPU backend)\n");
+    let names: Vec<&str> = r.backends.iter().map(|b| b.name()).collect();
+    let _ = writeln!(s, "\n## Cut-out casters\n");
     let _ = writeln!(
         s,
-        "{}x{}, on the CPU backend: the scenes whose textures cut their casters out. A clear texel blocks no \
-         light: the references test each ray's hit against its texel (level 0, the magnification filter), \
-         the light passes discard the fragments of clear texels, each read over the footprint of one map \
-         texel. The techniques that extrude silhouettes take no cut-out casters and are left out.\n",
-        r.size.0, r.size.1
+        "{}x{}, on {}: the scenes whose textures cut their casters out. A clear texel blocks no light: the \
+         references test each ray's hit against its texel (level 0, the magnification filter), the light \
+         passes of both backends discard the fragments of clear texels, each read over the footprint of one \
+         map texel by the same rule. The techniques that extrude silhouettes take no cut-out casters and are \
+         left out.\n",
+        r.size.0,
+        r.size.1,
+        names.join(" and ")
     );
     let _ = writeln!(
         s,
         "The lit share of `cutout`'s shadow: the mean visibility over the ground under the checkerboard card, \
-         of which half is clear; under the scene's sun straight above the card, and under a spot light in its \
-         place (which the soft techniques take). A dash: a light the technique does not take.\n"
+         of which half is clear, at each backend's own pixels; under the scene's sun straight above the card, \
+         and under a spot light in its place (which the soft techniques take). A dash: a light the technique \
+         does not take (the references run on the CPU).\n"
     );
-    let _ = writeln!(s, "| technique | lit share, sun | lit share, spot |\n|---|---:|---:|");
+    let _ = write!(s, "| technique |");
+    for light in ["sun", "spot"] {
+        for name in &names {
+            let _ = write!(s, " {light}, {name} |");
+        }
+    }
+    let _ = writeln!(s, "\n|---|{}", "---:|".repeat(2 * names.len()));
     for (name, shares) in &r.lit_shares {
-        let cell = |v: &Option<f64>| v.map_or("-".into(), |v| format!("{:.2}%", v * 100.0));
-        let _ = writeln!(s, "| `{name}` | {} | {} |", cell(&shares[0]), cell(&shares[1]));
+        let cell = |v: Option<f64>| v.map_or("-".into(), |v| format!("{:.2}%", v * 100.0));
+        let _ = write!(s, "| `{name}` |");
+        for light in 0..2 {
+            for per_backend in shares {
+                let _ = write!(s, " {} |", cell(per_backend[light]));
+            }
+        }
+        s.push('\n');
     }
     let _ = writeln!(
         s,
         "\nEach technique's error on a scene of cut-out casters beside its error on the scene they were made \
-         from, with the same settings: hard techniques by mismatch, soft ones (marked RMSE) by RMSE. A dash: \
-         the scene's light is of a kind the technique or its reference does not take.\n"
+         from, with the same settings, on each backend: hard techniques by mismatch, soft ones (marked RMSE) \
+         by RMSE. A dash: the scene's light is of a kind the technique or its reference does not take.\n"
     );
-    let _ = write!(s, "| technique |");
+    let _ = write!(s, "| technique | backend |");
     for (with, without) in &r.pairs {
         let _ = write!(s, " {} | {} | x |", with.scene, without.scene);
     }
-    let _ = write!(s, "\n|---|");
-    for _ in &r.pairs {
-        let _ = write!(s, "---:|---:|---:|");
-    }
-    s.push('\n');
-    let mut names: Vec<(&str, bool)> = Vec::new();
+    let _ = writeln!(s, "\n|---|---|{}", "---:|---:|---:|".repeat(r.pairs.len()));
+    let mut rows: Vec<(&str, &str, bool)> = Vec::new();
     for (with, _) in &r.pairs {
         for e in &with.results {
-            if !names.iter().any(|(n, _)| *n == e.technique) {
-                names.push((&e.technique, e.reference != shadow_hard::RayTraced::NAME));
+            if !rows.iter().any(|(n, b, _)| *n == e.technique && *b == e.backend) {
+                rows.push((&e.technique, &e.backend, e.reference != shadow_hard::RayTraced::NAME));
             }
         }
     }
-    for (name, soft) in names {
-        let _ = write!(s, "| `{name}`{} |", if soft { " (RMSE)" } else { "" });
+    for (name, backend, soft) in rows {
+        let _ = write!(s, "| `{name}`{} | {backend} |", if soft { " (RMSE)" } else { "" });
         for (with, without) in &r.pairs {
-            let find = |r: &CompareReport| r.results.iter().find(|e| e.technique == name).map(error);
+            let find =
+                |r: &CompareReport| r.results.iter().find(|e| e.technique == name && e.backend == backend).map(error);
             match (find(with), find(without)) {
                 (Some((a, a_text)), Some((b, b_text))) => {
                     let _ = write!(s, " {a_text} | {b_text} | {:.2} |", a / b);
@@ -174,6 +228,40 @@ pub fn markdown(s: &mut String, r: &CutoutReport) {
             }
         }
         s.push('\n');
+    }
+    if r.pairs.iter().any(|(with, _)| !with.cross_backend.is_empty()) {
+        let _ = writeln!(
+            s,
+            "\nThe two backends against each other on the scenes of cut-out casters: the share of pixels where \
+             one says lit and the other shadowed, and the RMS difference of their visibilities.\n"
+        );
+        let _ = write!(s, "| technique |");
+        for (with, _) in &r.pairs {
+            let _ = write!(s, " {0} mismatch | {0} RMSE |", with.scene);
+        }
+        let _ = writeln!(s, "\n|---|{}", "---:|---:|".repeat(r.pairs.len()));
+        let mut names: Vec<&str> = Vec::new();
+        for (with, _) in &r.pairs {
+            for c in &with.cross_backend {
+                if !names.contains(&c.technique.as_str()) {
+                    names.push(&c.technique);
+                }
+            }
+        }
+        for name in names {
+            let _ = write!(s, "| `{name}` |");
+            for (with, _) in &r.pairs {
+                match with.cross_backend.iter().find(|c| c.technique == name) {
+                    Some(c) => {
+                        let _ = write!(s, " {:.3}% | {:.4} |", c.mismatch * 100.0, c.rmse);
+                    }
+                    None => {
+                        let _ = write!(s, " - | - |");
+                    }
+                }
+            }
+            s.push('\n');
+        }
     }
     let _ = writeln!(
         s,

@@ -4,8 +4,8 @@
 //! The error of each technique against its reference on each scene (both backends), the largest
 //! disagreement between the backends, the frame time per phase on one scene (`bench`), on a GPU adapter
 //! the real-time path on that scene (`bench --realtime`), perspective aliasing on the outdoor street
-//! ([`outdoor`]), the soft techniques against the area light ([`soft`]), the scenes of cut-out casters on
-//! the CPU ([`cutouts`]), and the kernels under them all timed on their own ([`kernels`]).
+//! ([`outdoor`]), the soft techniques against the area light ([`soft`]), the scenes of cut-out casters
+//! ([`cutouts`]), and the kernels under them all timed on their own ([`kernels`]).
 
 pub mod cutouts;
 pub mod kernels;
@@ -116,7 +116,8 @@ pub fn run_results(renderer: &mut Renderer, job: &ResultsJob, mut progress: impl
     let outdoor = outdoor::run_outdoor(renderer, &outdoor_job, &mut progress)?;
     let soft_job = soft::SoftJob { backends: job.backends.clone(), pictures: job.pictures.clone() };
     let soft = soft::run_soft(renderer, &soft_job, &mut progress)?;
-    let cutout_job = cutouts::CutoutJob { size: job.size, pictures: job.pictures.clone() };
+    let cutout_job =
+        cutouts::CutoutJob { size: job.size, backends: job.backends.clone(), pictures: job.pictures.clone() };
     let cutouts = cutouts::run_cutouts(renderer, &cutout_job, &mut progress)?;
     let kernels = kernels::run_kernels(&mut progress)?;
     let mut text = markdown(renderer, job, &reports, (&timing, realtime.as_ref()));

@@ -7,6 +7,7 @@
 use super::{DepthLayers, LayerCulling, LayerKind};
 use bytemuck::{Pod, Zeroable};
 use shadow_core::FrameInputs;
+use shadow_core::frame::Coverage;
 use shadow_core::light::LightProjection;
 use shadow_core::technique::LightPass;
 use shadow_core::technique::settings::Filter;
@@ -15,8 +16,9 @@ use shadow_core::technique::{ShadowTechnique, TechniqueError};
 use shadow_wgpu::frame::{GpuVisibility, layer_view};
 use shadow_wgpu::gbuffer::{GpuGBuffer, check_size};
 use shadow_wgpu::passes::maps::{LookupParams, MapQuery, QueryExtras, map_texture};
-use shadow_wgpu::pipelines::{MAP_DEPTH, POSITION_LAYOUT, ViewRaw, buffer_entry, depth_entry, depth_pass};
+use shadow_wgpu::pipelines::{MAP_DEPTH, POSITION_LAYOUT, UV_LAYOUT, ViewRaw, buffer_entry, depth_entry, depth_pass};
 use shadow_wgpu::shaders;
+use shadow_wgpu::textures::read_texture;
 use shadow_wgpu::{WgpuBackend, WgpuContext, WgpuError};
 
 /// GPU twin of `LayerParams` in layers.wgsl.
@@ -27,7 +29,7 @@ struct LayerParams {
     settings: [f32; 4],
 }
 
-/// Pipelines (index: peel pass, back-face culling, clockwise fronts) and the maps of the last build.
+/// Pipelines (index: [`Pass::index`]) and the maps of the last build.
 pub struct State {
     passes: Vec<wgpu::RenderPipeline>,
     combine: wgpu::RenderPipeline,
@@ -37,8 +39,26 @@ pub struct State {
     scratch: Option<(wgpu::Texture, wgpu::Texture)>,
 }
 
-fn pass_index(peel: bool, cull: bool, cw: bool) -> usize {
-    usize::from(peel) * 4 + usize::from(cull) * 2 + usize::from(cw)
+/// Which pass draws a caster: the peel pass or the first, culling back faces or not, fronts clockwise or
+/// not, cut out by its texture or not.
+#[derive(Clone, Copy)]
+struct Pass {
+    peel: bool,
+    cull: bool,
+    cw: bool,
+    cutout: bool,
+}
+
+impl Pass {
+    const COUNT: usize = 16;
+
+    fn index(self) -> usize {
+        usize::from(self.cutout) * 8 + usize::from(self.peel) * 4 + usize::from(self.cull) * 2 + usize::from(self.cw)
+    }
+
+    fn of(index: usize) -> Self {
+        Self { cutout: index & 8 != 0, peel: index & 4 != 0, cull: index & 2 != 0, cw: index & 1 != 0 }
+    }
 }
 
 fn kind_code(k: LayerKind) -> f32 {
@@ -61,21 +81,29 @@ fn depth_state(compare: wgpu::CompareFunction) -> wgpu::DepthStencilState {
 }
 
 /// One light pass of the layers: the nearest layer, or with `peel` the next one behind the first; back
-/// faces culled when `cull`, fronts wound clockwise (mirrored instances) when `cw`.
+/// faces culled when `cull`, fronts wound clockwise (mirrored instances) when `cw`, the fragments of
+/// clear texels discarded when `cutout` (group 2: the caster's texture).
 fn layer_pipeline(
     cx: &WgpuContext,
-    layout: &wgpu::PipelineLayout,
+    layouts: [&wgpu::PipelineLayout; 2],
     module: &wgpu::ShaderModule,
-    (peel, cull, cw): (bool, bool, bool),
+    Pass { peel, cull, cw, cutout }: Pass,
 ) -> wgpu::RenderPipeline {
+    let fragment = match (peel, cutout) {
+        (false, false) => None,
+        (true, false) => Some("fs_peel"),
+        (false, true) => Some("fs_layer_cutout"),
+        (true, true) => Some("fs_peel_cutout"),
+    };
+    let buffers = [Some(POSITION_LAYOUT), Some(UV_LAYOUT)];
     cx.pipelines.render(&wgpu::RenderPipelineDescriptor {
-        label: Some("depth layer"),
-        layout: Some(layout),
+        label: Some(if cutout { "depth layer, cut out" } else { "depth layer" }),
+        layout: Some(layouts[usize::from(cutout)]),
         vertex: wgpu::VertexState {
             module,
-            entry_point: Some("vs_layer"),
+            entry_point: Some(if cutout { "vs_light_cutout" } else { "vs_layer" }),
             compilation_options: Default::default(),
-            buffers: &[Some(POSITION_LAYOUT)],
+            buffers: if cutout { &buffers } else { &buffers[..1] },
         },
         primitive: wgpu::PrimitiveState {
             front_face: if cw { wgpu::FrontFace::Cw } else { wgpu::FrontFace::Ccw },
@@ -84,9 +112,9 @@ fn layer_pipeline(
         },
         depth_stencil: Some(depth_state(wgpu::CompareFunction::Less)),
         multisample: Default::default(),
-        fragment: peel.then(|| wgpu::FragmentState {
+        fragment: fragment.map(|entry| wgpu::FragmentState {
             module,
-            entry_point: Some("fs_peel"),
+            entry_point: Some(entry),
             compilation_options: Default::default(),
             targets: &[],
         }),
@@ -107,17 +135,10 @@ impl State {
                 buffer_entry(2, wgpu::BufferBindingType::Uniform, wgpu::ShaderStages::FRAGMENT),
             ],
         );
-        let groups = [Some(&cx.shared.frame_layout), Some(&layout)];
-        let pl = cx.pipelines.layout("depth layers", &groups);
-        let mut passes = Vec::new();
-        for peel in [false, true] {
-            for cull in [false, true] {
-                for cw in [false, true] {
-                    debug_assert_eq!(passes.len(), pass_index(peel, cull, cw));
-                    passes.push(layer_pipeline(cx, &pl, &module, (peel, cull, cw)));
-                }
-            }
-        }
+        let groups = [Some(&cx.shared.frame_layout), Some(&layout), Some(&cx.shared.material_layout)];
+        let pl = cx.pipelines.layout("depth layers", &groups[..2]);
+        let cut_out = cx.pipelines.layout("depth layers, cut out", &groups);
+        let passes = (0..Pass::COUNT).map(|i| layer_pipeline(cx, [&pl, &cut_out], &module, Pass::of(i))).collect();
         let combine = cx.pipelines.render(&wgpu::RenderPipelineDescriptor {
             label: Some("combine layers"),
             layout: Some(&pl),
@@ -189,8 +210,19 @@ fn render_projection(
         pass.set_bind_group(1, group, &[]);
         for (i, inst) in frame.instances.iter().enumerate().filter(|(_, i)| i.casts_shadow) {
             let Some(m) = cx.cache.mesh(inst.mesh_key) else { continue };
+            let cutout = match inst.coverage() {
+                Coverage::Solid => false,
+                Coverage::Cutout => true,
+                Coverage::Absent => continue,
+            };
+            if cutout {
+                let texture = read_texture(inst).and_then(|t| cx.cache.textures.get(t));
+                let (Some(texture), Some(uvs)) = (texture, &m.uvs) else { continue };
+                pass.set_bind_group(2, &texture.group, &[]);
+                pass.set_vertex_buffer(1, uvs.slice(..));
+            }
             let cull = s.culling == LayerCulling::Auto && inst.adjacency.closed();
-            pass.set_pipeline(&state.passes[pass_index(peeling, cull, inst.mirrored)]);
+            pass.set_pipeline(&state.passes[Pass { peel: peeling, cull, cw: inst.mirrored, cutout }.index()]);
             pass.set_vertex_buffer(0, m.positions.slice(..));
             pass.set_index_buffer(m.indices.slice(..), wgpu::IndexFormat::Uint32);
             pass.draw_indexed(0..m.index_count, 0, i as u32..i as u32 + 1);
@@ -235,6 +267,7 @@ impl ShadowTechnique<WgpuBackend> for DepthLayers {
                 Some(cx.scoped("allocating depth layers", |cx| (map_texture(cx, res, 1), map_texture(cx, res, 1)))?);
         }
         cx.upload_meshes(frame);
+        cx.upload_textures(frame)?;
         let instances = cx.instances(frame);
         let maps = state.maps.clone().ok_or_else(|| TechniqueError::NotBuilt(self.kind.name().into()))?;
         cx.scoped("the depth-layer passes", |cx| {
@@ -273,5 +306,5 @@ pub fn shaders() -> Vec<(&'static str, String)> {
 /// The peeling and combination passes.
 #[must_use]
 pub fn shader() -> String {
-    shaders::with_common(include_str!("layers.wgsl"))
+    shaders::with_cutout_casters(include_str!("layers.wgsl"))
 }

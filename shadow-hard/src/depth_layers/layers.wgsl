@@ -1,5 +1,5 @@
 // Depth layers (twin: depth_layers/cpu.rs): the nearest depth, the second-nearest by
-// peeling, and their combination written as depth.
+// peeling, and their combination written as depth. After `cutout_casters.wgsl`.
 
 struct LayerParams {
     // x: near, y: far, z: 1 for an orthographic view, w: kind (0 midpoint, 1 second depth, 2 dual)
@@ -23,11 +23,32 @@ fn vs_layer(@location(0) p: vec4<f32>, @builtin(instance_index) instance: u32) -
     return out;
 }
 
-// The second layer: fragments at the first layer's depth (within epsilon) are peeled away.
+// Whether a fragment at `pos` lies on the first layer (within epsilon), which the second peels away.
+fn on_first_layer(pos: vec4<f32>) -> bool {
+    let z1 = textureLoad(z1_map, vec2<i32>(pos.xy), 0);
+    return pos.z <= z1 + layer.settings.y;
+}
+
+// The second layer: fragments at the first layer's depth are peeled away.
 @fragment
 fn fs_peel(in: DepthOut) {
-    let z1 = textureLoad(z1_map, vec2<i32>(in.pos.xy), 0);
-    if (in.pos.z <= z1 + layer.settings.y) {
+    if (on_first_layer(in.pos)) {
+        discard;
+    }
+}
+
+// Both layers of casters a texture cuts out (`cutout_casters.wgsl`): the fragments of clear texels
+// are discarded too.
+@fragment
+fn fs_layer_cutout(in: CutoutOut) {
+    if (!caster_there(in)) {
+        discard;
+    }
+}
+
+@fragment
+fn fs_peel_cutout(in: CutoutOut) {
+    if (!caster_there(in) || on_first_layer(in.pos)) {
         discard;
     }
 }

@@ -20,7 +20,7 @@ use shadow_core::technique::{DebugView, ShadowTechnique, TechniqueError};
 use shadow_wgpu::frame::{GpuVisibility, layer_view, layered};
 use shadow_wgpu::gbuffer::{GpuGBuffer, check_size};
 use shadow_wgpu::passes::maps::{
-    LookupParams, MapQuery, QueryExtras, depth_bias, light_pass_pipeline, map_texture, render_maps,
+    LightPipelines, LookupParams, MapQuery, QueryExtras, depth_bias, light_pass_pipeline, map_texture, render_maps,
 };
 use shadow_wgpu::pipelines::{MAP_DEPTH, attribute_entry, buffer_entry, depth_array_entry};
 use shadow_wgpu::{Transient, WgpuBackend, WgpuContext, WgpuError};
@@ -46,7 +46,7 @@ struct Maps {
 
 /// Pipelines, the maps of the last build and the two counters.
 pub struct State {
-    light_pass: wgpu::RenderPipeline,
+    light_pass: LightPipelines,
     points: wgpu::RenderPipeline,
     points_layout: wgpu::BindGroupLayout,
     count: wgpu::ComputePipeline,
@@ -357,6 +357,7 @@ impl ShadowTechnique<WgpuBackend> for SilhouetteMap {
         state.allocate(cx, res, light.projections.len() as u32)?;
         let Some(maps) = &state.maps else { return Err(TechniqueError::NotBuilt(Self::NAME.into()).into()) };
         cx.upload_meshes(frame);
+        cx.upload_textures(frame)?;
         let instances = cx.instances(frame);
         let edges = frame.silhouette_segments(light);
         cx.scoped("the silhouette-map passes", |cx| {

@@ -24,7 +24,7 @@ use shadow_core::technique::{DebugView, ShadowTechnique, TechniqueError};
 use shadow_wgpu::frame::{GpuVisibility, layered};
 use shadow_wgpu::gbuffer::{GpuGBuffer, check_size};
 use shadow_wgpu::passes::maps::{
-    ID_FORMAT, depth_bias, light_id_pipeline, light_pass_pipeline, map_texture, render_maps,
+    ID_FORMAT, LightPipelines, depth_bias, light_id_pipeline, light_pass_pipeline, map_texture, render_maps,
 };
 use shadow_wgpu::passes::volumes::{StencilResolve, count_all, occlusion_query, read_query, volume_pipeline};
 use shadow_wgpu::{WgpuBackend, WgpuContext, WgpuError};
@@ -33,7 +33,7 @@ use shadow_wgpu::{readback, shaders};
 /// Pipelines, the maps and the reconstruction of the last build.
 pub struct State {
     /// The light pass, with the ID target when `ids` is not `off`.
-    light_pass: wgpu::RenderPipeline,
+    light_pass: LightPipelines,
     /// Parity passes: the boundary with the depth test, the caps without.
     boundary: wgpu::RenderPipeline,
     caps: wgpu::RenderPipeline,
@@ -157,6 +157,7 @@ impl ShadowTechnique<WgpuBackend> for VolumeReconstruction {
         let maps = state.maps.clone().ok_or_else(|| TechniqueError::NotBuilt(Self::NAME.into()))?;
         let id_maps = state.ids.clone();
         cx.upload_meshes(frame);
+        cx.upload_textures(frame)?;
         let instances = cx.instances(frame);
         cx.scoped("the light pass", |cx| {
             render_maps(cx, &state.light_pass, frame, &view, &maps, id_maps.as_ref(), &instances);

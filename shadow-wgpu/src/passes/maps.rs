@@ -5,15 +5,16 @@
 
 use bytemuck::{Pod, Zeroable};
 use shadow_core::FrameInputs;
+use shadow_core::frame::Coverage;
 use shadow_core::light::LightView;
 use shadow_core::technique::maps::DepthMap;
 use shadow_core::technique::settings::{BiasMode, Filter};
 
 use crate::context::{WgpuContext, WgpuError};
 use crate::frame::{GpuVisibility, layer_view, layered};
-use crate::gbuffer::{GpuGBuffer, check_size, draw_instances};
+use crate::gbuffer::{GpuGBuffer, check_size, draw_instances, draw_textured};
 use crate::pipelines::{
-    FragmentEntry, LightRaw, MAP_DEPTH, POSITION_LAYOUT, VISIBILITY, ViewRaw, attribute_entry, buffer_entry,
+    FragmentEntry, LightRaw, MAP_DEPTH, POSITION_LAYOUT, UV_LAYOUT, VISIBILITY, ViewRaw, attribute_entry, buffer_entry,
     depth_array_entry, full_screen_pipeline,
 };
 use crate::shaders;
@@ -229,25 +230,46 @@ pub fn depth_bias(s: &DepthMap) -> wgpu::DepthBiasState {
     }
 }
 
+/// The light pass's pipelines: one for the casters that are everywhere (depth only, or depth and ID) and
+/// one for those their texture cuts out, whose fragment stage discards the fragments of clear texels
+/// (the texel rule of `texel.wgsl` over one map texel's footprint; group 2: the caster's texture). The
+/// second is made by the first frame that has such casters, so a scene without them compiles nothing
+/// for them.
+pub struct LightPipelines {
+    solid: wgpu::RenderPipeline,
+    module: wgpu::ShaderModule,
+    bias: wgpu::DepthBiasState,
+    ids: bool,
+    cutout: std::cell::OnceCell<wgpu::RenderPipeline>,
+}
+
+impl LightPipelines {
+    fn new(cx: &WgpuContext, module: &wgpu::ShaderModule, bias: wgpu::DepthBiasState, ids: bool) -> Self {
+        let solid = light_pipeline(cx, module, bias, ids, false);
+        Self { solid, module: module.clone(), bias, ids, cutout: std::cell::OnceCell::new() }
+    }
+
+    /// The pipeline of the casters their texture cuts out.
+    fn cutout(&self, cx: &WgpuContext) -> &wgpu::RenderPipeline {
+        self.cutout.get_or_init(|| light_pipeline(cx, &self.module, self.bias, self.ids, true))
+    }
+}
+
 /// The light pass: casters' depth, both faces, with `bias`.
 #[must_use]
 pub fn light_pass_pipeline(
     cx: &WgpuContext,
     module: &wgpu::ShaderModule,
     bias: wgpu::DepthBiasState,
-) -> wgpu::RenderPipeline {
-    light_pipeline(cx, module, bias, false)
+) -> LightPipelines {
+    LightPipelines::new(cx, module, bias, false)
 }
 
 /// The light pass with an object-ID target ([`ID_FORMAT`]): 1 + the instance index of the caster a texel
 /// shows (McCool's ID channel).
 #[must_use]
-pub fn light_id_pipeline(
-    cx: &WgpuContext,
-    module: &wgpu::ShaderModule,
-    bias: wgpu::DepthBiasState,
-) -> wgpu::RenderPipeline {
-    light_pipeline(cx, module, bias, true)
+pub fn light_id_pipeline(cx: &WgpuContext, module: &wgpu::ShaderModule, bias: wgpu::DepthBiasState) -> LightPipelines {
+    LightPipelines::new(cx, module, bias, true)
 }
 
 /// The format of the light pass's ID target.
@@ -258,17 +280,30 @@ fn light_pipeline(
     module: &wgpu::ShaderModule,
     bias: wgpu::DepthBiasState,
     ids: bool,
+    cutout: bool,
 ) -> wgpu::RenderPipeline {
-    let layout = cx.pipelines.layout("light pass", &[Some(&cx.shared.frame_layout)]);
+    let layout = if cutout {
+        cx.pipelines
+            .layout("light pass cut out", &[Some(&cx.shared.frame_layout), None, Some(&cx.shared.material_layout)])
+    } else {
+        cx.pipelines.layout("light pass", &[Some(&cx.shared.frame_layout)])
+    };
+    let (vertex, fragment, label) = match (ids, cutout) {
+        (false, false) => ("vs_light_depth", None, "light pass"),
+        (true, false) => ("vs_light_id", Some("fs_light_id"), "light pass with IDs"),
+        (false, true) => ("vs_light_cutout", Some("fs_light_cutout"), "light pass, cut out"),
+        (true, true) => ("vs_light_cutout", Some("fs_light_id_cutout"), "light pass with IDs, cut out"),
+    };
     let id_target = [Some(wgpu::ColorTargetState::from(ID_FORMAT))];
+    let buffers = [Some(POSITION_LAYOUT), Some(UV_LAYOUT)];
     cx.pipelines.render(&wgpu::RenderPipelineDescriptor {
-        label: Some(if ids { "light pass with IDs" } else { "light pass" }),
+        label: Some(label),
         layout: Some(&layout),
         vertex: wgpu::VertexState {
             module,
-            entry_point: Some(if ids { "vs_light_id" } else { "vs_light_depth" }),
+            entry_point: Some(vertex),
             compilation_options: Default::default(),
-            buffers: &[Some(POSITION_LAYOUT)],
+            buffers: if cutout { &buffers } else { &buffers[..1] },
         },
         primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
         depth_stencil: Some(wgpu::DepthStencilState {
@@ -279,23 +314,24 @@ fn light_pipeline(
             bias,
         }),
         multisample: Default::default(),
-        fragment: ids.then(|| wgpu::FragmentState {
+        fragment: fragment.map(|entry| wgpu::FragmentState {
             module,
-            entry_point: Some("fs_light_id"),
+            entry_point: Some(entry),
             compilation_options: Default::default(),
-            targets: &id_target,
+            targets: if ids { &id_target } else { &[] },
         }),
         multiview_mask: None,
         cache: None,
     })
 }
 
-/// Renders the casters' depth from every projection of `light` into the layers of `maps` (meshes and
-/// `instances` already uploaded), and their IDs into the layers of `ids` when given (with a pipeline from
-/// [`light_id_pipeline`]).
+/// Renders the casters' depth from every projection of `light` into the layers of `maps` (meshes,
+/// textures and `instances` already uploaded), and their IDs into the layers of `ids` when given (with
+/// pipelines from [`light_id_pipeline`]). Casters their texture cuts out are drawn through the alpha test
+/// after the others; a masked caster with nothing there is drawn nowhere.
 pub fn render_maps(
     cx: &WgpuContext,
-    pipeline: &wgpu::RenderPipeline,
+    pipelines: &LightPipelines,
     frame: &FrameInputs,
     light: &LightView,
     maps: &wgpu::Texture,
@@ -303,6 +339,7 @@ pub fn render_maps(
     instances: &wgpu::Buffer,
 ) {
     let res = maps.width();
+    let cutouts = frame.has_cutout_casters();
     let mut enc = cx.encoder("light pass");
     for (k, p) in light.projections.iter().enumerate() {
         let group = cx.shared.frame_group(cx, &ViewRaw::new(p.clip_from_world, glam::Vec3::ZERO, res, res), instances);
@@ -327,9 +364,13 @@ pub fn render_maps(
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_pipeline(pipeline);
+        pass.set_pipeline(&pipelines.solid);
         pass.set_bind_group(0, &group, &[]);
-        draw_instances(cx, &mut pass, frame, |i| i.casts_shadow, false);
+        draw_instances(cx, &mut pass, frame, |i| i.casts_shadow && i.coverage() == Coverage::Solid, false);
+        if cutouts {
+            pass.set_pipeline(pipelines.cutout(cx));
+            draw_textured(cx, &mut pass, frame, |i| i.casts_shadow && i.coverage() == Coverage::Cutout, false);
+        }
     }
     cx.submit(enc);
 }
@@ -354,7 +395,7 @@ fn filter_code(f: Filter) -> f64 {
 /// The light pass and the maps it last rendered: what every technique built on a depth map renders in its
 /// build (twin: shadow-cpu's `passes::maps::render_depth_maps`).
 pub struct DepthMaps {
-    pipeline: wgpu::RenderPipeline,
+    pipelines: LightPipelines,
     maps: Option<wgpu::Texture>,
 }
 
@@ -369,7 +410,7 @@ impl DepthMaps {
     /// [`DepthMaps::new`] from a module already holding the shadow-map shader.
     #[must_use]
     pub fn with_module(cx: &WgpuContext, module: &wgpu::ShaderModule, map: &DepthMap) -> Self {
-        Self { pipeline: light_pass_pipeline(cx, module, depth_bias(map)), maps: None }
+        Self { pipelines: light_pass_pipeline(cx, module, depth_bias(map)), maps: None }
     }
 
     /// Renders the casters' depth from every projection of `light` into one layer each of a
@@ -394,9 +435,10 @@ impl DepthMaps {
             }
         };
         cx.upload_meshes(frame);
+        cx.upload_textures(frame)?;
         let instances = cx.instances(frame);
         cx.scoped("the shadow-map light pass", |cx| {
-            render_maps(cx, &self.pipeline, frame, light, &maps, None, &instances)
+            render_maps(cx, &self.pipelines, frame, light, &maps, None, &instances)
         })
     }
 

@@ -16,6 +16,12 @@ struct Instance {
     color: vec4<f32>,
     // x: receives shadow, y: mirrored
     flags: vec4<u32>,
+    // How the material reads its base-colour texture, where the instance reads one: the fields of
+    // texel.wgsl's `TexelRule`, in its order.
+    texel_row_u: vec4<f32>,
+    texel_row_v: vec4<f32>,
+    texel_sampler: vec4<u32>,
+    texel_alpha: vec4<f32>,
 };
 
 struct Light {

@@ -62,6 +62,22 @@ fn fs_light_id(in: IdOut) -> @location(0) u32 {
     return in.id;
 }
 
+// The light pass of casters a texture cuts out (`cutout_casters.wgsl`): depth, or depth and ID.
+@fragment
+fn fs_light_cutout(in: CutoutOut) {
+    if (!caster_there(in)) {
+        discard;
+    }
+}
+
+@fragment
+fn fs_light_id_cutout(in: CutoutOut) -> @location(0) u32 {
+    if (!caster_there(in)) {
+        discard;
+    }
+    return in.id;
+}
+
 // Twin: shadow_core::light::cube_face.
 fn cube_face(d: vec3<f32>) -> i32 {
     let a = abs(d);
