@@ -31,7 +31,11 @@ struct LayerParams {
 
 /// Pipelines (index: [`Pass::index`]) and the maps of the last build.
 pub struct State {
-    passes: Vec<wgpu::RenderPipeline>,
+    /// Made with the state but for the cut-out passes, which the first frame with such casters makes.
+    passes: Vec<std::cell::OnceCell<wgpu::RenderPipeline>>,
+    /// The module and the pipeline layouts (without and with the caster's texture) the passes are made from.
+    module: wgpu::ShaderModule,
+    layouts: [wgpu::PipelineLayout; 2],
     combine: wgpu::RenderPipeline,
     layout: wgpu::BindGroupLayout,
     query: MapQuery,
@@ -124,6 +128,12 @@ fn layer_pipeline(
 }
 
 impl State {
+    /// The pipeline of `pass`, made now if it is a cut-out one not made yet.
+    fn pass(&self, cx: &WgpuContext, pass: Pass) -> &wgpu::RenderPipeline {
+        let [plain, cut_out] = &self.layouts;
+        self.passes[pass.index()].get_or_init(|| layer_pipeline(cx, [plain, cut_out], &self.module, pass))
+    }
+
     fn new(cx: &WgpuContext, filter: Filter, lookup: LookupParams) -> Self {
         let module = cx.pipelines.module("depth_layers", shader());
         let map_module = cx.pipelines.module("shadow_map", shaders::shadow_map());
@@ -138,7 +148,16 @@ impl State {
         let groups = [Some(&cx.shared.frame_layout), Some(&layout), Some(&cx.shared.material_layout)];
         let pl = cx.pipelines.layout("depth layers", &groups[..2]);
         let cut_out = cx.pipelines.layout("depth layers, cut out", &groups);
-        let passes = (0..Pass::COUNT).map(|i| layer_pipeline(cx, [&pl, &cut_out], &module, Pass::of(i))).collect();
+        let passes: Vec<std::cell::OnceCell<wgpu::RenderPipeline>> = (0..Pass::COUNT)
+            .map(|i| {
+                let pass = Pass::of(i);
+                let made = std::cell::OnceCell::new();
+                if !pass.cutout {
+                    let _ = made.set(layer_pipeline(cx, [&pl, &cut_out], &module, pass));
+                }
+                made
+            })
+            .collect();
         let combine = cx.pipelines.render(&wgpu::RenderPipelineDescriptor {
             label: Some("combine layers"),
             layout: Some(&pl),
@@ -162,6 +181,8 @@ impl State {
         });
         Self {
             passes,
+            module: module.clone(),
+            layouts: [pl.clone(), cut_out],
             combine,
             layout,
             query: MapQuery::new(cx, &map_module, filter).with_lookup(lookup),
@@ -222,7 +243,7 @@ fn render_projection(
                 pass.set_vertex_buffer(1, uvs.slice(..));
             }
             let cull = s.culling == LayerCulling::Auto && inst.adjacency.closed();
-            pass.set_pipeline(&state.passes[Pass { peel: peeling, cull, cw: inst.mirrored, cutout }.index()]);
+            pass.set_pipeline(state.pass(cx, Pass { peel: peeling, cull, cw: inst.mirrored, cutout }));
             pass.set_vertex_buffer(0, m.positions.slice(..));
             pass.set_index_buffer(m.indices.slice(..), wgpu::IndexFormat::Uint32);
             pass.draw_indexed(0..m.index_count, 0, i as u32..i as u32 + 1);
