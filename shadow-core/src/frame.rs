@@ -48,6 +48,8 @@ pub struct Instance {
     pub base_color: Vec3,
     /// Lit from both sides.
     pub two_sided: bool,
+    /// Its back faces are not drawn in the camera's view ([`Material::cull_back_faces`]).
+    pub cull_back_faces: bool,
     /// Blocks light (node and material flags combined).
     pub casts_shadow: bool,
     /// Shows shadows (node and material flags combined).
@@ -176,6 +178,7 @@ impl FrameInputs {
                     base_color_texture: material.base_color_texture.and_then(|r| scene.texture(r.texture)).cloned(),
                     base_color: material.base_color,
                     two_sided: material.two_sided,
+                    cull_back_faces: material.cull_back_faces,
                     casts_shadow: n.casts_shadow() && material.casts_shadow,
                     receives_shadow: n.receives_shadow() && material.receives_shadow,
                     bounds: mesh.bounds().transformed(world),

@@ -124,6 +124,20 @@ fn nearest_clamp() -> serde_json::Value {
     json!({"magFilter": 9728, "minFilter": 9984, "wrapS": 33071, "wrapT": 33648})
 }
 
+/// glTF's `doubleSided` decides both sides' lighting and whether the camera sees back faces: a
+/// double-sided material is lit from both sides and seen from both; a single-sided one (the default) is
+/// culled from behind.
+#[test]
+fn double_sidedness_decides_back_face_culling() {
+    let dir = folder("sides");
+    std::fs::write(dir.join("checker.png"), checker_png()).unwrap();
+    for (double_sided, material) in [(true, masked_material()), (false, json!({"name": "single"}))] {
+        let scene = assets::load(card_gltf(&dir, "checker.png", material, nearest_clamp())).expect("card");
+        let (_, _, _, material) = scene.drawables().next().expect("card");
+        assert_eq!((material.two_sided, material.cull_back_faces), (double_sided, !double_sided), "{}", material.name);
+    }
+}
+
 #[test]
 fn a_masked_card_loads_its_texture_sampler_transform_and_coordinates() {
     let dir = folder("card");

@@ -495,16 +495,15 @@ pub fn render_reusing(
         Image::from_vec(width, height, refill(old.visible, n, NO_INSTANCE)).unwrap_or_else(|| unreachable!("n pixels"));
     let receiver = overwritten(old.receiver, n, false);
     // Every instance in one draw, in order (the same fragments as a draw each), each pixel left with the id
-    // of its primitive in the batch.
-    let all =
-        Batch::new(frame.instances.iter().zip(&clip).map(|(inst, clip)| Indexed::instance(inst, clip)).collect())?;
+    // of its primitive in the batch; the back faces of single-sided materials not drawn.
+    let all = Batch::new(frame.instances.iter().zip(&clip).map(|(inst, clip)| Indexed::seen(inst, clip)).collect())?;
     let drawn = Drawn::sort(frame, |_| true);
     if drawn.solid.len() == frame.instances.len() {
         draw_flat(&mut ds, &mut visible, &all, &RasterState::default(), |prim| prim);
     } else {
         // The solid instances in one draw, then the cut-out ones through their alpha test, each pixel
         // left with its primitive's id in `all`.
-        let part = |k: usize| Indexed::instance(&frame.instances[k], &clip[k]);
+        let part = |k: usize| Indexed::seen(&frame.instances[k], &clip[k]);
         let solid = Batch::new(drawn.solid.iter().map(|&k| part(k)).collect())?;
         let in_all = |list: &[usize], batch: &Batch<'_>, prim: u32| {
             let (part, triangle) = batch.part_of(prim);

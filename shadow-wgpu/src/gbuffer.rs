@@ -7,7 +7,7 @@ use shadow_core::scene::Camera;
 use shadow_core::{FrameInputs, Image};
 
 use crate::context::{WgpuContext, WgpuError};
-use crate::pipelines::{ATTRIBUTE, ViewRaw};
+use crate::pipelines::{ATTRIBUTE, FaceCull, ViewRaw};
 use crate::textures::read_texture;
 
 /// The camera view of a frame, on the GPU.
@@ -103,10 +103,14 @@ impl GBufferTargets {
 /// A bad size or a GPU failure.
 pub fn render(cx: &mut WgpuContext, frame: &FrameInputs, width: u32, height: u32) -> Result<GpuGBuffer, WgpuError> {
     fill(cx, frame, (width, height), "the G-buffer pass", |cx, pass| {
-        pass.set_pipeline(&cx.shared.gbuffer);
-        draw_instances(cx, pass, frame, |i| read_texture(i).is_none() && i.coverage() != Coverage::Absent, true);
-        pass.set_pipeline(&cx.shared.gbuffer_textured);
-        draw_textured(cx, pass, frame, |_| true, true);
+        for cull in FaceCull::ALL {
+            let here = |i: &shadow_core::Instance| FaceCull::of(i) == cull;
+            pass.set_pipeline(&cx.shared.gbuffer[cull.index()]);
+            let untextured = |i: &shadow_core::Instance| read_texture(i).is_none() && i.coverage() != Coverage::Absent;
+            draw_instances(cx, pass, frame, |i| here(i) && untextured(i), true);
+            pass.set_pipeline(&cx.shared.gbuffer_textured[cull.index()]);
+            draw_textured(cx, pass, frame, here, true);
+        }
     })
 }
 

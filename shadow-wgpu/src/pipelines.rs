@@ -152,17 +152,60 @@ pub fn buffer_entry(
     }
 }
 
+/// Which faces of an instance the camera's view leaves out: none, or the back faces of a single-sided
+/// material (`Instance::cull_back_faces`), whose fronts wind clockwise on screen where the instance is
+/// mirrored.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FaceCull {
+    /// Both faces drawn.
+    None,
+    /// Back faces culled, fronts counter-clockwise.
+    Back,
+    /// Back faces culled, fronts clockwise (a mirrored instance).
+    BackMirrored,
+}
+
+impl FaceCull {
+    /// Every mode, in the order of [`FaceCull::index`].
+    pub const ALL: [Self; 3] = [Self::None, Self::Back, Self::BackMirrored];
+
+    /// The mode of an instance in the camera's view.
+    #[must_use]
+    pub fn of(inst: &shadow_core::Instance) -> Self {
+        match (inst.cull_back_faces, inst.mirrored) {
+            (false, _) => Self::None,
+            (true, false) => Self::Back,
+            (true, true) => Self::BackMirrored,
+        }
+    }
+
+    /// Its place in [`FaceCull::ALL`].
+    #[must_use]
+    pub fn index(self) -> usize {
+        self as usize
+    }
+
+    fn primitive(self) -> wgpu::PrimitiveState {
+        let (front_face, cull_mode) = match self {
+            Self::None => (wgpu::FrontFace::Ccw, None),
+            Self::Back => (wgpu::FrontFace::Ccw, Some(wgpu::Face::Back)),
+            Self::BackMirrored => (wgpu::FrontFace::Cw, Some(wgpu::Face::Back)),
+        };
+        wgpu::PrimitiveState { front_face, cull_mode, ..Default::default() }
+    }
+}
+
 /// Pipelines and layouts every frame uses.
 pub struct Shared {
     /// Group 0: view uniform and instance data.
     pub frame_layout: wgpu::BindGroupLayout,
     /// A material's base-colour texture, as every pass that reads one binds it (group 2, binding 0).
     pub material_layout: wgpu::BindGroupLayout,
-    /// The G-buffer pipeline.
-    pub gbuffer: wgpu::RenderPipeline,
-    /// The G-buffer pipeline of instances whose material reads a texture (group 2: the texture), with
-    /// their texture coordinates in vertex slot 2.
-    pub gbuffer_textured: wgpu::RenderPipeline,
+    /// The G-buffer pipelines, one per [`FaceCull`] (index: `FaceCull::of`).
+    pub gbuffer: [wgpu::RenderPipeline; 3],
+    /// The G-buffer pipelines of instances whose material reads a texture (group 2: the texture), with
+    /// their texture coordinates in vertex slot 2; one per [`FaceCull`].
+    pub gbuffer_textured: [wgpu::RenderPipeline; 3],
     /// Group 1 of the shading pass.
     pub shade_layout: wgpu::BindGroupLayout,
     /// The shading pipeline.
@@ -185,49 +228,56 @@ impl Shared {
         );
         let material_layout = pipelines.group_layout("material texture", &[material_texture_entry(0)]);
         let gmod = pipelines.module("gbuffer", shaders::gbuffer());
-        let gbuffer_pipeline = |label, groups: &[Option<&wgpu::BindGroupLayout>], buffers: &[_], entries: [&str; 2]| {
-            let target =
-                Some(wgpu::ColorTargetState { format: ATTRIBUTE, blend: None, write_mask: wgpu::ColorWrites::ALL });
-            pipelines.render(&wgpu::RenderPipelineDescriptor {
-                label: Some(label),
-                layout: Some(&pipelines.layout(label, groups)),
-                vertex: wgpu::VertexState {
-                    module: &gmod,
-                    entry_point: Some(entries[0]),
-                    compilation_options: Default::default(),
-                    buffers,
-                },
-                primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
-                depth_stencil: Some(wgpu::DepthStencilState {
-                    format: depth_stencil,
-                    depth_write_enabled: Some(true),
-                    depth_compare: Some(wgpu::CompareFunction::Less),
-                    stencil: Default::default(),
-                    bias: Default::default(),
-                }),
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module: &gmod,
-                    entry_point: Some(entries[1]),
-                    compilation_options: Default::default(),
-                    targets: &[target.clone(), target.clone(), target.clone(), target],
-                }),
-                multiview_mask: None,
-                cache: None,
-            })
-        };
-        let gbuffer = gbuffer_pipeline(
-            "gbuffer",
-            &[Some(&frame_layout)],
-            &[Some(POSITION_LAYOUT), Some(NORMAL_LAYOUT)],
-            ["vs_gbuffer", "fs_gbuffer"],
-        );
-        let gbuffer_textured = gbuffer_pipeline(
-            "gbuffer textured",
-            &[Some(&frame_layout), None, Some(&material_layout)],
-            &[Some(POSITION_LAYOUT), Some(NORMAL_LAYOUT), Some(UV_LAYOUT)],
-            ["vs_gbuffer_textured", "fs_gbuffer_textured"],
-        );
+        let gbuffer_pipeline =
+            |label, groups: &[Option<&wgpu::BindGroupLayout>], buffers: &[_], entries: [&str; 2], cull: FaceCull| {
+                let target =
+                    Some(wgpu::ColorTargetState { format: ATTRIBUTE, blend: None, write_mask: wgpu::ColorWrites::ALL });
+                pipelines.render(&wgpu::RenderPipelineDescriptor {
+                    label: Some(label),
+                    layout: Some(&pipelines.layout(label, groups)),
+                    vertex: wgpu::VertexState {
+                        module: &gmod,
+                        entry_point: Some(entries[0]),
+                        compilation_options: Default::default(),
+                        buffers,
+                    },
+                    primitive: cull.primitive(),
+                    depth_stencil: Some(wgpu::DepthStencilState {
+                        format: depth_stencil,
+                        depth_write_enabled: Some(true),
+                        depth_compare: Some(wgpu::CompareFunction::Less),
+                        stencil: Default::default(),
+                        bias: Default::default(),
+                    }),
+                    multisample: Default::default(),
+                    fragment: Some(wgpu::FragmentState {
+                        module: &gmod,
+                        entry_point: Some(entries[1]),
+                        compilation_options: Default::default(),
+                        targets: &[target.clone(), target.clone(), target.clone(), target],
+                    }),
+                    multiview_mask: None,
+                    cache: None,
+                })
+            };
+        let gbuffer = FaceCull::ALL.map(|cull| {
+            gbuffer_pipeline(
+                "gbuffer",
+                &[Some(&frame_layout)],
+                &[Some(POSITION_LAYOUT), Some(NORMAL_LAYOUT)],
+                ["vs_gbuffer", "fs_gbuffer"],
+                cull,
+            )
+        });
+        let gbuffer_textured = FaceCull::ALL.map(|cull| {
+            gbuffer_pipeline(
+                "gbuffer textured",
+                &[Some(&frame_layout), None, Some(&material_layout)],
+                &[Some(POSITION_LAYOUT), Some(NORMAL_LAYOUT), Some(UV_LAYOUT)],
+                ["vs_gbuffer_textured", "fs_gbuffer_textured"],
+                cull,
+            )
+        });
         let shade_layout = pipelines.group_layout(
             "shade",
             &[

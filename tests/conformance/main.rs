@@ -17,6 +17,7 @@ mod per_light;
 mod pipelines;
 mod settings;
 mod silhouette_map;
+mod single_sided;
 mod smoothies;
 // The technique of examples/custom_technique.rs, registered at runtime like a user's would be.
 #[path = "../../examples/planar/mod.rs"]

@@ -165,21 +165,21 @@ fn a_moving_light_and_node_allocate_nothing_after_the_first_frame() {
     assert!(checked >= 10, "only {checked} techniques checked");
 }
 
-/// Casters and receivers cut out by their texture in recorded frames: the texture goes to the device with
-/// the first frame and nothing is made after it, while the light circles and the card moves, and the
-/// last frame's visibility is a fresh render's, with the card's shadow in it.
+/// Casters and receivers cut out by their texture in recorded frames: on `foliage`, the leaves' texture goes
+/// to the device with the first frame and nothing is made in the 99 after it, while the light circles and
+/// a node moves, and the last frame's visibility is a fresh render's, with the leaves' shadow in it.
 #[test]
 fn recorded_cutouts_allocate_nothing_after_the_first_frame() {
     let Some(mut renderer) = crate::with_wgpu("recorded cut-out casters") else { return };
     let mut cx = WgpuContext::new(&shadow_wgpu::AdapterChoice { name: None, allow_software: true }).expect("context");
     let target = color_target(&cx, wgpu::TextureFormat::Rgba8UnormSrgb, 128, 96);
-    let mut scene = scenes::build("cutout", &SceneParams::default()).expect("cutout");
-    let spec = TechniqueSpec::named("shadow-map");
+    let mut scene = scenes::build("foliage", &SceneParams::default()).expect("foliage");
+    let spec = TechniqueSpec::parse("shadow-map:res=1024").expect("spec");
     let mut technique = renderer.registry().wgpu(&spec).expect("technique");
     let (made, last, visibility) =
-        made_after_the_first_frame(&mut cx, &mut scene, technique.as_mut(), &target, 20).expect("recorded frames");
+        made_after_the_first_frame(&mut cx, &mut scene, technique.as_mut(), &target, 100).expect("recorded frames");
     assert_eq!(made, shadow_wgpu::Created::default(), "made after the first frame");
-    assert_eq!(cx.cache.textures.len(), 1, "the card's texture, once");
+    assert_eq!(cx.cache.textures.len(), 1, "the leaves' texture, once");
     let fresh = renderer.run(BackendKind::Wgpu, &last, 128, 96, &spec).expect("a frame");
     assert!(visibility.data() == fresh.visibility[0].data(), "the last recorded frame is not a fresh render's");
     let shadowed = visibility.data().iter().filter(|&&v| crate::shadowed(v)).count();

@@ -335,6 +335,7 @@ impl Loader<'_> {
             alpha: c[3],
             alpha_mode,
             two_sided: m.double_sided(),
+            cull_back_faces: !m.double_sided(),
             ..Material::colored(&name, Vec3::new(c[0], c[1], c[2]))
         });
         let mut uv_set = None;

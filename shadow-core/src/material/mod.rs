@@ -131,6 +131,9 @@ pub struct Material {
     pub alpha_mode: AlphaMode,
     /// Lit from both sides (the shading normal faces the viewer).
     pub two_sided: bool,
+    /// The camera does not see its back faces (glTF's `doubleSided: false`): an open surface seen from
+    /// behind is not drawn, nor a closed one's inside. They still cast shadows.
+    pub cull_back_faces: bool,
     /// Whether surfaces with this material block light.
     pub casts_shadow: bool,
     /// Whether shadows are computed on surfaces with this material.
@@ -146,6 +149,7 @@ impl Default for Material {
             base_color_texture: None,
             alpha_mode: AlphaMode::Opaque,
             two_sided: false,
+            cull_back_faces: false,
             casts_shadow: true,
             receives_shadow: true,
         }

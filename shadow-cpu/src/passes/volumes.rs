@@ -133,8 +133,9 @@ impl<'a> ClipVolume<'a> {
     #[must_use]
     pub fn draws(&self, [sides, forward, reversed]: Runs) -> [VolumeDraw<'_>; 5] {
         let flip = self.mirrored;
-        let indexed =
-            |positions, triangles, flip| VolumeDraw::Caps(Indexed { positions, triangles, prim_base: 0, flip });
+        let indexed = |positions, triangles, flip| {
+            VolumeDraw::Caps(Indexed { positions, triangles, prim_base: 0, flip, cull_back: false })
+        };
         [
             VolumeDraw::Sides(Soup { triangles: &self.sides[sides], prim_base: 0, flip }),
             indexed(self.near, &self.forward[forward.clone()], flip),

@@ -59,6 +59,9 @@ pub(super) fn setup_one(
     // Counter-clockwise in NDC (y up) is clockwise on screen (y down): negative screen area.
     let ccw = area < 0;
     let front = (ccw == (st.front_face == FrontFace::Ccw)) != src.flip;
+    if src.cull_back && !front {
+        return None;
+    }
     match st.cull {
         CullMode::Back if !front => return None,
         CullMode::Front if front => return None,

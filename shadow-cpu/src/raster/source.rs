@@ -13,6 +13,8 @@ pub struct SourceTriangle {
     pub prim: u32,
     /// Swap front and back for this triangle (a face drawn turned around).
     pub flip: bool,
+    /// Not drawn where its back faces the view, whatever the draw's culling.
+    pub cull_back: bool,
 }
 
 /// Anything that yields triangles by index.
@@ -37,6 +39,9 @@ pub struct Indexed<'a> {
     pub prim_base: u32,
     /// Swap front and back for every triangle.
     pub flip: bool,
+    /// Draw none of its back faces, whatever the draw's culling (a single-sided surface in the camera's
+    /// view).
+    pub cull_back: bool,
 }
 
 impl<'a> Indexed<'a> {
@@ -44,7 +49,14 @@ impl<'a> Indexed<'a> {
     /// makes them), turned around where the instance is mirrored.
     #[must_use]
     pub fn instance(inst: &'a Instance, clip: &'a [Vec4]) -> Self {
-        Self { positions: clip, triangles: inst.mesh.triangles(), prim_base: 0, flip: inst.mirrored }
+        Self { positions: clip, triangles: inst.mesh.triangles(), prim_base: 0, flip: inst.mirrored, cull_back: false }
+    }
+
+    /// An instance's triangles as the camera sees them: [`Self::instance`], with its back faces left out
+    /// where its material is single-sided ([`Instance::cull_back_faces`]).
+    #[must_use]
+    pub fn seen(inst: &'a Instance, clip: &'a [Vec4]) -> Self {
+        Self { cull_back: inst.cull_back_faces, ..Self::instance(inst, clip) }
     }
 }
 
@@ -55,7 +67,12 @@ impl TriangleSource for Indexed<'_> {
     #[inline]
     fn get(&self, i: usize) -> SourceTriangle {
         let t = self.triangles[i];
-        SourceTriangle { v: t.map(|k| self.positions[k as usize]), prim: self.prim_base + i as u32, flip: self.flip }
+        SourceTriangle {
+            v: t.map(|k| self.positions[k as usize]),
+            prim: self.prim_base + i as u32,
+            flip: self.flip,
+            cull_back: self.cull_back,
+        }
     }
 }
 
@@ -134,6 +151,6 @@ impl TriangleSource for Soup<'_> {
     }
     #[inline]
     fn get(&self, i: usize) -> SourceTriangle {
-        SourceTriangle { v: self.triangles[i], prim: self.prim_base + i as u32, flip: self.flip }
+        SourceTriangle { v: self.triangles[i], prim: self.prim_base + i as u32, flip: self.flip, cull_back: false }
     }
 }

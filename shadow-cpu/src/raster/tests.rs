@@ -411,7 +411,13 @@ fn a_batch_draws_what_its_parts_draw_in_turn_and_flat_draws_what_the_general_loo
     let layers: Vec<Vec<Vec4>> =
         tilts.iter().map(|t| positions.iter().map(|v| Vec4::new(v.x, v.y, v.z + t.dot(*v), v.w)).collect()).collect();
     let triangles: Vec<[u32; 3]> = (0..grid.len() as u32).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect();
-    let part = |k: usize| Indexed { positions: &layers[k], triangles: &triangles, prim_base: 0, flip: k == 1 };
+    let part = |k: usize| Indexed {
+        positions: &layers[k],
+        triangles: &triangles,
+        prim_base: 0,
+        flip: k == 1,
+        cull_back: false,
+    };
     let bias = DepthBias { constant: 2.0, slope: 1.0, clamp: 0.0 };
     let st = RasterState { depth: Some(DepthState { bias, ..DepthState::LESS_WRITE }), ..RasterState::default() };
     let none = (u32::MAX, u32::MAX);
@@ -500,7 +506,14 @@ fn the_edge_walk_steps_to_the_divided_spans() {
     let st = RasterState { cull: CullMode::None, ..count_state() };
     let mut setups = Vec::new();
     for (i, v) in tris.iter().enumerate() {
-        setup(SourceTriangle { v: *v, prim: i as u32, flip: false }, &st, w, h, guard_band(w, h), &mut setups);
+        setup(
+            SourceTriangle { v: *v, prim: i as u32, flip: false, cull_back: false },
+            &st,
+            w,
+            h,
+            guard_band(w, h),
+            &mut setups,
+        );
     }
     let slivers = setups.iter().filter(|t| t.prim >= grid).count();
     assert!(slivers > 40, "{slivers} slivers set up");

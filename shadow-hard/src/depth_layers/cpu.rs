@@ -52,7 +52,13 @@ fn layer_pass(
         let cull =
             if culling == LayerCulling::Auto && inst.adjacency.closed() { CullMode::Back } else { CullMode::None };
         let clip = clip_vertices(inst.mesh.positions(), proj.clip_from_world * inst.world_from_local);
-        let src = Indexed { positions: &clip, triangles: inst.mesh.triangles(), prim_base: 0, flip: inst.mirrored };
+        let src = Indexed {
+            positions: &clip,
+            triangles: inst.mesh.triangles(),
+            prim_base: 0,
+            flip: inst.mirrored,
+            cull_back: false,
+        };
         let state = RasterState { cull, depth: Some(DepthState::LESS_WRITE), ..RasterState::default() };
         match (Cutout::of(inst), first) {
             (None, None) => {
