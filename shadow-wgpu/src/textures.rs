@@ -157,9 +157,10 @@ impl DeviceTextures {
     /// # Errors
     /// A texture over the device's limit.
     pub fn upload(&mut self, cx: &WgpuContext, frame: &FrameInputs) -> Result<(), WgpuError> {
-        let read: Vec<&Arc<Texture>> = frame.instances.iter().filter_map(read_texture).collect();
-        self.textures.retain(|k, _| read.iter().any(|t| key(t) == *k));
-        for texture in read {
+        let read: HashMap<usize, &Arc<Texture>> =
+            frame.instances.iter().filter_map(read_texture).map(|t| (key(t), t)).collect();
+        self.textures.retain(|k, _| read.contains_key(k));
+        for texture in read.into_values() {
             if let std::collections::hash_map::Entry::Vacant(slot) = self.textures.entry(key(texture)) {
                 slot.insert(TextureGpu::upload(cx, texture)?);
             }
