@@ -48,9 +48,9 @@ pub struct LeftOut {
 impl LeftOut {
     /// It or its reference takes none of the frame's kinds of light.
     pub const LIGHTS: &'static str = "as they or their reference take no light of this scene's kinds";
-    /// It extrudes silhouettes, and the frame has casters cut out by their texture.
+    /// It takes no masked casters, and the frame has casters cut out by their texture.
     pub const CUTOUTS: &'static str =
-        "as they extrude silhouettes and this scene's casters are cut out by their textures, which have none";
+        "as they take no masked casters and this scene's casters are cut out by their textures";
 }
 
 /// Every technique, by name.
@@ -105,7 +105,7 @@ impl TechniqueRegistry {
         for e in self.entries.iter().filter(|e| !e.reference) {
             if !(lit(e) && self.entries.iter().filter(|r| r.reference && r.soft == e.soft).all(lit)) {
                 left.push(LeftOut { name: e.name, why: LeftOut::LIGHTS });
-            } else if cutouts && !e.cutouts {
+            } else if cutouts && !e.casters.takes_cutouts() {
                 left.push(LeftOut { name: e.name, why: LeftOut::CUTOUTS });
             } else {
                 taken.push(TechniqueSpec::named(e.name));
@@ -173,10 +173,11 @@ mod tests {
 
     use super::*;
 
-    /// On a scene whose card is cut out by its texture, the techniques that extrude silhouettes are left
-    /// out, each saying why; the same card made opaque or blended leaves none out for it.
+    /// On a scene whose card is cut out by its texture, the techniques that extrude silhouettes and take
+    /// no masked casters are left out, each saying why; the same card made opaque or blended leaves none
+    /// out for it.
     #[test]
-    fn cutouts_leave_out_the_techniques_that_extrude_silhouettes() {
+    fn cutouts_leave_out_the_techniques_that_take_no_masked_casters() {
         let registry = TechniqueRegistry::builtin();
         let mut scene = scenes::build("cutout", &SceneParams::default()).expect("cutout");
         let left_for_cutouts = |scene: &shadow_core::Scene| {
@@ -185,10 +186,11 @@ mod tests {
             assert!(taken.iter().any(|t| t.name == "shadow-map"), "the map techniques are measured");
             left.iter().filter(|l| l.why == LeftOut::CUTOUTS).map(|l| l.name).collect::<Vec<_>>()
         };
-        let extruding: Vec<&str> = registry.entries().iter().filter(|e| !e.cutouts).map(|e| e.name).collect();
-        assert_eq!(extruding, ["hybrid", "penumbra-wedges", "shadow-volume-zpass", "shadow-volume-zfail"]);
+        let extruding: Vec<&str> =
+            registry.entries().iter().filter(|e| !e.casters.takes_cutouts()).map(|e| e.name).collect();
+        assert_eq!(extruding, ["hybrid", "penumbra-wedges"]);
         // Penumbra wedges take no directional light, which leaves them out first.
-        assert_eq!(left_for_cutouts(&scene), ["hybrid", "shadow-volume-zpass", "shadow-volume-zfail"]);
+        assert_eq!(left_for_cutouts(&scene), ["hybrid"]);
         let card = scene.materials().find(|(_, m)| m.name == "checkerboard").expect("the card").0;
         for mode in [AlphaMode::Opaque, AlphaMode::Blend] {
             scene.material_mut(card).expect("material").alpha_mode = mode;

@@ -72,6 +72,13 @@ pub enum Coverage {
 }
 
 impl Instance {
+    /// Whether it blocks light over its whole surface: a caster of [`Coverage::Solid`], the casters whose
+    /// silhouettes bound their shadows (what shadow volumes and wedges are extruded from).
+    #[must_use]
+    pub fn casts_solid_shadow(&self) -> bool {
+        self.casts_shadow && self.coverage() == Coverage::Solid
+    }
+
     /// How much of the surface is there ([`Coverage`]).
     #[must_use]
     pub fn coverage(&self) -> Coverage {
@@ -261,22 +268,25 @@ impl FrameInputs {
         })
     }
 
-    /// Shadow volumes of every casting instance for the light, found afresh (in parallel over instances).
+    /// Shadow volumes of every instance casting a solid shadow for the light
+    /// ([`Instance::casts_solid_shadow`]), found afresh (in parallel over instances). A caster its texture
+    /// cuts out has none: its outline does not bound its shadow, which the techniques built on volumes take
+    /// from a map of those casters' depths instead.
     #[must_use]
     pub fn shadow_volumes(&self, light: &LightView, caps: Caps) -> Vec<InstanceVolume> {
         self.silhouettes(light)
-            .filter(|(i, ..)| self.instances[*i].casts_shadow)
+            .filter(|(i, ..)| self.instances[*i].casts_solid_shadow())
             .map(|(i, local_light, sil)| self.volume(i, local_light, &sil, caps))
             .collect()
     }
 
     /// [`Self::shadow_volumes`] and [`Self::silhouette_segments`] from one silhouette pass (`hybrid`'s edge
-    /// maps need both).
+    /// maps need both), of the same casters as [`Self::shadow_volumes`].
     #[must_use]
     pub fn shadow_volumes_and_segments(&self, light: &LightView, caps: Caps) -> (Vec<InstanceVolume>, Vec<[Vec3; 2]>) {
         let (volumes, segments): (Vec<_>, Vec<_>) = self
             .silhouettes(light)
-            .filter(|(i, ..)| self.instances[*i].casts_shadow)
+            .filter(|(i, ..)| self.instances[*i].casts_solid_shadow())
             .map(|(i, local_light, sil)| (self.volume(i, local_light, &sil, caps), self.world_segments(i, &sil)))
             .unzip();
         (volumes, segments.concat())
@@ -350,6 +360,7 @@ mod tests {
     use glam::{Mat4, Vec3};
 
     use super::{FrameError, FrameInputs, MAX_FRAME_TRIANGLES};
+    use crate::geometry::volume::Caps;
     use crate::material::AlphaMode;
     use crate::{Camera, Light, Material, Mesh, Scene};
 
@@ -419,8 +430,9 @@ mod tests {
         assert_eq!(scene.material(card).unwrap().alpha_mode, AlphaMode::Opaque);
     }
 
-    /// A caster its texture cuts out gives silhouette maps and the penumbrae built on silhouettes no
-    /// edges, though its mesh has an outline; made opaque, it does.
+    /// A caster its texture cuts out gives silhouette maps, the penumbrae built on silhouettes and the
+    /// shadow volumes (with the hybrid's edge segments) no edges, though its mesh has an outline; made
+    /// opaque, it does.
     #[test]
     fn cut_out_casters_give_silhouette_techniques_no_edges() {
         let mut scene = crate::scenes::build("cutout", &crate::scenes::SceneParams::default()).expect("cutout");
@@ -433,11 +445,17 @@ mod tests {
             let card = |i: usize| frame.instances[i].bounds.min.y > 0.5;
             let silhouettes: usize =
                 frame.caster_silhouettes(&light).iter().filter(|(i, _)| card(*i)).map(|(_, s)| s.edges.len()).sum();
-            (segments, silhouettes)
+            let volumes = frame.shadow_volumes(&light, Caps::Both);
+            let volume_edges: usize = volumes.iter().filter(|v| card(v.instance)).map(|v| v.silhouette_edges).sum();
+            let (volumes, segments_too) = frame.shadow_volumes_and_segments(&light, Caps::Both);
+            let card_volumes = volumes.iter().filter(|v| card(v.instance)).count();
+            let high = segments_too.iter().filter(|[a, b]| a.y > 0.5 && b.y > 0.5).count();
+            assert_eq!(high, segments, "the hybrid's segments are the silhouette maps'");
+            (segments, silhouettes, volume_edges, card_volumes)
         };
-        assert_eq!(edges(&scene), (0, 0), "the cut-out card");
+        assert_eq!(edges(&scene), (0, 0, 0, 0), "the cut-out card");
         let card = scene.materials().find(|(_, m)| m.name == "checkerboard").expect("the card").0;
         scene.material_mut(card).expect("material").alpha_mode = AlphaMode::Opaque;
-        assert_eq!(edges(&scene), (4, 4), "the opaque card's outline");
+        assert_eq!(edges(&scene), (4, 4, 4, 1), "the opaque card's outline");
     }
 }

@@ -88,3 +88,26 @@ fn a_settings_change_compiles_only_the_pipelines_that_depend_on_it() {
     assert_eq!(run("shadow-map:bias_constant=8,filter=pcf3x3"), (0, 0), "both, each seen before");
     assert_eq!(run("shadow-map"), (0, 0), "back to the defaults");
 }
+
+/// The volumes render a map of the casters their texture cuts out only for a frame with such casters: on
+/// a scene without them, the map's settings compile nothing (no pass of theirs runs); on `cutout`, the
+/// first frame compiles its light pass and lookup.
+#[test]
+fn volumes_make_their_cutout_map_only_for_cutout_casters() {
+    let Some((mut cx, frame, target)) = setup() else { return };
+    let registry = TechniqueRegistry::builtin();
+    let cutout = FrameInputs::from_first_camera(&scenes::build("cutout", &SceneParams::default()).expect("scene"))
+        .expect("frame");
+    let mut run = |spec: &str, frame: &FrameInputs| {
+        let mut technique = registry.wgpu(&TechniqueSpec::parse(spec).expect("spec")).expect("technique");
+        compiled(made_by_a_frame(&mut cx, technique.as_mut(), frame, &target))
+    };
+    // Each with a filter of its own, so that the second's lookup is not the first's.
+    for (name, filter) in [("shadow-volume-zfail", "pcf3x3"), ("shadow-volume-zpass", "poisson16")] {
+        run(name, &frame);
+        let other_map = format!("{name}:cutout_res=512,cutout_filter={filter}");
+        assert_eq!(run(&other_map, &frame), (0, 0), "{name}: no cut-out casters, no map");
+        let (pipelines, _) = run(&other_map, &cutout);
+        assert!(pipelines >= 1, "{name}: the cut-out casters' map compiled {pipelines} pipelines");
+    }
+}

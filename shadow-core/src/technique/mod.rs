@@ -25,7 +25,7 @@ use crate::light::{LightView, LightViewError};
 use crate::scene::Light;
 use crate::stats::{Counters, Timings};
 
-pub use registry::LightKinds;
+pub use registry::{CasterHandling, CasterKinds, LightKinds};
 pub use settings::{SettingKey, SettingsError, TechniqueSettings, TechniqueSpec, key_values};
 
 /// A backend: a bundle of associated types (after wgpu-hal's `Api`).
@@ -184,10 +184,11 @@ pub trait ShadowTechnique<B: Backend>: Send + Sync {
         out: &mut B::Visibility,
     ) -> Result<(), B::Error>;
 
-    /// Whether a light's build may be kept for later frames while the light's view, the casters and the
-    /// meshes it reads stay the same (default: yes). A technique whose build reads the camera, or leaves
-    /// its query data that lasts one frame only (the frame's transient buffer), says no.
-    fn build_is_reusable(&self) -> bool {
+    /// Whether a light's build of `frame` may be kept for later frames while the light's view, the
+    /// casters and the meshes it reads stay the same (default: yes). A technique whose build reads the
+    /// camera, or leaves its query data that lasts one frame only (the frame's transient buffer), says no.
+    fn build_is_reusable(&self, frame: &FrameInputs) -> bool {
+        let _ = frame;
         true
     }
 
@@ -284,7 +285,7 @@ impl<B: Backend, T: ShadowTechnique<B>> DynShadowTechnique<B> for Stateful<B, T>
         if !self.lights.takes(&pass.light.light) {
             return Err(TechniqueError::unsupported_light(self.technique.name(), &pass.light.light).into());
         }
-        let reads = self.technique.build_is_reusable().then(|| pass.build_key());
+        let reads = self.technique.build_is_reusable(pass.frame).then(|| pass.build_key());
         if self.slots.len() <= pass.slot {
             self.slots.resize_with(pass.slot + 1, || None);
         }

@@ -57,6 +57,98 @@ impl LightKinds {
     }
 }
 
+/// How a technique shadows the casters of one alpha mode ([`crate::material::AlphaMode`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CasterHandling {
+    /// By its own method, exactly as the casters are: opaque ones whole, masked ones where their texels
+    /// pass the alpha test (references: rays continue past clear texels; maps: light passes discard them).
+    Exact,
+    /// Through a depth map of those casters alone, cut out by their texture as every light pass cuts them
+    /// ([`crate::technique::maps::CutoutMap`], its `cutout_res` and `cutout_filter`), a receiver lit only
+    /// where both that map and the technique say lit: the way of the techniques that extrude silhouettes,
+    /// as a card's outline is not its shadow's edge.
+    CutoutMap,
+    /// As opaque casters: the whole surface blocks light.
+    AsOpaque,
+    /// Not at all: `compare` leaves the technique out of a scene with such casters, and warns where it
+    /// is named.
+    LeftOut,
+}
+
+impl CasterHandling {
+    /// A short name (`techniques --json`).
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Exact => "exact",
+            Self::CutoutMap => "cutout-map",
+            Self::AsOpaque => "as-opaque",
+            Self::LeftOut => "left-out",
+        }
+    }
+
+    /// How it is done, as a clause after the kind of caster.
+    #[must_use]
+    pub fn clause(self) -> &'static str {
+        match self {
+            Self::Exact => "exactly, by its own method",
+            Self::CutoutMap => {
+                "through an alpha-tested depth map of them alone (cutout_res, cutout_filter), lit only where both say lit"
+            }
+            Self::AsOpaque => "as opaque (the whole surface blocks light)",
+            Self::LeftOut => "not at all (compare leaves it out of scenes with them)",
+        }
+    }
+}
+
+/// How a technique takes each kind of caster: opaque, masked (alpha-tested, cut out by a texture) and
+/// blended. A blended caster blocks light as an opaque one in every technique and reference.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct CasterKinds {
+    /// Opaque casters.
+    pub opaque: CasterHandling,
+    /// Masked casters cut out by their texture ([`crate::frame::Coverage::Cutout`]).
+    pub masked: CasterHandling,
+    /// Blended casters.
+    pub blend: CasterHandling,
+}
+
+impl CasterKinds {
+    /// Opaque and masked casters exactly, blended ones as opaque: every technique built on depth maps,
+    /// and the references.
+    pub const MAPS: Self =
+        Self { opaque: CasterHandling::Exact, masked: CasterHandling::Exact, blend: CasterHandling::AsOpaque };
+
+    /// Whether a frame whose casters a texture cuts out is taken.
+    #[must_use]
+    pub fn takes_cutouts(&self) -> bool {
+        self.masked != CasterHandling::LeftOut
+    }
+
+    /// Each kind with its handling, in the order opaque, masked, blend (glTF's alpha modes).
+    #[must_use]
+    pub fn kinds(&self) -> [(&'static str, CasterHandling); 3] {
+        [("opaque", self.opaque), ("masked", self.masked), ("blend", self.blend)]
+    }
+
+    /// What `shadowlab techniques` prints: the kinds it takes exactly, then how it takes each other one,
+    /// e.g. "opaque exactly, by its own method; masked through an alpha-tested depth map ...; blend as
+    /// opaque (the whole surface blocks light)".
+    #[must_use]
+    pub fn describe(&self) -> String {
+        let exact: Vec<&str> =
+            self.kinds().iter().filter(|(_, h)| *h == CasterHandling::Exact).map(|(k, _)| *k).collect();
+        let mut parts = Vec::new();
+        if !exact.is_empty() {
+            parts.push(format!("{} {}", exact.join(" and "), CasterHandling::Exact.clause()));
+        }
+        for (kind, h) in self.kinds().into_iter().filter(|(_, h)| *h != CasterHandling::Exact) {
+            parts.push(format!("{kind} {}", h.clause()));
+        }
+        parts.join("; ")
+    }
+}
+
 /// Builds a technique for backend `B` from a spec.
 pub type Constructor<B> = fn(&TechniqueSpec) -> Result<Box<dyn DynShadowTechnique<B>>, SettingsError>;
 
@@ -91,9 +183,9 @@ pub struct Entry<C: Backend, G: Backend> {
     pub wgsl: fn() -> Vec<(&'static str, String)>,
     /// For a technique built on depth maps, where its texels fall ([`MapLayout`]).
     pub layout: Option<Layout>,
-    /// Whether it takes casters that their texture cuts out ([`crate::frame::Coverage::Cutout`]); one
-    /// that extrudes silhouettes cannot, as a cutout has none to extrude.
-    pub cutouts: bool,
+    /// How it takes each kind of caster; whether it takes those their texture cuts out
+    /// ([`crate::frame::Coverage::Cutout`]) at all is [`CasterKinds::takes_cutouts`].
+    pub casters: CasterKinds,
 }
 
 /// No WGSL of its own.
@@ -131,7 +223,7 @@ impl<C: Backend, G: Backend> Entry<C, G> {
             wgpu,
             wgsl: no_wgsl,
             layout: None,
-            cutouts: true,
+            casters: CasterKinds::MAPS,
         }
     }
 
@@ -172,11 +264,18 @@ impl<C: Backend, G: Backend> Entry<C, G> {
         Self { layout: Some(layout::<S>), ..self }
     }
 
-    /// The same entry, for a technique that extrudes the casters' silhouettes, so takes no casters
-    /// cut out by their texture.
+    /// The same entry, for a technique that extrudes the casters' silhouettes and takes no casters cut
+    /// out by their texture ([`CasterHandling::LeftOut`]).
     #[must_use]
     pub fn without_cutouts(self) -> Self {
-        Self { cutouts: false, ..self }
+        Self { casters: CasterKinds { masked: CasterHandling::LeftOut, ..self.casters }, ..self }
+    }
+
+    /// The same entry, for a technique that extrudes the casters' silhouettes and takes those their
+    /// texture cuts out through their own map ([`CasterHandling::CutoutMap`]).
+    #[must_use]
+    pub fn cutouts_by_map(self) -> Self {
+        Self { casters: CasterKinds { masked: CasterHandling::CutoutMap, ..self.casters }, ..self }
     }
 
     /// The same entry, for a reference.
@@ -236,4 +335,25 @@ where
     let s = S::parse(&spec.name, &spec.values)?;
     let text = s.settings_string();
     Ok(Box::new(Stateful::new(s.into(), text).taking(S::LIGHTS)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn casters_say_what_is_exact_and_how_the_others_are_taken() {
+        assert_eq!(
+            CasterKinds::MAPS.describe(),
+            "opaque and masked exactly, by its own method; blend as opaque (the whole surface blocks light)"
+        );
+        let volumes = CasterKinds { masked: CasterHandling::CutoutMap, ..CasterKinds::MAPS };
+        let text = volumes.describe();
+        assert!(
+            text.starts_with("opaque exactly, by its own method; masked through an alpha-tested depth map"),
+            "{text}"
+        );
+        assert!(volumes.takes_cutouts() && CasterKinds::MAPS.takes_cutouts());
+        assert!(!CasterKinds { masked: CasterHandling::LeftOut, ..CasterKinds::MAPS }.takes_cutouts());
+    }
 }

@@ -2,12 +2,14 @@
 //! one per light projection (a point light's six cube faces), optionally with McCool's object-ID channel;
 //! looked up per receiver through `shadow_core::lookup::shadow_lookup` with each filter. Casters cut out
 //! by their texture discard the fragments of clear texels, each read over the footprint of one map texel.
+//! [`CutoutMaps`] holds those casters alone, for the techniques built on silhouettes.
 
-use shadow_core::frame::FrameError;
+use shadow_core::frame::{Coverage, FrameError};
 use shadow_core::glam::{Vec2, Vec3, Vec4};
 use shadow_core::light::{LightProjection, LightView};
 use shadow_core::lookup::shadow_lookup;
 use shadow_core::technique::DebugView;
+use shadow_core::technique::maps::{Casters, CutoutMap};
 use shadow_core::technique::settings::{DepthBias, Filter};
 use shadow_core::{FrameInputs, Image};
 
@@ -37,15 +39,16 @@ pub fn check_maps(res: u32, count: usize) -> Result<(), CpuError> {
     Ok(())
 }
 
-/// Renders the depth of every casting instance from one light projection into a `res x res` map, in the
-/// storage of `reuse` when given (last frame's map: its pages are already mapped). Casters cut out by
-/// their texture are drawn after the others, through their alpha test ([`crate::alpha_test`]).
+/// Renders the depth of the casting instances `casters` names from one light projection into a
+/// `res x res` map, in the storage of `reuse` when given (last frame's map: its pages are already mapped).
+/// Casters cut out by their texture are drawn after the others, through their alpha test
+/// ([`crate::alpha_test`]).
 ///
 /// # Errors
 /// [`FrameError::TooManyTriangles`] for casters of more triangles than a draw can number.
 pub fn render_depth_map(
     frame: &FrameInputs,
-    proj: &LightProjection,
+    (proj, casters): (&LightProjection, Casters),
     res: u32,
     bias: DepthBias,
     cull: CullMode,
@@ -58,7 +61,7 @@ pub fn render_depth_map(
     let mut ds = DepthStencil::from_parts(res, res, depth, vec![0; n]);
     let state =
         RasterState { cull, depth: Some(DepthState { bias, ..DepthState::LESS_WRITE }), ..RasterState::default() };
-    let casters = Casters::new(frame, proj);
+    let casters = LightCasters::new(frame, proj, casters);
     let mut counters = draw_depth(&mut ds, &casters.solid()?, &state);
     if !casters.drawn.cutout.is_empty() {
         let mut none = Image::new(res, res, ());
@@ -70,16 +73,19 @@ pub fn render_depth_map(
 
 /// The shadow casters of a frame, sorted by their coverage (in frame order within each kind), with their
 /// vertices in the clip space of one light projection.
-struct Casters<'a> {
+struct LightCasters<'a> {
     frame: &'a FrameInputs,
     drawn: Drawn<'a>,
     /// The clip-space vertices of each of `drawn.solid`, then of each of `drawn.cutout`.
     clip: Vec<Vec<Vec4>>,
 }
 
-impl<'a> Casters<'a> {
-    fn new(frame: &'a FrameInputs, proj: &LightProjection) -> Self {
-        let drawn = Drawn::sort(frame, |i| i.casts_shadow);
+impl<'a> LightCasters<'a> {
+    fn new(frame: &'a FrameInputs, proj: &LightProjection, casters: Casters) -> Self {
+        let drawn = match casters {
+            Casters::All => Drawn::sort(frame, |i| i.casts_shadow),
+            Casters::CutOut => Drawn::sort(frame, |i| i.casts_shadow && i.coverage() == Coverage::Cutout),
+        };
         let clip = (drawn.solid.iter().chain(&drawn.cutout))
             .map(|&k| {
                 let inst = &frame.instances[k];
@@ -118,12 +124,23 @@ pub fn render_depth_maps(
     bias: DepthBias,
     maps: &mut Vec<Image<f32>>,
 ) -> Result<(), CpuError> {
+    render_maps_of(frame, (light, Casters::All), res, bias, maps)
+}
+
+/// [`render_depth_maps`] of the casters `casters` names.
+fn render_maps_of(
+    frame: &FrameInputs,
+    (light, casters): (&LightView, Casters),
+    res: u32,
+    bias: DepthBias,
+    maps: &mut Vec<Image<f32>>,
+) -> Result<(), CpuError> {
     check_maps(res, light.projections.len())?;
     let mut old = std::mem::take(maps).into_iter();
     *maps = light
         .projections
         .iter()
-        .map(|p| Ok(render_depth_map(frame, p, res, bias, CullMode::None, old.next())?.0))
+        .map(|p| Ok(render_depth_map(frame, (p, casters), res, bias, CullMode::None, old.next())?.0))
         .collect::<Result<_, CpuError>>()?;
     Ok(())
 }
@@ -149,7 +166,7 @@ pub fn render_depth_and_id_maps(
     for p in &light.projections {
         let mut ds = DepthStencil::new(res, res, 1.0, 0);
         let mut id = Image::new(res, res, 0u32);
-        let casters = Casters::new(frame, p);
+        let casters = LightCasters::new(frame, p, Casters::All);
         let (solid, list) = (casters.solid()?, &casters.drawn.solid);
         draw_flat(&mut ds, &mut id, &solid, &state, |prim| list[solid.part_of(prim).0] as u32 + 1);
         if !casters.drawn.cutout.is_empty() {
@@ -201,18 +218,95 @@ pub fn query_maps(
     radius: f32,
     receiver_offset: f32,
 ) {
-    per_receiver(g, out, |x, y, i| {
-        let m = map_position(light, g.position.data()[i], receiver_offset);
-        let v = shadow_lookup(&maps[m.projection], m.uv, m.depth, filter, radius, (x, y));
+    let lookup = MapLookup { filter, radius, receiver_offset };
+    per_receiver(g, out, |x, y, i| lookup.visibility(maps, light, g.position.data()[i], (x, y)));
+}
+
+/// How a receiver reads a light's maps: the filter, its kernel radius in texels, and how far the receiver
+/// moves towards the light first (`bias=world`).
+#[derive(Clone, Copy, Debug)]
+struct MapLookup {
+    filter: Filter,
+    radius: f32,
+    receiver_offset: f32,
+}
+
+impl MapLookup {
+    /// The visibility of the receiver at `p`, seen at pixel `px`, through `maps` (one per projection of
+    /// `light`); with cascades, faded into the next cascade's answer over the blend band at its far end.
+    fn visibility(&self, maps: &[Image<f32>], light: &LightView, p: Vec3, px: (u32, u32)) -> f32 {
+        let Self { filter, radius, receiver_offset } = *self;
+        let m = map_position(light, p, receiver_offset);
+        let v = shadow_lookup(&maps[m.projection], m.uv, m.depth, filter, radius, px);
         match light.cascade_pick(m.world).and_then(|pick| pick.next) {
             Some((next, weight)) => {
                 let (uv, depth) = light.projections[next].uv_depth(m.world);
-                let w = shadow_lookup(&maps[next], uv, depth, filter, radius, (x, y));
+                let w = shadow_lookup(&maps[next], uv, depth, filter, radius, px);
                 v * (1.0 - weight) + w * weight
             }
             None => v,
         }
-    });
+    }
+}
+
+/// The depth maps of the casters their texture cuts out, alone ([`Casters::CutOut`]), and how they are
+/// read ([`CutoutMap`]): where the techniques built on silhouettes (which give such casters no volume or
+/// wedge) take those casters' shadows from (twin: shadow-wgpu's `passes::maps::CutoutMaps`). A frame
+/// without cut-out casters renders none, and every receiver is lit by them.
+#[derive(Default)]
+pub struct CutoutMaps {
+    maps: Vec<Image<f32>>,
+    /// The view the maps were rendered from, and how they are read; `None` when there are none.
+    lookup: Option<(LightView, MapLookup)>,
+}
+
+impl CutoutMaps {
+    /// Renders the maps of `frame`'s cut-out casters from every projection of `view` (the light's own, or
+    /// its cascades over the camera's view) as `settings` asks, or, for a frame without such casters, lets
+    /// last frame's go.
+    ///
+    /// # Errors
+    /// As [`render_depth_maps`].
+    pub fn render(&mut self, frame: &FrameInputs, view: &LightView, settings: &CutoutMap) -> Result<(), CpuError> {
+        if !frame.has_cutout_casters() {
+            *self = Self::default();
+            return Ok(());
+        }
+        let map = settings.map();
+        let (res, bias) = (map.resolution, map.depth_bias());
+        let lookup = MapLookup {
+            filter: settings.filter,
+            radius: settings.filter_radius(),
+            receiver_offset: map.receiver_offset(),
+        };
+        self.lookup = None;
+        render_maps_of(frame, (view, Casters::CutOut), res, bias, &mut self.maps)?;
+        self.lookup = Some((view.clone(), lookup));
+        Ok(())
+    }
+
+    /// The share of the light the cut-out casters of the last render leave the receiver at `p`, seen at
+    /// pixel `px`: 1 when that frame had none.
+    #[must_use]
+    #[inline]
+    pub fn visibility(&self, p: Vec3, px: (u32, u32)) -> f32 {
+        match &self.lookup {
+            Some((view, lookup)) => lookup.visibility(&self.maps, view, p, px),
+            None => 1.0,
+        }
+    }
+
+    /// Whether the last render drew maps (its frame had cut-out casters).
+    #[must_use]
+    pub fn is_rendered(&self) -> bool {
+        self.lookup.is_some()
+    }
+
+    /// The maps, named `{prefix}{k}` ([`depth_views`]).
+    #[must_use]
+    pub fn views(&self, prefix: &str) -> Vec<DebugView> {
+        depth_views(prefix, &self.maps)
+    }
 }
 
 /// False-colour pictures of depth maps, named `{prefix}{k}`.

@@ -25,7 +25,9 @@ use std::borrow::Cow;
 use crate::Entry;
 use shadow_core::light::{CascadeFit, LightView, Stabilize};
 use shadow_core::technique::LightKinds;
-use shadow_core::technique::maps::{DepthMap, FILTER, FILTER_RADIUS, MapLayout, MapSampling, resolution_key};
+use shadow_core::technique::maps::{
+    CutoutMap, DepthMap, FILTER, FILTER_RADIUS, MapLayout, MapSampling, resolution_key,
+};
 use shadow_core::technique::settings::TechniqueSettings;
 use shadow_core::technique::settings::{Filter, SettingKey};
 use shadow_core::{FrameInputs, LightKind};
@@ -127,6 +129,18 @@ pub fn cascaded_view<'a>(
     }
     let fit = CascadeFit { count: count as usize, blend, resolution, ..CascadedShadowMap::defaults().fit() };
     Cow::Owned(light.cascaded(&frame.camera, aspect, &frame.bounds, &fit))
+}
+
+/// The view the map of the cut-out casters renders (`map`'s `cutout_cascades` over `frame`'s camera, seen
+/// `aspect` wide, as [`cascaded_view`] fits them), for a frame with such casters; the light's own
+/// otherwise, and for lights other than directional.
+#[must_use]
+pub fn cutout_view<'a>(map: &CutoutMap, frame: &FrameInputs, light: &'a LightView, aspect: f32) -> Cow<'a, LightView> {
+    if !frame.has_cutout_casters() {
+        return Cow::Borrowed(light);
+    }
+    let blend = CascadedShadowMap::defaults().blend;
+    cascaded_view(light, frame, aspect, map.cascades, map.resolution, blend)
 }
 
 /// The registry entry.

@@ -136,7 +136,7 @@ impl ShadowTechnique<CpuBackend> for DepthLayers {
     }
 
     /// With cascades the maps follow the camera, which the build key does not hold.
-    fn build_is_reusable(&self) -> bool {
+    fn build_is_reusable(&self, _: &FrameInputs) -> bool {
         self.cascades == 0
     }
 

@@ -313,7 +313,7 @@ impl ShadowTechnique<WgpuBackend> for DepthLayers {
     }
 
     /// With cascades the maps follow the camera, which the build key does not hold.
-    fn build_is_reusable(&self) -> bool {
+    fn build_is_reusable(&self, _: &FrameInputs) -> bool {
         self.cascades == 0
     }
 }

@@ -334,7 +334,7 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
 
     /// Its build sizes the caster masks' tolerances by the camera, and leaves the volumes and the small
     /// pieces' parameters in the frame's transient buffer.
-    fn build_is_reusable(&self) -> bool {
+    fn build_is_reusable(&self, _: &shadow_core::FrameInputs) -> bool {
         false
     }
 

@@ -1,16 +1,19 @@
 //! Stencil shadow volumes on the GPU (twin: [`super::cpu`]): found, extruded and counted by
 //! `passes::extrusion` with the technique's counting (or, with `extrusion=cpu`, the shared extrusion
-//! uploaded and counted by `passes::volumes`), then resolved.
+//! uploaded and counted by `passes::volumes`), then resolved; with cut-out casters, resolved over their
+//! map's visibility (`passes::maps::CutoutMaps`), which the query writes first.
 //!
 //! In instrumented frames the build reads back the extrusion's edge and triangle counts, and the other
 //! counters come from occlusion queries: samples passing the volume pass, and, in a separate pass with
 //! the depth test off, every rasterized volume fragment (inside the query phase, timed as its sub-phase
 //! `count_fragments` so it can be taken out).
 
+use shadow_core::FrameInputs;
 use shadow_core::geometry::volume::{Caps, VolumeCounting};
 use shadow_core::technique::LightPass;
 use shadow_core::technique::{ShadowTechnique, TechniqueError};
 use shadow_wgpu::passes::extrusion::GpuExtrusion;
+use shadow_wgpu::passes::maps::CutoutMaps;
 use shadow_wgpu::passes::volumes::{
     StencilResolve, VolumeDraw, VolumePass, build_draws, count_all_pipeline, counting_state, read_query,
     volume_pipeline,
@@ -18,11 +21,13 @@ use shadow_wgpu::passes::volumes::{
 use shadow_wgpu::{GpuGBuffer, GpuVisibility, WgpuBackend, WgpuContext, WgpuError, shaders};
 
 use super::{Extrusion, ShadowVolume};
+use crate::cascaded_shadow_map::cutout_view;
 
-/// The resolve, and the volumes as the `extrusion` setting makes them.
+/// The resolve, the volumes as the `extrusion` setting makes them, and the cut-out casters' maps.
 pub struct State {
     resolve: StencilResolve,
     volumes: Volumes,
+    cutouts: CutoutMaps,
     /// Whether a light was built since the state was made.
     built: bool,
 }
@@ -50,9 +55,9 @@ impl ShadowTechnique<WgpuBackend> for ShadowVolume {
     }
 
     /// The compute pass's lists outlast the frame; volumes extruded on the host are uploaded into the
-    /// frame's transient buffer, which does not.
-    fn build_is_reusable(&self) -> bool {
-        self.gpu.extrusion == Extrusion::Gpu
+    /// frame's transient buffer, which does not; cascades of the cut-out casters' map follow the camera.
+    fn build_is_reusable(&self, frame: &FrameInputs) -> bool {
+        self.gpu.extrusion == Extrusion::Gpu && !self.cutouts_follow_the_camera(frame)
     }
 
     fn create_state(&self, cx: &mut WgpuContext) -> Result<State, WgpuError> {
@@ -72,12 +77,12 @@ impl ShadowTechnique<WgpuBackend> for ShadowVolume {
                     }
                 }
             };
-            State { resolve, volumes, built: false }
+            State { resolve, volumes, cutouts: CutoutMaps::default(), built: false }
         })
     }
 
     fn build(&self, cx: &mut WgpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), WgpuError> {
-        let LightPass { frame, light, slot, stats, .. } = pass;
+        let LightPass { frame, light, slot, aspect, stats } = pass;
         match &mut state.volumes {
             Volumes::Gpu(extrusion) => {
                 extrusion.build(cx, frame, light, slot, self.caps())?;
@@ -89,6 +94,8 @@ impl ShadowTechnique<WgpuBackend> for ShadowVolume {
             }
             Volumes::Cpu { draws, .. } => *draws = build_draws(cx, frame, light, self.caps(), stats)?,
         }
+        let view = cutout_view(&self.cutouts, frame, light, aspect);
+        state.cutouts.render(cx, frame, &view, &self.cutouts)?;
         state.built = true;
         Ok(())
     }
@@ -107,6 +114,7 @@ impl ShadowTechnique<WgpuBackend> for ShadowVolume {
         }
         let depth = g.depth_view();
         let volumes = &state.volumes;
+        let cutouts = state.cutouts.query(cx, g, out)?;
         let passed = cx.scoped("the shadow-volume pass", |cx| {
             let q = match volumes {
                 Volumes::Gpu(extrusion) => extrusion.draw(cx, frame, g, &depth, slot, false),
@@ -122,7 +130,12 @@ impl ShadowTechnique<WgpuBackend> for ShadowVolume {
                     counting.run(cx, draws, frame, g, &depth)
                 }
             };
-            state.resolve.run(cx, g, out, &depth);
+            // Lit where no volume holds the receiver and the cut-out casters, when there are any, leave it light.
+            if cutouts {
+                state.resolve.run_onto(cx, g, out, &depth);
+            } else {
+                state.resolve.run(cx, g, out, &depth);
+            }
             q
         })?;
         let Some(passed) = passed.filter(|_| cx.instrumented()) else { return Ok(()) };

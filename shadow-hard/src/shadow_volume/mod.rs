@@ -11,13 +11,20 @@
 //! with its `passes::volumes`; the GPU finds and extrudes the volumes itself in a compute pass
 //! (`passes::extrusion`, the cost Sen, Chan and Nealen each name for volumes), or, with `extrusion=cpu`,
 //! draws shadow-core's extrusion uploaded each frame, the reference the compute pass is held to.
+//!
+//! Casters their texture cuts out get no volume (a card's outline is not its shadow's edge): their
+//! shadows come from a depth map of them alone, alpha-tested as every light pass is (`passes::maps`'
+//! `CutoutMaps` on each backend, [`CutoutMap`] its settings), and a receiver is lit only where its count
+//! is zero and that map says lit. A frame without such casters renders no map and runs as before.
 
 pub mod cpu;
 pub mod gpu;
 
+use shadow_core::FrameInputs;
 use shadow_core::geometry::volume::VolumeCounting;
+use shadow_core::technique::maps::CutoutMap;
 use shadow_core::technique::settings::{
-    SettingField, SettingKey, SettingsError, TechniqueSettings, TechniqueSpec, Values,
+    Filter, SettingField, SettingKey, SettingsError, TechniqueSettings, TechniqueSpec, Values,
 };
 use shadow_core::technique::{Backend, DynShadowTechnique, ShadowTechnique, Stateful};
 use shadow_cpu::CpuBackend;
@@ -30,13 +37,19 @@ use crate::Entry;
 pub struct ShadowVolume {
     /// Which counting (from the technique's name).
     pub counting: VolumeCounting,
+    /// The map of the casters their texture cuts out.
+    pub cutouts: CutoutMap,
     /// What the GPU backend alone reads.
     pub gpu: GpuOptions,
 }
 
 impl ShadowVolume {
     /// Z-pass volumes.
-    pub const ZPASS: Self = Self { counting: VolumeCounting::ZPass, gpu: GpuOptions { extrusion: Extrusion::Gpu } };
+    pub const ZPASS: Self = Self {
+        counting: VolumeCounting::ZPass,
+        cutouts: CutoutMap { resolution: 2048, filter: Filter::None, cascades: 4 },
+        gpu: GpuOptions { extrusion: Extrusion::Gpu },
+    };
     /// Z-fail volumes.
     pub const ZFAIL: Self = Self { counting: VolumeCounting::ZFail, ..Self::ZPASS };
 }
@@ -65,15 +78,23 @@ shadow_core::named_enum! {
     }
 }
 
+/// The cut-out casters' map's keys, then the GPU's.
+const KEYS: [SettingKey; 4] = [CutoutMap::KEYS[0], CutoutMap::KEYS[1], CutoutMap::KEYS[2], GpuOptions::KEYS[0]];
+
 impl TechniqueSettings for ShadowVolume {
     fn keys() -> &'static [SettingKey] {
-        GpuOptions::KEYS
+        &KEYS
     }
     fn from_values(v: &Values<'_>) -> Result<Self, SettingsError> {
-        Ok(Self { gpu: GpuOptions::read(v, GpuOptions::KEYS)?, ..Self::ZFAIL })
+        Ok(Self {
+            cutouts: CutoutMap::read(v, CutoutMap::KEYS)?,
+            gpu: GpuOptions::read(v, GpuOptions::KEYS)?,
+            ..Self::ZFAIL
+        })
     }
     fn to_values(&self) -> Vec<String> {
         let mut out = Vec::new();
+        self.cutouts.write(&mut out);
         self.gpu.write(&mut out);
         out
     }
@@ -93,6 +114,13 @@ impl ShadowVolume {
             Self::ZFAIL_NAME => Some(Self::ZFAIL),
             _ => None,
         }
+    }
+
+    /// Whether the build reads the camera: `frame` has cut-out casters, whose map is in cascades over
+    /// the view.
+    #[must_use]
+    pub fn cutouts_follow_the_camera(&self, frame: &FrameInputs) -> bool {
+        self.cutouts.cascades > 0 && frame.has_cutout_casters()
     }
 
     /// The registry name of this counting.
@@ -127,7 +155,7 @@ pub fn zpass_entry() -> Entry {
         "stencil shadow volumes counted from the eye: wrong when the eye is in shadow",
         "Crow 1977; Heidmann 1991",
     )
-    .without_cutouts()
+    .cutouts_by_map()
 }
 
 /// The registry entry of z-fail volumes.
@@ -138,7 +166,7 @@ pub fn zfail_entry() -> Entry {
         "stencil shadow volumes counted from infinity, capped: right with the eye in shadow",
         "Everitt-Kilgard 2002",
     )
-    .without_cutouts()
+    .cutouts_by_map()
 }
 
 #[cfg(test)]
@@ -146,8 +174,12 @@ mod tests {
     use super::*;
 
     #[test]
-    fn takes_only_the_extrusion() {
-        assert_eq!(ShadowVolume::defaults().settings_string(), "extrusion=gpu");
+    fn takes_the_cutout_map_and_the_extrusion() {
+        assert_eq!(
+            ShadowVolume::defaults().settings_string(),
+            "cutout_res=2048,cutout_filter=none,cutout_cascades=4,extrusion=gpu"
+        );
+        assert_eq!(ShadowVolume::defaults().cutouts, ShadowVolume::ZPASS.cutouts, "the constants' map is the keys'");
         let cpu = vec![("extrusion".to_string(), "cpu".to_string())];
         assert_eq!(ShadowVolume::parse("shadow-volume-zpass", &cpu).expect("valid").gpu.extrusion, Extrusion::Cpu);
         let given = vec![("res".to_string(), "1".to_string())];

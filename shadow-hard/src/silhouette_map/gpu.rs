@@ -344,7 +344,7 @@ impl ShadowTechnique<WgpuBackend> for SilhouetteMap {
     }
 
     /// With cascades the maps follow the camera, which the build key does not hold.
-    fn build_is_reusable(&self) -> bool {
+    fn build_is_reusable(&self, _: &shadow_core::FrameInputs) -> bool {
         self.cascades == 0
     }
 

@@ -89,7 +89,7 @@ macro_rules! view_fitted_on_cpu {
                 state.query(Self::NAME, g, out, self.filter, self.filter_radius, self.map.receiver_offset())
             }
 
-            fn build_is_reusable(&self) -> bool {
+            fn build_is_reusable(&self, _: &shadow_core::FrameInputs) -> bool {
                 false
             }
 

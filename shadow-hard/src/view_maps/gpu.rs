@@ -100,7 +100,7 @@ macro_rules! view_fitted_on_gpu {
                 state.query(cx, Self::NAME, g, out)
             }
 
-            fn build_is_reusable(&self) -> bool {
+            fn build_is_reusable(&self, _: &shadow_core::FrameInputs) -> bool {
                 false
             }
         }

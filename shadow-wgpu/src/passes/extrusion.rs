@@ -315,7 +315,7 @@ impl Jobs {
             .instances
             .iter()
             .enumerate()
-            .filter(|(_, inst)| inst.casts_shadow)
+            .filter(|(_, inst)| inst.casts_solid_shadow())
             .map(|(i, inst)| (i, inst.mesh_key, inst.mesh_version))
             .collect();
         if !slot.as_ref().is_some_and(|j| j.key == key && j.slots >= slots) {

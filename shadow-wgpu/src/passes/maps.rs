@@ -2,12 +2,13 @@
 //! pipeline's depth bias into one layer per projection; a map query runs `shadow_lookup` of
 //! shadow_map.wgsl over the G-buffer, with the hardware comparison sampler for bilinear taps. Techniques
 //! that look into the maps their own way add a fragment entry and bindings from 4 on ([`MapQuery::with_entry`]).
+//! [`CutoutMaps`] holds the casters their texture cuts out alone, for the techniques built on silhouettes.
 
 use bytemuck::{Pod, Zeroable};
 use shadow_core::FrameInputs;
 use shadow_core::frame::Coverage;
 use shadow_core::light::LightView;
-use shadow_core::technique::maps::DepthMap;
+use shadow_core::technique::maps::{Casters, CutoutMap, DepthMap};
 use shadow_core::technique::settings::{BiasMode, Filter};
 
 use crate::context::{WgpuContext, WgpuError};
@@ -338,6 +339,18 @@ pub fn render_maps(
     ids: Option<&wgpu::Texture>,
     instances: &wgpu::Buffer,
 ) {
+    render_casters(cx, pipelines, (frame, Casters::All), light, (maps, ids), instances);
+}
+
+/// [`render_maps`] of the casters `casters` names.
+fn render_casters(
+    cx: &WgpuContext,
+    pipelines: &LightPipelines,
+    (frame, casters): (&FrameInputs, Casters),
+    light: &LightView,
+    (maps, ids): (&wgpu::Texture, Option<&wgpu::Texture>),
+    instances: &wgpu::Buffer,
+) {
     let res = maps.width();
     let cutouts = frame.has_cutout_casters();
     let mut enc = cx.encoder("light pass");
@@ -364,9 +377,11 @@ pub fn render_maps(
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_pipeline(&pipelines.solid);
         pass.set_bind_group(0, &group, &[]);
-        draw_instances(cx, &mut pass, frame, |i| i.casts_shadow && i.coverage() == Coverage::Solid, false);
+        if casters == Casters::All {
+            pass.set_pipeline(&pipelines.solid);
+            draw_instances(cx, &mut pass, frame, |i| i.casts_shadow && i.coverage() == Coverage::Solid, false);
+        }
         if cutouts {
             pass.set_pipeline(pipelines.cutout(cx));
             draw_textured(cx, &mut pass, frame, |i| i.casts_shadow && i.coverage() == Coverage::Cutout, false);
@@ -397,6 +412,7 @@ fn filter_code(f: Filter) -> f64 {
 pub struct DepthMaps {
     pipelines: LightPipelines,
     maps: Option<wgpu::Texture>,
+    casters: Casters,
 }
 
 impl DepthMaps {
@@ -410,7 +426,13 @@ impl DepthMaps {
     /// [`DepthMaps::new`] from a module already holding the shadow-map shader.
     #[must_use]
     pub fn with_module(cx: &WgpuContext, module: &wgpu::ShaderModule, map: &DepthMap) -> Self {
-        Self { pipelines: light_pass_pipeline(cx, module, depth_bias(map)), maps: None }
+        Self { pipelines: light_pass_pipeline(cx, module, depth_bias(map)), maps: None, casters: Casters::All }
+    }
+
+    /// The same light pass drawing only the casters `casters` names.
+    #[must_use]
+    pub fn of(self, casters: Casters) -> Self {
+        Self { casters, ..self }
     }
 
     /// Renders the casters' depth from every projection of `light` into one layer each of a
@@ -438,7 +460,7 @@ impl DepthMaps {
         cx.upload_textures(frame)?;
         let instances = cx.instances(frame);
         cx.scoped("the shadow-map light pass", |cx| {
-            render_maps(cx, &self.pipelines, frame, light, &maps, None, &instances)
+            render_casters(cx, &self.pipelines, (frame, self.casters), light, (&maps, None), &instances)
         })
     }
 
@@ -446,5 +468,71 @@ impl DepthMaps {
     #[must_use]
     pub fn maps(&self) -> Option<&wgpu::Texture> {
         self.maps.as_ref()
+    }
+}
+
+/// The depth maps of the casters their texture cuts out, alone ([`Casters::CutOut`]), and their lookup
+/// ([`CutoutMap`]): where the techniques built on silhouettes (which give such casters no volume or wedge)
+/// take those casters' shadows from (twin: shadow-cpu's `passes::maps::CutoutMaps`). Its pipelines are
+/// made by the first frame with such casters; a frame without them renders nothing.
+#[derive(Default)]
+pub struct CutoutMaps {
+    passes: Option<CutoutPasses>,
+    /// The view of the last render, when its frame had cut-out casters.
+    rendered: Option<LightView>,
+}
+
+/// The light pass and the lookup of one [`CutoutMap`].
+struct CutoutPasses {
+    settings: CutoutMap,
+    maps: DepthMaps,
+    query: MapQuery,
+}
+
+impl CutoutMaps {
+    /// Renders the maps of `frame`'s cut-out casters from every projection of `view` (the light's own, or
+    /// its cascades over the camera's view) as `settings` asks; for a frame without such casters, nothing.
+    ///
+    /// # Errors
+    /// As [`DepthMaps::render`].
+    pub fn render(
+        &mut self,
+        cx: &mut WgpuContext,
+        frame: &FrameInputs,
+        view: &LightView,
+        settings: &CutoutMap,
+    ) -> Result<(), WgpuError> {
+        self.rendered = None;
+        if !frame.has_cutout_casters() {
+            return Ok(());
+        }
+        let passes = match &mut self.passes {
+            Some(p) if p.settings == *settings => p,
+            _ => self.passes.insert(cx.scoped("creating the cut-out casters' map", |cx| {
+                let module = cx.pipelines.module("shadow_map", shaders::shadow_map());
+                let map = settings.map();
+                let lookup = LookupParams { radius: settings.filter_radius(), receiver_offset: map.receiver_offset() };
+                CutoutPasses {
+                    settings: *settings,
+                    maps: DepthMaps::with_module(cx, &module, &map).of(Casters::CutOut),
+                    query: MapQuery::new(cx, &module, settings.filter).with_lookup(lookup),
+                }
+            })?),
+        };
+        passes.maps.render(cx, frame, view, settings.resolution)?;
+        self.rendered = Some(view.clone());
+        Ok(())
+    }
+
+    /// Writes into `out` the share of the light the cut-out casters of the last render leave each receiver
+    /// of `g`, and says so; says false and writes nothing when that frame had none.
+    ///
+    /// # Errors
+    /// A GPU failure.
+    pub fn query(&self, cx: &WgpuContext, g: &GpuGBuffer, out: &GpuVisibility) -> Result<bool, WgpuError> {
+        let (Some(passes), Some(view)) = (&self.passes, &self.rendered) else { return Ok(false) };
+        let Some(maps) = passes.maps.maps() else { return Ok(false) };
+        passes.query.run(cx, maps, view, g, out, &QueryExtras::NONE)?;
+        Ok(true)
     }
 }

@@ -6,7 +6,8 @@
 //!   count what a pass rasterizes;
 //! - [`extrusion`]: find and extrude shadow volumes on the GPU and count them in the stencil.
 //!
-//! [`full_screen`] runs a technique's full-screen pass into a visibility target.
+//! [`full_screen`] runs a technique's full-screen pass into a visibility target, [`full_screen_to`] over
+//! what it holds too.
 
 pub mod extrusion;
 pub mod maps;
@@ -22,6 +23,19 @@ pub fn full_screen(
     groups: &[&wgpu::BindGroup],
     depth_stencil: Option<(&wgpu::TextureView, u32)>,
 ) {
+    let clear = wgpu::LoadOp::Clear(wgpu::Color::WHITE);
+    full_screen_to(cx, (label, target, clear), pipeline, groups, depth_stencil);
+}
+
+/// [`full_screen`] into `target` loaded as `load` says: cleared to a colour, or kept
+/// (`wgpu::LoadOp::Load`: the fragments the pipeline writes replace its values, the others keep them).
+pub fn full_screen_to(
+    cx: &crate::WgpuContext,
+    (label, target, load): (&str, &wgpu::TextureView, wgpu::LoadOp<wgpu::Color>),
+    pipeline: &wgpu::RenderPipeline,
+    groups: &[&wgpu::BindGroup],
+    depth_stencil: Option<(&wgpu::TextureView, u32)>,
+) {
     let mut enc = cx.encoder(label);
     {
         let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -30,7 +44,7 @@ pub fn full_screen(
                 view: target,
                 depth_slice: None,
                 resolve_target: None,
-                ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::WHITE), store: wgpu::StoreOp::Store },
+                ops: wgpu::Operations { load, store: wgpu::StoreOp::Store },
             })],
             depth_stencil_attachment: depth_stencil.map(|(view, _)| wgpu::RenderPassDepthStencilAttachment {
                 view,

@@ -158,13 +158,26 @@ impl StencilResolve {
 
     /// Writes the visibility from the stencil of `depth` (G-buffer `g`'s depth-stencil).
     pub fn run(&self, cx: &WgpuContext, g: &GpuGBuffer, out: &GpuVisibility, depth: &wgpu::TextureView) {
-        let group = cx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        let group = self.group(cx, g);
+        let groups = [&g.frame_group, &group];
+        super::full_screen(cx, "stencil resolve", &out.view, &self.pipeline, &groups, Some((depth, 0)));
+    }
+
+    /// Shadows the receivers whose stencil is not 0 in the visibility `out` already holds (what another
+    /// pass wrote there), leaving the others as they are: a receiver stays lit only where both say lit.
+    pub fn run_onto(&self, cx: &WgpuContext, g: &GpuGBuffer, out: &GpuVisibility, depth: &wgpu::TextureView) {
+        let group = self.group(cx, g);
+        let groups = [&g.frame_group, &group];
+        let target = ("stencil resolve", &out.view, wgpu::LoadOp::Load);
+        super::full_screen_to(cx, target, &self.pipeline, &groups, Some((depth, 0)));
+    }
+
+    fn group(&self, cx: &WgpuContext, g: &GpuGBuffer) -> wgpu::BindGroup {
+        cx.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("stencil resolve"),
             layout: &self.layout,
             entries: &[wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&g.position) }],
-        });
-        let groups = [&g.frame_group, &group];
-        super::full_screen(cx, "stencil resolve", &out.view, &self.pipeline, &groups, Some((depth, 0)));
+        })
     }
 }
 

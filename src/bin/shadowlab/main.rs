@@ -228,22 +228,25 @@ fn list_techniques(json: bool) -> Result<(), Error> {
             .iter()
             .map(|e| {
                 let keys: Vec<_> = (e.keys)().iter().map(setting_json).collect();
-                json!({"name": e.name, "description": e.description, "paper": e.paper, "reference": e.reference, "lights": e.lights.names(), "settings": keys, "backends": backends(e)})
+                let casters: serde_json::Map<String, serde_json::Value> =
+                    e.casters.kinds().iter().map(|(kind, h)| ((*kind).to_string(), json!(h.name()))).collect();
+                json!({"name": e.name, "description": e.description, "paper": e.paper, "reference": e.reference, "lights": e.lights.names(), "casters": casters, "settings": keys, "backends": backends(e)})
             })
             .collect();
         return print_json(&json!(v));
     }
     for e in reg.entries() {
         out!(
-            "{}  [{}]\n  {}\n  paper: {}\n  lights: {}",
+            "{}  [{}]\n  {}\n  paper: {}\n  lights: {}\n  casters: {}",
             e.name,
             backends(e).join(", "),
             e.description,
             e.paper,
-            e.lights.names().join(", ")
+            e.lights.names().join(", "),
+            e.casters.describe()
         );
         for k in (e.keys)() {
-            out!("    {}={:<10} {}", k.key, k.default, k.help);
+            out!("    {:<28} {}", format!("{}={}", k.key, k.default), k.help);
         }
     }
     Ok(())
@@ -469,9 +472,10 @@ fn technique_specs(
         renderer.registry().canonical(s)?;
     }
     if frame.has_cutout_casters() {
-        for s in specs.iter().filter(|s| renderer.registry().get(&s.name).is_ok_and(|e| !e.cutouts)) {
+        let takes_none = |e: &shadowlab::TechniqueEntry| !e.casters.takes_cutouts();
+        for s in specs.iter().filter(|s| renderer.registry().get(&s.name).is_ok_and(takes_none)) {
             eprintln!(
-                "warning: {} extrudes silhouettes: the casters this scene's textures cut out shadow as solid in it",
+                "warning: {} takes no masked casters: those this scene's textures cut out shadow as solid in it",
                 s.name
             );
         }
