@@ -169,7 +169,7 @@ impl TechniqueRegistry {
 #[cfg(test)]
 mod tests {
     use shadow_core::material::AlphaMode;
-    use shadow_core::scenes::{self, SceneParams};
+    use shadow_core::scenes::{self, LightType, SceneParams};
 
     use super::*;
 
@@ -188,9 +188,11 @@ mod tests {
         };
         let extruding: Vec<&str> =
             registry.entries().iter().filter(|e| !e.casters.takes_cutouts()).map(|e| e.name).collect();
-        assert_eq!(extruding, ["hybrid", "penumbra-wedges"]);
+        assert_eq!(extruding, ["penumbra-wedges"]);
         // Penumbra wedges take no directional light, which leaves them out first.
-        assert_eq!(left_for_cutouts(&scene), ["hybrid"]);
+        assert!(left_for_cutouts(&scene).is_empty());
+        let spot = scenes::build("cutout", &SceneParams { light: Some(LightType::Spot), ..SceneParams::default() });
+        assert_eq!(left_for_cutouts(&spot.expect("cutout under a spot")), ["penumbra-wedges"]);
         let card = scene.materials().find(|(_, m)| m.name == "checkerboard").expect("the card").0;
         for mode in [AlphaMode::Opaque, AlphaMode::Blend] {
             scene.material_mut(card).expect("material").alpha_mode = mode;

@@ -89,11 +89,11 @@ fn a_settings_change_compiles_only_the_pipelines_that_depend_on_it() {
     assert_eq!(run("shadow-map"), (0, 0), "back to the defaults");
 }
 
-/// The volumes render a map of the casters their texture cuts out only for a frame with such casters: on
-/// a scene without them, the map's settings compile nothing (no pass of theirs runs); on `cutout`, the
-/// first frame compiles its light pass and lookup.
+/// The volumes and the hybrid render a map of the casters their texture cuts out only for a frame with
+/// such casters: on a scene without them, the map's settings compile nothing (no pass of theirs runs); on
+/// `cutout`, the first frame compiles its light pass and lookup.
 #[test]
-fn volumes_make_their_cutout_map_only_for_cutout_casters() {
+fn silhouette_techniques_make_their_cutout_map_only_for_cutout_casters() {
     let Some((mut cx, frame, target)) = setup() else { return };
     let registry = TechniqueRegistry::builtin();
     let cutout = FrameInputs::from_first_camera(&scenes::build("cutout", &SceneParams::default()).expect("scene"))
@@ -103,7 +103,8 @@ fn volumes_make_their_cutout_map_only_for_cutout_casters() {
         compiled(made_by_a_frame(&mut cx, technique.as_mut(), frame, &target))
     };
     // Each with a filter of its own, so that the second's lookup is not the first's.
-    for (name, filter) in [("shadow-volume-zfail", "pcf3x3"), ("shadow-volume-zpass", "poisson16")] {
+    let techniques = [("shadow-volume-zfail", "pcf3x3"), ("shadow-volume-zpass", "poisson16"), ("hybrid", "bilinear")];
+    for (name, filter) in techniques {
         run(name, &frame);
         let other_map = format!("{name}:cutout_res=512,cutout_filter={filter}");
         assert_eq!(run(&other_map, &frame), (0, 0), "{name}: no cut-out casters, no map");

@@ -221,6 +221,9 @@ impl CutoutMap {
 pub enum Casters {
     /// Every one, those their texture cuts out through their alpha test.
     All,
+    /// Only those that block light over their whole surface ([`crate::frame::Instance::casts_solid_shadow`]):
+    /// the casters shadow volumes are extruded from (`hybrid`'s classifying map).
+    Solid,
     /// Only those their texture cuts out ([`crate::frame::Coverage::Cutout`]), through their alpha test:
     /// the map of [`CutoutMap`].
     CutOut,

@@ -4,7 +4,7 @@
 //! by their texture discard the fragments of clear texels, each read over the footprint of one map texel.
 //! [`CutoutMaps`] holds those casters alone, for the techniques built on silhouettes.
 
-use shadow_core::frame::{Coverage, FrameError};
+use shadow_core::frame::{Coverage, FrameError, Instance};
 use shadow_core::glam::{Vec2, Vec3, Vec4};
 use shadow_core::light::{LightProjection, LightView};
 use shadow_core::lookup::shadow_lookup;
@@ -84,6 +84,7 @@ impl<'a> LightCasters<'a> {
     fn new(frame: &'a FrameInputs, proj: &LightProjection, casters: Casters) -> Self {
         let drawn = match casters {
             Casters::All => Drawn::sort(frame, |i| i.casts_shadow),
+            Casters::Solid => Drawn::sort(frame, Instance::casts_solid_shadow),
             Casters::CutOut => Drawn::sort(frame, |i| i.casts_shadow && i.coverage() == Coverage::Cutout),
         };
         let clip = (drawn.solid.iter().chain(&drawn.cutout))
@@ -124,11 +125,14 @@ pub fn render_depth_maps(
     bias: DepthBias,
     maps: &mut Vec<Image<f32>>,
 ) -> Result<(), CpuError> {
-    render_maps_of(frame, (light, Casters::All), res, bias, maps)
+    render_caster_maps(frame, (light, Casters::All), res, bias, maps)
 }
 
 /// [`render_depth_maps`] of the casters `casters` names.
-fn render_maps_of(
+///
+/// # Errors
+/// As [`render_depth_maps`].
+pub fn render_caster_maps(
     frame: &FrameInputs,
     (light, casters): (&LightView, Casters),
     res: u32,
@@ -280,7 +284,7 @@ impl CutoutMaps {
             receiver_offset: map.receiver_offset(),
         };
         self.lookup = None;
-        render_maps_of(frame, (view, Casters::CutOut), res, bias, &mut self.maps)?;
+        render_caster_maps(frame, (view, Casters::CutOut), res, bias, &mut self.maps)?;
         self.lookup = Some((view.clone(), lookup));
         Ok(())
     }

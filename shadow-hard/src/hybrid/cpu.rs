@@ -32,7 +32,6 @@ use super::Hybrid;
 use super::edge_map::edge_cells;
 use glam::Vec3;
 use rayon::prelude::*;
-use shadow_core::Image;
 use shadow_core::frame::InstanceVolume;
 use shadow_core::geometry::volume::Caps;
 use shadow_core::geometry::volume::VolumeCounting;
@@ -40,13 +39,16 @@ use shadow_core::light::LightView;
 use shadow_core::lookup::{MapClass, PixelClass, classify, near_edge_pair};
 use shadow_core::stats::ms;
 use shadow_core::technique::LightPass;
+use shadow_core::technique::maps::Casters;
 use shadow_core::technique::{DebugView, ShadowTechnique, TechniqueError};
+use shadow_core::{FrameInputs, Image};
 use std::time::Instant;
 
 use super::shafts::CasterShafts;
+use crate::cascaded_shadow_map::cutout_view;
 use casters::count_volumes;
 use shadow_cpu::GBuffer;
-use shadow_cpu::passes::maps::{map_position, render_depth_maps};
+use shadow_cpu::passes::maps::{CutoutMaps, map_position, render_caster_maps};
 use shadow_cpu::passes::per_receiver;
 use shadow_cpu::passes::volumes::rasterize_volumes;
 use shadow_cpu::raster::{ComputationMask, DepthStencil};
@@ -62,6 +64,8 @@ pub struct State {
     volumes: Option<Vec<InstanceVolume>>,
     /// With `caster_masks=on`: where each volume piece's shadow can lie.
     shafts: CasterShafts,
+    /// The map of the casters their texture cuts out.
+    cutouts: CutoutMaps,
     last: Option<LastQuery>,
 }
 
@@ -135,13 +139,20 @@ impl ShadowTechnique<CpuBackend> for Hybrid {
         Self::NAME
     }
 
+    /// Cascades of the cut-out casters' map follow the camera.
+    fn build_is_reusable(&self, frame: &FrameInputs) -> bool {
+        !self.cutouts_follow_the_camera(frame)
+    }
+
     fn create_state(&self, _: &mut CpuContext) -> Result<State, CpuError> {
         Ok(State::default())
     }
 
     fn build(&self, _: &mut CpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), CpuError> {
-        let LightPass { frame, light, stats, .. } = pass;
-        render_depth_maps(frame, light, self.depth.resolution, self.depth.depth_bias(), &mut state.maps)?;
+        let LightPass { frame, light, aspect, stats, .. } = pass;
+        let (res, bias) = (self.depth.resolution, self.depth.depth_bias());
+        render_caster_maps(frame, (light, Casters::Solid), res, bias, &mut state.maps)?;
+        state.cutouts.render(frame, &cutout_view(&self.cutouts, frame, light, aspect), &self.cutouts)?;
         // The edge maps' segments come from the volumes' own silhouette pass (unused with
         // `edge_texels=off`, where they cost two transforms per silhouette edge).
         let (volumes, segments) = frame.shadow_volumes_and_segments(light, Caps::Both);
@@ -192,10 +203,15 @@ impl ShadowTechnique<CpuBackend> for Hybrid {
             rasterize_volumes(frame, g, volumes, VolumeCounting::ZFail, &mut ds, Some(&mask))
         };
         stats.timings.extra.insert("volumes".into(), ms(t.elapsed()));
-        per_receiver(g, out, |x, y, i| match map_class.get(x, y) {
-            MapClass::Lit => 1.0,
-            MapClass::Shadowed => 0.0,
-            MapClass::Silhouette => f32::from(u8::from(ds.stencil[i] == 0)),
+        // Lit where the hybrid's answer and the cut-out casters' map both say lit.
+        let cutouts = &state.cutouts;
+        per_receiver(g, out, |x, y, i| {
+            let lit = match map_class.get(x, y) {
+                MapClass::Lit => true,
+                MapClass::Shadowed => false,
+                MapClass::Silhouette => ds.stencil[i] == 0,
+            };
+            if lit { cutouts.visibility(g.position.data()[i], (x, y)) } else { 0.0 }
         });
         let counters = &mut stats.counters;
         counters.silhouette_pixels = Some(mask.count() as u64);
@@ -216,16 +232,13 @@ impl ShadowTechnique<CpuBackend> for Hybrid {
     }
 
     fn debug_views(&self, _: &mut CpuContext, state: &State) -> Result<Vec<DebugView>, CpuError> {
-        Ok(state
-            .last
-            .iter()
-            .map(|last| {
-                let c = last.classes();
-                DebugView {
-                    name: "classes".into(),
-                    image: Image::from_fn(c.width(), c.height(), |x, y| c.get(x, y).colour()),
-                }
-            })
-            .collect())
+        let classes = state.last.iter().map(|last| {
+            let c = last.classes();
+            DebugView {
+                name: "classes".into(),
+                image: Image::from_fn(c.width(), c.height(), |x, y| c.get(x, y).colour()),
+            }
+        });
+        Ok(classes.chain(state.cutouts.views("cutout-depth")).collect())
     }
 }

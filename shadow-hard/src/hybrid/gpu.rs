@@ -67,6 +67,7 @@ use tiles::TileMarks;
 
 use super::shafts::CasterShafts;
 use super::{GpuMask, Hybrid};
+use crate::cascaded_shadow_map::cutout_view;
 use shadow_core::Image;
 use shadow_core::frame::InstanceVolume;
 use shadow_core::geometry::volume::Caps;
@@ -76,7 +77,7 @@ use shadow_core::technique::{DebugView, ShadowTechnique, TechniqueError};
 
 use shadow_wgpu::frame::GpuVisibility;
 use shadow_wgpu::gbuffer::GpuGBuffer;
-use shadow_wgpu::passes::maps::{DepthMaps, MapBindings};
+use shadow_wgpu::passes::maps::{CutoutMaps, DepthMaps, MapBindings};
 use shadow_wgpu::passes::volumes::{
     VolumeDraw, count_all_pipeline, counting_state, upload_draws, upload_volumes, volume_pipeline,
 };
@@ -96,8 +97,10 @@ const CODES: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
 
 /// Pipelines, the maps and volumes of the last build, and what the debug view needs of the last query.
 pub struct State {
-    /// The classifying maps (`shadow-map`'s own build).
+    /// The classifying maps (`shadow-map`'s own build, of the casters the volumes are extruded from).
     map: DepthMaps,
+    /// The map of the casters their texture cuts out.
+    cutouts: CutoutMaps,
     bindings: MapBindings,
     module: wgpu::ShaderModule,
     mask: wgpu::RenderPipeline,
@@ -249,13 +252,13 @@ const SHADOWED: (wgpu::CompareFunction, u32, u32) = (wgpu::CompareFunction::Less
 const LIT: (wgpu::CompareFunction, u32, u32) = (wgpu::CompareFunction::Equal, 0xff, MASK);
 
 /// One pass of full-screen draws over the depth-stencil `depth` (each aspect loaded or cleared as its
-/// load op says), into `target` cleared to `clear` when given; each draw a pipeline and its stencil
-/// reference. With a `query` (an occlusion query set and its
+/// load op says), into `target` loaded or cleared as its load op says when given; each draw a pipeline
+/// and its stencil reference. With a `query` (an occlusion query set and its
 /// resolve buffer), counts the samples of the first draw that pass.
 fn full_screen_draws(
     cx: &WgpuContext,
     label: &str,
-    target: Option<(&wgpu::TextureView, wgpu::Color)>,
+    target: Option<(&wgpu::TextureView, wgpu::LoadOp<wgpu::Color>)>,
     depth: (&wgpu::TextureView, wgpu::LoadOp<f32>, wgpu::LoadOp<u32>),
     groups: [&wgpu::BindGroup; 2],
     draws: &[(&wgpu::RenderPipeline, u32)],
@@ -263,11 +266,11 @@ fn full_screen_draws(
 ) -> wgpu::CommandEncoder {
     let mut enc = cx.encoder(label);
     {
-        let colour = target.map(|(view, clear)| wgpu::RenderPassColorAttachment {
+        let colour = target.map(|(view, load)| wgpu::RenderPassColorAttachment {
             view,
             depth_slice: None,
             resolve_target: None,
-            ops: wgpu::Operations { load: wgpu::LoadOp::Clear(clear), store: wgpu::StoreOp::Store },
+            ops: wgpu::Operations { load, store: wgpu::StoreOp::Store },
         });
         let colour = [colour];
         let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -345,7 +348,7 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
                 .to_string();
             return Err(TechniqueError::BadSettings { technique: Self::NAME.into(), message }.into());
         }
-        let map = DepthMaps::new(cx, &self.depth);
+        let map = DepthMaps::new(cx, &self.depth).of(shadow_core::technique::maps::Casters::Solid);
         cx.scoped("creating the hybrid pipelines", |cx| {
             let caster_masks = self.caster_masks.is_on();
             let source = shaders::query(self.edge_texels, self.gpu.scissor_tile > 0, caster_masks);
@@ -393,6 +396,7 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
             });
             State {
                 map,
+                cutouts: CutoutMaps::default(),
                 bindings,
                 module,
                 mask,
@@ -415,8 +419,9 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
     }
 
     fn build(&self, cx: &mut WgpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), WgpuError> {
-        let LightPass { frame, light, slot, stats, .. } = pass;
+        let LightPass { frame, light, slot, aspect, stats } = pass;
         state.map.render(cx, frame, light, self.depth.resolution)?;
+        state.cutouts.render(cx, frame, &cutout_view(&self.cutouts, frame, light, aspect), &self.cutouts)?;
         cx.step("map");
         if state.kept.len() <= slot {
             state.kept.resize_with(slot + 1, Kept::default);
@@ -478,7 +483,14 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
             let state = &*state;
             let inputs = query::Inputs::of(self, state, g, target).ok_or_else(not_built)?;
             let map_group = inputs.map_group(cx, state, light, self.depth.receiver_offset());
-            let counts = cx.scoped("the hybrid passes", |cx| inputs.record(cx, state, (frame, &map_group), out))??;
+            // The cut-out casters' visibility first, which the answer shadows more of; without them, lit.
+            let answer_over = match state.cutouts.query(cx, g, out)? {
+                true => wgpu::LoadOp::Load,
+                false => wgpu::LoadOp::Clear(wgpu::Color::WHITE),
+            };
+            let counts = cx.scoped("the hybrid passes", |cx| {
+                inputs.record(cx, state, (frame, &map_group), (out, answer_over))
+            })??;
             // The counters are not the technique's work: after it is done, a sub-phase of their own.
             if cx.instrumented() {
                 cx.end_of_work();
@@ -540,7 +552,7 @@ fn classes(cx: &WgpuContext, state: &State, last: &LastQuery) -> Result<Image<u3
     let pass = full_screen_draws(
         cx,
         "hybrid classes",
-        Some((&view, wgpu::Color::TRANSPARENT)),
+        Some((&view, wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT))),
         (&depth, wgpu::LoadOp::Load, wgpu::LoadOp::Load),
         [&last.frame_group, &last.map_group],
         &draws,

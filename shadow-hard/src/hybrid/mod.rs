@@ -11,6 +11,12 @@
 //! Ours, on top of the thesis: [`shafts`] (each caster's volume counted only at the silhouette pixels its
 //! shadow's bounds hold, `caster_masks`) and [`edge_map`] (receivers near silhouette edges thinner than a
 //! texel masked in too, `edge_texels`).
+//!
+//! Casters their texture cuts out have no silhouette for a volume to extrude, so the classifying map, the
+//! mask and the volumes are of the other casters alone (`Casters::Solid`), and the cut-out ones cast
+//! through a map of their own, alpha-tested (`passes::maps::CutoutMaps`, the settings `cutout_*`, as the
+//! shadow volumes have it): a receiver is lit only where the hybrid's answer and that map both say lit.
+//! A frame without such casters renders no such map and runs as before.
 
 pub mod cpu;
 pub mod edge_map;
@@ -18,7 +24,8 @@ pub mod gpu;
 pub mod shafts;
 
 use crate::Entry;
-use shadow_core::technique::maps::{DepthMap, resolution_key};
+use shadow_core::FrameInputs;
+use shadow_core::technique::maps::{CutoutMap, DepthMap, resolution_key};
 use shadow_core::technique::settings::{OnOff, SettingKey};
 
 shadow_core::technique_settings! {
@@ -63,6 +70,8 @@ shadow_core::technique_settings! {
             OnOff::NAMES,
             "on: also count the volumes' fill without the mask (unmasked_volume_fragments), in an extra pass",
         ),
+        /// The map of the casters their texture cuts out.
+        pub cutouts: CutoutMap = CutoutMap::KEYS,
         /// What the CPU backend alone reads.
         pub cpu: CpuOptions = CpuOptions::KEYS,
         /// What the GPU backend alone reads.
@@ -164,6 +173,13 @@ shadow_core::named_enum! {
 impl Hybrid {
     /// The technique's name.
     pub const NAME: &'static str = "hybrid";
+
+    /// Whether the build reads the camera for the cut-out casters: `frame` has some, and their map is in
+    /// cascades over the view.
+    #[must_use]
+    pub fn cutouts_follow_the_camera(&self, frame: &FrameInputs) -> bool {
+        self.cutouts.cascades > 0 && frame.has_cutout_casters()
+    }
 }
 
 /// The registry entry.
@@ -175,5 +191,5 @@ pub fn entry() -> Entry {
         "Chan 2004 (thesis, chapter 3)",
     )
     .wgsl(gpu::shaders::all)
-    .without_cutouts()
+    .cutouts_by_map()
 }

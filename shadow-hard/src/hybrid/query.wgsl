@@ -66,14 +66,15 @@ fn vs_hybrid_far(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> 
     return vec4<f32>(f32(i32(i & 1u) * 4 - 1), f32(i32(i >> 1u) * 4 - 1), 1.0, 1.0);
 }
 
-// The map's answer, drawn under the stencil test "outside the mask"; non-receivers keep the cleared 1.
+// The map's answer, drawn under the stencil test "outside the mask": the shadowed receivers get 0, the
+// lit ones and non-receivers keep what the target holds (1, or the cut-out casters' visibility).
 @fragment
 fn fs_hybrid_map(in: FullScreen) -> @location(0) vec4<f32> {
     let c = remembered_class(vec2<i32>(in.pos.xy));
-    if (c == NOT_RECEIVER) {
+    if (c == NOT_RECEIVER || c == MAP_LIT) {
         discard;
     }
-    return vec4<f32>(select(0.0, 1.0, c == MAP_LIT));
+    return vec4<f32>(0.0);
 }
 
 // Shadowed: drawn under the stencil test "inside the mask and a count that is not 0".

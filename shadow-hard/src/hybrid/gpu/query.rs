@@ -134,7 +134,8 @@ impl<'a> Inputs<'a> {
 
     /// Records and submits the passes: the scratch copied and the marks and lists cleared, the mask, the
     /// caster masks' compute passes, the volumes under the mask (in scissor rectangles around the marked
-    /// tiles with `scissor_tile`), and the answer into `out`.
+    /// tiles with `scissor_tile`), and the answer into `out`, loaded as `load` says (cleared to lit, or
+    /// holding the cut-out casters' visibility, which the answer's shadowed pixels write 0 over).
     ///
     /// # Errors
     /// A GPU failure (reading the tile marks back).
@@ -143,7 +144,7 @@ impl<'a> Inputs<'a> {
         cx: &WgpuContext,
         state: &State,
         (frame, map_group): (&FrameInputs, &wgpu::BindGroup),
-        out: &GpuVisibility,
+        (out, load): (&GpuVisibility, wgpu::LoadOp<wgpu::Color>),
     ) -> Result<Counts, WgpuError> {
         let g = self.g;
         let groups = [&g.frame_group, map_group];
@@ -193,7 +194,7 @@ impl<'a> Inputs<'a> {
         if let Some((_, answer, ..)) = self.casters {
             answers.push((answer, LIT.2));
         }
-        let target = Some((&out.view, wgpu::Color::WHITE));
+        let target = Some((&out.view, load));
         let stencil = (&self.depth, wgpu::LoadOp::Load, wgpu::LoadOp::Load);
         cx.submit(full_screen_draws(cx, "hybrid answer", target, stencil, groups, &answers, None));
         cx.step("answer");
