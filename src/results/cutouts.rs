@@ -161,8 +161,10 @@ pub fn markdown(s: &mut String, r: &CutoutReport) {
         "{}x{}, on {}: the scenes whose textures cut their casters out. A clear texel blocks no light: the \
          references test each ray's hit against its texel (level 0, the magnification filter), the light \
          passes of both backends discard the fragments of clear texels, each read over the footprint of one \
-         map texel by the same rule. The techniques that extrude silhouettes take no cut-out casters and are \
-         left out.\n",
+         map texel by the same rule. The techniques that extrude silhouettes (the shadow volumes, `hybrid`, \
+         `penumbra-wedges`) give cut-out casters no volume or wedge and take their shadows from a depth map \
+         of them alone, alpha-tested the same way (`cutout_res`, `cutout_filter`, `cutout_cascades`): a \
+         receiver is lit only where both say lit (the soft visibility times the map's for the wedges).\n",
         r.size.0,
         r.size.1,
         names.join(" and ")

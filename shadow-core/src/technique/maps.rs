@@ -152,50 +152,78 @@ pub trait MapLayout {
     fn sampling(&self, frame: &FrameInputs, light: &LightView, aspect: f32) -> MapSampling;
 }
 
-crate::setting_group! {
-    /// The map the techniques built on silhouettes (shadow volumes, the hybrid, penumbra wedges) take the
-    /// shadows of casters their texture cuts out from ([`crate::frame::Coverage::Cutout`]): a card's
-    /// outline is not its shadow's edge, so those casters get no volume or wedge; their depths, cut out as
-    /// every light pass cuts them ([`Casters::CutOut`]), are looked up at each receiver, and a receiver is
-    /// lit only where both the technique and this map say so. A frame without such casters renders no map.
-    /// The bias is `shadow-map`'s default one.
-    ///
-    /// The defaults, measured with `shadow-volume-zfail` at 512x512: the error falls by half with each
-    /// doubling of the side (`foliage` under its spot light: 0.413%, 0.215%, 0.108% mismatch at 2048,
-    /// 4096, 8192), and under the low sun of `fence` one map over the light's view leaves 6.59% (2048) or
-    /// 5.98% (4096) where four cascades of 2048 leave 0.963% (of 4096, 0.482%). Four cascades of 2048
-    /// take the memory of `cascaded-shadow-map`'s defaults and match the best map on each scene
-    /// (`shadow-map`'s 0.414% on foliage, `cascaded-shadow-map`'s 0.963% on fence).
-    pub struct CutoutMap {
-        /// Map side in texels.
-        pub resolution: u32 = SettingKey::int(
-            "cutout_res",
-            "2048",
-            16,
-            MAX_MAP_RESOLUTION,
-            "side in texels of the depth map of the casters their texture cuts out (16 to 16384)",
-        ),
-        /// Lookup filter.
-        pub filter: Filter = SettingKey::choice(
-            "cutout_filter",
-            "none",
-            Filter::NAMES,
-            "lookup filter of the cut-out casters' map: none, bilinear, pcf3x3, pcf4x4-jitter or poisson16",
-        ),
-        /// Under a directional light, how many cascades over the camera's view the map is split into
-        /// (each `resolution` wide, fitted as `cascaded-shadow-map`'s); 0, one map over the light's view.
-        /// Other lights always take one map per projection.
-        pub cascades: u32 = SettingKey::int(
-            "cutout_cascades",
-            "4",
-            0,
-            4,
-            "directional lights: the cut-out casters' map in this many cascades over the view (1 to 4), or 0: one map over the light's view",
-        ),
+/// The map the techniques built on silhouettes (shadow volumes, the hybrid, penumbra wedges) take the
+/// shadows of casters their texture cuts out from ([`crate::frame::Coverage::Cutout`]): a card's outline
+/// is not its shadow's edge, so those casters get no volume or wedge; their depths, cut out as every
+/// light pass cuts them ([`Casters::CutOut`]), are looked up at each receiver, and a receiver is lit only
+/// where both the technique and this map say so (a soft technique's visibility is multiplied by the
+/// map's). A frame without such casters renders no map. The bias is `shadow-map`'s default one. Read
+/// from [`CutoutMap::KEYS`] by the hard techniques, from [`CutoutMap::SOFT_KEYS`] by the soft ones.
+///
+/// The defaults, measured with `shadow-volume-zfail` at 512x512: the error falls by half with each
+/// doubling of the side (`foliage` under its spot light: 0.413%, 0.215%, 0.108% mismatch at 2048, 4096,
+/// 8192), and under the low sun of `fence` one map over the light's view leaves 6.59% (2048) or 5.98%
+/// (4096) where four cascades of 2048 leave 0.963% (of 4096, 0.482%). Four cascades of 2048 take the
+/// memory of `cascaded-shadow-map`'s defaults and match the best map on each scene (`shadow-map`'s
+/// 0.414% on foliage, `cascaded-shadow-map`'s 0.963% on fence). A soft technique filters the map: with
+/// `penumbra-wedges` on foliage the RMSE against the area light is 0.0924 unfiltered, 0.0704 through
+/// `pcf3x3`, 0.0702 through `poisson16` (on tree, without cut-out casters, 0.0696).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CutoutMap {
+    /// Map side in texels.
+    pub resolution: u32,
+    /// Lookup filter.
+    pub filter: Filter,
+    /// Under a directional light, how many cascades over the camera's view the map is split into (each
+    /// `resolution` wide, fitted as `cascaded-shadow-map`'s); 0, one map over the light's view. Other
+    /// lights always take one map per projection.
+    pub cascades: u32,
+}
+
+/// `cutout_res`: the side of the cut-out casters' map.
+const CUTOUT_RES: SettingKey = SettingKey::int(
+    "cutout_res",
+    "2048",
+    16,
+    MAX_MAP_RESOLUTION,
+    "side in texels of the depth map of the casters their texture cuts out (16 to 16384)",
+);
+
+/// `cutout_filter`: its lookup filter.
+const CUTOUT_FILTER: SettingKey = SettingKey::choice(
+    "cutout_filter",
+    "none",
+    Filter::NAMES,
+    "lookup filter of the cut-out casters' map: none, bilinear, pcf3x3, pcf4x4-jitter or poisson16",
+);
+
+/// `cutout_cascades`: its cascades under a directional light.
+const CUTOUT_CASCADES: SettingKey = SettingKey::int(
+    "cutout_cascades",
+    "4",
+    0,
+    4,
+    "directional lights: the cut-out casters' map in this many cascades over the view (1 to 4), or 0: one map over the light's view",
+);
+
+/// A cut-out casters' map reads its three keys together.
+impl SettingField for CutoutMap {
+    fn read(v: &Values<'_>, keys: &[SettingKey]) -> Result<Self, SettingsError> {
+        Ok(Self { resolution: v.read(&keys[0])?, filter: v.read(&keys[1])?, cascades: v.read(&keys[2])? })
+    }
+
+    fn write(&self, out: &mut Vec<String>) {
+        out.extend([self.resolution.to_string(), self.filter.to_string(), self.cascades.to_string()]);
     }
 }
 
 impl CutoutMap {
+    /// The keys of a hard technique's map, unfiltered by default.
+    pub const KEYS: [SettingKey; 3] = [CUTOUT_RES, CUTOUT_FILTER, CUTOUT_CASCADES];
+
+    /// The keys of a soft technique's map, filtered by `pcf3x3` by default.
+    pub const SOFT_KEYS: [SettingKey; 3] = [CUTOUT_RES, CUTOUT_FILTER.with_default("pcf3x3"), CUTOUT_CASCADES];
+
     /// The map: its side, with `shadow-map`'s default bias.
     #[must_use]
     pub fn map(&self) -> DepthMap {

@@ -87,7 +87,7 @@ impl TechniqueSettings for ShadowVolume {
     }
     fn from_values(v: &Values<'_>) -> Result<Self, SettingsError> {
         Ok(Self {
-            cutouts: CutoutMap::read(v, CutoutMap::KEYS)?,
+            cutouts: CutoutMap::read(v, &CutoutMap::KEYS)?,
             gpu: GpuOptions::read(v, GpuOptions::KEYS)?,
             ..Self::ZFAIL
         })

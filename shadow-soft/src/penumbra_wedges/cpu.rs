@@ -5,7 +5,8 @@
 use shadow_core::Image;
 use shadow_core::glam::{Mat4, Vec4};
 use shadow_core::technique::LightPass;
-use shadow_core::technique::{ShadowTechnique, TechniqueError};
+use shadow_core::technique::{DebugView, ShadowTechnique, TechniqueError};
+use shadow_cpu::passes::maps::CutoutMaps;
 use shadow_cpu::passes::per_receiver;
 use shadow_cpu::raster::{CompareFn, CullMode, DepthBias, DepthState, DepthStencil, Fragment, RasterState, Soup, draw};
 use shadow_cpu::{CpuBackend, CpuContext, CpuError, GBuffer};
@@ -14,10 +15,11 @@ use super::PenumbraWedges;
 use super::coverage::{SphereLight, count_step, horizon_share, wedge_term};
 use super::geometry::{LAYERS, QUAD_DEPTH_BIAS, WedgeEdge, WedgeGeometry};
 
-/// The geometry of the last build.
+/// The geometry and the cut-out casters' map of the last build.
 #[derive(Default)]
 pub struct State {
     built: Option<(WedgeGeometry, SphereLight)>,
+    cutouts: CutoutMaps,
 }
 
 /// The back faces of the wedges, behind the receiver: the receiver may be inside.
@@ -77,7 +79,7 @@ impl ShadowTechnique<CpuBackend> for PenumbraWedges {
     fn build(&self, _: &mut CpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), CpuError> {
         let LightPass { frame, light, stats, .. } = pass;
         state.built = Some((Self::construct(frame, light, stats)?, Self::sphere(light)?));
-        Ok(())
+        state.cutouts.render(frame, light, &self.cutouts)
     }
 
     fn query(
@@ -115,13 +117,20 @@ impl ShadowTechnique<CpuBackend> for PenumbraWedges {
         } else {
             0
         };
-        per_receiver(g, out, |_, _, i| {
-            let horizon = horizon_share(g.position.data()[i], g.geometric_normal.data()[i], *light);
+        // The soft visibility, times the cut-out casters' map's.
+        let cutouts = &state.cutouts;
+        per_receiver(g, out, |x, y, i| {
+            let p = g.position.data()[i];
+            let horizon = horizon_share(p, g.geometric_normal.data()[i], *light);
             let [closed, facing, turned] = std::array::from_fn(|k| eye_counts[k] + occluded.data()[i][k]);
-            (1.0 - closed - facing.max(turned) - horizon).clamp(0.0, 1.0)
+            (1.0 - closed - facing.max(turned) - horizon).clamp(0.0, 1.0) * cutouts.visibility(p, (x, y))
         });
         stats.counters.volume_fragments = Some(quads);
         stats.counters.extra.insert("wedge_fragments".into(), wedges as f64);
         Ok(())
+    }
+
+    fn debug_views(&self, _: &mut CpuContext, state: &State) -> Result<Vec<DebugView>, CpuError> {
+        Ok(state.cutouts.views("cutout-depth"))
     }
 }

@@ -1,6 +1,7 @@
 //! `penumbra-wedges` on the wgpu backend (twin: [`super::cpu`]), through its public API: the shared
 //! quads and wedges, uploaded by the query, which draws both over the G-buffer in one pass into a buffer
-//! of occluded shares (wedges.wgsl, with coverage.wgsl's terms), then resolves it full-screen.
+//! of occluded shares (wedges.wgsl, with coverage.wgsl's terms), then resolves it full-screen; with cut-out
+//! casters, times the visibility their map's lookup wrote into a target of its own first.
 
 use bytemuck::{Pod, Zeroable};
 use shadow_core::glam::Vec4;
@@ -13,6 +14,7 @@ use super::PenumbraWedges;
 use super::coverage::SphereLight;
 use super::geometry::{LAYERS, QUAD_DEPTH_BIAS, WedgeEdge, WedgeGeometry};
 use crate::min_target;
+use shadow_wgpu::passes::maps::CutoutMaps;
 
 /// GPU twin of `WedgeParams` in wedges.wgsl.
 #[repr(C)]
@@ -60,12 +62,34 @@ const VERTEX_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayou
 /// Pipelines, and the last build's uploads.
 pub struct State {
     layout: wgpu::BindGroupLayout,
+    module: wgpu::ShaderModule,
     quads: wgpu::RenderPipeline,
     wedges: wgpu::RenderPipeline,
     resolve: wgpu::RenderPipeline,
     built: Option<Built>,
     /// The per-pixel sums, one view's worth per layer, kept while the view's size does not change.
     occluded: Option<wgpu::Buffer>,
+    /// The cut-out casters' map, and, made by the first frame with such casters, the resolve that
+    /// multiplies by its visibility and the target that visibility is written into (at the view's size).
+    cutouts: CutoutMaps,
+    cutout_resolve: Option<(wgpu::BindGroupLayout, wgpu::RenderPipeline)>,
+    cutout_target: Option<wgpu::Texture>,
+}
+
+/// The bindings of the resolve's group 1: the passes', and with `cutouts` the cut-out visibility (5).
+fn group_entries(cutouts: bool) -> Vec<wgpu::BindGroupLayoutEntry> {
+    let read_write = wgpu::BufferBindingType::Storage { read_only: false };
+    let mut entries = vec![
+        attribute_entry(0),
+        buffer_entry(1, read_write, wgpu::ShaderStages::FRAGMENT),
+        buffer_entry(2, wgpu::BufferBindingType::Uniform, wgpu::ShaderStages::FRAGMENT),
+        attribute_entry(3),
+        buffer_entry(4, wgpu::BufferBindingType::Storage { read_only: true }, wgpu::ShaderStages::FRAGMENT),
+    ];
+    if cutouts {
+        entries.push(attribute_entry(5));
+    }
+    entries
 }
 
 /// One build's geometry, as vertices and edges: uploaded by each query into the frame's transient
@@ -136,17 +160,7 @@ impl ShadowTechnique<WgpuBackend> for PenumbraWedges {
         cx.scoped("creating the penumbra-wedge pipelines", |cx| {
             let early = cx.device.features().contains(wgpu::Features::SHADER_EARLY_DEPTH_TEST);
             let module = cx.pipelines.module("penumbra wedges", shader(early));
-            let read_write = wgpu::BufferBindingType::Storage { read_only: false };
-            let layout = cx.pipelines.group_layout(
-                "penumbra wedges",
-                &[
-                    attribute_entry(0),
-                    buffer_entry(1, read_write, wgpu::ShaderStages::FRAGMENT),
-                    buffer_entry(2, wgpu::BufferBindingType::Uniform, wgpu::ShaderStages::FRAGMENT),
-                    attribute_entry(3),
-                    buffer_entry(4, wgpu::BufferBindingType::Storage { read_only: true }, wgpu::ShaderStages::FRAGMENT),
-                ],
-            );
+            let layout = cx.pipelines.group_layout("penumbra wedges", &group_entries(false));
             // Side quads: the crossings in front of the receiver, and those within rounding of it (the
             // fragment decides); wedges: back faces behind the receiver.
             let bias = QUAD_DEPTH_BIAS;
@@ -167,12 +181,24 @@ impl ShadowTechnique<WgpuBackend> for PenumbraWedges {
                 Some(VISIBILITY),
                 None,
             );
-            State { layout, quads, wedges, resolve, built: None, occluded: None }
+            State {
+                layout,
+                module,
+                quads,
+                wedges,
+                resolve,
+                built: None,
+                occluded: None,
+                cutouts: CutoutMaps::default(),
+                cutout_resolve: None,
+                cutout_target: None,
+            }
         })
     }
 
-    fn build(&self, _: &mut WgpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), WgpuError> {
+    fn build(&self, cx: &mut WgpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), WgpuError> {
         let LightPass { frame, light, stats, .. } = pass;
+        state.cutouts.render(cx, frame, light, &self.cutouts)?;
         let geometry = Self::construct(frame, light, stats)?;
         let light = Self::sphere(light)?;
         let edges = geometry.edges.iter().map(GpuEdge::from).collect();
@@ -191,6 +217,7 @@ impl ShadowTechnique<WgpuBackend> for PenumbraWedges {
         out: &mut GpuVisibility,
     ) -> Result<(), WgpuError> {
         let LightPass { frame, .. } = pass;
+        let cutouts = cutout_visibility(cx, state, g)?;
         let built = state.built.as_ref().ok_or_else(|| TechniqueError::NotBuilt(Self::NAME.into()))?;
         let eye = g.camera.eye;
         let [closed, facing, turned] = built.geometry.eye_counts(frame, eye);
@@ -214,20 +241,21 @@ impl ShadowTechnique<WgpuBackend> for PenumbraWedges {
         cx.scoped("the penumbra wedges", |cx| {
             let uniform = cx.transient(bytemuck::bytes_of(&params));
             let edges = cx.transient(bytemuck::cast_slice(&built.edges));
-            let group = cx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("penumbra wedges"),
-                layout: &state.layout,
-                entries: &[
-                    wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&g.position) },
-                    wgpu::BindGroupEntry { binding: 1, resource: occluded.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 2, resource: uniform.binding() },
-                    wgpu::BindGroupEntry {
-                        binding: 3,
-                        resource: wgpu::BindingResource::TextureView(&g.geometric_normal),
-                    },
-                    wgpu::BindGroupEntry { binding: 4, resource: edges.binding() },
-                ],
-            });
+            let mut entries = vec![
+                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&g.position) },
+                wgpu::BindGroupEntry { binding: 1, resource: occluded.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 2, resource: uniform.binding() },
+                wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&g.geometric_normal) },
+                wgpu::BindGroupEntry { binding: 4, resource: edges.binding() },
+            ];
+            let bind = |layout: &wgpu::BindGroupLayout, entries: &[wgpu::BindGroupEntry<'_>]| {
+                cx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("penumbra wedges"),
+                    layout,
+                    entries,
+                })
+            };
+            let group = bind(&state.layout, &entries);
             let depth = g.depth_view();
             let mut enc = cx.encoder("penumbra wedges");
             enc.clear_buffer(occluded, 0, None);
@@ -256,9 +284,58 @@ impl ShadowTechnique<WgpuBackend> for PenumbraWedges {
                 }
             }
             cx.submit(enc);
-            passes::full_screen(cx, "wedge resolve", &out.view, &state.resolve, &[&g.frame_group, &group], None);
+            match (&cutouts, &state.cutout_resolve) {
+                (Some(visibility), Some((layout, resolve))) => {
+                    let resource = wgpu::BindingResource::TextureView(visibility);
+                    entries.push(wgpu::BindGroupEntry { binding: 5, resource });
+                    let group = bind(layout, &entries);
+                    passes::full_screen(cx, "wedge resolve", &out.view, resolve, &[&g.frame_group, &group], None);
+                }
+                _ => {
+                    passes::full_screen(cx, "wedge resolve", &out.view, &state.resolve, &[&g.frame_group, &group], None)
+                }
+            }
         })
     }
+}
+
+/// The cut-out casters' visibility at every pixel of `g`, written by their map's lookup into the state's
+/// target (made for the view's size) with the resolve that reads it made on first use; `None` when the
+/// last build had no cut-out casters.
+fn cutout_visibility(
+    cx: &WgpuContext,
+    state: &mut State,
+    g: &GpuGBuffer,
+) -> Result<Option<wgpu::TextureView>, WgpuError> {
+    if !state.cutouts.is_rendered() {
+        return Ok(None);
+    }
+    let target = match &state.cutout_target {
+        Some(t) if (t.width(), t.height()) == (g.width, g.height) => t.clone(),
+        _ => {
+            let t = shadow_wgpu::frame::layered(cx, "cut-out visibility", g.width, g.height, 1, VISIBILITY);
+            state.cutout_target.insert(t).clone()
+        }
+    };
+    let view = target.create_view(&Default::default());
+    let visibility = GpuVisibility { view: view.clone(), width: g.width, height: g.height };
+    state.cutouts.query(cx, g, &visibility)?;
+    if state.cutout_resolve.is_none() {
+        let layout = cx.pipelines.group_layout("penumbra wedges, cut out", &group_entries(true));
+        let groups = [&cx.shared.frame_layout, &layout];
+        let module = &state.module;
+        let resolve = full_screen_pipeline(
+            &cx.pipelines,
+            "wedge resolve, cut out",
+            module,
+            "fs_resolve_cutouts",
+            &groups,
+            Some(VISIBILITY),
+            None,
+        );
+        state.cutout_resolve = Some((layout, resolve));
+    }
+    Ok(Some(view))
 }
 
 /// The technique's shaders as compiled, by name (its registry entry's WGSL): with the depth tests

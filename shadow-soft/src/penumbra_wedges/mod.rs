@@ -40,6 +40,11 @@
 //!
 //! Spot and point lights, with the light's `radius`; a directional light has no position to find wedges
 //! from and is refused by name.
+//!
+//! Casters their texture cuts out have no silhouette that bounds their shadow, so they get no wedge and
+//! no side quad: their shadows come from a depth map of them alone, alpha-tested as every light pass
+//! (`passes::maps::CutoutMaps`, the settings `cutout_*`), and the soft visibility is multiplied by that
+//! map's. A frame without such casters renders no map and runs as before.
 
 pub mod coverage;
 pub mod cpu;
@@ -48,6 +53,7 @@ pub mod gpu;
 
 use shadow_core::FrameInputs;
 use shadow_core::light::LightView;
+use shadow_core::technique::maps::CutoutMap;
 use shadow_core::technique::settings::{OnOff, SettingKey};
 use shadow_core::technique::{FrameStats, LightKinds, TechniqueError};
 
@@ -65,6 +71,9 @@ shadow_core::technique_settings! {
             OnOff::NAMES,
             "on: soft shadows; off: the count alone, the hard shadow of the light's centre",
         ),
+        /// The map of the casters their texture cuts out, filtered by default (its cascades are for
+        /// directional lights, which wedges do not take).
+        pub cutouts: CutoutMap = CutoutMap::SOFT_KEYS,
     }
     lights = LightKinds::POSITIONED;
 }
@@ -114,5 +123,5 @@ pub fn entry() -> Entry {
     )
     .wgsl(gpu::shaders)
     .soft()
-    .without_cutouts()
+    .cutouts_by_map()
 }

@@ -21,6 +21,8 @@ const SCALE: f32 = 1048576.0;
 @group(1) @binding(2) var<uniform> params: WedgeParams;
 @group(1) @binding(3) var g_geometric_normal: texture_2d<f32>;
 @group(1) @binding(4) var<storage, read> edges: array<Edge>;
+// With casters cut out by their texture: the visibility their map leaves each pixel (fs_resolve_cutouts).
+@group(1) @binding(5) var cutout_visibility: texture_2d<f32>;
 
 struct Edge {
     // a, weight
@@ -80,14 +82,30 @@ fn wedge_fragment(in: EdgeVertex) {
     }
 }
 
+// The soft visibility of the receiver `g` at `pos`.
+fn soft_visibility(pos: vec4<f32>, g: vec4<f32>) -> f32 {
+    let n = textureLoad(g_geometric_normal, vec2<i32>(pos.xy), 0).xyz;
+    let horizon = horizon_share(g.xyz, n, params.light.xyz, params.light.w);
+    let share = sum(pos, 0u) + max(sum(pos, 1u), sum(pos, 2u)) + horizon;
+    return clamp(1.0 - share, 0.0, 1.0);
+}
+
 @fragment
 fn fs_resolve(in: FullScreen) -> @location(0) vec4<f32> {
     let g = receiver(in.pos);
     if (g.w == 0.0) {
         discard;
     }
-    let n = textureLoad(g_geometric_normal, vec2<i32>(in.pos.xy), 0).xyz;
-    let horizon = horizon_share(g.xyz, n, params.light.xyz, params.light.w);
-    let share = sum(in.pos, 0u) + max(sum(in.pos, 1u), sum(in.pos, 2u)) + horizon;
-    return vec4<f32>(clamp(1.0 - share, 0.0, 1.0), 0.0, 0.0, 0.0);
+    return vec4<f32>(soft_visibility(in.pos, g), 0.0, 0.0, 0.0);
+}
+
+// The soft visibility times the cut-out casters' map's.
+@fragment
+fn fs_resolve_cutouts(in: FullScreen) -> @location(0) vec4<f32> {
+    let g = receiver(in.pos);
+    if (g.w == 0.0) {
+        discard;
+    }
+    let cutouts = textureLoad(cutout_visibility, vec2<i32>(in.pos.xy), 0).x;
+    return vec4<f32>(soft_visibility(in.pos, g) * cutouts, 0.0, 0.0, 0.0);
 }

@@ -524,6 +524,12 @@ impl CutoutMaps {
         Ok(())
     }
 
+    /// Whether the last render drew maps (its frame had cut-out casters).
+    #[must_use]
+    pub fn is_rendered(&self) -> bool {
+        self.rendered.is_some()
+    }
+
     /// Writes into `out` the share of the light the cut-out casters of the last render leave each receiver
     /// of `g`, and says so; says false and writes nothing when that frame had none.
     ///
