@@ -93,7 +93,7 @@ impl CasterHandling {
         match self {
             Self::Exact => "exactly, by its own method",
             Self::CutoutMap => {
-                "through an alpha-tested depth map of them alone (cutout_res, cutout_filter), lit only where both say lit"
+                "through an alpha-tested depth map of them alone (the cutout_* settings), its visibility times the technique's"
             }
             Self::AsOpaque => "as opaque (the whole surface blocks light)",
             Self::LeftOut => "not at all (compare leaves it out of scenes with them)",
