@@ -6,7 +6,7 @@
 use super::settings::{
     BiasMode, DepthBias, Filter, MAX_MAP_RESOLUTION, SettingField, SettingKey, SettingsError, Values,
 };
-use crate::frame::FrameInputs;
+use crate::frame::{Coverage, FrameInputs, Instance};
 use crate::light::LightView;
 
 /// `bias`: how the map's depth is offset.
@@ -237,6 +237,14 @@ impl CutoutMap {
         }
     }
 
+    /// Whether a build of `frame` reads the camera for this map: the frame has cut-out casters and the
+    /// map is in cascades over the view (under a directional light; other lights ignore the cascades, so
+    /// for them this only says a build may not be kept when it could be).
+    #[must_use]
+    pub fn follows_the_camera(&self, frame: &FrameInputs) -> bool {
+        self.cascades > 0 && frame.has_cutout_casters()
+    }
+
     /// The kernel radius of the jittered and Poisson filters: `shadow-map`'s default.
     #[must_use]
     pub fn filter_radius(&self) -> f32 {
@@ -244,7 +252,7 @@ impl CutoutMap {
     }
 }
 
-/// Which shadow casters a light pass draws.
+/// Which shadow casters a light pass draws ([`Casters::takes`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Casters {
     /// Every one, those their texture cuts out through their alpha test.
@@ -257,9 +265,37 @@ pub enum Casters {
     CutOut,
 }
 
+impl Casters {
+    /// Whether a light pass of these casters draws `instance` (a caster of the kind named; a masked one
+    /// with nothing there is drawn by none).
+    #[must_use]
+    pub fn takes(self, instance: &Instance) -> bool {
+        let coverage = instance.coverage();
+        instance.casts_shadow
+            && match self {
+                Self::All => coverage != Coverage::Absent,
+                Self::Solid => coverage == Coverage::Solid,
+                Self::CutOut => coverage == Coverage::Cutout,
+            }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// On `cutout` the card (cut out) is drawn by the passes of every caster and of the cut-out ones, the
+    /// ground by those of every caster and of the solid ones.
+    #[test]
+    fn each_light_pass_takes_its_casters() {
+        let scene = crate::scenes::build("cutout", &crate::scenes::SceneParams::default()).expect("cutout");
+        let frame = FrameInputs::from_first_camera(&scene).expect("frame");
+        let takers = |i: &Instance| [Casters::All, Casters::Solid, Casters::CutOut].map(|c| c.takes(i));
+        let card = frame.instances.iter().find(|i| i.coverage() == Coverage::Cutout).expect("the card");
+        assert_eq!(takers(card), [true, false, true]);
+        let solid = frame.instances.iter().find(|i| i.casts_shadow && i.coverage() == Coverage::Solid);
+        assert_eq!(takers(solid.expect("a solid caster")), [true, true, false]);
+    }
 
     /// The cut-out casters' map is biased as `shadow-map`'s default one (the keys' defaults parse).
     #[test]

@@ -4,7 +4,7 @@
 //! by their texture discard the fragments of clear texels, each read over the footprint of one map texel.
 //! [`CutoutMaps`] holds those casters alone, for the techniques built on silhouettes.
 
-use shadow_core::frame::{Coverage, FrameError, Instance};
+use shadow_core::frame::FrameError;
 use shadow_core::glam::{Vec2, Vec3, Vec4};
 use shadow_core::light::{LightProjection, LightView};
 use shadow_core::lookup::shadow_lookup;
@@ -82,11 +82,7 @@ struct LightCasters<'a> {
 
 impl<'a> LightCasters<'a> {
     fn new(frame: &'a FrameInputs, proj: &LightProjection, casters: Casters) -> Self {
-        let drawn = match casters {
-            Casters::All => Drawn::sort(frame, |i| i.casts_shadow),
-            Casters::Solid => Drawn::sort(frame, Instance::casts_solid_shadow),
-            Casters::CutOut => Drawn::sort(frame, |i| i.casts_shadow && i.coverage() == Coverage::Cutout),
-        };
+        let drawn = Drawn::sort(frame, |i| casters.takes(i));
         let clip = (drawn.solid.iter().chain(&drawn.cutout))
             .map(|&k| {
                 let inst = &frame.instances[k];

@@ -141,7 +141,7 @@ impl ShadowTechnique<CpuBackend> for Hybrid {
 
     /// Cascades of the cut-out casters' map follow the camera.
     fn build_is_reusable(&self, frame: &FrameInputs) -> bool {
-        !self.cutouts_follow_the_camera(frame)
+        !self.cutouts.follows_the_camera(frame)
     }
 
     fn create_state(&self, _: &mut CpuContext) -> Result<State, CpuError> {

@@ -24,7 +24,6 @@ pub mod gpu;
 pub mod shafts;
 
 use crate::Entry;
-use shadow_core::FrameInputs;
 use shadow_core::technique::maps::{CutoutMap, DepthMap, resolution_key};
 use shadow_core::technique::settings::{OnOff, SettingKey};
 
@@ -173,13 +172,6 @@ shadow_core::named_enum! {
 impl Hybrid {
     /// The technique's name.
     pub const NAME: &'static str = "hybrid";
-
-    /// Whether the build reads the camera for the cut-out casters: `frame` has some, and their map is in
-    /// cascades over the view.
-    #[must_use]
-    pub fn cutouts_follow_the_camera(&self, frame: &FrameInputs) -> bool {
-        self.cutouts.cascades > 0 && frame.has_cutout_casters()
-    }
 }
 
 /// The registry entry.

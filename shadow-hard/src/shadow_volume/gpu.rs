@@ -57,7 +57,7 @@ impl ShadowTechnique<WgpuBackend> for ShadowVolume {
     /// The compute pass's lists outlast the frame; volumes extruded on the host are uploaded into the
     /// frame's transient buffer, which does not; cascades of the cut-out casters' map follow the camera.
     fn build_is_reusable(&self, frame: &FrameInputs) -> bool {
-        self.gpu.extrusion == Extrusion::Gpu && !self.cutouts_follow_the_camera(frame)
+        self.gpu.extrusion == Extrusion::Gpu && !self.cutouts.follows_the_camera(frame)
     }
 
     fn create_state(&self, cx: &mut WgpuContext) -> Result<State, WgpuError> {

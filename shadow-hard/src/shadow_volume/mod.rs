@@ -20,7 +20,6 @@
 pub mod cpu;
 pub mod gpu;
 
-use shadow_core::FrameInputs;
 use shadow_core::geometry::volume::VolumeCounting;
 use shadow_core::technique::maps::CutoutMap;
 use shadow_core::technique::settings::{
@@ -114,13 +113,6 @@ impl ShadowVolume {
             Self::ZFAIL_NAME => Some(Self::ZFAIL),
             _ => None,
         }
-    }
-
-    /// Whether the build reads the camera: `frame` has cut-out casters, whose map is in cascades over
-    /// the view.
-    #[must_use]
-    pub fn cutouts_follow_the_camera(&self, frame: &FrameInputs) -> bool {
-        self.cutouts.cascades > 0 && frame.has_cutout_casters()
     }
 
     /// The registry name of this counting.

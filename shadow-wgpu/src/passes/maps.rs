@@ -6,7 +6,7 @@
 
 use bytemuck::{Pod, Zeroable};
 use shadow_core::FrameInputs;
-use shadow_core::frame::{Coverage, Instance};
+use shadow_core::frame::Coverage;
 use shadow_core::light::LightView;
 use shadow_core::technique::maps::{Casters, CutoutMap, DepthMap};
 use shadow_core::technique::settings::{BiasMode, Filter};
@@ -380,11 +380,11 @@ fn render_casters(
         pass.set_bind_group(0, &group, &[]);
         if casters != Casters::CutOut {
             pass.set_pipeline(&pipelines.solid);
-            draw_instances(cx, &mut pass, frame, Instance::casts_solid_shadow, false);
+            draw_instances(cx, &mut pass, frame, |i| casters.takes(i) && i.coverage() == Coverage::Solid, false);
         }
         if cutouts && casters != Casters::Solid {
             pass.set_pipeline(pipelines.cutout(cx));
-            draw_textured(cx, &mut pass, frame, |i| i.casts_shadow && i.coverage() == Coverage::Cutout, false);
+            draw_textured(cx, &mut pass, frame, |i| casters.takes(i) && i.coverage() == Coverage::Cutout, false);
         }
     }
     cx.submit(enc);
