@@ -82,7 +82,7 @@ fn zpass_fails_with_the_eye_in_shadow() {
 }
 
 #[test]
-fn shadow_map_error_falls_with_resolution() {
+fn shadow_map_mismatch_falls_with_resolution() {
     let cyl = scenes::build("cylinder", &SceneParams::default()).expect("cylinder");
     let map = |res| {
         Stateful::boxed(

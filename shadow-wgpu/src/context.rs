@@ -204,7 +204,9 @@ pub struct WgpuContext {
     pub depth_stencil: wgpu::TextureFormat,
 }
 
-/// The instance. Set `XDG_RUNTIME_DIR` (CI does) to keep the Vulkan loader quiet on headless machines.
+/// The instance. On a headless Linux machine without `XDG_RUNTIME_DIR`, listing its Vulkan adapters makes
+/// Mesa's device-selection layer print an `error:` line that is no error; give the process any absolute path
+/// there to quiet it (the workspace's tests and the `shadowlab` binary do).
 fn instance() -> wgpu::Instance {
     wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle())
 }

@@ -164,7 +164,7 @@ fn a_closed_pipe_ends_the_program_quietly() {
 }
 
 #[test]
-fn no_error_line_on_a_run_that_succeeds_without_a_runtime_folder() {
+fn a_run_that_succeeds_without_a_runtime_folder_raises_no_alarm() {
     let out = std::env::temp_dir().join(format!("shadowlab-xdg-{}.png", std::process::id()));
     let out = out.to_str().unwrap();
     let status = Command::new(env!("CARGO_BIN_EXE_shadowlab"))
@@ -177,6 +177,20 @@ fn no_error_line_on_a_run_that_succeeds_without_a_runtime_folder() {
     assert!(!err.lines().any(|l| l.starts_with("error")), "{err}");
     let _ = std::fs::remove_file(out);
     let _ = std::fs::remove_file(out.replace(".png", ".vis.png"));
+}
+
+/// `cargo test` on a headless machine: the GPU tests, run with the environment cargo gives them, print no
+/// line with "error" when they pass (the workspace's `.cargo/config.toml` quiets the Vulkan layers).
+#[test]
+fn gpu_tests_that_pass_raise_no_alarm() {
+    let Some(_) = crate::with_wgpu("the test run's error lines") else { return };
+    let out = Command::new(std::env::current_exe().expect("the test binary"))
+        .args(["--exact", "host::a_host_device_short_of_the_limits_is_refused_by_name", "--nocapture"])
+        .output()
+        .expect("the test binary runs");
+    let all = format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+    assert!(out.status.success() && all.contains("1 passed"), "{all}");
+    assert!(!all.lines().any(|l| l.contains("error")), "{all}");
 }
 
 #[test]

@@ -11,7 +11,7 @@ use shadowlab::compare::{CompareJob, run_compare};
 use shadowlab::results::soft::frame_with_radius;
 
 #[test]
-fn wedges_halve_the_error_of_pcss_and_agree_across_backends() {
+fn wedges_halve_the_rmse_of_pcss_and_agree_across_backends() {
     let Some(mut renderer) = crate::with_wgpu("the penumbra wedges' conformance") else {
         return;
     };

@@ -13,7 +13,7 @@ use shadowlab::compare::{CompareJob, run_compare};
 use shadowlab::{BackendKind, Renderer, TechniqueRegistry};
 
 #[test]
-fn silhouette_maps_cut_edge_errors_to_a_third_of_a_shadow_maps() {
+fn silhouette_maps_cut_a_shadow_maps_edge_mismatch_to_a_third() {
     let mut rows = Vec::new();
     let mut failures = Vec::new();
     for scene in ["cylinder", "primitives", "strike", "crowd"] {
