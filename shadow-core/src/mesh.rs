@@ -271,6 +271,30 @@ pub fn face_normal([a, b, c]: [Vec3; 3]) -> Vec3 {
     (b - a).cross(c - a)
 }
 
+/// `n` scaled by the power of two that brings its largest component into [1, 2): the same direction, in a
+/// range where products of it with unit-sized vectors, and its length, neither overflow nor underflow.
+///
+/// A face normal's length is the square of the mesh's size: from coordinates of about 1e10 its squared
+/// length passes f32's range (3.4e38), and a normal matrix undoing a small staging scale multiplies it
+/// further. Scaling by a power of two is exact and every product and sum made of the result scales by the
+/// same power, so a sign read from it, or the unit vector made of it, is bit for bit what the raw normal
+/// gives wherever that did not overflow. Normals too small to scale into range unharmed (subnormal
+/// components) are left as they are.
+#[must_use]
+pub fn power_of_two_unit(n: Vec3) -> Vec3 {
+    let largest = n.abs().max_element();
+    if !(largest.is_normal() && largest.is_finite()) {
+        return n;
+    }
+    // largest = 2^e * m with m in [1, 2); 2^-e is a normal f32 for every e of a normal f32 but the top one.
+    let e = ((largest.to_bits() >> 23) & 0xff) as i32 - 127;
+    if e >= 127 {
+        return n;
+    }
+    n * f32::from_bits(((127 - e) as u32) << 23)
+}
+
+/// Each vertex's normal: the area-weighted mean of its faces' normals.
 fn vertex_normals(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Vec3> {
     let mut normals = vec![Vec3::ZERO; positions.len()];
     for t in triangles {
@@ -279,7 +303,7 @@ fn vertex_normals(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Vec3> {
             normals[i as usize] += n;
         }
     }
-    normals.iter().map(|n| n.normalize_or(Vec3::Y)).collect()
+    normals.iter().map(|&n| power_of_two_unit(n).normalize_or(Vec3::Y)).collect()
 }
 
 #[cfg(test)]
@@ -298,6 +322,15 @@ mod tests {
         assert_eq!(appended_base(most - 1, 1), Ok(most as u32 - 1));
         assert_eq!(appended_base(most, 1), Err(MeshError::TooManyVertices(most + 1)));
         assert_eq!(appended_base(usize::MAX, 1), Err(MeshError::TooManyVertices(usize::MAX)));
+    }
+
+    #[test]
+    fn vertex_normals_hold_at_the_largest_coordinates() {
+        // A face normal's squared length passes f32's range here: the normals must still be the face's.
+        for size in [1e14, MAX_COORDINATE] {
+            let m = Mesh::new(vec![Vec3::ZERO, Vec3::X * size, Vec3::Y * size], vec![[0, 1, 2]]).expect("triangle");
+            assert!(m.normals().iter().all(|&n| n == Vec3::Z), "side {size:e}: {:?}", m.normals());
+        }
     }
 
     #[test]

@@ -9,6 +9,7 @@
 use glam::{BVec4A, Mat3, Mat4, Vec2, Vec3, Vec4};
 use rayon::prelude::*;
 use shadow_core::material::Footprint;
+use shadow_core::mesh::{face_normal, power_of_two_unit};
 use shadow_core::scene::Camera;
 use shadow_core::{FrameInputs, Image};
 
@@ -171,7 +172,9 @@ impl Triangle {
             corners: t.map(|k| inst.world_from_local.transform_point3(p[k as usize])),
             normals: t.map(|k| nn[k as usize]),
             normal_from_local,
-            face: (normal_from_local * shadow_core::mesh::face_normal(t.map(|k| p[k as usize]))).try_normalize(),
+            // Scaled first: a model staged from large coordinates has a normal matrix that would multiply
+            // the raw face normal past f32's range.
+            face: (normal_from_local * power_of_two_unit(face_normal(t.map(|k| p[k as usize])))).try_normalize(),
             uvs: inst.mesh.uvs().filter(|_| textured).map(|uv| t.map(|k| uv[k as usize])),
         }
     }

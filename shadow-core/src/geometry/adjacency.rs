@@ -24,7 +24,7 @@ use rayon::prelude::*;
 
 use super::facing::FacingRuns;
 use crate::bounds::Aabb;
-use crate::mesh::{Mesh, face_normal};
+use crate::mesh::{Mesh, face_normal, power_of_two_unit};
 
 /// One face's use of an edge: `face << 1 | reversed`, where `reversed` means the face runs from the
 /// edge's higher welded vertex to its lower one.
@@ -106,26 +106,6 @@ pub struct Adjacency {
 /// Bit pattern of a position with `-0.0` folded into `0.0`, so the two weld.
 fn weld_key(p: Vec3) -> [u32; 3] {
     [p.x, p.y, p.z].map(|c| if c == 0.0 { 0 } else { c.to_bits() })
-}
-
-/// `n` scaled by the power of two that brings its largest component into [1, 2).
-///
-/// The raw normal's length is the square of the mesh's size, and the plane offset `n . p` its cube: at
-/// coordinates of 1e13 that offset passes f32's range (3.4e38) and every facing test of the face reads
-/// infinity. Scaling by a power of two is exact, and every product and sum of the facing test scales by
-/// the same power, so each test keeps the sign the raw normal gives wherever that did not overflow.
-/// Normals too small to scale into range unharmed (subnormal components) are left as they are.
-fn power_of_two_unit(n: Vec3) -> Vec3 {
-    let largest = n.abs().max_element();
-    if !(largest.is_normal() && largest.is_finite()) {
-        return n;
-    }
-    // largest = 2^e * m with m in [1, 2); 2^-e is a normal f32 for every e of a normal f32 but the top one.
-    let e = ((largest.to_bits() >> 23) & 0xff) as i32 - 127;
-    if e >= 127 {
-        return n;
-    }
-    n * f32::from_bits(((127 - e) as u32) << 23)
 }
 
 impl Adjacency {
@@ -288,6 +268,9 @@ fn faces(mesh_triangles: &[[u32; 3]], remap: &[u32], positions: &[Vec3]) -> (Vec
                 let [a, b, c] = *t;
                 *d = a == b || b == c || c == a;
                 let p = t.map(|i| positions[i as usize]);
+                // The raw normal's length is the square of the mesh's size and the plane offset `n . p`
+                // its cube: at coordinates of 1e13 that offset passes f32's range and every facing test of
+                // the face would read infinity. Scaled, each test keeps the sign the raw normal gives.
                 let n = power_of_two_unit(face_normal(p));
                 // Exactly zero for two equal corners; -0.0 folded so the facing test gives exactly 0.
                 *plane = if n == Vec3::ZERO { Vec4::ZERO } else { n.extend(-n.dot(p[0])) };
