@@ -6,7 +6,7 @@
 use std::sync::mpsc::{Receiver, TryRecvError};
 
 use shadow_core::image::{Rgb8, error_map_over};
-use shadow_core::metrics::{compare_visibility, measured_pixels};
+use shadow_core::metrics::{VisibilityMetrics, compare_visibility, measured_pixels};
 use shadow_core::scene::{Camera, Light, LightShadow};
 use shadow_core::technique::TechniqueSpec;
 use shadow_core::{FrameInputs, Image};
@@ -36,10 +36,16 @@ pub(super) struct Reference {
 
 /// An overlay, being made or made.
 pub(super) enum Overlay {
-    /// The reference is being computed; the technique's visibility and picture wait for it.
-    Computing { key: ViewKey, reference: Receiver<Result<Reference, String>>, test: Image<f32>, picture: Image<Rgb8> },
-    /// The error map, with the mismatch over the measured pixels.
-    Errors { key: ViewKey, texture: egui::TextureHandle, mismatch: f64, false_shadow: f64, false_light: f64 },
+    /// The reference (soft or not) is being computed; the technique's visibility and picture wait for it.
+    Computing {
+        key: ViewKey,
+        soft: bool,
+        reference: Receiver<Result<Reference, String>>,
+        test: Image<f32>,
+        picture: Image<Rgb8>,
+    },
+    /// The error map, with the score over the measured pixels ([`score_line`]).
+    Errors { key: ViewKey, texture: egui::TextureHandle, score: String },
     /// An instrumented frame of the technique: its debug views (one of them shown) and counters.
     Inspect { key: ViewKey, views: Vec<(String, egui::TextureHandle)>, shown: usize, counters: Vec<(String, f64)> },
 }
@@ -57,12 +63,12 @@ impl Overlay {
         let (send, reference) = std::sync::mpsc::channel();
         let (width, height) = key.size;
         std::thread::spawn(move || {
-            let spec = TechniqueSpec::named(if soft { "area-light-reference" } else { "ray-traced" });
-            let made = reference_of(&frame, width, height, &spec).map_err(|e| e.to_string());
+            let made = reference_of(&frame, width, height, &TechniqueSpec::named(reference_name(soft)))
+                .map_err(|e| e.to_string());
             // The viewer may have moved on and dropped the receiver: nothing waits for this result then.
             let _ = send.send(made);
         });
-        Self::Computing { key, reference, test, picture }
+        Self::Computing { key, soft, reference, test, picture }
     }
 
     /// The inspection of the view of `key`, its debug views as egui textures.
@@ -87,17 +93,37 @@ impl Overlay {
 
     /// Turns a finished comparison into its error map. An error computing the reference is returned.
     pub(super) fn poll(self, ui: &egui::Context) -> Result<Self, String> {
-        let Self::Computing { key, reference, test, picture } = self else { return Ok(self) };
+        let Self::Computing { key, soft, reference, test, picture } = self else { return Ok(self) };
         let r = match reference.try_recv() {
             Ok(made) => made?,
-            Err(TryRecvError::Empty) => return Ok(Self::Computing { key, reference, test, picture }),
+            Err(TryRecvError::Empty) => return Ok(Self::Computing { key, soft, reference, test, picture }),
             Err(TryRecvError::Disconnected) => return Err("the reference's thread stopped".into()),
         };
         let metrics = compare_visibility(&test, &r.visibility, &r.measured).map_err(|e| e.to_string())?;
         let map = error_map_over(&test, &r.visibility, &r.measured, &r.shown, &picture);
         let texture = ui.load_texture("error map", color_image(&map), Default::default());
-        let (mismatch, false_shadow, false_light) = (metrics.mismatch, metrics.false_shadow, metrics.false_light);
-        Ok(Self::Errors { key, texture, mismatch, false_shadow, false_light })
+        Ok(Self::Errors { key, texture, score: score_line(&metrics, soft) })
+    }
+}
+
+/// The reference a soft technique, or a hard one, is measured against.
+fn reference_name(soft: bool) -> &'static str {
+    if soft { shadow_soft::AreaLightReference::NAME } else { shadow_hard::RayTraced::NAME }
+}
+
+/// What a comparison says, as `compare` scores it: a soft technique by its RMSE against the area-light
+/// reference (a penumbra has no lit or shadowed state to mismatch), a hard one by its mismatch against
+/// the ray-traced one, split into false shadow and false light.
+pub(super) fn score_line(m: &VisibilityMetrics, soft: bool) -> String {
+    let pc = |f: f64| 100.0 * f;
+    if soft {
+        format!("RMSE {:.4} against {} (mean difference {:.4})", m.rmse, reference_name(true), m.mean_abs)
+    } else {
+        let (mismatch, shadow, light) = (pc(m.mismatch), pc(m.false_shadow), pc(m.false_light));
+        format!(
+            "mismatch {mismatch:.2}% (false shadow {shadow:.2}%, false light {light:.2}%) against {}",
+            reference_name(false)
+        )
     }
 }
 

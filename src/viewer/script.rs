@@ -6,8 +6,8 @@
 //! `fly FORWARD RIGHT UP` (scene units), `technique SPEC`, `backend wgpu|cpu`, `scene NAME|FILE`,
 //! `wait FRAMES`, `screenshot FILE.png`, `command` (prints the `shadowlab render` command of the view),
 //! `memory` (prints the buffers and textures alive on the device), `compare` (compares the view with the
-//! reference and prints the mismatch; the script waits for it), `inspect` (prints an instrumented frame's
-//! counters and lays its first debug view over the view) and `quit`.
+//! reference and prints its score as `compare` scores it; the script waits for it), `inspect` (prints an
+//! instrumented frame's counters and lays its first debug view over the view) and `quit`.
 
 use std::path::PathBuf;
 
@@ -40,7 +40,7 @@ pub enum Step {
     Command,
     /// Print the buffers and textures alive on the device.
     Memory,
-    /// Compare the view with its reference and print the mismatch.
+    /// Compare the view with its reference and print the score (mismatch, or RMSE for a soft technique).
     Compare,
     /// Inspect an instrumented frame: print its counters, show its debug views.
     Inspect,

@@ -217,9 +217,7 @@ impl Viewer {
         });
         match &mut self.overlay {
             Some(Overlay::Computing { .. }) => drop(ui.label("computing the reference...")),
-            Some(Overlay::Errors { mismatch, false_shadow, false_light, .. }) => {
-                ui.label(mismatch_line(*mismatch, *false_shadow, *false_light));
-            }
+            Some(Overlay::Errors { score, .. }) => drop(ui.label(score.as_str())),
             Some(Overlay::Inspect { views, shown, counters, .. }) => {
                 let names: Vec<String> = views.iter().map(|(n, _)| n.clone()).collect();
                 if let Some(name) = names.get(*shown) {
@@ -240,17 +238,6 @@ impl Viewer {
             None => {}
         }
     }
-}
-
-/// The comparison's numbers, as the panel and the script print them.
-pub(super) fn mismatch_line(mismatch: f64, false_shadow: f64, false_light: f64) -> String {
-    let pc = |f: f64| 100.0 * f;
-    format!(
-        "mismatch {:.2}% (false shadow {:.2}%, false light {:.2}%)",
-        pc(mismatch),
-        pc(false_shadow),
-        pc(false_light)
-    )
 }
 
 /// Colours of the plot's lines: the whole frame, then its phases in order.

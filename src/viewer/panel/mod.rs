@@ -166,8 +166,8 @@ impl Viewer {
             let computing = matches!(overlay, Overlay::Computing { .. });
             match overlay.poll(painter.2) {
                 Ok(o) => {
-                    if let (true, Overlay::Errors { mismatch, false_shadow, false_light, .. }) = (computing, &o) {
-                        self.say(controls::mismatch_line(*mismatch, *false_shadow, *false_light));
+                    if let (true, Overlay::Errors { score, .. }) = (computing, &o) {
+                        self.say(score.clone());
                     }
                     self.overlay = Some(o);
                 }
