@@ -13,7 +13,7 @@ use shadow_cpu::{CpuBackend, CpuContext, CpuError, GBuffer};
 
 use super::PenumbraWedges;
 use super::coverage::{SphereLight, count_step, horizon_share, wedge_term};
-use super::geometry::{LAYERS, QUAD_DEPTH_BIAS, WedgeEdge, WedgeGeometry};
+use super::geometry::{LAYERS, PixelScale, QUAD_DEPTH_BIAS, WedgeEdge, WedgeGeometry};
 
 /// The geometry and the cut-out casters' map of the last build.
 #[derive(Default)]
@@ -101,7 +101,7 @@ impl ShadowTechnique<CpuBackend> for PenumbraWedges {
             g,
             &mut ds,
             &mut occluded,
-            (&built.quads, &QUAD_STATE),
+            (&built.side_quads(PixelScale::of(&g.camera, g.height())), &QUAD_STATE),
             |prim| edges[prim as usize / 2],
             |e, p| count_step(p, eye, e.a, e.b, c),
         );

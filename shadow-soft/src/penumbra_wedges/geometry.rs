@@ -3,8 +3,9 @@
 //! light centre's count at the eye.
 //!
 //! **Side quads** `(b, a, a_inf, b_inf)`, extruded from the centre to infinity as shadow-core's volumes
-//! are: counted z-pass from the eye, they give the hard shadow volume's count at every receiver. They are
-//! drawn slightly larger than they are; which pixels they hold is decided per fragment.
+//! are: counted z-pass from the eye, they give the hard shadow volume's count at every receiver. Each
+//! query draws them half a pixel of its view larger than they are ([`WedgeGeometry::side_quads`]); which
+//! pixels they hold is decided per fragment.
 //!
 //! **Wedges.** The receivers for which edge `a -> b` cuts the light's disc are those behind the edge from
 //! some point of the sphere. They lie inside four planes, each through the edge or one of its ends and
@@ -32,6 +33,7 @@ use shadow_core::FrameInputs;
 use shadow_core::geometry::adjacency::Adjacency;
 use shadow_core::geometry::silhouette::Silhouette;
 use shadow_core::glam::{Mat4, Vec3, Vec4};
+use shadow_core::scene::Camera;
 use shadow_core::technique::settings::DepthBias;
 
 use super::coverage::SphereLight;
@@ -78,9 +80,6 @@ pub const LAYERS: usize = 3;
 pub struct WedgeGeometry {
     /// The casters' silhouette edges.
     pub edges: Vec<WedgeEdge>,
-    /// Per edge, its side quad as two triangles of homogeneous world points (w = 0 at infinity):
-    /// triangles `2 i` and `2 i + 1` are edge `i`'s.
-    pub quads: Vec<[Vec4; 3]>,
     /// The wedges' faces, wound counter-clockwise seen from outside, homogeneous as the quads.
     pub hulls: Vec<[Vec4; 3]>,
     /// The edge of each wedge face.
@@ -93,9 +92,31 @@ pub struct WedgeGeometry {
     pub without_wedge: usize,
 }
 
-/// How much larger than the side quads they cover the quads are drawn, as a fraction of the edge's
-/// length and of its distance from the light.
-const QUAD_MARGIN: f32 = 0.01;
+/// How much larger than the side quads they cover the quads are drawn, in pixels of the view: the
+/// fragment decides exactly which pixels a quad holds (`coverage::crosses_quad`), the rasterizer only has
+/// to reach them, whatever its snapping of corners to its sub-pixel grid (Vulkan allows a grid as coarse
+/// as a sixteenth of a pixel). A margin in proportion to the quad instead leaves the thin quads of short
+/// edges, a fraction of a pixel wide, within that snapping of the pixels they hold, and a pixel they lose
+/// is a full step of the count: a dark speck in the light.
+pub const QUAD_MARGIN_PIXELS: f32 = 0.5;
+
+/// How large a view's pixels are where the side quads are drawn ([`WedgeGeometry::side_quads`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PixelScale {
+    /// The eye.
+    pub eye: Vec3,
+    /// A pixel's width per unit of distance from the eye at the view's centre, `2 tan(fov_y / 2) / height`
+    /// (pixels off the centre subtend less, so a width of this many holds at least as many there).
+    pub per_distance: f32,
+}
+
+impl PixelScale {
+    /// The pixels of `camera`'s view `height` pixels high.
+    #[must_use]
+    pub fn of(camera: &Camera, height: u32) -> Self {
+        Self { eye: camera.eye, per_distance: 2.0 * (camera.fov_y * 0.5).tan() / height.max(1) as f32 }
+    }
+}
 
 /// The depth bias the side quads are drawn with against the G-buffer's depth, test "less": a quad that
 /// meets the eye's ray behind the receiver adds nothing (the receiver and the eye are on one side of it),
@@ -148,13 +169,6 @@ impl WedgeGeometry {
         let index = self.edges.len() as u32;
         let planes = wedge_planes(a, b, light);
         self.edges.push(WedgeEdge { a, b, weight, layer, planes: planes.unwrap_or([Vec4::ZERO; 4]) });
-        let c = light.centre;
-        // Drawn a little larger (ends moved apart and towards the light): the fragment decides exactly
-        // which pixels the quad holds (`coverage::crosses_quad`), the rasterizer only has to reach them.
-        let (qa, qb) = (a + ((c - a) + (a - b)) * QUAD_MARGIN, b + ((c - b) + (b - a)) * QUAD_MARGIN);
-        let (a_inf, b_inf) = ((qa - c).extend(0.0), (qb - c).extend(0.0));
-        self.quads.push([qb.extend(1.0), qa.extend(1.0), a_inf]);
-        self.quads.push([qb.extend(1.0), a_inf, b_inf]);
         match planes {
             Some(planes) => {
                 self.hulls.extend(faces(a, b, light, planes));
@@ -163,6 +177,44 @@ impl WedgeGeometry {
             None => self.without_wedge += 1,
         }
     }
+}
+
+impl WedgeGeometry {
+    /// Each edge's side quad `(b, a, a_inf, b_inf)` as two triangles of homogeneous world points (w = 0
+    /// at infinity), triangles `2 i` and `2 i + 1` edge `i`'s, drawn [`QUAD_MARGIN_PIXELS`] larger than
+    /// it is in the view of `pixels`.
+    #[must_use]
+    pub fn side_quads(&self, pixels: PixelScale) -> Vec<[Vec4; 3]> {
+        let mut quads = Vec::with_capacity(2 * self.edges.len());
+        for e in &self.edges {
+            quads.extend(side_quad(e.a, e.b, self.centre, pixels));
+        }
+        quads
+    }
+}
+
+/// The side quad of edge `a -> b` from a light centred at `c`, grown by [`QUAD_MARGIN_PIXELS`] in the view
+/// of `pixels`: the edge moved towards the light, and each end's ray to infinity moved outwards, by a
+/// margin of that many pixels at the end's distance from the eye or from the light, whichever is larger.
+/// Along an end's ray, `s` times its distance from the light beyond the end, the ray's shift grows to
+/// `(1 + s)` margins while the point's distance from the eye grows by at most `s` times that distance, so
+/// the margin holds along the whole ray, out to the ray's direction at infinity.
+fn side_quad(a: Vec3, b: Vec3, c: Vec3, pixels: PixelScale) -> [[Vec4; 3]; 2] {
+    let grown = |v: Vec3, other: Vec3| {
+        let margin = QUAD_MARGIN_PIXELS * pixels.per_distance * (v - pixels.eye).length().max((v - c).length());
+        // Square to the end's ray, away from the other end; square to the edge, towards the light.
+        let out = (v - other).reject_from(v - c).normalize_or_zero();
+        let toward = (c - v).reject_from(other - v).normalize_or_zero();
+        // Where the ray moved out meets the edge moved towards the light: back along the ray by as much
+        // as brings the corner `margin` nearer the light than the edge.
+        // (Where the light is nearly on the edge's line that would be past half way to the light; there
+        // the ends move out and towards the light alone.)
+        let back = margin * (1.0 - out.dot(toward)) / (c - v).dot(toward);
+        if (0.0..=0.5).contains(&back) { v + out * margin + (c - v) * back } else { v + (out + toward) * margin }
+    };
+    let (qa, qb) = (grown(a, b), grown(b, a));
+    let (a_inf, b_inf) = ((qa - c).extend(0.0), (qb - c).extend(0.0));
+    [[qb.extend(1.0), qa.extend(1.0), a_inf], [qb.extend(1.0), a_inf, b_inf]]
 }
 
 /// A plane through `point` with unit normal `n`, as `(n, -n . point)`: positive on the inner side.

@@ -12,7 +12,7 @@ use shadow_wgpu::{GpuGBuffer, GpuVisibility, WgpuBackend, WgpuContext, WgpuError
 
 use super::PenumbraWedges;
 use super::coverage::SphereLight;
-use super::geometry::{LAYERS, QUAD_DEPTH_BIAS, WedgeEdge, WedgeGeometry};
+use super::geometry::{LAYERS, PixelScale, QUAD_DEPTH_BIAS, WedgeEdge, WedgeGeometry};
 use crate::min_target;
 use shadow_wgpu::passes::maps::CutoutMaps;
 
@@ -93,12 +93,12 @@ fn group_entries(cutouts: bool) -> Vec<wgpu::BindGroupLayoutEntry> {
 }
 
 /// One build's geometry, as vertices and edges: uploaded by each query into the frame's transient
-/// buffer, so a kept build costs no allocation and a moving light none either.
+/// buffer, so a kept build costs no allocation and a moving light none either. The side quads are grown
+/// by a margin in the view's pixels ([`WedgeGeometry::side_quads`]), so each query makes them afresh.
 struct Built {
     geometry: WedgeGeometry,
     light: SphereLight,
     edges: Vec<GpuEdge>,
-    quads: Vec<EdgeVertex>,
     wedges: Vec<EdgeVertex>,
 }
 
@@ -202,9 +202,8 @@ impl ShadowTechnique<WgpuBackend> for PenumbraWedges {
         let geometry = Self::construct(frame, light, stats)?;
         let light = Self::sphere(light)?;
         let edges = geometry.edges.iter().map(GpuEdge::from).collect();
-        let quads = vertices(&geometry.quads, |t| (t / 2) as u32);
         let wedges = vertices(&geometry.hulls, |t| geometry.hull_edges[t]);
-        state.built = Some(Built { geometry, light, edges, quads, wedges });
+        state.built = Some(Built { geometry, light, edges, wedges });
         Ok(())
     }
 
@@ -237,6 +236,7 @@ impl ShadowTechnique<WgpuBackend> for PenumbraWedges {
                 mapped_at_creation: false,
             })),
         };
+        let quads = vertices(&built.geometry.side_quads(PixelScale::of(&g.camera, g.height)), |t| (t / 2) as u32);
         let draw_wedges = self.wedges.is_on();
         cx.scoped("the penumbra wedges", |cx| {
             let uniform = cx.transient(bytemuck::bytes_of(&params));
@@ -275,7 +275,7 @@ impl ShadowTechnique<WgpuBackend> for PenumbraWedges {
                 pass.set_bind_group(0, &g.frame_group, &[]);
                 pass.set_bind_group(1, &group, &[]);
                 let wedges: &[EdgeVertex] = if draw_wedges { &built.wedges } else { &[] };
-                for (pipeline, data) in [(&state.quads, &built.quads[..]), (&state.wedges, wedges)] {
+                for (pipeline, data) in [(&state.quads, &quads[..]), (&state.wedges, wedges)] {
                     if let Some((vertices, count)) = min_target::vertex_buffer(cx, data) {
                         pass.set_pipeline(pipeline);
                         pass.set_vertex_buffer(0, vertices.slice());

@@ -106,7 +106,7 @@ impl PenumbraWedges {
         let built = WedgeGeometry::build(frame, frame.caster_silhouettes(light), sphere);
         let c = &mut stats.counters;
         c.silhouette_edges = Some(built.edges.len() as u64);
-        c.volume_triangles = Some(built.quads.len() as u64);
+        c.volume_triangles = Some(2 * built.edges.len() as u64);
         c.extra.insert("wedge_triangles".into(), built.hulls.len() as f64);
         c.extra.insert("edges_without_wedge".into(), built.without_wedge as f64);
         Ok(built)
