@@ -120,24 +120,7 @@ impl ShadowTechnique<CpuBackend> for PlanarShadow {
     }
 }
 
-const WGSL: &str = r#"
-@group(0) @binding(0) var g_position: texture_2d<f32>;
-@group(0) @binding(1) var<uniform> plane_y: vec4<f32>;
-
-@vertex
-fn vs(@location(0) p: vec4<f32>) -> @builtin(position) vec4<f32> {
-    return p;
-}
-
-@fragment
-fn fs(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
-    let g = textureLoad(g_position, vec2<i32>(pos.xy), 0);
-    if (g.w == 0.0 || abs(g.y - plane_y.x) >= 1e-3) {
-        discard;
-    }
-    return vec4<f32>(0.0);
-}
-"#;
+const WGSL: &str = include_str!("planar.wgsl");
 
 /// The GPU state: one pipeline and its layout, made once.
 pub struct GpuState {

@@ -19,6 +19,7 @@ mod settings;
 mod silhouette_map;
 mod single_sided;
 mod smoothies;
+mod sources;
 // The technique of examples/custom_technique.rs, registered at runtime like a user's would be.
 #[path = "../../examples/planar/mod.rs"]
 #[allow(dead_code)]

@@ -17,12 +17,11 @@
 //! closed on its own (every face of each of its edges is in it), so it shadows nothing outside its own
 //! shadow, which lets a technique skip it wherever that cannot hold the point it counts.
 
-use std::sync::atomic::{AtomicU32, Ordering};
-
 use glam::{Vec3, Vec4};
 use rayon::prelude::*;
 
 use super::facing::FacingRuns;
+use super::weld::weld;
 use crate::bounds::Aabb;
 use crate::mesh::{Mesh, face_normal, power_of_two_unit};
 
@@ -101,11 +100,6 @@ pub struct Adjacency {
     component_bounds: Vec<Aabb>,
     /// Bounds that decide the facing of runs of faces at once.
     facing_runs: FacingRuns,
-}
-
-/// Bit pattern of a position with `-0.0` folded into `0.0`, so the two weld.
-fn weld_key(p: Vec3) -> [u32; 3] {
-    [p.x, p.y, p.z].map(|c| if c == 0.0 { 0 } else { c.to_bits() })
 }
 
 impl Adjacency {
@@ -519,119 +513,6 @@ fn components(adj: &Adjacency) -> (Vec<u32>, Vec<Aabb>) {
     }
     (component, bounds)
 }
-
-/// A hash of a weld key: multiply-rotate mixing, whose high bits are well spread (positions are not
-/// adversarial, and this is many times faster than SipHash).
-fn weld_hash(key: [u32; 3]) -> u64 {
-    key.iter().fold(0u64, |h, &c| (h.rotate_left(26) ^ u64::from(c)).wrapping_mul(0x9e37_79b9_7f4a_7c15))
-}
-
-/// Welds equal positions (by [`weld_key`]): the distinct positions in order of first appearance, and each
-/// position's index among them.
-///
-/// One hash table over half a million positions misses the cache on nearly every insert. So the
-/// positions are first split by their hash's top byte into [`WELD_PARTS`] parts (counting sorts that
-/// keep each part in position order); each part, a few thousand keys whose table stays in cache, is
-/// welded on its own and in parallel, giving every position the first position with its key; a prefix
-/// count over those firsts then numbers them in order of first appearance, as one table in position
-/// order would. Every step runs on all threads.
-fn weld(positions: &[Vec3]) -> (Vec<Vec3>, Vec<u32>) {
-    let n = positions.len();
-    // Each run of positions sorts its own into the parts (with its keys, so a part's table reads its
-    // keys in order, not from all over the positions), all runs at once; a part's members are then its
-    // members from each run, run after run: in position order.
-    let per_run = n.div_ceil(rayon::current_num_threads().clamp(1, 64)).max(1);
-    let runs: Vec<(Vec<usize>, Vec<[u32; 4]>)> = positions
-        .par_chunks(per_run)
-        .enumerate()
-        .map(|(r, run)| {
-            // Hashing twice costs less than keeping every key and its part between the two passes.
-            let part = |k: [u32; 3]| (weld_hash(k) >> 56) as usize;
-            let mut start = vec![0usize; WELD_PARTS + 1];
-            for &p in run {
-                start[part(weld_key(p)) + 1] += 1;
-            }
-            for i in 1..start.len() {
-                start[i] += start[i - 1];
-            }
-            let mut next = start.clone();
-            let mut members = vec![[0u32; 4]; run.len()];
-            for (j, &p) in run.iter().enumerate() {
-                let [x, y, z] = weld_key(p);
-                let slot = &mut next[part([x, y, z])];
-                members[*slot] = [x, y, z, (r * per_run + j) as u32];
-                *slot += 1;
-            }
-            (start, members)
-        })
-        .collect();
-    // Relaxed atomic stores are plain stores here; they let the parts share the array.
-    let first: Vec<AtomicU32> = (0..n).into_par_iter().map(|_| AtomicU32::new(0)).collect();
-    (0..WELD_PARTS).into_par_iter().for_each(|part| {
-        let members = || runs.iter().flat_map(|(start, members)| &members[start[part]..start[part + 1]]);
-        weld_part(members(), members().count(), &first);
-    });
-    let first: Vec<u32> = first.into_iter().map(AtomicU32::into_inner).collect();
-    // Number the first positions in order, run by run: each run counts its firsts, then numbers its own
-    // from the count of the runs before it and writes their positions. Every other position takes its
-    // first's number.
-    const RUN: usize = 16384;
-    let is_first = |k: usize, j: usize, f: u32| f as usize == k * RUN + j;
-    let counts: Vec<usize> = first
-        .par_chunks(RUN)
-        .enumerate()
-        .map(|(k, run)| run.iter().enumerate().filter(|&(j, &f)| is_first(k, j, f)).count())
-        .collect();
-    let mut number = vec![0u32; n];
-    let mut welded = vec![Vec3::ZERO; counts.iter().sum()];
-    let mut numbering = Vec::with_capacity(counts.len());
-    let (mut rest, mut at) = (welded.as_mut_slice(), 0);
-    for (k, (&count, (number, first))) in counts.iter().zip(number.chunks_mut(RUN).zip(first.chunks(RUN))).enumerate() {
-        let (welded, tail) = rest.split_at_mut(count);
-        numbering.push((k, at, number, first, welded));
-        (rest, at) = (tail, at + count);
-    }
-    numbering.into_par_iter().for_each(|(k, at, number, first, welded)| {
-        let mut next = 0;
-        for (j, (number, &f)) in number.iter_mut().zip(first).enumerate() {
-            if is_first(k, j, f) {
-                *number = (at + next) as u32;
-                welded[next] = positions[k * RUN + j];
-                next += 1;
-            }
-        }
-    });
-    let remap = first.par_iter().map(|&f| number[f as usize]).collect();
-    (welded, remap)
-}
-
-/// For each of one part's `count` members (`[key, position]`, in position order), the first position with
-/// the same key, stored at the member's position in `first`: an open addressing table with linear
-/// probing, at most half full, holding each key beside its first position so a probe reads no other
-/// memory.
-fn weld_part<'a>(members: impl Iterator<Item = &'a [u32; 4]>, count: usize, first: &[AtomicU32]) {
-    const EMPTY: u32 = u32::MAX;
-    let size = (2 * count).next_power_of_two().max(16);
-    let mut table = vec![[0, 0, 0, EMPTY]; size];
-    for &[x, y, z, i] in members {
-        // The bits below the part's: the top ones chose the part, so they are the same for all.
-        let mut slot = (weld_hash([x, y, z]) >> 24) as usize & (size - 1);
-        let f = loop {
-            match table[slot] {
-                [_, _, _, EMPTY] => {
-                    table[slot] = [x, y, z, i];
-                    break i;
-                }
-                [a, b, c, f] if [a, b, c] == [x, y, z] => break f,
-                _ => slot = (slot + 1) & (size - 1),
-            }
-        };
-        first[i as usize].store(f, Ordering::Relaxed);
-    }
-}
-
-/// How many parts [`weld`] splits the positions into: one per value of the hash's top byte.
-const WELD_PARTS: usize = 256;
 
 #[cfg(test)]
 mod tests {

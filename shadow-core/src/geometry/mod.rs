@@ -1,6 +1,6 @@
 //! Shadow geometry shared by both backends: pure functions over plain data, written once.
 //!
-//! - [`adjacency`]: weld coincident positions, map edges to faces, classify manifold, boundary and
+//! - [`adjacency`]: weld coincident positions (`weld`), map edges to faces, classify manifold, boundary and
 //!   non-manifold edges, and decide whether a mesh is closed.
 //! - [`silhouette`]: the silhouette edges of a mesh for one light, with Bergeron weights for open meshes;
 //!   `facing` decides the facing of whole runs of faces at once, so it reads only faces near the
@@ -11,6 +11,7 @@ pub mod adjacency;
 mod facing;
 pub mod silhouette;
 pub mod volume;
+mod weld;
 
 #[cfg(test)]
 mod proptests;

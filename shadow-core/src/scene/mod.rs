@@ -19,10 +19,12 @@ use crate::mesh::Mesh;
 
 mod camera;
 mod light;
+mod placed;
 
 pub use crate::material::Material;
 pub use camera::Camera;
 pub use light::{Light, LightKind, LightShadow};
+use placed::Placed;
 
 slotmap::new_key_type! {
     /// A node of the hierarchy.
@@ -490,135 +492,6 @@ impl Scene {
     pub fn triangle_count(&self) -> usize {
         self.drawables().map(|(_, _, m, _)| self.meshes[m].mesh.triangle_count()).sum()
     }
-
-    // ---- lights and cameras ----
-
-    /// Adds a light placed in world space.
-    pub fn add_light(&mut self, light: Light) -> LightKey {
-        self.lights.insert(Placed { value: light, node: None })
-    }
-
-    /// Adds a light placed in `node`'s space: it follows the node, and moving a parent moves it.
-    ///
-    /// # Errors
-    /// An unknown node key.
-    pub fn add_light_to(&mut self, node: NodeKey, light: Light) -> Result<LightKey, SceneError> {
-        self.nodes.get(node).ok_or(SceneError::UnknownKey("node"))?;
-        Ok(self.lights.insert(Placed { value: light, node: Some(node) }))
-    }
-
-    /// A light as it was given: in world space, or in its node's ([`Scene::light_node`]).
-    #[must_use]
-    pub fn light(&self, key: LightKey) -> Option<&Light> {
-        self.lights.get(key).map(|p| &p.value)
-    }
-
-    /// A light as it was given, to edit (lights hold no cached state; nothing depending on the light is
-    /// cached).
-    pub fn light_mut(&mut self, key: LightKey) -> Option<&mut Light> {
-        self.lights.get_mut(key).map(|p| &mut p.value)
-    }
-
-    /// The node a light follows, if any.
-    #[must_use]
-    pub fn light_node(&self, key: LightKey) -> Option<NodeKey> {
-        self.lights.get(key)?.node
-    }
-
-    /// A light placed in world space.
-    #[must_use]
-    pub fn world_light(&self, key: LightKey) -> Option<Light> {
-        self.lights.get(key).map(|p| self.placed(p, Light::transformed))
-    }
-
-    /// Every light, placed in world space.
-    pub fn lights(&self) -> impl Iterator<Item = (LightKey, Light)> + '_ {
-        self.lights.iter().map(|(k, p)| (k, self.placed(p, Light::transformed)))
-    }
-
-    /// Removes every light.
-    pub fn clear_lights(&mut self) {
-        self.lights.clear();
-        self.light_shadows.clear();
-    }
-
-    /// Sets how a light casts shadows: whether it does, and with which technique and settings.
-    ///
-    /// # Errors
-    /// An unknown light key.
-    pub fn set_light_shadow(&mut self, key: LightKey, shadow: LightShadow) -> Result<(), SceneError> {
-        self.lights.get(key).ok_or(SceneError::UnknownKey("light"))?;
-        self.light_shadows.insert(key, shadow);
-        Ok(())
-    }
-
-    /// How a light casts shadows (by default: it does, with the frame's technique).
-    #[must_use]
-    pub fn light_shadow(&self, key: LightKey) -> LightShadow {
-        self.light_shadows.get(key).cloned().unwrap_or_default()
-    }
-
-    /// Adds a camera placed in world space.
-    pub fn add_camera(&mut self, camera: Camera) -> CameraKey {
-        self.cameras.insert(Placed { value: camera, node: None })
-    }
-
-    /// Adds a camera placed in `node`'s space: it follows the node.
-    ///
-    /// # Errors
-    /// An unknown node key.
-    pub fn add_camera_to(&mut self, node: NodeKey, camera: Camera) -> Result<CameraKey, SceneError> {
-        self.nodes.get(node).ok_or(SceneError::UnknownKey("node"))?;
-        Ok(self.cameras.insert(Placed { value: camera, node: Some(node) }))
-    }
-
-    /// A camera as it was given: in world space, or in its node's ([`Scene::camera_node`]).
-    #[must_use]
-    pub fn camera(&self, key: CameraKey) -> Option<&Camera> {
-        self.cameras.get(key).map(|p| &p.value)
-    }
-
-    /// A camera as it was given, to edit.
-    pub fn camera_mut(&mut self, key: CameraKey) -> Option<&mut Camera> {
-        self.cameras.get_mut(key).map(|p| &mut p.value)
-    }
-
-    /// The node a camera follows, if any.
-    #[must_use]
-    pub fn camera_node(&self, key: CameraKey) -> Option<NodeKey> {
-        self.cameras.get(key)?.node
-    }
-
-    /// A camera placed in world space.
-    #[must_use]
-    pub fn world_camera(&self, key: CameraKey) -> Option<Camera> {
-        self.cameras.get(key).map(|p| self.placed(p, Camera::transformed))
-    }
-
-    /// Every camera, placed in world space.
-    pub fn cameras(&self) -> impl Iterator<Item = (CameraKey, Camera)> + '_ {
-        self.cameras.iter().map(|(k, p)| (k, self.placed(p, Camera::transformed)))
-    }
-
-    /// Removes every camera.
-    pub fn clear_cameras(&mut self) {
-        self.cameras.clear();
-    }
-
-    /// `p` in world space: moved by its node's world transform when it has a node.
-    fn placed<T: Copy>(&self, p: &Placed<T>, transformed: fn(&T, Mat4) -> T) -> T {
-        match p.node.and_then(|n| self.nodes.get(n)) {
-            Some(node) => transformed(&p.value, node.world),
-            None => p.value,
-        }
-    }
-}
-
-/// A light or camera: in world space, or in a node's space, following the node.
-#[derive(Clone, Copy, Debug)]
-struct Placed<T> {
-    value: T,
-    node: Option<NodeKey>,
 }
 
 #[cfg(test)]

@@ -352,11 +352,7 @@ pub fn shaders() -> Vec<(&'static str, String)> {
 /// most of the view (what they would add there is zero either way).
 #[must_use]
 pub fn shader(early: bool) -> String {
-    let attribute = if early { " @early_depth_test(force)" } else { "" };
-    let entries = format!(
-        "@fragment{attribute}\nfn fs_quad(in: EdgeVertex) {{\n    quad_fragment(in);\n}}\n\n\
-         @fragment{attribute}\nfn fs_wedge(in: EdgeVertex) {{\n    wedge_fragment(in);\n}}\n"
-    );
-    let passes = format!("{}\n{}\n{entries}", include_str!("coverage.wgsl"), include_str!("wedges.wgsl"));
+    let entries = if early { include_str!("edge_entries_early.wgsl") } else { include_str!("edge_entries.wgsl") };
+    let passes = [include_str!("coverage.wgsl"), include_str!("wedges.wgsl"), entries].join("\n");
     shaders::with_common(&passes)
 }

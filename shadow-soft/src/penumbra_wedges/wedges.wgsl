@@ -64,7 +64,7 @@ fn sum(pos: vec4<f32>, layer: u32) -> f32 {
     return params.eye_counts[layer] + f32(atomicLoad(&occluded[sum_index(pos, layer)])) / SCALE;
 }
 
-// The side quads' fragments (entry point `fs_quad`, made by the host).
+// The side quads' fragments (entry point `fs_quad`, in edge_entries.wgsl).
 fn quad_fragment(in: EdgeVertex) {
     let g = receiver(in.pos);
     if (g.w != 0.0) {
