@@ -399,6 +399,45 @@ mod tests {
     }
 
     #[test]
+    fn a_side_quad_is_drawn_its_margin_beyond_every_point_it_holds() {
+        // Each point of the quad (beyond the edge, between the centre's rays through its ends) lies inside
+        // the drawn quad, in its plane, by at least the margin at the point's distance from the eye: half
+        // a pixel there. Short edges and long, eyes near and far.
+        let c = LIGHT.centre;
+        for k in 0..300 {
+            let (a, far, eye) = (point(20, 3 * k), point(20, 3 * k + 1), point(20, 3 * k + 2));
+            let b = a + (far - a) * [0.002, 0.05, 1.0][k as usize % 3];
+            let pixels = PixelScale { eye: eye * [0.5, 1.0, 8.0][k as usize / 3 % 3], per_distance: 2e-3 };
+            let [[qb, qa, _], _] = side_quad(a, b, c, pixels);
+            let (qa, qb) = (qa.truncate(), qb.truncate());
+            let normal = (a - c).cross(b - c).normalize();
+            // In-plane normals of the drawn quad's three sides, pointing inwards.
+            let inward = |from: Vec3, along: Vec3, towards: Vec3| {
+                let n = along.cross(normal).normalize();
+                if n.dot(towards - from) > 0.0 { n } else { -n }
+            };
+            let sides = [
+                (c, inward(c, qa - c, qb)),
+                (c, inward(c, qb - c, qa)),
+                (qa, inward(qa, qb - qa, a + (a - c) + (b - a) * 0.5)),
+            ];
+            for i in 0..50 {
+                let (t, s) = (hash_unit(pixel_hash(k, 2 * i)), 4.0 * hash_unit(pixel_hash(k, 2 * i + 1)));
+                let on_edge = a + (b - a) * t;
+                let x = on_edge + (on_edge - c) * s;
+                let margin = QUAD_MARGIN_PIXELS * pixels.per_distance * (x - pixels.eye).length();
+                for (n, &(from, inwards)) in sides.iter().enumerate() {
+                    let inside = (x - from).dot(inwards);
+                    assert!(
+                        inside >= 0.999 * margin,
+                        "case {k}, point {i}, side {n}: {inside} inside, margin {margin}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
     fn the_wedge_faces_close_around_the_wedge_facing_out() {
         let (a, b) = (Vec3::new(-1.0, 2.0, 1.0), Vec3::new(1.0, 2.2, 1.0));
         let faces = wedge(a, b, LIGHT).expect("a wedge");
