@@ -51,7 +51,7 @@ fn scenes_json_lists_every_scene() {
 }
 
 #[test]
-fn usage_errors_exit_2() {
+fn bad_usage_exits_2() {
     assert_eq!(shadowlab(&["inspect"]).0, 2);
     assert_eq!(shadowlab(&["frobnicate"]).0, 2);
     let (code, _, err) = shadowlab(&["inspect", "no-such-scene"]);
@@ -191,6 +191,11 @@ fn gpu_tests_that_pass_raise_no_alarm() {
     let all = format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
     assert!(out.status.success() && all.contains("1 passed"), "{all}");
     assert!(!all.lines().any(|l| l.contains("error")), "{all}");
+    // Nor does a test's name, printed beside its "ok".
+    let list = Command::new(std::env::current_exe().expect("the test binary")).arg("--list").output().expect("a list");
+    let names = String::from_utf8_lossy(&list.stdout);
+    let alarming: Vec<&str> = names.lines().filter(|l| l.contains("error")).collect();
+    assert!(alarming.is_empty(), "test names a passing run prints as 'error': {alarming:?}");
 }
 
 #[test]
