@@ -139,10 +139,18 @@ pub fn reference_for(registry: &crate::TechniqueRegistry, techniques: &[Techniqu
 }
 
 /// The registry's reference for soft techniques, or for hard ones.
-fn reference_of(registry: &crate::TechniqueRegistry, soft: bool) -> TechniqueSpec {
+#[must_use]
+pub fn reference_of(registry: &crate::TechniqueRegistry, soft: bool) -> TechniqueSpec {
     let found = registry.entries().iter().find(|e| e.reference && e.soft == soft);
     let builtin = if soft { shadow_soft::AreaLightReference::NAME } else { shadow_hard::RayTraced::NAME };
     TechniqueSpec::named(found.map_or(builtin, |e| e.name))
+}
+
+/// A technique's score against its reference: the RMSE for a soft technique (a penumbra has no lit or
+/// shadowed state to mismatch), the mismatch for a hard one.
+#[must_use]
+pub fn score(metrics: &VisibilityMetrics, soft: bool) -> String {
+    if soft { format!("RMSE {:.4}", metrics.rmse) } else { format!("mismatch {:.3}%", metrics.mismatch * 100.0) }
 }
 
 /// The references of a run: [`reference_for`], and for a mix of hard and soft techniques
@@ -379,9 +387,7 @@ fn measure(
     } else {
         String::new()
     };
-    // Soft techniques are scored by RMSE: a penumbra has no lit/shadowed state to mismatch.
-    let score =
-        if soft { format!("RMSE {:.4}", metrics.rmse) } else { format!("mismatch {:.3}%", metrics.mismatch * 100.0) };
+    let score = score(&metrics, soft);
     sheet.push(SheetItem {
         label: format!("{}\n{given}{} {score}", spec.name, backend.name()),
         picture: run.color.clone(),

@@ -40,6 +40,7 @@ pub(super) enum Overlay {
     Computing {
         key: ViewKey,
         soft: bool,
+        against: TechniqueSpec,
         reference: Receiver<Result<Reference, String>>,
         test: Image<f32>,
         picture: Image<Rgb8>,
@@ -62,13 +63,14 @@ impl Overlay {
     ) -> Self {
         let (send, reference) = std::sync::mpsc::channel();
         let (width, height) = key.size;
+        let against = crate::compare::reference_of(&TechniqueRegistry::builtin(), soft);
+        let spec = against.clone();
         std::thread::spawn(move || {
-            let made = reference_of(&frame, width, height, &TechniqueSpec::named(reference_name(soft)))
-                .map_err(|e| e.to_string());
+            let made = reference_of(&frame, width, height, &spec).map_err(|e| e.to_string());
             // The viewer may have moved on and dropped the receiver: nothing waits for this result then.
             let _ = send.send(made);
         });
-        Self::Computing { key, soft, reference, test, picture }
+        Self::Computing { key, soft, against, reference, test, picture }
     }
 
     /// The inspection of the view of `key`, its debug views as egui textures.
@@ -93,38 +95,30 @@ impl Overlay {
 
     /// Turns a finished comparison into its error map. An error computing the reference is returned.
     pub(super) fn poll(self, ui: &egui::Context) -> Result<Self, String> {
-        let Self::Computing { key, soft, reference, test, picture } = self else { return Ok(self) };
+        let Self::Computing { key, soft, against, reference, test, picture } = self else { return Ok(self) };
         let r = match reference.try_recv() {
             Ok(made) => made?,
-            Err(TryRecvError::Empty) => return Ok(Self::Computing { key, soft, reference, test, picture }),
+            Err(TryRecvError::Empty) => return Ok(Self::Computing { key, soft, against, reference, test, picture }),
             Err(TryRecvError::Disconnected) => return Err("the reference's thread stopped".into()),
         };
         let metrics = compare_visibility(&test, &r.visibility, &r.measured).map_err(|e| e.to_string())?;
         let map = error_map_over(&test, &r.visibility, &r.measured, &r.shown, &picture);
         let texture = ui.load_texture("error map", color_image(&map), Default::default());
-        Ok(Self::Errors { key, texture, score: score_line(&metrics, soft) })
+        Ok(Self::Errors { key, texture, score: score_line(&metrics, soft, &against.name) })
     }
 }
 
-/// The reference a soft technique, or a hard one, is measured against.
-fn reference_name(soft: bool) -> &'static str {
-    if soft { shadow_soft::AreaLightReference::NAME } else { shadow_hard::RayTraced::NAME }
-}
-
-/// What a comparison says, as `compare` scores it: a soft technique by its RMSE against the area-light
-/// reference (a penumbra has no lit or shadowed state to mismatch), a hard one by its mismatch against
-/// the ray-traced one, split into false shadow and false light.
-pub(super) fn score_line(m: &VisibilityMetrics, soft: bool) -> String {
+/// What a comparison says, as `compare` scores it ([`crate::compare::score`]), against `reference`: a
+/// soft technique's RMSE with its mean difference, a hard one's mismatch split into false shadow and false
+/// light.
+fn score_line(m: &VisibilityMetrics, soft: bool, reference: &str) -> String {
     let pc = |f: f64| 100.0 * f;
-    if soft {
-        format!("RMSE {:.4} against {} (mean difference {:.4})", m.rmse, reference_name(true), m.mean_abs)
+    let detail = if soft {
+        format!("mean difference {:.4}", m.mean_abs)
     } else {
-        let (mismatch, shadow, light) = (pc(m.mismatch), pc(m.false_shadow), pc(m.false_light));
-        format!(
-            "mismatch {mismatch:.2}% (false shadow {shadow:.2}%, false light {light:.2}%) against {}",
-            reference_name(false)
-        )
-    }
+        format!("false shadow {:.2}%, false light {:.2}%", pc(m.false_shadow), pc(m.false_light))
+    };
+    format!("{} against {reference} ({detail})", crate::compare::score(m, soft))
 }
 
 /// The reference `spec` renders of `frame`, with the pixels compared.
