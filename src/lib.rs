@@ -15,6 +15,7 @@ pub mod renderer;
 pub mod results;
 pub mod setup;
 pub mod sheet;
+#[cfg(feature = "viewer")]
 pub mod viewer;
 
 use std::path::Path;

@@ -29,6 +29,7 @@ mod scale;
 mod suite;
 mod texel_rule;
 mod view_fitted;
+#[cfg(feature = "viewer")]
 mod viewer;
 mod volume_reconstruction;
 mod wgsl;

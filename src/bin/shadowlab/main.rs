@@ -274,6 +274,7 @@ fn check_availability(renderer: &Renderer, specs: &[TechniqueSpec], choice: &str
     Ok(())
 }
 
+#[cfg(feature = "viewer")]
 fn view(args: &SceneArgs, technique: String, backend: &str, size: &str, script: Option<String>) -> Result<(), Error> {
     use shadowlab::viewer::{ViewerOptions, script::parse};
     let size = parse_size(size).map_err(|e| Error::Usage(e.to_string()))?;
@@ -281,6 +282,12 @@ fn view(args: &SceneArgs, technique: String, backend: &str, size: &str, script: 
     TechniqueRegistry::builtin().canonical(&TechniqueSpec::parse(&technique)?)?;
     let backend = if backend == "cpu" { shadowlab::BackendKind::Cpu } else { shadowlab::BackendKind::Wgpu };
     shadowlab::viewer::run(ViewerOptions { setup: args.setup(), technique, backend, script, size })
+}
+
+/// Without the `viewer` feature there is no window to open: the one line says how to get one.
+#[cfg(not(feature = "viewer"))]
+fn view(_: &SceneArgs, _: String, _: &str, _: &str, _: Option<String>) -> Result<(), Error> {
+    Err(Error::Window("this shadowlab was built without its `viewer` feature (cargo's `--features viewer`)".into()))
 }
 
 /// The `--backend` choice, or the usage error naming what it takes.
