@@ -10,6 +10,7 @@ pub mod clock;
 pub mod context;
 pub mod frame;
 pub mod gbuffer;
+pub mod host_wgsl;
 pub mod passes;
 pub mod pipeline_cache;
 pub mod pipelines;

@@ -9,6 +9,7 @@ mod extrusion;
 mod gpu_clock;
 mod head_on;
 mod host;
+mod host_shading;
 mod hybrid;
 mod moment_maps;
 mod own_pixels;
