@@ -19,7 +19,7 @@ use crate::compare::{CompareJob, CompareReport, run_compare};
 use crate::renderer::{BackendKind, Renderer};
 
 /// The nine configurations' scenes and light radii, then two models from files, then the bleeding case.
-/// A name ending in `.obj` is a file in [`MODELS`], staged on a ground under the default spot light.
+/// A name ending in `.obj` is a file in `MODELS`, staged on a ground under the default spot light.
 const CONFIGURATIONS: [(&str, f32); 12] = [
     ("cylinder", 0.05),
     ("cylinder", 0.1),
@@ -81,7 +81,7 @@ pub struct SoftReport {
     missing: Vec<&'static str>,
 }
 
-/// Built-in scene `name`, or the model file `name` in [`MODELS`] staged with a ground, with its lights'
+/// Built-in scene `name`, or the model file `name` in `MODELS` staged with a ground, with its lights'
 /// radius set to `radius`; `None` for a model file that is not there.
 ///
 /// # Errors

@@ -3,7 +3,7 @@
 //!
 //! The window is winit's, the UI egui's (egui-winit for input, egui-wgpu to draw it), on one wgpu device
 //! that shadowlab's shadows share ([`crate::realtime::RealtimeShadows`] on the viewer's device). The 3D
-//! view is a texture the UI draws ([`view::View`]); a script ([`script`]) can stand in for the user.
+//! view is a texture the UI draws (`view::View`); a script ([`script`]) can stand in for the user.
 
 mod overlay;
 mod panel;

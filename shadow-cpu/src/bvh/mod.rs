@@ -1,6 +1,6 @@
 //! Ray casting for the exact reference: an eight-wide BVH over every casting triangle in world space,
-//! built by the surface area heuristic on every core ([`build`]) and traversed for any hit, eight boxes
-//! or eight triangles per step ([`wide`]). A hit on an alpha-tested triangle counts only where its texel
+//! built by the surface area heuristic on every core (`build`) and traversed for any hit, eight boxes
+//! or eight triangles per step (`wide`). A hit on an alpha-tested triangle counts only where its texel
 //! passes ([`cutout`]); the walk goes on past a clear one.
 
 mod build;

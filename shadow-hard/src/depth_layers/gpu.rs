@@ -29,7 +29,7 @@ struct LayerParams {
     settings: [f32; 4],
 }
 
-/// Pipelines (index: [`Pass::index`]) and the maps of the last build.
+/// Pipelines (index: `Pass::index`) and the maps of the last build.
 pub struct State {
     /// Made with the state but for the cut-out passes, which the first frame with such casters makes.
     passes: Vec<std::cell::OnceCell<wgpu::RenderPipeline>>,

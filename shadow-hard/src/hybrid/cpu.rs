@@ -8,7 +8,7 @@
 //! the volumes are counted z-fail through it, and a silhouette pixel is shadowed where its count is not 0.
 //!
 //! With `caster_masks=on` (the default; ours) each connected component's volume is counted only at the
-//! silhouette pixels its shadow's light-space bounds hold ([`casters`]): its count is zero
+//! silhouette pixels its shadow's light-space bounds hold (`casters`): its count is zero
 //! everywhere else, so the stencil and the picture are the whole mask's, at a fraction of the fragments
 //! where the volumes of many casters cross each other's shadows on screen (cubes, tree, crowd).
 //!

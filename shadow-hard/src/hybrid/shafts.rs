@@ -1,7 +1,7 @@
 //! Caster shafts for `hybrid`'s caster masks (ours, shared by both backends): where in light space one
 //! connected component's shadow can lie.
 //!
-//! A component's volume is closed by itself ([`crate::geometry::volume::VolumePiece`]), so its count is
+//! A component's volume is closed by itself ([`shadow_core::geometry::volume::VolumePiece`]), so its count is
 //! zero at every point outside it. Every point inside lies on a ray from the light through one of the
 //! component's casting faces, beyond it: in light space (where rays from the light are points) within the
 //! convex hull of those faces' corners, so within any outline of the corners, and farther from the light

@@ -56,7 +56,7 @@ const HAMBURGER_BIAS_MOMENTS: [f32; 4] = [0.0, 0.63, 0.0, 0.63];
 
 /// The Hamburger 4MSM shadow intensity (Peters-Klein 2015, algorithm 2): the fraction of the
 /// distribution with moments `b` (of depths in [-1, 1]) nearer the light than `z`, as the canonical
-/// representation through `z` bounds it, after mixing `b` with [`HAMBURGER_BIAS_MOMENTS`] by `alpha`.
+/// representation through `z` bounds it, after mixing `b` with `HAMBURGER_BIAS_MOMENTS` by `alpha`.
 #[must_use]
 pub fn hamburger_shadow(b: [f32; 4], z: f32, alpha: f32) -> f32 {
     let b: [f32; 4] = std::array::from_fn(|k| (1.0 - alpha) * b[k] + alpha * HAMBURGER_BIAS_MOMENTS[k]);

@@ -46,7 +46,7 @@ macro_rules! named_enum {
 
 /// Declares a technique's settings once: each field with the key (or group of keys, such as a depth
 /// map's) it reads, in the order the canonical settings string lists them. The struct, its
-/// [`TechniqueSettings`] (keys, parsing with every value checked against its key's kind, printing) and,
+/// [`TechniqueSettings`](crate::technique::settings::TechniqueSettings) (keys, parsing with every value checked against its key's kind, printing) and,
 /// when given, the light kinds it takes and a check across fields all come from this one table.
 ///
 /// ```
@@ -119,7 +119,7 @@ macro_rules! technique_settings {
 
 /// Declares settings read together as one field of a [`technique_settings!`] table, such as the knobs
 /// of one backend alone: the struct, its keys in order (`KEYS`, the field's keys in the table) and its
-/// [`SettingField`] reading and printing.
+/// [`SettingField`](crate::technique::settings::SettingField) reading and printing.
 ///
 /// ```
 /// use shadow_core::technique::settings::{SettingKey, TechniqueSettings};
