@@ -21,6 +21,12 @@ pub mod viewer;
 use std::path::Path;
 
 pub use error::Error;
+
+/// The README's Rust code, compiled and run as doctests (its "In an application" section).
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;
+
 pub use registry::{RegistryError, TechniqueEntry, TechniqueRegistry};
 pub use renderer::{BackendChoice, BackendKind, Renderer};
 pub use shadow_core as core;

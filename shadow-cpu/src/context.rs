@@ -76,6 +76,54 @@ impl Backend for CpuBackend {
 
 /// What the CPU backend keeps between frames: the ray-casting BVH of the casters (it does not depend on
 /// the light, so it survives a moving light; it is rebuilt when a caster moves or changes).
+///
+/// A technique of one's own on the CPU backend, here hard shadows by one ray per pixel through the
+/// context's BVH, rendered in a frame:
+///
+/// ```
+/// use shadow_core::scenes::{self, SceneParams};
+/// use shadow_core::technique::{LightPass, ShadowTechnique, Stateful};
+/// use shadow_core::{FrameInputs, Image};
+/// use shadow_cpu::{CpuBackend, CpuContext, CpuError, GBuffer};
+///
+/// struct Rays;
+///
+/// impl ShadowTechnique<CpuBackend> for Rays {
+///     type State = ();
+///
+///     fn name(&self) -> &'static str {
+///         "rays"
+///     }
+///
+///     fn create_state(&self, _: &mut CpuContext) -> Result<(), CpuError> {
+///         Ok(())
+///     }
+///
+///     fn build(&self, _: &mut CpuContext, _: &mut (), _: LightPass<'_>) -> Result<(), CpuError> {
+///         Ok(())
+///     }
+///
+///     fn query(&self, cx: &mut CpuContext, _: &mut (), pass: LightPass<'_>, g: &GBuffer, out: &mut Image<f32>) -> Result<(), CpuError> {
+///         let (bvh, light) = (cx.bvh(pass.frame), &pass.light.light);
+///         for (i, v) in out.data_mut().iter_mut().enumerate() {
+///             if g.receiver.data()[i] {
+///                 // Off the surface a little, towards its seen side, so it does not shadow itself.
+///                 let p = g.position.data()[i] + g.geometric_normal.data()[i] * 1e-3;
+///                 let reach = light.position().map_or(f32::INFINITY, |l| l.distance(p));
+///                 *v = f32::from(u8::from(!bvh.occluded(p, light.to_light(p), reach)));
+///             }
+///         }
+///         Ok(())
+///     }
+/// }
+///
+/// let frame = FrameInputs::from_first_camera(&scenes::build("cubes", &SceneParams::default())?)?;
+/// let mut cx = CpuContext::new();
+/// let rendered = shadow_cpu::frame::render_frame(&mut cx, &frame, 160, 120, &mut Stateful::new(Rays, String::new()))?;
+/// let visibility = rendered.visibility[0].data();
+/// assert!(visibility.contains(&0.0) && visibility.contains(&1.0));
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 #[derive(Default)]
 pub struct CpuContext {
     bvh: Option<(u64, Arc<SceneBvh>)>,

@@ -173,6 +173,25 @@ impl AdapterSummary {
 }
 
 /// Device, queue and what the adapter can do.
+///
+/// A context on a device of its own (where the machine has an adapter), and the G-buffer of a scene
+/// drawn on it; [`WgpuContext::from_host`] takes an application's device instead.
+///
+/// ```
+/// use shadow_core::FrameInputs;
+/// use shadow_core::scenes::{self, SceneParams};
+/// use shadow_wgpu::{AdapterChoice, WgpuContext};
+///
+/// let Ok(mut cx) = WgpuContext::new(&AdapterChoice { allow_software: true, ..Default::default() }) else {
+/// #   assert_ne!(std::env::var("SHADOWLAB_REQUIRE_GPU").as_deref(), Ok("1"), "no wgpu adapter");
+///     return Ok(()); // no adapter on this machine
+/// };
+/// let frame = FrameInputs::from_first_camera(&scenes::build("cubes", &SceneParams::default())?)?;
+/// let g = shadow_wgpu::gbuffer::render(&mut cx, &frame, 160, 120)?;
+/// let depth = shadow_wgpu::readback::read_f32(&cx, &g.depth, 0, wgpu::TextureAspect::DepthOnly)?;
+/// assert!(depth.data().iter().any(|&d| d < 1.0), "nothing drawn");
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 pub struct WgpuContext {
     /// The adapter's description.
     pub adapter: AdapterSummary,

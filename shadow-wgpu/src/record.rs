@@ -26,6 +26,73 @@ use crate::timer::{FrameTimer, FrameTimes};
 /// Records frames into a host's encoder, keeping what it made for them: the visibility targets (remade
 /// when the view's size or the number of lights changes) and a shading pipeline per
 /// colour format.
+///
+/// A frame recorded into an encoder with a technique of one's own, here a shadow map filtered by a 3x3
+/// PCF kernel through the backend's shared map passes:
+///
+/// ```
+/// use shadow_core::FrameInputs;
+/// use shadow_core::scenes::{self, SceneParams};
+/// use shadow_core::technique::maps::DepthMap;
+/// use shadow_core::technique::settings::BiasMode;
+/// use shadow_core::technique::settings::Filter;
+/// use shadow_core::technique::{LightPass, ShadowTechnique, Stateful, TechniqueError};
+/// use shadow_wgpu::passes::maps::{DepthMaps, MapQuery, QueryExtras};
+/// use shadow_wgpu::{AdapterChoice, ColorTarget, FrameRecorder, GpuGBuffer, GpuVisibility};
+/// use shadow_wgpu::{WgpuBackend, WgpuContext, WgpuError, shaders};
+///
+/// struct Pcf;
+///
+/// impl ShadowTechnique<WgpuBackend> for Pcf {
+///     type State = (DepthMaps, MapQuery);
+///
+///     fn name(&self) -> &'static str {
+///         "pcf"
+///     }
+///
+///     fn create_state(&self, cx: &mut WgpuContext) -> Result<Self::State, WgpuError> {
+///         let module = cx.pipelines.module("shadow_map", shaders::shadow_map());
+///         let map = DepthMap { resolution: 1024, bias: BiasMode::Slope, bias_constant: 16.0, bias_slope: 2.0, bias_world: 0.0 };
+///         Ok((DepthMaps::with_module(cx, &module, &map), MapQuery::new(cx, &module, Filter::Pcf3x3)))
+///     }
+///
+///     fn build(&self, cx: &mut WgpuContext, (maps, _): &mut Self::State, pass: LightPass<'_>) -> Result<(), WgpuError> {
+///         maps.render(cx, pass.frame, pass.light, 1024)
+///     }
+///
+///     fn query(
+///         &self,
+///         cx: &mut WgpuContext,
+///         (maps, query): &mut Self::State,
+///         pass: LightPass<'_>,
+///         g: &GpuGBuffer,
+///         out: &mut GpuVisibility,
+///     ) -> Result<(), WgpuError> {
+///         let maps = maps.maps().ok_or_else(|| TechniqueError::NotBuilt("pcf".into()))?;
+///         query.run(cx, maps, pass.light, g, out, &QueryExtras::NONE)
+///     }
+/// }
+///
+/// let Ok(mut cx) = WgpuContext::new(&AdapterChoice { allow_software: true, ..Default::default() }) else {
+/// #   assert_ne!(std::env::var("SHADOWLAB_REQUIRE_GPU").as_deref(), Ok("1"), "no wgpu adapter");
+///     return Ok(()); // no adapter on this machine
+/// };
+/// let frame = FrameInputs::from_first_camera(&scenes::build("cubes", &SceneParams::default())?)?;
+/// let format = wgpu::TextureFormat::Rgba8UnormSrgb;
+/// let texture = shadow_wgpu::frame::layered(&cx, "target", 320, 240, 1, format);
+/// let view = texture.create_view(&Default::default());
+/// let mut recorder = FrameRecorder::new();
+/// let mut technique = Stateful::new(Pcf, String::new());
+/// let mut encoder = cx.device.create_command_encoder(&Default::default());
+/// let target = ColorTarget { view: &view, format, width: 320, height: 240 };
+/// recorder.record(&mut cx, &mut encoder, &frame, &mut technique, &target)?;
+/// cx.queue.submit([encoder.finish()]);
+/// // The picture is in `texture`; each light's visibility stays for engines that shade themselves.
+/// let layers = recorder.visibility().expect("a recorded frame");
+/// let visibility = shadow_wgpu::readback::read_f32(&cx, layers, 0, wgpu::TextureAspect::All)?;
+/// assert!(visibility.data().contains(&0.0) && visibility.data().contains(&1.0));
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 #[derive(Default)]
 pub struct FrameRecorder {
     visibility: Option<Visibility>,

@@ -129,6 +129,24 @@ struct MeshEntry {
 }
 
 /// The scene: nodes, meshes, materials, lights and cameras.
+///
+/// ```
+/// use shadow_core::glam::{Mat4, Vec3};
+/// use shadow_core::{Camera, FrameInputs, Light, Material, Scene, procedural};
+///
+/// let mut scene = Scene::new();
+/// let ground = scene.add_mesh(procedural::plane(10.0, 10.0)?);
+/// let cube = scene.add_mesh(procedural::cuboid(Vec3::ONE)?);
+/// let grey = scene.add_material(Material::colored("grey", Vec3::splat(0.8)));
+/// scene.add_instance("ground", ground, grey, Mat4::IDENTITY)?;
+/// scene.add_instance("cube", cube, grey, Mat4::from_translation(Vec3::new(0.0, 0.5, 0.0)))?;
+/// scene.add_light(Light::spot(Vec3::new(3.0, 6.0, 2.0), Vec3::ZERO, 60.0));
+/// scene.add_camera(Camera::look_at(Vec3::new(6.0, 4.0, 6.0), Vec3::ZERO, 45.0));
+/// // What a backend renders: the drawn instances in world space, the camera and the lights.
+/// let frame = FrameInputs::from_first_camera(&scene)?;
+/// assert_eq!((frame.instances.len(), frame.lights.len()), (2, 1));
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 #[derive(Default)]
 pub struct Scene {
     nodes: SlotMap<NodeKey, Node>,

@@ -152,6 +152,51 @@ pub struct DebugView {
 }
 
 /// A shadow technique on backend `B`: a build phase per light, then a query phase per view.
+///
+/// A technique is written once per backend (`impl ShadowTechnique<CpuBackend>` in shadow-cpu's terms,
+/// `ShadowTechnique<WgpuBackend>` in shadow-wgpu's; their crates' docs show one each), or once for every
+/// backend, as this wrapper that counts the builds of the technique it wraps:
+///
+/// ```
+/// use std::sync::atomic::{AtomicUsize, Ordering};
+/// use shadow_core::technique::{Backend, LightPass, ShadowTechnique};
+///
+/// struct Counted<T> {
+///     inner: T,
+///     builds: AtomicUsize,
+/// }
+///
+/// impl<B: Backend, T: ShadowTechnique<B>> ShadowTechnique<B> for Counted<T> {
+///     type State = T::State;
+///
+///     fn name(&self) -> &'static str {
+///         self.inner.name()
+///     }
+///
+///     fn create_state(&self, cx: &mut B::Context) -> Result<T::State, B::Error> {
+///         self.inner.create_state(cx)
+///     }
+///
+///     fn build(&self, cx: &mut B::Context, state: &mut T::State, pass: LightPass<'_>) -> Result<(), B::Error> {
+///         self.builds.fetch_add(1, Ordering::Relaxed);
+///         self.inner.build(cx, state, pass)
+///     }
+///
+///     fn query(
+///         &self,
+///         cx: &mut B::Context,
+///         state: &mut T::State,
+///         pass: LightPass<'_>,
+///         gbuffer: &B::GBuffer,
+///         out: &mut B::Visibility,
+///     ) -> Result<(), B::Error> {
+///         self.inner.query(cx, state, pass, gbuffer, out)
+///     }
+/// }
+/// ```
+///
+/// [`Stateful`] gives it a state per light and the object-safe [`DynShadowTechnique`] face that frames and
+/// registries take.
 pub trait ShadowTechnique<B: Backend>: Send + Sync {
     /// What the technique keeps between frames: pipelines, maps, buffers.
     type State: Send;
