@@ -117,6 +117,13 @@ impl RealtimeShadows {
         self.recorder.visibility()
     }
 
+    /// The depth maps light `light` of the last frame was shadowed through, where its technique lends
+    /// them (see [`FrameRecorder::map`]).
+    #[must_use]
+    pub fn map(&self, light: usize) -> Option<&shadow_wgpu::HostMap> {
+        self.recorder.map(light)
+    }
+
     /// shadowlab's context on the host's device.
     #[must_use]
     pub fn context(&self) -> &WgpuContext {

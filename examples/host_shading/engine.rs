@@ -387,7 +387,7 @@ fn gpu_light(light: &shadow_core::Light) -> GpuLight {
 pub type Failure = Box<dyn std::error::Error>;
 
 /// The engine's device, as it would make it for itself, with what shadowlab needs of it.
-fn device() -> Result<(wgpu::Adapter, wgpu::Device, wgpu::Queue), Failure> {
+pub fn device() -> Result<(wgpu::Adapter, wgpu::Device, wgpu::Queue), Failure> {
     let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle());
     let adapters = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::PRIMARY));
     let adapter = adapters.into_iter().find(WgpuContext::can_use).ok_or("no adapter shadowlab can use")?;

@@ -221,6 +221,8 @@ pub struct WgpuContext {
     /// The format of the G-buffer's depth and the volumes' stencil: Depth32FloatStencil8 where the
     /// device has it, Depth24PlusStencil8 otherwise.
     pub depth_stencil: wgpu::TextureFormat,
+    /// The maps the lights' techniques lend to a host while a frame is recorded.
+    pub(crate) host_maps: crate::host_maps::Capture,
 }
 
 /// The instance. On a headless Linux machine without `XDG_RUNTIME_DIR`, listing its Vulkan adapters makes
@@ -454,6 +456,7 @@ impl WgpuContext {
             gbuffer_targets: None,
             resources: Default::default(),
             depth_stencil,
+            host_maps: Default::default(),
         }
     }
 

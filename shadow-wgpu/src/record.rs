@@ -5,7 +5,9 @@
 //! ([`WgpuContext::instrumented`]).
 //!
 //! An engine that renders its own depth and normals and shades itself lends them in place of the G-buffer
-//! pass ([`FrameRecorder::record_visibility`]) and reads each light's visibility.
+//! pass ([`FrameRecorder::record_visibility`]) and reads each light's visibility, or looks into the
+//! depth maps of the techniques that lend them itself ([`FrameRecorder::map`]), both in WGSL of its
+//! own ([`crate::host_wgsl`]).
 //!
 //! A technique that needs the GPU's results within the frame (one reconstructing on the CPU from a map
 //! it reads back, or drawing in rectangles read back from the GPU) fails here with
@@ -13,13 +15,14 @@
 
 use std::collections::HashMap;
 
-use shadow_core::script::{FrameRun, FrameSteps, LightTechniques, run_frame};
+use shadow_core::script::{FrameSteps, LightTechniques, run_frame};
 use shadow_core::technique::FrameStats;
 use shadow_core::{FrameInputs, LightView};
 
 use crate::context::{WgpuBackend, WgpuContext, WgpuError};
 use crate::frame::{GpuVisibility, check_lights, clear_lit, full_screen_shade, layer_view, layered, shade_group};
 use crate::gbuffer::{self, GpuGBuffer, HostSurfaces, ImportPass};
+use crate::host_maps::HostMap;
 use crate::pipelines::{VISIBILITY, full_screen_pipeline};
 use crate::timer::{FrameTimer, FrameTimes};
 
@@ -101,6 +104,8 @@ pub struct FrameRecorder {
     import: Option<ImportPass>,
     /// With frames timed: their GPU times, read back frames later.
     timer: Option<FrameTimer>,
+    /// The maps each light of the last frame lent (see [`Self::map`]).
+    maps: Vec<Option<HostMap>>,
 }
 
 /// Every light's visibility, a layer each of one R32Float array texture (1 lit, 0 shadowed).
@@ -199,8 +204,10 @@ impl FrameRecorder {
             Surfaces::Host(host) => (Some((host, &*self.import.get_or_insert_with(|| ImportPass::new(cx)))), None),
         };
         let steps = RecordSteps { width, height, visibility, host, shade, timer: self.timer.as_mut() };
-        let FrameRun { light_views, .. } = cx.record_into(encoder, |cx| run_frame(cx, frame, steps, techniques))?;
-        Ok(light_views)
+        cx.host_maps.begin(frame.lights.len());
+        let run = cx.record_into(encoder, |cx| run_frame(cx, frame, steps, techniques));
+        self.maps = cx.host_maps.end();
+        Ok(run?.light_views)
     }
 
     /// Times every frame on the GPU from now on (or stops): timestamps at its start, after the G-buffer,
@@ -218,6 +225,15 @@ impl FrameRecorder {
     #[must_use]
     pub fn gpu_times(&self) -> Option<&FrameTimes> {
         self.timer.as_ref().and_then(FrameTimer::last)
+    }
+
+    /// The depth maps light `light` of the last recorded frame was shadowed through, and how to look into
+    /// them, where its technique lends them (`shadow-map`, cascades, LiSPSM, perspective shadow maps;
+    /// see [`crate::host_maps`]): for a host that samples them in its own shader with
+    /// `host_wgsl::MAPS`. `None` for other techniques and lights past the frame's.
+    #[must_use]
+    pub fn map(&self, light: usize) -> Option<&HostMap> {
+        self.maps.get(light).and_then(Option::as_ref)
     }
 
     /// The last recorded frame's visibility, a layer per light (R32Float: 1 lit, 0 shadowed), for engines
@@ -299,7 +315,8 @@ impl FrameSteps<WgpuBackend> for RecordSteps<'_> {
         Ok(g)
     }
 
-    fn visibility(&mut self, _cx: &mut WgpuContext, k: usize) -> Result<GpuVisibility, WgpuError> {
+    fn visibility(&mut self, cx: &mut WgpuContext, k: usize) -> Result<GpuVisibility, WgpuError> {
+        cx.host_maps.light(k);
         Ok(GpuVisibility { view: layer_view(self.visibility, k as u32), width: self.width, height: self.height })
     }
 

@@ -27,10 +27,12 @@ impl ShadowTechnique<WgpuBackend> for ShadowMap {
             let module = cx.pipelines.module("shadow_map", shaders::shadow_map());
             State {
                 maps: DepthMaps::with_module(cx, &module, &self.map()),
-                query: MapQuery::new(cx, &module, self.filter).with_lookup(LookupParams {
-                    radius: self.filter_radius,
-                    receiver_offset: self.map().receiver_offset(),
-                }),
+                query: MapQuery::new(cx, &module, self.filter)
+                    .with_lookup(LookupParams {
+                        radius: self.filter_radius,
+                        receiver_offset: self.map().receiver_offset(),
+                    })
+                    .lent_to_hosts(),
             }
         })
     }

@@ -22,7 +22,7 @@ impl ViewMaps {
         let module = cx.pipelines.module("shadow_map", shaders::shadow_map());
         Self {
             maps: DepthMaps::with_module(cx, &module, map),
-            query: MapQuery::new(cx, &module, filter).with_lookup(lookup),
+            query: MapQuery::new(cx, &module, filter).with_lookup(lookup).lent_to_hosts(),
             view: None,
         }
     }

@@ -20,10 +20,11 @@ use crate::pipelines::{
 };
 use crate::shaders;
 
-/// GPU twin of `MapParams` in shadow_map.wgsl.
+/// How a map lookup reads one light's maps: GPU twin of `MapParams` in shadow_map.wgsl, and of
+/// `ShadowlabMap` in the host module (`host_wgsl::MAPS`), which reads the filter from `settings.x`.
 #[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-struct MapParams {
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct MapParams {
     proj: [[[f32; 4]; 4]; 6],
     light: LightRaw,
     settings: [f32; 4],
@@ -81,15 +82,8 @@ impl MapBindings {
         ];
         entries.extend_from_slice(extra);
         let layout = cx.pipelines.group_layout("map query", &entries);
-        let sampler = cx.device.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("shadow comparison"),
-            address_mode_u: wgpu::AddressMode::ClampToEdge,
-            address_mode_v: wgpu::AddressMode::ClampToEdge,
-            mag_filter: wgpu::FilterMode::Linear,
-            min_filter: wgpu::FilterMode::Linear,
-            compare: Some(wgpu::CompareFunction::LessEqual),
-            ..Default::default()
-        });
+        // The sampler a host's lookup into lent maps makes too: the bilinear taps compare alike.
+        let sampler = cx.device.create_sampler(&crate::HostMap::sampler_descriptor());
         Self { layout, sampler }
     }
 
@@ -110,27 +104,7 @@ impl MapBindings {
         lookup: LookupParams,
         extras: &QueryExtras<'_>,
     ) -> wgpu::BindGroup {
-        let (mut proj, mut planes) = ([[[0.0f32; 4]; 4]; 6], [[[0.0f32; 4]; 4]; 6]);
-        for ((slot, plane), p) in proj.iter_mut().zip(&mut planes).zip(&light.projections) {
-            *slot = p.clip_from_world.to_cols_array_2d();
-            *plane = p.clip_plane_from_world_plane.to_cols_array_2d();
-        }
-        let (mut cascade, mut cascade_axis, mut cascade_far) = ([0.0f32; 4], [0.0f32; 4], [0.0f32; 4]);
-        if let Some(c) = &light.cascades {
-            cascade = [c.far.len() as f32, c.blend, c.near, 0.0];
-            cascade_axis = c.axis.extend(-c.axis.dot(c.eye)).to_array();
-            cascade_far[..c.far.len()].copy_from_slice(&c.far);
-        }
-        let params = MapParams {
-            proj,
-            light: LightRaw::from(&light.light),
-            settings: [0.0, lookup.radius, maps.width() as f32, lookup.receiver_offset],
-            planes,
-            extra: extras.settings,
-            cascade,
-            cascade_axis,
-            cascade_far,
-        };
+        let params = map_params(maps, light, lookup, extras.settings, None);
         let params = cx.transient(bytemuck::bytes_of(&params));
         let maps_view = maps.create_view(&wgpu::TextureViewDescriptor {
             dimension: Some(wgpu::TextureViewDimension::D2Array),
@@ -151,12 +125,49 @@ impl MapBindings {
     }
 }
 
+/// The parameters of a lookup into `maps` (one layer per projection of `light`), with `filter` in
+/// `settings.x` where a host reads it (the backend's own query compiles its filter in).
+fn map_params(
+    maps: &wgpu::Texture,
+    light: &LightView,
+    lookup: LookupParams,
+    extra: [f32; 4],
+    filter: Option<Filter>,
+) -> MapParams {
+    let (mut proj, mut planes) = ([[[0.0f32; 4]; 4]; 6], [[[0.0f32; 4]; 4]; 6]);
+    for ((slot, plane), p) in proj.iter_mut().zip(&mut planes).zip(&light.projections) {
+        *slot = p.clip_from_world.to_cols_array_2d();
+        *plane = p.clip_plane_from_world_plane.to_cols_array_2d();
+    }
+    let (mut cascade, mut cascade_axis, mut cascade_far) = ([0.0f32; 4], [0.0f32; 4], [0.0f32; 4]);
+    if let Some(c) = &light.cascades {
+        cascade = [c.far.len() as f32, c.blend, c.near, 0.0];
+        cascade_axis = c.axis.extend(-c.axis.dot(c.eye)).to_array();
+        cascade_far[..c.far.len()].copy_from_slice(&c.far);
+    }
+    let filter = filter.map_or(0.0, |f| filter_code(f) as f32);
+    MapParams {
+        proj,
+        light: LightRaw::from(&light.light),
+        settings: [filter, lookup.radius, maps.width() as f32, lookup.receiver_offset],
+        planes,
+        extra,
+        cascade,
+        cascade_axis,
+        cascade_far,
+    }
+}
+
 /// The lookup every map-based technique shares (twin: `query_maps` in shadow-cpu): a full-screen pass
 /// running `shadow_lookup` of shadow_map.wgsl over the G-buffer.
 pub struct MapQuery {
     pipeline: wgpu::RenderPipeline,
     bindings: MapBindings,
     lookup: LookupParams,
+    /// The filter of the plain lookup (`None` for a technique's own entry).
+    filter: Option<Filter>,
+    /// Whether a recorded frame lends the maps to the host ([`Self::lent_to_hosts`]).
+    lent: bool,
 }
 
 impl MapQuery {
@@ -164,7 +175,8 @@ impl MapQuery {
     #[must_use]
     pub fn new(cx: &WgpuContext, module: &wgpu::ShaderModule, filter: Filter) -> Self {
         let constants = [("FILTER", filter_code(filter))];
-        Self::with_entry(cx, module, FragmentEntry { name: "fs_shadow_map_query", constants: &constants }, &[])
+        let entry = FragmentEntry { name: "fs_shadow_map_query", constants: &constants };
+        Self { filter: Some(filter), ..Self::with_entry(cx, module, entry, &[]) }
     }
 
     /// A query pipeline running `entry` of `module` (the shadow-map shader with more after it), with the
@@ -186,7 +198,7 @@ impl MapQuery {
             Some(VISIBILITY),
             None,
         );
-        Self { pipeline, bindings, lookup: LookupParams::default() }
+        Self { pipeline, bindings, lookup: LookupParams::default(), filter: None, lent: false }
     }
 
     /// The same query, reading the maps with `lookup` (the kernel radius and the receiver offset its
@@ -194,6 +206,14 @@ impl MapQuery {
     #[must_use]
     pub fn with_lookup(self, lookup: LookupParams) -> Self {
         Self { lookup, ..self }
+    }
+
+    /// The same query, lending its maps to a host in recorded frames
+    /// ([`FrameRecorder::map`](crate::FrameRecorder::map)): for a technique whose visibility is this one
+    /// plain lookup and nothing more. A technique's own entry lends nothing.
+    #[must_use]
+    pub fn lent_to_hosts(self) -> Self {
+        Self { lent: self.filter.is_some(), ..self }
     }
 
     /// Writes the visibility of every receiver through the maps (one layer per light projection).
@@ -209,6 +229,13 @@ impl MapQuery {
         out: &GpuVisibility,
         extras: &QueryExtras<'_>,
     ) -> Result<(), WgpuError> {
+        if let (true, Some(filter)) = (self.lent, self.filter) {
+            cx.host_maps.lend(|| crate::HostMap {
+                texture: maps.clone(),
+                params: map_params(maps, light, self.lookup, extras.settings, Some(filter)),
+                filter,
+            });
+        }
         cx.scoped("the shadow-map query", |cx| {
             let group = self.bindings.group(cx, maps, light, g, self.lookup, extras);
             super::full_screen(cx, "map query", &out.view, &self.pipeline, &[&g.frame_group, &group], None);
