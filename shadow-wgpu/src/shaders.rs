@@ -98,5 +98,11 @@ pub fn all() -> Vec<(&'static str, String)> {
         ("shadow_volume", shadow_volume()),
         ("extrusion", extrusion()),
         ("texel", TEXEL.to_string()),
+        // The host modules, each before a host's shader that uses it.
+        (
+            "host visibility",
+            format!("{}\n{}", crate::host_wgsl::VISIBILITY, include_str!("shaders/host/test_host.wgsl")),
+        ),
+        ("host maps", format!("{}\n{}", crate::host_wgsl::MAPS, include_str!("shaders/host/test_host_maps.wgsl"))),
     ]
 }
