@@ -124,25 +124,7 @@ fn looked_up_and_recorded(frame: &FrameInputs, spec: &str, (width, height): (u32
             wgpu::BindGroupEntry { binding: 4, resource: camera.as_entire_binding() },
         ],
     });
-    {
-        let view = target.create_view(&Default::default());
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("host maps"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::BLACK), store: wgpu::StoreOp::Store },
-            })],
-            depth_stencil_attachment: None,
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        pass.set_pipeline(&pipeline);
-        pass.set_bind_group(0, &group, &[]);
-        pass.draw(0..3, 0..1);
-    }
+    engine::full_screen(&mut encoder, &target.create_view(&Default::default()), &pipeline, &group);
     queue.submit([encoder.finish()]);
     let looked_up = read_f32(&cx, &target, 0, wgpu::TextureAspect::All).expect("read back");
     let layers = recorder.visibility().expect("recorded visibility");

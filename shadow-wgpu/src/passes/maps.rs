@@ -104,8 +104,19 @@ impl MapBindings {
         lookup: LookupParams,
         extras: &QueryExtras<'_>,
     ) -> wgpu::BindGroup {
-        let params = map_params(maps, light, lookup, extras.settings, None);
-        let params = cx.transient(bytemuck::bytes_of(&params));
+        self.group_of(cx, maps, &map_params(maps, light, lookup, extras.settings, None), g, extras)
+    }
+
+    /// [`Self::group`] with the lookup's parameters made already.
+    fn group_of(
+        &self,
+        cx: &WgpuContext,
+        maps: &wgpu::Texture,
+        params: &MapParams,
+        g: &GpuGBuffer,
+        extras: &QueryExtras<'_>,
+    ) -> wgpu::BindGroup {
+        let params = cx.transient(bytemuck::bytes_of(params));
         let maps_view = maps.create_view(&wgpu::TextureViewDescriptor {
             dimension: Some(wgpu::TextureViewDimension::D2Array),
             ..Default::default()
@@ -229,15 +240,14 @@ impl MapQuery {
         out: &GpuVisibility,
         extras: &QueryExtras<'_>,
     ) -> Result<(), WgpuError> {
-        if let (true, Some(filter)) = (self.lent, self.filter) {
-            cx.host_maps.lend(|| crate::HostMap {
-                texture: maps.clone(),
-                params: map_params(maps, light, self.lookup, extras.settings, Some(filter)),
-                filter,
-            });
+        // The filter rides in `settings.x` for a host; the backend's own query compiles it in.
+        let lent = self.filter.filter(|_| self.lent);
+        let params = map_params(maps, light, self.lookup, extras.settings, lent);
+        if let Some(filter) = lent {
+            cx.host_maps.lend(|| crate::HostMap { texture: maps.clone(), params, filter });
         }
         cx.scoped("the shadow-map query", |cx| {
-            let group = self.bindings.group(cx, maps, light, g, self.lookup, extras);
+            let group = self.bindings.group_of(cx, maps, &params, g, extras);
             super::full_screen(cx, "map query", &out.view, &self.pipeline, &[&g.frame_group, &group], None);
         })
     }
