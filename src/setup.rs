@@ -175,6 +175,8 @@ pub struct SceneSetup {
     pub light: Option<String>,
     /// Which files a model file may name besides itself.
     pub file_access: FileAccess,
+    /// Pose the scene's animations at this time in seconds; at rest (as built or loaded) without one.
+    pub time: Option<f32>,
 }
 
 impl SceneSetup {
@@ -188,6 +190,7 @@ impl SceneSetup {
             camera: None,
             light: None,
             file_access: FileAccess::default(),
+            time: None,
         }
     }
 
@@ -198,6 +201,12 @@ impl SceneSetup {
     pub fn build(&self) -> Result<Scene, SetupError> {
         let options = LoadOptions { file_access: self.file_access, ..LoadOptions::default() };
         let mut scene = load_scene_with(&self.source, &self.params, self.ground, &options)?;
+        if let Some(t) = self.time {
+            if scene.animations().next().is_none() {
+                scene.add_warning(format!("{}: no animations to pose at {t} s; shown as it stands", self.source));
+            }
+            scene.pose(t).map_err(|e| OptionError { flag: "--time", value: t.to_string(), why: e.to_string() })?;
+        }
         if let Some(c) = &self.camera {
             let cam = parse_camera(c)?;
             scene.clear_cameras();

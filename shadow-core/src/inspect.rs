@@ -34,6 +34,23 @@ pub struct Inspection {
     pub meshes: usize,
     /// Of those, the meshes that carry texture coordinates.
     pub meshes_with_uvs: usize,
+    /// The scene's animations, in the order they were added.
+    pub animations: Vec<AnimationStats>,
+}
+
+/// One animation as `inspect` reports it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AnimationStats {
+    /// Its name.
+    pub name: String,
+    /// The time of its last key, in seconds.
+    pub duration: f32,
+    /// Its channels.
+    pub channels: usize,
+    /// The nodes they move.
+    pub nodes: usize,
+    /// The interpolations its channels use, each named once, in glTF's names.
+    pub interpolations: Vec<&'static str>,
 }
 
 /// One material as `inspect` reports it.
@@ -82,7 +99,26 @@ impl Inspection {
             materials: Vec::new(),
             meshes: 0,
             meshes_with_uvs: 0,
+            animations: Vec::new(),
         };
+        for (_, a) in scene.animations() {
+            let mut nodes: Vec<_> = a.channels().iter().map(|c| c.node).collect();
+            nodes.sort_unstable();
+            nodes.dedup();
+            let mut interpolations: Vec<&'static str> = Vec::new();
+            for c in a.channels() {
+                if !interpolations.contains(&c.interpolation.name()) {
+                    interpolations.push(c.interpolation.name());
+                }
+            }
+            out.animations.push(AnimationStats {
+                name: a.name().to_string(),
+                duration: a.duration(),
+                channels: a.channels().len(),
+                nodes: nodes.len(),
+                interpolations,
+            });
+        }
         let mut texture_index = std::collections::HashMap::new();
         for (key, t) in scene.textures() {
             texture_index.insert(key, out.textures.len());

@@ -394,3 +394,38 @@ fn inspect_lists_a_textured_cards_material_and_texture_and_names_a_bad_image() {
     assert_eq!((code, err.as_str()), (0, ""));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `--time` poses the scene's animations: the mill's rotor throws its shadow elsewhere a second later,
+/// `inspect` lists the clip, a time that is not a number is a usage error, and a scene with nothing to
+/// pose says so.
+#[test]
+fn time_poses_the_animations_and_inspect_lists_them() {
+    let dir = std::env::temp_dir().join(format!("shadowlab-cli-time-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let vis = |t: &str| {
+        let out = dir.join(format!("mill-{t}.png"));
+        let args = ["render", "--scene", "mill", "--backend", "cpu", "--technique", "ray-traced", "--size", "96x96"];
+        let (code, _, err) = shadowlab(&[&args[..], &["--time", t, "-o", out.to_str().unwrap()]].concat());
+        assert_eq!(code, 0, "{err}");
+        let png = shadow_core::Image::<[u8; 3]>::load_png(out.with_extension("vis.png")).unwrap();
+        let pixels: Vec<u8> = png.data().iter().map(|p| p[0]).collect();
+        assert!(pixels.iter().any(|&p| p < 128) && pixels.iter().any(|&p| p > 128), "a shadow and light at {t}");
+        pixels
+    };
+    assert_ne!(vis("0"), vis("1"), "the rotor has turned");
+    let (code, out, err) = shadowlab(&["inspect", "mill", "--json"]);
+    assert_eq!(code, 0, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["animations"][0]["name"], "spin");
+    assert_eq!(v["animations"][0]["duration_s"], 6.0);
+    let (code, _, err) = shadowlab(&["render", "--scene", "mill", "--time", "soon"]);
+    assert_eq!(code, 2);
+    assert!(err.contains("'soon' is not a number of seconds"), "{err}");
+    let out = dir.join("still.png");
+    let args = ["render", "--scene", "cylinder", "--backend", "cpu", "--technique", "ray-traced", "--size", "32x32"];
+    let (code, _, err) = shadowlab(&[&args[..], &["--time", "2", "-o", out.to_str().unwrap()]].concat());
+    assert_eq!(code, 0, "{err}");
+    assert!(err.contains("cylinder: no animations to pose at 2 s"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

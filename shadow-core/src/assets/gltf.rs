@@ -2,7 +2,8 @@
 //! TRS; every triangle primitive (lists, strips, fans) with u8, u16, u32 or no indices; the base colour
 //! factor and texture (PNG or JPEG, from a buffer view, a data URI or a file beside the model) with its
 //! sampler, texture coordinates and `KHR_texture_transform`; the alpha mode and cutoff;
-//! double-sidedness; perspective cameras and KHR_lights_punctual lights.
+//! double-sidedness; perspective cameras and KHR_lights_punctual lights; animations of nodes' translation,
+//! rotation and scale.
 //!
 //! The gltf crate parses and validates the JSON (index ranges, enum values). Everything that touches
 //! bytes is done here, with bounds checks: the GLB container, buffer sources, and accessor reads (offsets,
@@ -20,6 +21,7 @@ use crate::material::{AlphaMode, Filter, Sampler, TextureRef, UvTransform, Wrap}
 use crate::mesh::{MAX_COORDINATE, Mesh};
 use crate::scene::{Camera, Light, LightKind, Material, MaterialKey, MeshKey, NodeKey, Scene};
 
+mod animation;
 mod bytes;
 
 use bytes::{assemble, base64_decode, load_buffers, percent_decode, read_indices, read_uvs, read_vec3, split_glb};
@@ -72,6 +74,8 @@ struct Loader<'a> {
     dir: &'a Path,
     options: &'a LoadOptions,
     triangles: usize,
+    /// The scene node of each glTF node the scene holds.
+    node_keys: Vec<Option<NodeKey>>,
 }
 
 impl Loader<'_> {
@@ -210,6 +214,9 @@ impl Loader<'_> {
                 continue;
             }
             let what = format!("mesh {} primitive {}", mesh.index(), prim.index());
+            if prim.morph_targets().len() > 0 {
+                self.scene.add_warning(format!("{what} has morph targets, which are not applied"));
+            }
             let pos_acc =
                 prim.get(&Semantic::Positions).ok_or_else(|| Fault::Malformed(format!("{what} has no POSITION")))?;
             let positions = read_vec3(&pos_acc, &self.buffers, "POSITION")?;
@@ -272,6 +279,7 @@ impl Loader<'_> {
             }
             let node = nodes.get(index).ok_or_else(|| Fault::Malformed(format!("node {index} does not exist")))?;
             let (key, world) = self.node(node, parent, parent_world)?;
+            self.node_keys[index] = Some(key);
             on_path[index] = true;
             stack.push(Step::Leave(index));
             let children: Vec<usize> = node.children().map(|c| c.index()).collect();
@@ -300,6 +308,10 @@ impl Loader<'_> {
         let name = node.name().map_or_else(|| format!("node {index}"), str::to_string);
         let key = self.scene.add_node(&name, parent, local).map_err(|e| Fault::Malformed(e.to_string()))?;
         let world = parent_world * local;
+        if node.skin().is_some() {
+            self.scene
+                .add_warning(format!("node {index} ('{name}') has a skin, which is not applied: it is drawn as bound"));
+        }
         if let Some(mesh) = node.mesh() {
             let prims = self.primitives(&mesh)?;
             for (i, p) in prims.into_iter().enumerate() {
@@ -470,6 +482,7 @@ fn parse(path: &Path, options: &LoadOptions) -> Result<Scene, Fault> {
         dir,
         options,
         triangles: 0,
+        node_keys: vec![None; doc.nodes().len()],
     };
     let roots: Vec<usize> = match doc.default_scene().or_else(|| doc.scenes().next()) {
         Some(s) => s.nodes().map(|n| n.index()).collect(),
@@ -486,6 +499,7 @@ fn parse(path: &Path, options: &LoadOptions) -> Result<Scene, Fault> {
         return Err(Fault::Cycle("every node is some node's child, so there is no root".into()));
     }
     loader.walk(&roots)?;
+    loader.animations()?;
     loader.finish_textures()?;
     if loader.triangles == 0 {
         let any_prims = doc.meshes().any(|m| m.primitives().len() > 0);

@@ -17,11 +17,13 @@ use crate::geometry::adjacency::Adjacency;
 use crate::material::Texture;
 use crate::mesh::Mesh;
 
+mod animation;
 mod camera;
 mod light;
 mod placed;
 
 pub use crate::material::Material;
+pub use animation::{Animation, AnimationKey, Channel, Interpolation, Keyframes, Trs};
 pub use camera::Camera;
 pub use light::{Light, LightKind, LightShadow};
 use placed::Placed;
@@ -64,6 +66,16 @@ pub enum SceneError {
     /// A light or camera with unusable parameters.
     #[error("{0}")]
     Invalid(String),
+    /// Animation data that cannot be played.
+    #[error("animation '{animation}', {channel}: {why}")]
+    Animation {
+        /// The animation's name.
+        animation: String,
+        /// Which channel, and the property it moves.
+        channel: String,
+        /// What is wrong.
+        why: String,
+    },
 }
 
 /// A node: a local transform, optionally a mesh with a material, and shadow flags.
@@ -159,6 +171,9 @@ pub struct Scene {
     lights: SlotMap<LightKey, Placed<Light>>,
     light_shadows: SecondaryMap<LightKey, LightShadow>,
     cameras: SlotMap<CameraKey, Placed<Camera>>,
+    animations: SlotMap<AnimationKey, Animation>,
+    /// The rest pose of every node an animation moves.
+    rest: SecondaryMap<NodeKey, Trs>,
 }
 
 /// Mesh versions are unique in the process, not per scene: two scenes hand out the same [`MeshKey`]s,
@@ -374,14 +389,20 @@ impl Scene {
         Ok(())
     }
 
-    /// Moves a node: sets its local transform and recomputes the world transforms of its subtree.
+    /// Moves a node: sets its local transform and recomputes the world transforms of its subtree. On a node
+    /// an animation moves, this is its new rest pose too.
     ///
     /// # Errors
-    /// Unknown node, or a non-finite transform.
+    /// Unknown node, a non-finite transform, or one with shear on an animated node.
     pub fn set_local_transform(&mut self, node: NodeKey, local: Mat4) -> Result<(), SceneError> {
         let n = self.nodes.get_mut(node).ok_or(SceneError::UnknownKey("node"))?;
         if !local.is_finite() {
             return Err(SceneError::NonFiniteTransform { node: n.name.clone() });
+        }
+        if let Some(rest) = self.rest.get_mut(node) {
+            *rest = Trs::from_matrix(local).ok_or_else(|| {
+                SceneError::Invalid(format!("node '{}' is animated and cannot take a transform with shear", n.name))
+            })?;
         }
         n.local = local;
         self.update_subtree(node);
@@ -464,6 +485,10 @@ impl Scene {
         let lights = &self.lights;
         self.light_shadows.retain(|k, _| lights.contains_key(k));
         self.cameras.retain(|_, c| c.node.is_none_or(|n| nodes.contains_key(n)));
+        self.rest.retain(|n, _| nodes.contains_key(n));
+        for a in self.animations.values_mut() {
+            a.retain_nodes(nodes);
+        }
         Ok(())
     }
 

@@ -4,6 +4,7 @@
 //! placement (the same seed always gives the same scene). [`stage_model`] puts a loaded model on a ground
 //! plane with the default spotlight and camera of DESIGN 11.
 
+pub mod animated;
 mod builders;
 pub mod cutouts;
 
@@ -170,10 +171,19 @@ pub const CUTOUT: &[SceneInfo] = &[
     },
 ];
 
-/// Every built-in scene: the papers' ([`ALL`]), the outdoor ones ([`OUTDOOR`]), then those of cutouts
-/// ([`CUTOUT`]).
+/// The animated scenes: casters that move over a clip ([`crate::Scene::pose`]). Apart from [`ALL`], as
+/// they are measured at several times of their clips.
+pub const ANIMATED: &[SceneInfo] = &[SceneInfo {
+    name: "mill",
+    after: "node animation",
+    description: "a wind mill's three-bladed rotor turning under a sun, its shadow sweeping the tower and the ground",
+    build: animated::mill,
+}];
+
+/// Every built-in scene: the papers' ([`ALL`]), the outdoor ones ([`OUTDOOR`]), those of cutouts
+/// ([`CUTOUT`]), then the animated ones ([`ANIMATED`]).
 pub fn every() -> impl Iterator<Item = &'static SceneInfo> {
-    ALL.iter().chain(OUTDOOR).chain(CUTOUT)
+    ALL.iter().chain(OUTDOOR).chain(CUTOUT).chain(ANIMATED)
 }
 
 /// Why a scene could not be built.

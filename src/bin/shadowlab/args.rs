@@ -48,6 +48,19 @@ pub(crate) struct SceneArgs {
     /// model cannot read other files on the machine.
     #[arg(long)]
     pub(crate) allow_outside_files: bool,
+    /// Pose the scene's animations at this time, in seconds (each clip holds its last key after its end);
+    /// without it the scene stands at rest, as built or loaded.
+    #[arg(long, value_name = "SECONDS", value_parser = parse_time)]
+    pub(crate) time: Option<f32>,
+}
+
+/// A time in seconds: a finite number.
+fn parse_time(text: &str) -> Result<f32, String> {
+    text.trim()
+        .parse::<f32>()
+        .ok()
+        .filter(|t| t.is_finite())
+        .ok_or_else(|| format!("'{text}' is not a number of seconds"))
 }
 
 /// Which techniques, on which backend: what `compare` and `bench` measure.
@@ -125,6 +138,7 @@ impl SceneArgs {
             camera: self.camera.clone(),
             light: self.light.clone(),
             file_access: if self.allow_outside_files { FileAccess::Anywhere } else { FileAccess::ModelFolder },
+            time: self.time,
         }
     }
 

@@ -47,6 +47,10 @@ pub(crate) fn inspect(target: &str, json: bool, allow_outside_files: bool) -> Re
             "textures": i.textures.iter().map(|t| json!({
                 "name": t.name, "width": t.width, "height": t.height, "bytes_with_mips": t.bytes,
             })).collect::<Vec<_>>(),
+            "animations": i.animations.iter().map(|a| json!({
+                "name": a.name, "duration_s": a.duration, "channels": a.channels, "nodes": a.nodes,
+                "interpolations": a.interpolations,
+            })).collect::<Vec<_>>(),
         }));
     }
     out!("{target}");
@@ -85,6 +89,17 @@ pub(crate) fn inspect(target: &str, json: bool, allow_outside_files: bool) -> Re
     out!("  textures            {} ({:.1} MiB with mip chains)", i.textures.len(), bytes as f64 / f64::from(1 << 20));
     for (n, t) in i.textures.iter().enumerate() {
         out!("    {n:<3} {} x {}  {}", t.width, t.height, t.name);
+    }
+    out!("  animations          {}", i.animations.len());
+    for a in &i.animations {
+        out!(
+            "    {:<20} {:.3} s, {} channel(s) on {} node(s), {}",
+            a.name,
+            a.duration,
+            a.channels,
+            a.nodes,
+            a.interpolations.join(", ")
+        );
     }
     Ok(())
 }

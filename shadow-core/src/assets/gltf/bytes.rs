@@ -122,8 +122,8 @@ pub(super) fn load_buffers(
         .collect()
 }
 
-/// An accessor's elements as f64 components, bounds-checked against its view and buffer.
-pub(super) fn read_accessor(acc: &gltf::Accessor, buffers: &[Vec<u8>], what: &str) -> Result<Vec<[f64; 3]>, Fault> {
+/// An accessor's components as f64, element after element, bounds-checked against its view and buffer.
+pub(super) fn read_accessor(acc: &gltf::Accessor, buffers: &[Vec<u8>], what: &str) -> Result<Vec<f64>, Fault> {
     if acc.sparse().is_some() {
         return Err(Fault::Unsupported(format!("sparse accessor {} ({what})", acc.index())));
     }
@@ -183,14 +183,11 @@ pub(super) fn read_accessor(acc: &gltf::Accessor, buffers: &[Vec<u8>], what: &st
         }
     };
     Ok((0..count)
-        .map(|i| {
+        .flat_map(|i| {
             let base = acc.offset() + i * stride;
-            let mut e = [0.0; 3];
-            for (c, slot) in e.iter_mut().enumerate().take(comps.min(3)) {
-                *slot = read(base + c * csize);
-            }
-            e
+            (0..comps).map(move |c| base + c * csize)
         })
+        .map(read)
         .collect())
 }
 
@@ -203,7 +200,8 @@ pub(super) fn read_vec3(acc: &gltf::Accessor, buffers: &[Vec<u8>], what: &str) -
             acc.data_type()
         )));
     }
-    Ok(read_accessor(acc, buffers, what)?.iter().map(|e| Vec3::new(e[0] as f32, e[1] as f32, e[2] as f32)).collect())
+    let floats = read_accessor(acc, buffers, what)?;
+    Ok(floats.chunks_exact(3).map(|e| Vec3::new(e[0] as f32, e[1] as f32, e[2] as f32)).collect())
 }
 
 /// Texture coordinates: float pairs, or normalized unsigned bytes or shorts (glTF 2.0 3.7.2.1).
@@ -219,7 +217,7 @@ pub(super) fn read_uvs(acc: &gltf::Accessor, buffers: &[Vec<u8>], what: &str) ->
             if acc.normalized() { " (normalized)" } else { "" }
         )));
     }
-    Ok(read_accessor(acc, buffers, what)?.iter().map(|e| Vec2::new(e[0] as f32, e[1] as f32)).collect())
+    Ok(read_accessor(acc, buffers, what)?.chunks_exact(2).map(|e| Vec2::new(e[0] as f32, e[1] as f32)).collect())
 }
 
 pub(super) fn read_indices(acc: &gltf::Accessor, buffers: &[Vec<u8>]) -> Result<Vec<u32>, Fault> {
@@ -233,7 +231,31 @@ pub(super) fn read_indices(acc: &gltf::Accessor, buffers: &[Vec<u8>]) -> Result<
             acc.data_type()
         )));
     }
-    Ok(read_accessor(acc, buffers, "indices")?.iter().map(|e| e[0] as u32).collect())
+    Ok(read_accessor(acc, buffers, "indices")?.iter().map(|&e| e as u32).collect())
+}
+
+/// Floats of the given shape, element after element: F32, or where `normalized` allows it the normalized
+/// integers glTF allows for rotations and morph weights (signed and unsigned bytes and shorts).
+pub(super) fn read_floats(
+    acc: &gltf::Accessor,
+    buffers: &[Vec<u8>],
+    what: &str,
+    dimensions: Dimensions,
+    normalized: bool,
+) -> Result<Vec<f32>, Fault> {
+    let integer = matches!(acc.data_type(), DataType::I8 | DataType::U8 | DataType::I16 | DataType::U16);
+    let allowed = acc.data_type() == DataType::F32 || (normalized && acc.normalized() && integer);
+    if acc.dimensions() != dimensions || !allowed {
+        return Err(Fault::WrongAccessor(format!(
+            "{what} accessor {} is {:?} of {:?}{}, expected {dimensions:?} of F32{}",
+            acc.index(),
+            acc.dimensions(),
+            acc.data_type(),
+            if acc.normalized() { " (normalized)" } else { "" },
+            if normalized { " or of normalized bytes or shorts" } else { "" }
+        )));
+    }
+    Ok(read_accessor(acc, buffers, what)?.iter().map(|&e| e as f32).collect())
 }
 
 /// Triangles of a primitive from its index list (or 0..n without indices).
