@@ -28,11 +28,12 @@ pub struct Instance {
     pub node: NodeKey,
     /// The mesh's key (backends cache uploads by key and version).
     pub mesh_key: MeshKey,
-    /// Changes whenever the mesh behind the key is replaced.
+    /// Changes whenever the mesh behind the key is replaced, and for a skinned or morphed mesh whenever
+    /// its pose does ([`crate::scene::Deformed::version`]).
     pub mesh_version: u64,
-    /// The geometry, in the mesh's own space.
+    /// The geometry, in the mesh's own space; a skinned or morphed mesh as posed.
     pub mesh: Arc<Mesh>,
-    /// Its adjacency (cached by the scene per mesh).
+    /// Its adjacency (cached by the scene per mesh; over the posed positions for a posed mesh).
     pub adjacency: Arc<Adjacency>,
     /// Mesh space to world space.
     pub world_from_local: Mat4,
@@ -172,13 +173,22 @@ impl FrameInputs {
         let instances: Vec<Instance> = scene
             .drawables()
             .filter_map(|(node, n, mesh_key, material)| {
-                let mesh = scene.mesh(mesh_key)?.clone();
-                let world = n.world_transform();
-                Some(Instance {
+                // A skinned or morphed mesh is drawn as posed; every other as it stands, where its node is.
+                let (mesh, adjacency, mesh_version, world) = match scene.deformed(node) {
+                    Some(Ok(d)) => (d.mesh, d.adjacency, d.version, d.world_from_local),
+                    Some(Err(e)) => return Some(Err(e)),
+                    None => (
+                        scene.mesh(mesh_key)?.clone(),
+                        scene.adjacency(mesh_key)?,
+                        scene.mesh_version(mesh_key)?,
+                        n.world_transform(),
+                    ),
+                };
+                Some(Ok(Instance {
                     node,
                     mesh_key,
-                    mesh_version: scene.mesh_version(mesh_key)?,
-                    adjacency: scene.adjacency(mesh_key)?,
+                    mesh_version,
+                    adjacency,
                     world_from_local: world,
                     local_from_world: crate::affine::inverse(world),
                     mirrored: world.determinant() < 0.0,
@@ -191,9 +201,9 @@ impl FrameInputs {
                     bounds: mesh.bounds().transformed(world),
                     material: Arc::clone(material),
                     mesh,
-                })
+                }))
             })
-            .collect();
+            .collect::<Result<_, SceneError>>()?;
         if instances.is_empty() {
             return Err(FrameError::Empty);
         }

@@ -36,6 +36,10 @@ pub struct Inspection {
     pub meshes_with_uvs: usize,
     /// The scene's animations, in the order they were added.
     pub animations: Vec<AnimationStats>,
+    /// The scene's skins: name and number of joints, in the order they were added.
+    pub skins: Vec<(String, usize)>,
+    /// Meshes drawn with morph targets, and the most targets one has.
+    pub morphed_meshes: (usize, usize),
 }
 
 /// One animation as `inspect` reports it.
@@ -100,6 +104,8 @@ impl Inspection {
             meshes: 0,
             meshes_with_uvs: 0,
             animations: Vec::new(),
+            skins: scene.skins().map(|(_, s)| (s.name.clone(), s.joints.len())).collect(),
+            morphed_meshes: (0, 0),
         };
         for (_, a) in scene.animations() {
             let mut nodes: Vec<_> = a.channels().iter().map(|c| c.node).collect();
@@ -144,6 +150,10 @@ impl Inspection {
             if seen.insert(mesh) {
                 out.meshes += 1;
                 out.meshes_with_uvs += usize::from(scene.mesh(mesh).is_some_and(|m| m.uvs().is_some()));
+                let targets = scene.mesh(mesh).and_then(|m| m.deformers()).map_or(0, |d| d.morph_targets.len());
+                if targets > 0 {
+                    out.morphed_meshes = (out.morphed_meshes.0 + 1, out.morphed_meshes.1.max(targets));
+                }
             }
         }
         for (_, _, mesh, _) in scene.drawables() {

@@ -11,6 +11,7 @@
 pub mod affine;
 pub mod assets;
 pub mod bounds;
+pub mod deform;
 pub mod frame;
 pub mod geometry;
 pub mod image;

@@ -1,14 +1,17 @@
 //! Triangle meshes: positions, per-vertex shading normals, optional texture coordinates and
-//! counter-clockwise triangles.
+//! counter-clockwise triangles, and for meshes that deform, their skin weights and morph targets.
 //!
 //! A [`Mesh`] is valid by construction: every index is in range, every position and normal is finite,
 //! every coordinate within [`MAX_COORDINATE`], and at least one triangle has an area. Loaders and builders
 //! go through [`Mesh::new`] or [`Mesh::with_normals`], so no backend ever sees a mesh that would rasterize
 //! garbage.
 
+use std::sync::Arc;
+
 use glam::{Vec2, Vec3};
 
 use crate::bounds::Aabb;
+use crate::deform::Deformers;
 
 /// The largest coordinate magnitude a mesh may hold: face normals and areas multiply coordinate
 /// differences, so anything near the square root of `f32::MAX` (1.8e19) overflows to infinity and the
@@ -71,6 +74,16 @@ pub enum MeshError {
     /// More vertices than a `u32` index can name.
     #[error("{0} vertices is more than 32-bit indices can address")]
     TooManyVertices(usize),
+    /// Skin weights or a morph target not given one per vertex.
+    #[error("{what}: {count} for {positions} positions")]
+    DeformerCount {
+        /// Which: skin weights, a morph target's positions or normals.
+        what: String,
+        /// How many were given.
+        count: usize,
+        /// Number of positions.
+        positions: usize,
+    },
 }
 
 /// An indexed triangle mesh with per-vertex normals and, for textured materials, texture coordinates.
@@ -83,6 +96,8 @@ pub struct Mesh {
     triangles: Vec<[u32; 3]>,
     /// The positions' bounds, kept with them: a frame reads them once per instance of the mesh.
     bounds: Aabb,
+    /// Skin weights and morph targets, where it deforms.
+    deformers: Option<Arc<Deformers>>,
 }
 
 impl Mesh {
@@ -94,7 +109,7 @@ impl Mesh {
         Self::check(&positions, &triangles)?;
         let normals = vertex_normals(&positions, &triangles);
         let bounds = Aabb::from_points(positions.iter().copied());
-        Ok(Self { positions, normals, uvs: None, triangles, bounds })
+        Ok(Self { positions, normals, uvs: None, triangles, bounds, deformers: None })
     }
 
     /// A mesh with the given shading normals (normalized here; zero normals are replaced by computed ones).
@@ -112,7 +127,7 @@ impl Mesh {
         let computed = vertex_normals(&positions, &triangles);
         let normals = normals.iter().zip(&computed).map(|(n, c)| n.try_normalize().unwrap_or(*c)).collect();
         let bounds = Aabb::from_points(positions.iter().copied());
-        Ok(Self { positions, normals, uvs: None, triangles, bounds })
+        Ok(Self { positions, normals, uvs: None, triangles, bounds, deformers: None })
     }
 
     /// The mesh with texture coordinates, one per vertex (glTF's `TEXCOORD_n`: u to the right, v down
@@ -130,6 +145,55 @@ impl Mesh {
         }
         self.uvs = Some(uvs);
         Ok(self)
+    }
+
+    /// The mesh with what it deforms by: skin weights and morph targets, one per vertex each.
+    ///
+    /// # Errors
+    /// [`MeshError::DeformerCount`] for a count that is not the vertex count, [`MeshError::NonFinite`]
+    /// for a displacement that is not finite.
+    pub fn with_deformers(mut self, deformers: Deformers) -> Result<Self, MeshError> {
+        let positions = self.positions.len();
+        let count = |what: String, count: usize| {
+            if count == positions { Ok(()) } else { Err(MeshError::DeformerCount { what, count, positions }) }
+        };
+        if let Some(skin) = &deformers.skin {
+            count("skin weights".into(), skin.len())?;
+        }
+        for (t, target) in deformers.morph_targets.iter().enumerate() {
+            count(format!("morph target {t}'s positions"), target.positions.len())?;
+            let normals = target.normals.iter().flatten();
+            if let Some(n) = &target.normals {
+                count(format!("morph target {t}'s normals"), n.len())?;
+            }
+            if let Some((vertex, d)) = target.positions.iter().chain(normals).enumerate().find(|(_, d)| !d.is_finite())
+            {
+                let what = "morph target displacement";
+                return Err(MeshError::NonFinite { vertex: vertex % positions, what, value: format!("{d}") });
+            }
+        }
+        self.deformers = Some(Arc::new(deformers));
+        Ok(self)
+    }
+
+    /// Its skin weights and morph targets, where it deforms.
+    #[must_use]
+    pub fn deformers(&self) -> Option<&Deformers> {
+        self.deformers.as_deref()
+    }
+
+    /// The mesh posed: the same triangles and texture coordinates over posed positions and normals (one
+    /// a vertex, finite), with no deformers of its own.
+    pub(crate) fn posed(&self, positions: Vec<Vec3>, normals: Vec<Vec3>) -> Self {
+        debug_assert_eq!(positions.len(), self.positions.len());
+        Self {
+            bounds: Aabb::from_points(positions.iter().copied()),
+            positions,
+            normals,
+            uvs: self.uvs.clone(),
+            triangles: self.triangles.clone(),
+            deformers: None,
+        }
     }
 
     fn check(positions: &[Vec3], triangles: &[[u32; 3]]) -> Result<(), MeshError> {
@@ -200,7 +264,8 @@ impl Mesh {
     }
 
     /// A copy with every position and normal moved by an affine transform (normals by its inverse transpose).
-    /// A mirroring transform reverses the triangles so they stay counter-clockwise outside.
+    /// A mirroring transform reverses the triangles so they stay counter-clockwise outside. The copy is
+    /// static: it keeps no skin weights or morph targets (as an appended mesh keeps none).
     #[must_use]
     pub fn transformed(&self, m: glam::Mat4) -> Self {
         let normal_m = crate::affine::normal_matrix(m);
@@ -211,6 +276,7 @@ impl Mesh {
             positions,
             normals: self.normals.iter().map(|&n| (normal_m * n).normalize_or_zero()).collect(),
             uvs: self.uvs.clone(),
+            deformers: None,
             triangles: if mirror {
                 self.triangles.iter().map(|&[a, b, c]| [a, c, b]).collect()
             } else {
@@ -220,7 +286,8 @@ impl Mesh {
     }
 
     /// Appends another mesh's vertices and triangles. Where only one of the two has texture
-    /// coordinates, the other's vertices get (0, 0).
+    /// coordinates, the other's vertices get (0, 0). The result is static: it keeps no skin weights or
+    /// morph targets.
     ///
     /// # Errors
     /// [`MeshError::TooManyVertices`] when the two together have more vertices than 32-bit indices can
@@ -239,6 +306,7 @@ impl Mesh {
         }
         self.triangles.extend(other.triangles.iter().map(|t| t.map(|i| i + base)));
         self.bounds = self.bounds.union(other.bounds);
+        self.deformers = None;
         Ok(())
     }
 

@@ -211,3 +211,253 @@ fn bad_animation_data_is_refused_by_animation_and_channel() {
     let e = refused("matrix", &[0.0], (&[0.0; 3], "VEC3"), matrix, "LINEAR");
     assert!(e.contains("given by a matrix"), "{e}");
 }
+
+/// The bar of the bend tests: 0.5 either side of the y axis, from y = 0 to y = 2, vertices at y = 0, 1
+/// and 2 (left then right), two triangles a storey.
+fn bar() -> (Vec<Vec3>, Vec<[u32; 3]>) {
+    let positions = (0..3).flat_map(|y| [Vec3::new(-0.5, y as f32, 0.0), Vec3::new(0.5, y as f32, 0.0)]).collect();
+    let triangles = vec![[0, 1, 3], [0, 3, 2], [2, 3, 5], [2, 5, 4]];
+    (positions, triangles)
+}
+
+/// Its joints and weights: the foot storey to the lower joint, the middle halved, the top to the upper.
+fn bar_weights() -> (Vec<[u16; 4]>, Vec<[f32; 4]>) {
+    let joints = vec![[0, 1, 0, 0]; 6];
+    let w = |lower: f32| [lower, 1.0 - lower, 0.0, 0.0];
+    (joints, vec![w(1.0), w(1.0), w(0.5), w(0.5), w(0.0), w(0.0)])
+}
+
+/// The bar bent a quarter turn about +z at its middle joint, by hand: the upper joint's skin matrix is
+/// T(0, 1, 0) Rz(90) T(0, -1, 0), which takes (x, y) to (1 - y, 1 + x) as Rz takes (x, y) to (-y, x). The
+/// top corners (-0.5, 2) and (0.5, 2) go to (-1, 0.5) and (-1, 1.5); the middle ones, half on each
+/// joint, to the mean of where each joint takes them: (-0.5, 1) and (0, 0.5) give (-0.25, 0.75), (0.5, 1)
+/// and (0, 1.5) give (0.25, 1.25); the foot stays.
+fn bent_bar() -> Vec<Vec3> {
+    [(-0.5, 0.0), (0.5, 0.0), (-0.25, 0.75), (0.25, 1.25), (-1.0, 0.5), (-1.0, 1.5)]
+        .map(|(x, y)| Vec3::new(x, y, 0.0))
+        .to_vec()
+}
+
+fn assert_near(got: &[Vec3], want: &[Vec3]) {
+    assert_eq!(got.len(), want.len());
+    for (v, (g, w)) in got.iter().zip(want).enumerate() {
+        assert!((*g - *w).length() < 1e-6, "vertex {v}: {g} against {w}");
+    }
+}
+
+/// The frame's instance of the first drawn node: its posed positions in world space.
+fn drawn(scene: &Scene) -> Vec<Vec3> {
+    let camera = shadow_core::Camera::look_at(Vec3::new(0.0, 1.0, 5.0), Vec3::new(0.0, 1.0, 0.0), 45.0);
+    let frame = shadow_core::FrameInputs::new(scene, camera, Vec::new()).unwrap();
+    let i = &frame.instances[0];
+    i.mesh.positions().iter().map(|p| i.world_from_local.transform_point3(*p)).collect()
+}
+
+/// A two-joint skin built through the scene's API and bent by an animation of the upper joint: the
+/// frame's posed positions are the hand-computed ones, whatever the skinned node's own transform.
+#[test]
+fn a_two_joint_skin_bends_as_worked_out_by_hand() {
+    use shadow_core::deform::{Deformers, SkinWeights};
+    use shadow_core::scene::{Animation, Channel, Interpolation, Keyframes, Skin};
+    let (positions, triangles) = bar();
+    let (joints, weights) = bar_weights();
+    let skin = Some(SkinWeights::new(joints, weights).unwrap());
+    let mesh = shadow_core::Mesh::new(positions.clone(), triangles)
+        .unwrap()
+        .with_deformers(Deformers { skin, morph_targets: Vec::new() })
+        .unwrap();
+    let mut scene = Scene::new();
+    let lower = scene.add_node("lower", None, Mat4::IDENTITY).unwrap();
+    let upper = scene.add_node("upper", Some(lower), Mat4::from_translation(Vec3::Y)).unwrap();
+    let m = scene.add_mesh(mesh);
+    let grey = scene.add_material(shadow_core::Material::default());
+    // The skinned node stands far off: glTF ignores its transform, the joints place the mesh.
+    let body = scene.add_instance("body", m, grey, Mat4::from_translation(Vec3::new(5.0, 0.0, 0.0))).unwrap();
+    let inverse_bind_matrices = vec![Mat4::IDENTITY, Mat4::from_translation(Vec3::NEG_Y)];
+    let skin = scene.add_skin(Skin { name: "legs".into(), joints: vec![lower, upper], inverse_bind_matrices }).unwrap();
+    scene.set_skin(body, Some(skin)).unwrap();
+    assert_near(&drawn(&scene), &positions);
+    let bend = Quat::from_rotation_z(std::f32::consts::FRAC_PI_2);
+    let c = Channel {
+        node: upper,
+        times: vec![0.0, 1.0],
+        interpolation: Interpolation::Linear,
+        values: Keyframes::Rotation(vec![Quat::IDENTITY, bend]),
+    };
+    scene.add_animation(Animation::new("bend", vec![c]).unwrap()).unwrap();
+    scene.pose(1.0).unwrap();
+    assert_near(&drawn(&scene), &bent_bar());
+    // The scene's bounds follow the pose: the top now reaches x = -1.
+    assert!((scene.bounds().min.x + 1.0).abs() < 1e-6, "{:?}", scene.bounds());
+    // A skin whose joints the mesh's weights outnumber is refused.
+    let one = Skin { name: "short".into(), joints: vec![lower], inverse_bind_matrices: vec![Mat4::IDENTITY] };
+    let short = scene.add_skin(one).unwrap();
+    let e = scene.set_skin(body, Some(short)).unwrap_err().to_string();
+    assert!(e.contains("its mesh names joint 1, but skin 'short' has 1 joints"), "{e}");
+}
+
+/// Morph targets through the scene's API, their weights keyed by an animation: the base plus each
+/// target's displacement times its weight, by hand.
+#[test]
+fn morph_targets_move_by_their_weights() {
+    use shadow_core::deform::{Deformers, MorphTarget};
+    use shadow_core::scene::{Animation, Channel, Interpolation, Keyframes};
+    let (positions, triangles) = bar();
+    let up = MorphTarget { positions: vec![Vec3::Y; 6], normals: None };
+    let out = MorphTarget { positions: (0..6).map(|v| Vec3::new(0.0, 0.0, v as f32)).collect(), normals: None };
+    let mesh = shadow_core::Mesh::new(positions.clone(), triangles)
+        .unwrap()
+        .with_deformers(Deformers { skin: None, morph_targets: vec![up, out] })
+        .unwrap();
+    let mut scene = Scene::new();
+    let m = scene.add_mesh(mesh);
+    let grey = scene.add_material(shadow_core::Material::default());
+    let node = scene.add_instance("blob", m, grey, Mat4::from_translation(Vec3::X)).unwrap();
+    scene.set_morph_weights(node, vec![0.5, 0.0]).unwrap();
+    let want = |a: f32, b: f32| -> Vec<Vec3> {
+        positions
+            .iter()
+            .enumerate()
+            .map(|(v, p)| *p + Vec3::X + Vec3::Y * a + Vec3::new(0.0, 0.0, v as f32) * b)
+            .collect()
+    };
+    assert_near(&drawn(&scene), &want(0.5, 0.0));
+    // Weights keyed from (0.5, 0) at 0 s to (1, 2) at 2 s, LINEAR: at 1 s, (0.75, 1).
+    let c = Channel {
+        node,
+        times: vec![0.0, 2.0],
+        interpolation: Interpolation::Linear,
+        values: Keyframes::Weights { targets: 2, values: vec![0.5, 0.0, 1.0, 2.0] },
+    };
+    scene.add_animation(Animation::new("swell", vec![c]).unwrap()).unwrap();
+    scene.pose(1.0).unwrap();
+    assert_eq!(scene.morph_weights(node), &[0.75, 1.0]);
+    assert_near(&drawn(&scene), &want(0.75, 1.0));
+    let bad = Channel {
+        node,
+        times: vec![0.0],
+        interpolation: Interpolation::Step,
+        values: Keyframes::Weights { targets: 2, values: vec![0.5, 0.0, 1.0] },
+    };
+    let e = Animation::new("odd", vec![bad]).unwrap_err().to_string();
+    assert!(e.contains("3 weights do not make keys of 2 targets"), "{e}");
+}
+
+/// The bar as a glTF mesh: POSITION, indices, the `attributes` given, and its morph `targets`.
+fn bar_mesh(g: &mut Gltf, attributes: Value, targets: Value) -> Value {
+    let (positions, triangles) = bar();
+    let p: Vec<f32> = positions.iter().flat_map(|p| p.to_array()).collect();
+    let idx: Vec<u16> = triangles.iter().flatten().map(|&i| i as u16).collect();
+    let pos =
+        g.accessor(bytemuck::cast_slice(&p), 5126, "VEC3", 6, json!({"min": [-0.5, 0.0, 0.0], "max": [0.5, 2.0, 0.0]}));
+    let indices = g.accessor(bytemuck::cast_slice(&idx), 5123, "SCALAR", idx.len(), json!({}));
+    let mut attrs = json!({"POSITION": pos});
+    if let (Some(a), Some(extra)) = (attrs.as_object_mut(), attributes.as_object()) {
+        a.extend(extra.clone());
+    }
+    json!({"primitives": [{"attributes": attrs, "indices": indices, "targets": targets}]})
+}
+
+/// A skinned bar written as glTF: joints as unsigned bytes, weights as floats, the inverse bind matrices,
+/// the body node far off (ignored, as glTF asks); `weights` replaces the bar's.
+fn skinned_bar(dir: &Path, weights: &[[f32; 4]], inverse_binds: usize) -> PathBuf {
+    let mut g = Gltf::default();
+    let (joints, _) = bar_weights();
+    let j: Vec<u8> = joints.iter().flatten().map(|&j| j as u8).collect();
+    let w: Vec<f32> = weights.iter().flatten().copied().collect();
+    let joints = g.accessor(&j, 5121, "VEC4", 6, json!({}));
+    let weights = g.floats(&w, "VEC4");
+    let mesh = bar_mesh(&mut g, json!({"JOINTS_0": joints, "WEIGHTS_0": weights}), json!([]));
+    let binds: Vec<f32> = [Mat4::IDENTITY, Mat4::from_translation(Vec3::NEG_Y)]
+        .iter()
+        .take(inverse_binds)
+        .flat_map(|m| m.to_cols_array())
+        .collect();
+    let binds = g.floats(&binds, "MAT4");
+    let times = g.floats(&[0.0, 1.0], "SCALAR");
+    let bend = Quat::from_rotation_z(std::f32::consts::FRAC_PI_2);
+    let turn = g.floats(&[0.0, 0.0, 0.0, 1.0, bend.x, bend.y, bend.z, bend.w], "VEC4");
+    g.write(
+        dir,
+        json!({
+            "scenes": [{"nodes": [0, 1]}],
+            "nodes": [
+                {"name": "body", "mesh": 0, "skin": 0, "translation": [5.0, 0.0, 0.0]},
+                {"name": "lower", "children": [2]},
+                {"name": "upper", "translation": [0.0, 1.0, 0.0]},
+            ],
+            "meshes": [mesh],
+            "skins": [{"name": "legs", "joints": [1, 2], "inverseBindMatrices": binds}],
+            "animations": [{
+                "name": "bend",
+                "samplers": [{"input": times, "output": turn}],
+                "channels": [{"sampler": 0, "target": {"node": 2, "path": "rotation"}}],
+            }],
+        }),
+    )
+}
+
+/// A two-joint skin written as glTF and bent a quarter turn: the posed vertices are the ones worked out
+/// by hand.
+#[test]
+fn a_skinned_gltf_bends_as_worked_out_by_hand() {
+    let dir = folder("skin");
+    let (_, weights) = bar_weights();
+    let mut scene = load(&skinned_bar(&dir, &weights, 2));
+    assert!(scene.warnings().is_empty(), "{:?}", scene.warnings());
+    assert_eq!(scene.skins().count(), 1);
+    assert_near(&drawn(&scene), &bar().0);
+    scene.pose(1.0).unwrap();
+    assert_near(&drawn(&scene), &bent_bar());
+}
+
+#[test]
+fn bad_skins_are_refused_by_name() {
+    let (_, mut weights) = bar_weights();
+    let e = assets::load(skinned_bar(&folder("binds"), &weights, 1)).map(|_| ()).unwrap_err().to_string();
+    assert!(e.contains("skin 'legs': 1 inverse bind matrices for 2 joints"), "{e}");
+    weights[3] = [0.0; 4];
+    let e = assets::load(skinned_bar(&folder("zero"), &weights, 2)).map(|_| ()).unwrap_err().to_string();
+    assert!(e.contains("mesh 0 primitive 0: vertex 3's weights sum to zero"), "{e}");
+}
+
+/// Morph targets written as glTF, the mesh's default weights and an animation of them (CUBICSPLINE with
+/// flat tangents, so halfway is the mean): the posed vertices by hand.
+#[test]
+fn gltf_morph_targets_and_their_weights_play() {
+    let dir = folder("morph");
+    let mut g = Gltf::default();
+    let up = g.floats(&[0.0, 1.0, 0.0].repeat(6), "VEC3");
+    let out: Vec<f32> = (0..6).flat_map(|v| [0.0, 0.0, v as f32]).collect();
+    let out = g.floats(&out, "VEC3");
+    let mut mesh = bar_mesh(&mut g, json!({}), json!([{"POSITION": up}, {"POSITION": out}]));
+    mesh["weights"] = json!([0.5, 0.0]);
+    let times = g.floats(&[0.0, 2.0], "SCALAR");
+    // Per key: in-tangents (2), values (2), out-tangents (2).
+    let keys = g.floats(&[0.0, 0.0, 0.5, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 2.0, 0.0, 0.0], "SCALAR");
+    let path = g.write(
+        &dir,
+        json!({
+            "scenes": [{"nodes": [0]}],
+            "nodes": [{"name": "blob", "mesh": 0, "translation": [1.0, 0.0, 0.0]}],
+            "meshes": [mesh],
+            "animations": [{
+                "name": "swell",
+                "samplers": [{"input": times, "output": keys, "interpolation": "CUBICSPLINE"}],
+                "channels": [{"sampler": 0, "target": {"node": 0, "path": "weights"}}],
+            }],
+        }),
+    );
+    let mut scene = load(&path);
+    let want = |a: f32, b: f32| -> Vec<Vec3> {
+        bar()
+            .0
+            .iter()
+            .enumerate()
+            .map(|(v, p)| *p + Vec3::X + Vec3::Y * a + Vec3::new(0.0, 0.0, v as f32) * b)
+            .collect()
+    };
+    assert_near(&drawn(&scene), &want(0.5, 0.0));
+    scene.pose(1.0).unwrap();
+    assert_near(&drawn(&scene), &want(0.75, 1.0));
+}

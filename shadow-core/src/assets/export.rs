@@ -1,9 +1,10 @@
 //! Writing a scene as glTF 2.0, binary (.glb) or JSON (.gltf with its buffer and images beside it):
 //! every drawn mesh (shared meshes written once) with its texture coordinates, its material's base colour
 //! and alpha, base-colour texture (level 0 as a PNG, with its sampler and `KHR_texture_transform`),
-//! alpha mode and cutoff and sidedness, the node hierarchy flattened to world matrices, the cameras and
-//! the lights (KHR_lights_punctual), so it opens in Blender or any glTF viewer and loads back through
-//! [`super::load`] with the same texels.
+//! alpha mode and cutoff and sidedness, the node hierarchy flattened to world matrices (skinned and
+//! morphed meshes as posed), the cameras and the lights (KHR_lights_punctual), so it opens in Blender or
+//! any glTF viewer and loads back through [`super::load`] with the same texels. The scene is written as it
+//! stands: its animations are not.
 
 use std::collections::HashMap;
 use std::io::Write;
@@ -77,11 +78,16 @@ fn document(scene: &Scene) -> Document {
     let mut parts = MeshParts::default();
     let mut nodes = vec![];
     let mut mesh_index: HashMap<(MeshKey, String), usize> = HashMap::new();
-    for (_, node, mesh_key, material) in scene.drawables() {
+    for (key, node, mesh_key, material) in scene.drawables() {
         let Some(mesh) = scene.mesh(mesh_key) else { continue };
-        let mi =
-            *mesh_index.entry((mesh_key, material.name.clone())).or_insert_with(|| parts.mesh(scene, mesh, material));
-        let m: Mat4 = node.world_transform();
+        // A skinned or morphed mesh is written as it stands posed, a mesh of its own.
+        let (mi, m) = match scene.deformed(key) {
+            Some(Ok(posed)) => (parts.mesh(scene, &posed.mesh, material), posed.world_from_local),
+            _ => {
+                let entry = mesh_index.entry((mesh_key, material.name.clone()));
+                (*entry.or_insert_with(|| parts.mesh(scene, mesh, material)), node.world_transform())
+            }
+        };
         let mut n = json!({"name": node.name(), "mesh": mi});
         // glTF asks that the identity be left out rather than written.
         if m != Mat4::IDENTITY {

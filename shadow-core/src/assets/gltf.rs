@@ -2,8 +2,9 @@
 //! TRS; every triangle primitive (lists, strips, fans) with u8, u16, u32 or no indices; the base colour
 //! factor and texture (PNG or JPEG, from a buffer view, a data URI or a file beside the model) with its
 //! sampler, texture coordinates and `KHR_texture_transform`; the alpha mode and cutoff;
-//! double-sidedness; perspective cameras and KHR_lights_punctual lights; animations of nodes' translation,
-//! rotation and scale.
+//! double-sidedness; perspective cameras and KHR_lights_punctual lights; skins (`JOINTS_0`/`WEIGHTS_0`,
+//! joints and inverse bind matrices) and morph targets (positions and normals) with their weights; and
+//! animations of nodes' translation, rotation, scale and morph weights.
 //!
 //! The gltf crate parses and validates the JSON (index ranges, enum values). Everything that touches
 //! bytes is done here, with bounds checks: the GLB container, buffer sources, and accessor reads (offsets,
@@ -23,6 +24,7 @@ use crate::scene::{Camera, Light, LightKind, Material, MaterialKey, MeshKey, Nod
 
 mod animation;
 mod bytes;
+mod skin;
 
 use bytes::{assemble, base64_decode, load_buffers, percent_decode, read_indices, read_uvs, read_vec3, split_glb};
 
@@ -76,6 +78,8 @@ struct Loader<'a> {
     triangles: usize,
     /// The scene node of each glTF node the scene holds.
     node_keys: Vec<Option<NodeKey>>,
+    /// The scene nodes that draw each glTF node's mesh primitives, in order.
+    primitive_nodes: Vec<Vec<NodeKey>>,
 }
 
 impl Loader<'_> {
@@ -214,9 +218,6 @@ impl Loader<'_> {
                 continue;
             }
             let what = format!("mesh {} primitive {}", mesh.index(), prim.index());
-            if prim.morph_targets().len() > 0 {
-                self.scene.add_warning(format!("{what} has morph targets, which are not applied"));
-            }
             let pos_acc =
                 prim.get(&Semantic::Positions).ok_or_else(|| Fault::Malformed(format!("{what} has no POSITION")))?;
             let positions = read_vec3(&pos_acc, &self.buffers, "POSITION")?;
@@ -242,7 +243,10 @@ impl Loader<'_> {
                     ))
                 })?;
                 let uvs = read_uvs(&acc, &self.buffers, &format!("TEXCOORD_{set}"))?;
-                m = m.with_uvs(uvs).map_err(|e| Fault::Mesh(what, e))?;
+                m = m.with_uvs(uvs).map_err(|e| Fault::Mesh(what.clone(), e))?;
+            }
+            if let Some(deformers) = self.deformers(&prim, &what)? {
+                m = m.with_deformers(deformers).map_err(|e| Fault::Mesh(what, e))?;
             }
             let key = (self.scene.add_mesh(m), mat.key);
             self.meshes.insert(id, key);
@@ -308,10 +312,6 @@ impl Loader<'_> {
         let name = node.name().map_or_else(|| format!("node {index}"), str::to_string);
         let key = self.scene.add_node(&name, parent, local).map_err(|e| Fault::Malformed(e.to_string()))?;
         let world = parent_world * local;
-        if node.skin().is_some() {
-            self.scene
-                .add_warning(format!("node {index} ('{name}') has a skin, which is not applied: it is drawn as bound"));
-        }
         if let Some(mesh) = node.mesh() {
             let prims = self.primitives(&mesh)?;
             for (i, p) in prims.into_iter().enumerate() {
@@ -327,6 +327,7 @@ impl Loader<'_> {
                         .map_err(|e| Fault::Malformed(e.to_string()))?
                 };
                 self.scene.set_mesh(target, Some(p)).map_err(|e| Fault::Malformed(e.to_string()))?;
+                self.primitive_nodes[index].push(target);
             }
         }
         self.camera_and_light(node, key, world);
@@ -483,6 +484,7 @@ fn parse(path: &Path, options: &LoadOptions) -> Result<Scene, Fault> {
         options,
         triangles: 0,
         node_keys: vec![None; doc.nodes().len()],
+        primitive_nodes: vec![Vec::new(); doc.nodes().len()],
     };
     let roots: Vec<usize> = match doc.default_scene().or_else(|| doc.scenes().next()) {
         Some(s) => s.nodes().map(|n| n.index()).collect(),
@@ -499,6 +501,7 @@ fn parse(path: &Path, options: &LoadOptions) -> Result<Scene, Fault> {
         return Err(Fault::Cycle("every node is some node's child, so there is no root".into()));
     }
     loader.walk(&roots)?;
+    loader.skins_and_weights()?;
     loader.animations()?;
     loader.finish_textures()?;
     if loader.triangles == 0 {

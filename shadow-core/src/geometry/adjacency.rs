@@ -141,6 +141,25 @@ impl Adjacency {
         adj
     }
 
+    /// The same topology over posed positions, one a mesh vertex (as [`crate::deform::pose`] gives them):
+    /// the welding, faces, edges and components stay the rest mesh's, and the welded positions, face
+    /// planes, component bounds and facing bounds are the pose's. A welded vertex takes the posed position
+    /// of the last mesh vertex welded into it, so a pose that parts vertices welded at rest (which a skin
+    /// weighting them alike never does) keeps the mesh closed.
+    #[must_use]
+    pub fn posed(&self, mesh_positions: &[Vec3]) -> Self {
+        let mut positions = vec![Vec3::ZERO; self.positions.len()];
+        for (&w, &p) in self.remap.iter().zip(mesh_positions) {
+            positions[w as usize] = p;
+        }
+        let planes: Vec<Vec4> =
+            self.triangles.par_iter().map(|t| face_plane(t.map(|i| positions[i as usize]))).collect();
+        let component_bounds =
+            component_bounds(&self.triangles, &self.component, self.component_bounds.len(), &positions);
+        let facing_runs = FacingRuns::new(&planes, &self.manifold_faces);
+        Self { positions, planes, component_bounds, facing_runs, ..self.clone() }
+    }
+
     /// Welded positions.
     #[must_use]
     pub fn positions(&self) -> &[Vec3] {
@@ -261,16 +280,20 @@ fn faces(mesh_triangles: &[[u32; 3]], remap: &[u32], positions: &[Vec3]) -> (Vec
                 *t = m.map(|i| remap[i as usize]);
                 let [a, b, c] = *t;
                 *d = a == b || b == c || c == a;
-                let p = t.map(|i| positions[i as usize]);
-                // The raw normal's length is the square of the mesh's size and the plane offset `n . p`
-                // its cube: at coordinates of 1e13 that offset passes f32's range and every facing test of
-                // the face would read infinity. Scaled, each test keeps the sign the raw normal gives.
-                let n = power_of_two_unit(face_normal(p));
-                // Exactly zero for two equal corners; -0.0 folded so the facing test gives exactly 0.
-                *plane = if n == Vec3::ZERO { Vec4::ZERO } else { n.extend(-n.dot(p[0])) };
+                *plane = face_plane(t.map(|i| positions[i as usize]));
             }
         });
     (triangles, degenerate, planes)
+}
+
+/// The plane of a face's corners, as [`Adjacency::planes`] gives it.
+fn face_plane(p: [Vec3; 3]) -> Vec4 {
+    // The raw normal's length is the square of the mesh's size and the plane offset `n . p` its cube: at
+    // coordinates of 1e13 that offset passes f32's range and every facing test of the face would read
+    // infinity. Scaled, each test keeps the sign the raw normal gives.
+    let n = power_of_two_unit(face_normal(p));
+    // Exactly zero for two equal corners; -0.0 folded so the facing test gives exactly 0.
+    if n == Vec3::ZERO { Vec4::ZERO } else { n.extend(-n.dot(p[0])) }
 }
 
 /// Every edge of the faces that are not degenerate, in the order of its welded endpoints (lower, then
@@ -489,16 +512,21 @@ fn components(adj: &Adjacency) -> (Vec<u32>, Vec<Aabb>) {
             component[p]
         };
     }
+    let bounds = component_bounds(&adj.triangles, &component, count as usize, &adj.positions);
+    (component, bounds)
+}
+
+/// The bounds of each of `count` components over `positions`, from the component of each face.
+fn component_bounds(triangles: &[[u32; 3]], component: &[u32], count: usize, positions: &[Vec3]) -> Vec<Aabb> {
     // Bounds by runs of faces of one component (a mesh's faces come component by component, mostly), the
     // runs found in parallel and merged in order.
-    let runs: Vec<Vec<(u32, Aabb)>> = adj
-        .triangles
+    let runs: Vec<Vec<(u32, Aabb)>> = triangles
         .par_chunks(16384)
         .zip(component.par_chunks(16384))
         .map(|(tris, comps)| {
             let mut runs: Vec<(u32, Aabb)> = Vec::new();
             for (t, &c) in tris.iter().zip(comps) {
-                let b = t.iter().fold(Aabb::EMPTY, |b, &v| b.including(adj.positions[v as usize]));
+                let b = t.iter().fold(Aabb::EMPTY, |b, &v| b.including(positions[v as usize]));
                 match runs.last_mut() {
                     Some((last, bounds)) if *last == c => *bounds = bounds.union(b),
                     _ => runs.push((c, b)),
@@ -507,17 +535,36 @@ fn components(adj: &Adjacency) -> (Vec<u32>, Vec<Aabb>) {
             runs
         })
         .collect();
-    let mut bounds = vec![Aabb::EMPTY; count as usize];
+    let mut bounds = vec![Aabb::EMPTY; count];
     for (c, b) in runs.into_iter().flatten() {
         bounds[c as usize] = bounds[c as usize].union(b);
     }
-    (component, bounds)
+    bounds
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::procedural;
+
+    /// Posed positions give the planes, component bounds and silhouettes a mesh built at them has: a
+    /// torus moved and squashed (affinely, so welding and faces stay) against the torus built that way.
+    #[test]
+    fn a_posed_adjacency_is_the_adjacency_of_the_posed_mesh() {
+        let mesh = procedural::torus(1.0, 0.25, 24, 12).expect("shape");
+        let m =
+            glam::Mat4::from_translation(Vec3::new(2.0, -1.0, 4.0)) * glam::Mat4::from_scale(Vec3::new(1.0, 0.5, 2.0));
+        let moved = mesh.transformed(m);
+        let (built, posed) = (Adjacency::build(&moved), Adjacency::build(&mesh).posed(moved.positions()));
+        assert_eq!(posed.positions(), built.positions());
+        assert_eq!(posed.planes(), built.planes());
+        assert_eq!(posed.component_bounds(), built.component_bounds());
+        let light = crate::geometry::LightSource::Point(Vec3::new(0.0, 6.0, 1.0));
+        let mode = crate::geometry::silhouette::CastMode::for_mesh(&built);
+        let edges = |a: &Adjacency| crate::geometry::silhouette::silhouette(a, light, mode).edges.len();
+        assert_eq!(edges(&posed), edges(&built));
+        assert!(edges(&posed) > 0);
+    }
 
     #[test]
     fn cube_is_closed_after_welding() {

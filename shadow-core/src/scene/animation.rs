@@ -84,6 +84,13 @@ pub enum Keyframes {
     Rotation(Vec<Quat>),
     /// The node's scale.
     Scale(Vec<Vec3>),
+    /// The morph target weights of the node's mesh: `targets` values a key.
+    Weights {
+        /// Targets of the mesh, and so weights a key.
+        targets: usize,
+        /// Key after key.
+        values: Vec<f32>,
+    },
 }
 
 impl Keyframes {
@@ -94,13 +101,16 @@ impl Keyframes {
             Self::Translation(_) => "translation",
             Self::Rotation(_) => "rotation",
             Self::Scale(_) => "scale",
+            Self::Weights { .. } => "weights",
         }
     }
 
+    /// Number of values (of weights, one per `targets` of them).
     fn len(&self) -> usize {
         match self {
             Self::Translation(v) | Self::Scale(v) => v.len(),
             Self::Rotation(v) => v.len(),
+            Self::Weights { targets, values } => values.len() / (*targets).max(1),
         }
     }
 
@@ -108,6 +118,7 @@ impl Keyframes {
         match self {
             Self::Translation(v) | Self::Scale(v) => v.iter().all(|x| x.is_finite()),
             Self::Rotation(v) => v.iter().all(|x| x.is_finite()),
+            Self::Weights { values, .. } => values.iter().all(|x| x.is_finite()),
         }
     }
 }
@@ -148,6 +159,11 @@ impl Channel {
             return Err(format!("key times are not increasing: key {} at {b} s after {a} s", k + 1));
         }
         let per_key = if self.interpolation == Interpolation::CubicSpline { 3 } else { 1 };
+        if let Keyframes::Weights { targets, values } = &self.values
+            && (*targets == 0 || values.len() % targets != 0)
+        {
+            return Err(format!("{} weights do not make keys of {targets} targets", values.len()));
+        }
         if self.values.len() != per_key * self.times.len() {
             return Err(format!(
                 "{} keys with {} interpolation need {} values, not {}",
@@ -191,37 +207,60 @@ impl Channel {
         (k, (t - self.times[k]) / span, span)
     }
 
-    /// The channel's value at time `t`, applied to `pose`.
+    /// The channel's value at time `t`, applied to `pose` (a channel of weights leaves it be).
     pub fn apply(&self, t: f32, pose: &mut Trs) {
         let (k, s, span) = self.locate(t);
         let ip = self.interpolation;
         match &self.values {
-            Keyframes::Translation(v) => pose.translation = sample(v, ip, k, s, span, Vec3::lerp),
-            Keyframes::Scale(v) => pose.scale = sample(v, ip, k, s, span, Vec3::lerp),
+            Keyframes::Translation(v) => pose.translation = sample(|j| v[j], ip, k, s, span, Vec3::lerp),
+            Keyframes::Scale(v) => pose.scale = sample(|j| v[j], ip, k, s, span, Vec3::lerp),
             Keyframes::Rotation(v) => {
-                let q = sample(v, ip, k, s, span, Quat::slerp);
+                let q = sample(|j| v[j], ip, k, s, span, Quat::slerp);
                 // A spline's quaternion leaves the unit sphere between keys; glTF normalizes it.
                 pose.rotation = if ip == Interpolation::CubicSpline { q.normalize() } else { q };
             }
+            Keyframes::Weights { .. } => {}
+        }
+    }
+
+    /// The channel's morph weights at time `t`, written over `weights` (grown to the targets' count; a
+    /// channel of another property leaves them be).
+    pub fn apply_weights(&self, t: f32, weights: &mut Vec<f32>) {
+        let Keyframes::Weights { targets, values } = &self.values else { return };
+        let (k, s, span) = self.locate(t);
+        if weights.len() < *targets {
+            weights.resize(*targets, 0.0);
+        }
+        let lerp = |a: f32, b: f32, s: f32| a + (b - a) * s;
+        for (i, w) in weights.iter_mut().take(*targets).enumerate() {
+            *w = sample(|j| values[j * targets + i], self.interpolation, k, s, span, lerp);
         }
     }
 }
 
-/// A value between key `k` and the next, `s` of the way there over `span` seconds.
-fn sample<T>(values: &[T], ip: Interpolation, k: usize, s: f32, span: f32, lerp: impl Fn(T, T, f32) -> T) -> T
+/// A value between key `k` and the next, `s` of the way there over `span` seconds, of values `at(j)`
+/// (key `j`'s, or with a spline the `j`th of the keys' in-tangents, values and out-tangents).
+fn sample<T>(
+    at: impl Fn(usize) -> T,
+    ip: Interpolation,
+    k: usize,
+    s: f32,
+    span: f32,
+    lerp: impl Fn(T, T, f32) -> T,
+) -> T
 where
     T: Copy + std::ops::Add<Output = T> + std::ops::Mul<f32, Output = T>,
 {
     let at_key = s == 0.0;
     match ip {
-        Interpolation::Step => values[k],
-        Interpolation::Linear if at_key => values[k],
-        Interpolation::Linear => lerp(values[k], values[k + 1], s),
+        Interpolation::Step => at(k),
+        Interpolation::Linear if at_key => at(k),
+        Interpolation::Linear => lerp(at(k), at(k + 1), s),
         // Keys of three: in-tangent a, value v, out-tangent b.
-        Interpolation::CubicSpline if at_key => values[3 * k + 1],
+        Interpolation::CubicSpline if at_key => at(3 * k + 1),
         Interpolation::CubicSpline => {
-            let (v0, b0) = (values[3 * k + 1], values[3 * k + 2]);
-            let (a1, v1) = (values[3 * k + 3], values[3 * k + 4]);
+            let (v0, b0) = (at(3 * k + 1), at(3 * k + 2));
+            let (a1, v1) = (at(3 * k + 3), at(3 * k + 4));
             let (s2, s3) = (s * s, s * s * s);
             v0 * (2.0 * s3 - 3.0 * s2 + 1.0)
                 + b0 * (span * (s3 - 2.0 * s2 + s))
@@ -289,7 +328,8 @@ impl Scene {
     pub fn add_animation(&mut self, animation: Animation) -> Result<AnimationKey, SceneError> {
         for (i, c) in animation.channels.iter().enumerate() {
             let node = self.nodes.get(c.node).ok_or(SceneError::UnknownKey("node"))?;
-            if !self.rest.contains_key(c.node) && Trs::from_matrix(node.local).is_none() {
+            let moves = !matches!(c.values, Keyframes::Weights { .. });
+            if moves && !self.rest.contains_key(c.node) && Trs::from_matrix(node.local).is_none() {
                 return Err(SceneError::Animation {
                     animation: animation.name.clone(),
                     channel: format!("channel {i} ({})", c.values.property()),
@@ -297,7 +337,7 @@ impl Scene {
                 });
             }
         }
-        for c in &animation.channels {
+        for c in animation.channels.iter().filter(|c| !matches!(c.values, Keyframes::Weights { .. })) {
             if !self.rest.contains_key(c.node)
                 && let Some(trs) = Trs::from_matrix(self.nodes[c.node].local)
             {
@@ -354,15 +394,24 @@ impl Scene {
         if !t.is_finite() {
             return Err(SceneError::Invalid(format!("cannot pose the scene at time {t}")));
         }
-        if self.rest.is_empty() {
+        if self.animations.is_empty() {
             return Ok(());
         }
         let mut pose = self.rest.clone();
+        let mut weights = self.rest_weights.clone();
         for c in playing.iter().filter_map(|&k| self.animations.get(k)).flat_map(|a| &a.channels) {
-            if let Some(trs) = pose.get_mut(c.node) {
+            if let Keyframes::Weights { targets, .. } = c.values {
+                if !weights.contains_key(c.node) {
+                    weights.insert(c.node, vec![0.0; targets]);
+                }
+                if let Some(w) = weights.get_mut(c.node) {
+                    c.apply_weights(t, w);
+                }
+            } else if let Some(trs) = pose.get_mut(c.node) {
                 c.apply(t, trs);
             }
         }
+        self.weights = weights;
         for (node, trs) in &pose {
             if let Some(n) = self.nodes.get_mut(node) {
                 n.local = trs.matrix();

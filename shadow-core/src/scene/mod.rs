@@ -21,12 +21,14 @@ mod animation;
 mod camera;
 mod light;
 mod placed;
+mod skin;
 
 pub use crate::material::Material;
 pub use animation::{Animation, AnimationKey, Channel, Interpolation, Keyframes, Trs};
 pub use camera::Camera;
 pub use light::{Light, LightKind, LightShadow};
 use placed::Placed;
+pub use skin::{Deformed, Skin, SkinKey};
 
 slotmap::new_key_type! {
     /// A node of the hierarchy.
@@ -174,6 +176,12 @@ pub struct Scene {
     animations: SlotMap<AnimationKey, Animation>,
     /// The rest pose of every node an animation moves.
     rest: SecondaryMap<NodeKey, Trs>,
+    skins: SlotMap<SkinKey, Skin>,
+    /// The skin each skinned node's mesh is bound to.
+    node_skins: SecondaryMap<NodeKey, SkinKey>,
+    /// Morph target weights at rest, and as posed.
+    rest_weights: SecondaryMap<NodeKey, Vec<f32>>,
+    weights: SecondaryMap<NodeKey, Vec<f32>>,
 }
 
 /// Mesh versions are unique in the process, not per scene: two scenes hand out the same [`MeshKey`]s,
@@ -486,6 +494,17 @@ impl Scene {
         self.light_shadows.retain(|k, _| lights.contains_key(k));
         self.cameras.retain(|_, c| c.node.is_none_or(|n| nodes.contains_key(n)));
         self.rest.retain(|n, _| nodes.contains_key(n));
+        self.node_skins.retain(|n, _| nodes.contains_key(n));
+        self.rest_weights.retain(|n, _| nodes.contains_key(n));
+        self.weights.retain(|n, _| nodes.contains_key(n));
+        for s in self.skins.values_mut() {
+            // A joint that is gone counts as one at the origin: its inverse bind matrix alone moves its vertices.
+            for j in &mut s.joints {
+                if !nodes.contains_key(*j) {
+                    *j = NodeKey::default();
+                }
+            }
+        }
         for a in self.animations.values_mut() {
             a.retain_nodes(nodes);
         }
@@ -524,10 +543,16 @@ impl Scene {
         })
     }
 
-    /// World-space bounds of every drawn mesh.
+    /// World-space bounds of every drawn mesh, as posed.
     #[must_use]
     pub fn bounds(&self) -> Aabb {
-        self.drawables().fold(Aabb::EMPTY, |b, (_, n, m, _)| b.union(self.meshes[m].mesh.bounds().transformed(n.world)))
+        self.drawables().fold(Aabb::EMPTY, |b, (k, n, m, _)| {
+            let placed = match self.deformed(k) {
+                Some(Ok(d)) => d.mesh.bounds().transformed(d.world_from_local),
+                _ => self.meshes[m].mesh.bounds().transformed(n.world),
+            };
+            b.union(placed)
+        })
     }
 
     /// Total triangles drawn (instances counted each time).

@@ -15,7 +15,7 @@ use crate::scene::{Animation, Camera, Channel, Interpolation, Keyframes, Light, 
 pub const MILL_TURN: f32 = 6.0;
 
 /// Adds a node drawing `mesh` in `color` under `parent`. The builders pass their own finite transforms.
-fn part(
+pub(super) fn part(
     scene: &mut Scene,
     name: &str,
     parent: Option<NodeKey>,

@@ -7,6 +7,7 @@
 pub mod animated;
 mod builders;
 pub mod cutouts;
+pub mod walker;
 
 use glam::{Mat4, Vec3};
 
@@ -173,12 +174,20 @@ pub const CUTOUT: &[SceneInfo] = &[
 
 /// The animated scenes: casters that move over a clip ([`crate::Scene::pose`]). Apart from [`ALL`], as
 /// they are measured at several times of their clips.
-pub const ANIMATED: &[SceneInfo] = &[SceneInfo {
-    name: "mill",
-    after: "node animation",
-    description: "a wind mill's three-bladed rotor turning under a sun, its shadow sweeping the tower and the ground",
-    build: animated::mill,
-}];
+pub const ANIMATED: &[SceneInfo] = &[
+    SceneInfo {
+        name: "mill",
+        after: "node animation",
+        description: "a wind mill's three-bladed rotor turning under a sun, its shadow sweeping the tower and the ground",
+        build: animated::mill,
+    },
+    SceneInfo {
+        name: "walker",
+        after: "skinning",
+        description: "a skinned figure of eleven joints walking through a spot light's cone between a ground and a wall",
+        build: walker::walker,
+    },
+];
 
 /// Every built-in scene: the papers' ([`ALL`]), the outdoor ones ([`OUTDOOR`]), those of cutouts
 /// ([`CUTOUT`]), then the animated ones ([`ANIMATED`]).

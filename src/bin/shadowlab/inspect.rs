@@ -51,6 +51,9 @@ pub(crate) fn inspect(target: &str, json: bool, allow_outside_files: bool) -> Re
                 "name": a.name, "duration_s": a.duration, "channels": a.channels, "nodes": a.nodes,
                 "interpolations": a.interpolations,
             })).collect::<Vec<_>>(),
+            "skins": i.skins.iter().map(|(name, joints)| json!({"name": name, "joints": joints})).collect::<Vec<_>>(),
+            "meshes_with_morph_targets": i.morphed_meshes.0,
+            "most_morph_targets": i.morphed_meshes.1,
         }));
     }
     out!("{target}");
@@ -90,6 +93,9 @@ pub(crate) fn inspect(target: &str, json: bool, allow_outside_files: bool) -> Re
     for (n, t) in i.textures.iter().enumerate() {
         out!("    {n:<3} {} x {}  {}", t.width, t.height, t.name);
     }
+    let joints: usize = i.skins.iter().map(|s| s.1).sum();
+    out!("  skins               {} ({joints} joints)", i.skins.len());
+    out!("  morph targets       {} meshes, up to {} targets", i.morphed_meshes.0, i.morphed_meshes.1);
     out!("  animations          {}", i.animations.len());
     for a in &i.animations {
         out!(

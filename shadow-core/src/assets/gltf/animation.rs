@@ -12,12 +12,11 @@ use crate::scene::{Animation, Channel, Interpolation, Keyframes};
 
 impl Loader<'_> {
     /// Adds the file's animations. A channel of a node outside the loaded scene moves nothing and is left
-    /// out; channels of morph target weights are left out with one warning each animation.
+    /// out; one of morph weights moves the weights of every primitive the node draws.
     pub(super) fn animations(&mut self) -> Result<(), Fault> {
         for anim in self.doc.animations() {
             let name = anim.name().map_or_else(|| format!("animation {}", anim.index()), str::to_string);
             let mut channels = Vec::new();
-            let mut weights = 0;
             for (i, channel) in anim.channels().enumerate() {
                 let target = channel.target();
                 let index = target.node().index();
@@ -28,11 +27,9 @@ impl Loader<'_> {
                     let property = format!("{property:?}").to_lowercase();
                     Fault::Malformed(format!("animation '{name}', channel {i} ({property} of node {index}): {why}"))
                 };
-                if property == Property::MorphTargetWeights {
-                    weights += 1;
-                    continue;
-                }
-                if matches!(target.node().transform(), gltf::scene::Transform::Matrix { .. }) {
+                if property != Property::MorphTargetWeights
+                    && matches!(target.node().transform(), gltf::scene::Transform::Matrix { .. })
+                {
                     return Err(fail(
                         "the node is given by a matrix, and glTF animates only translation, rotation \
                                      and scale"
@@ -56,7 +53,18 @@ impl Loader<'_> {
                             .map_err(|e| fail(e.to_string()))?;
                         Keyframes::Rotation(v.chunks_exact(4).map(Quat::from_slice).collect())
                     }
-                    Property::MorphTargetWeights => unreachable!("left out above"),
+                    Property::MorphTargetWeights => {
+                        let targets = target
+                            .node()
+                            .mesh()
+                            .map_or(0, |m| m.primitives().map(|p| p.morph_targets().len()).max().unwrap_or(0));
+                        if targets == 0 {
+                            return Err(fail("the node draws no morph targets".into()));
+                        }
+                        let values = read_floats(&output, &self.buffers, what, Dimensions::Scalar, true)
+                            .map_err(|e| fail(e.to_string()))?;
+                        Keyframes::Weights { targets, values }
+                    }
                 };
                 let interpolation = match sampler.interpolation() {
                     gltf::animation::Interpolation::Step => Interpolation::Step,
@@ -65,12 +73,14 @@ impl Loader<'_> {
                 };
                 let mut channel = Channel { node, times, interpolation, values };
                 channel.check().map_err(fail)?;
-                channels.push(channel);
-            }
-            if weights > 0 {
-                self.scene.add_warning(format!(
-                    "animation '{name}': {weights} channel(s) of morph target weights are not played"
-                ));
+                if property == Property::MorphTargetWeights {
+                    // Each primitive the node draws is a scene node of its own, with the node's weights.
+                    for &p in &self.primitive_nodes[index] {
+                        channels.push(Channel { node: p, ..channel.clone() });
+                    }
+                } else {
+                    channels.push(channel);
+                }
             }
             if channels.is_empty() {
                 continue;
