@@ -12,6 +12,13 @@
 //! still as when they move: every map flickers by that measure, a uniform map that never moves included.
 //! The CPU backend runs it, since it can query a frame over another view's receivers; the maps' fit is
 //! the same code on both backends.
+//!
+//! A walk may step through an animation too ([`FlickerWalk::through`]): the scene posed a little later
+//! at every frame. Then the casters move and the reference's own answer changes where the shadow truly
+//! moves, so a point flickers between two frames when the technique's state changes there and the
+//! reference's does not, or the reference's changes and the technique's does not. Only the receivers
+//! that stand still and stay in view are measured: a point on a moving caster does not stay on it, and
+//! one a caster walks in front of is not seen.
 
 use shadow_core::metrics::measured_pixels;
 use shadow_core::technique::TechniqueSpec;
@@ -44,6 +51,8 @@ pub struct FlickerWalk {
     frames: Vec<FrameInputs>,
     receivers: shadow_cpu::GBuffer,
     mask: Image<bool>,
+    /// Where the scene moves, the reference's lit state at the receivers in each frame.
+    reference: Option<Vec<Image<bool>>>,
 }
 
 impl FlickerWalk {
@@ -66,12 +75,77 @@ impl FlickerWalk {
             camera.validate().map_err(|e| Error::Usage(format!("camera {k} of the walk: {e}")))?;
             frames.push(FrameInputs { camera: *camera, ..frame.clone() });
         }
+        let (receivers, mask) = Self::receivers(renderer, &frames[0], (width, height))?;
+        Ok(Self { frames, receivers, mask, reference: None })
+    }
+
+    /// A walk through frames of a moving scene (each posed at its own time, seen from its own camera),
+    /// measured at the receivers of the first that stand still (on instances placed and posed alike in
+    /// every frame) and that no caster hides from the camera in any frame, against the reference's
+    /// answer at each.
+    ///
+    /// # Errors
+    /// Fewer than two frames; a frame that cannot be rendered.
+    pub fn through(renderer: &mut Renderer, frames: Vec<FrameInputs>, size: (u32, u32)) -> Result<Self, Error> {
+        if frames.len() < 2 {
+            return Err(Error::Usage(format!("flicker needs at least 2 frames, not {}", frames.len())));
+        }
+        let (receivers, mask) = Self::receivers(renderer, &frames[0], size)?;
+        let placed = |f: &FrameInputs, i: usize| f.instances.get(i).map(|x| (x.mesh_version, x.world_from_local));
+        let still: Vec<bool> = (0..frames[0].instances.len())
+            .map(|i| frames.iter().all(|f| placed(f, i) == placed(&frames[0], i)))
+            .collect();
+        let on_still = |i: &u32| still.get(*i as usize).copied().unwrap_or(false);
+        // A point a moving caster hides from the camera in some frame is left out too: the techniques
+        // that count along the eye's ray (z-pass volumes) answer only for points the eye sees.
+        let bvhs: Vec<shadow_cpu::bvh::SceneBvh> = frames.iter().map(shadow_cpu::bvh::SceneBvh::build).collect();
+        let seen = |p: glam::Vec3| {
+            frames.iter().zip(&bvhs).all(|(f, bvh)| {
+                let to = p - f.camera.eye;
+                let d = to.length();
+                // Short of the point by a little, so its own surface does not hide it.
+                d <= 0.0 || !bvh.occluded(f.camera.eye, to / d, d * (1.0 - 1e-4))
+            })
+        };
+        let mask = Image::from_fn(mask.width(), mask.height(), |x, y| {
+            *mask.get(x, y) && on_still(receivers.instance.get(x, y)) && seen(*receivers.position.get(x, y))
+        });
+        let mut walk = Self { frames, receivers, mask, reference: None };
         let reference = TechniqueSpec::named(shadow_hard::RayTraced::NAME);
-        let (first, _) = renderer.run_cpu_frame(&frames[0], width, height, &reference)?;
+        walk.reference = Some(walk.lit_states(renderer, &reference, |_| {})?);
+        Ok(walk)
+    }
+
+    /// The first frame's G-buffer and its measured pixels (receivers facing the light).
+    fn receivers(
+        renderer: &mut Renderer,
+        first: &FrameInputs,
+        (width, height): (u32, u32),
+    ) -> Result<(shadow_cpu::GBuffer, Image<bool>), Error> {
+        let reference = TechniqueSpec::named(shadow_hard::RayTraced::NAME);
+        let (first, _) = renderer.run_cpu_frame(first, width, height, &reference)?;
         let view = first.light_views.first().ok_or_else(|| Error::Usage("the scene has no light".into()))?;
         let g = &first.gbuffer;
         let mask = measured_pixels(&g.receiver, &g.position, &g.geometric_normal, view);
-        Ok(Self { frames, receivers: first.gbuffer, mask })
+        Ok((first.gbuffer, mask))
+    }
+
+    /// Where `spec` says lit at the receivers, frame by frame. The technique keeps its state from frame
+    /// to frame, as an application's would.
+    fn lit_states(
+        &self,
+        renderer: &mut Renderer,
+        spec: &TechniqueSpec,
+        mut progress: impl FnMut(usize),
+    ) -> Result<Vec<Image<bool>>, Error> {
+        let mut prepared = renderer.prepare(BackendKind::Cpu, spec)?;
+        let mut states = Vec::with_capacity(self.frames.len());
+        for (k, frame) in self.frames.iter().enumerate() {
+            progress(k);
+            let run = renderer.run_cpu_over(&mut prepared, frame, &self.receivers)?;
+            states.push(run.visibility[0].map(|&v| v >= 0.5));
+        }
+        Ok(states)
     }
 
     /// The flicker of `spec` (on the CPU) along the walk. The technique keeps its state from frame to
@@ -83,21 +157,23 @@ impl FlickerWalk {
         &self,
         renderer: &mut Renderer,
         spec: &TechniqueSpec,
-        mut progress: impl FnMut(usize),
+        progress: impl FnMut(usize),
     ) -> Result<f64, Error> {
-        let mut prepared = renderer.prepare(BackendKind::Cpu, spec)?;
+        let states = self.lit_states(renderer, spec, progress)?;
         let (mut flickered, mut pairs) = (0u64, 0u64);
-        let mut last: Option<Image<bool>> = None;
-        for (k, frame) in self.frames.iter().enumerate() {
-            progress(k);
-            let run = renderer.run_cpu_over(&mut prepared, frame, &self.receivers)?;
-            let lit = run.visibility[0].map(|&v| v >= 0.5);
-            if let Some(before) = &last {
-                let (f, n) = changed(before, &lit, &self.mask);
-                flickered += f;
-                pairs += n;
-            }
-            last = Some(lit);
+        for k in 1..states.len() {
+            let (f, n) = match &self.reference {
+                None => changed(&states[k - 1], &states[k], &self.mask),
+                Some(truth) => {
+                    // Where the technique changes and the truth does not, or the other way round.
+                    let moved = |s: &[Image<bool>], i: usize| s[k - 1].data()[i] != s[k].data()[i];
+                    let measured = self.mask.data().iter().enumerate().filter(|(_, m)| **m).map(|(i, _)| i);
+                    let wrong = measured.clone().filter(|&i| moved(&states, i) != moved(truth, i)).count();
+                    (wrong as u64, measured.count() as u64)
+                }
+            };
+            flickered += f;
+            pairs += n;
         }
         Ok(if pairs == 0 { 0.0 } else { flickered as f64 / pairs as f64 })
     }

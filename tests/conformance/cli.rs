@@ -396,8 +396,8 @@ fn inspect_lists_a_textured_cards_material_and_texture_and_names_a_bad_image() {
 }
 
 /// `--time` poses the scene's animations: the mill's rotor throws its shadow elsewhere a second later,
-/// `inspect` lists the clip, a time that is not a number is a usage error, and a scene with nothing to
-/// pose says so.
+/// `inspect` lists the clip, a time that is not a number is a usage error, a scene with nothing to pose
+/// says so, and `flicker --time-step` walks the clip.
 #[test]
 fn time_poses_the_animations_and_inspect_lists_them() {
     let dir = std::env::temp_dir().join(format!("shadowlab-cli-time-{}", std::process::id()));
@@ -427,5 +427,14 @@ fn time_poses_the_animations_and_inspect_lists_them() {
     let (code, _, err) = shadowlab(&[&args[..], &["--time", "2", "-o", out.to_str().unwrap()]].concat());
     assert_eq!(code, 0, "{err}");
     assert!(err.contains("cylinder: no animations to pose at 2 s"), "{err}");
+    // Flicker steps through the clip; a scene without one has nothing to step.
+    let walk =
+        ["flicker", "--technique", "shadow-volume-zfail", "--frames", "3", "--size", "48x48", "--time-step", "0.5"];
+    let (code, out, err) = shadowlab(&[&walk[..], &["--scene", "mill"]].concat());
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("0.5 s of the animation per frame"), "{out}");
+    let (code, _, err) = shadowlab(&[&walk[..], &["--scene", "cylinder"]].concat());
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("cylinder has no animations to step"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -248,6 +248,11 @@ pub(crate) enum Command {
         /// Degrees turned left per frame.
         #[arg(long, default_value_t = 0.15)]
         turn: f32,
+        /// Seconds of the scene's animations per frame, from --time (0: the scene stands still). A point
+        /// of a moving scene flickers where the technique's state changes and the reference's does not,
+        /// or the other way round.
+        #[arg(long, default_value_t = 0.0, value_name = "SECONDS")]
+        time_step: f32,
     },
     /// Measure every technique on every built-in scene (errors on both backends, frame times on one
     /// scene) and write the results page.

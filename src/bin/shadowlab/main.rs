@@ -123,8 +123,8 @@ fn run(cli: Cli) -> Result<(), Error> {
             bench(&scene, &view, BenchArgs { choice, frames, warmup, json, realtime, rebuild, sweep, out_dir })
         }
         Command::Export { scene, out } => export(&scene, &out),
-        Command::Flicker { scene, view, technique, frames, step, turn } => {
-            flicker(&scene, &view, &technique, (frames, step, turn))
+        Command::Flicker { scene, view, technique, frames, step, turn, time_step } => {
+            flicker(&scene, &view, &technique, (frames, step, turn, time_step))
         }
         Command::View { scene, technique, backend, size, script } => view(&scene, technique, &backend, &size, script),
         Command::Results { out, size, backend, bench_scene, bench_size, bench_frames, outdoor_size } => {
@@ -325,17 +325,20 @@ fn flicker(
     args: &SceneArgs,
     view: &ViewArgs,
     techniques: &[String],
-    (frames, step, turn): (usize, f32, f32),
+    (frames, step, turn, time_step): (usize, f32, f32, f32),
 ) -> Result<(), Error> {
     use shadowlab::flicker::{FlickerWalk, walk};
     view.check_adapter("cpu")?;
     if frames < 2 {
         return Err(Error::Usage(format!("--frames {frames}: flicker needs at least 2")));
     }
-    if !(step.is_finite() && turn.is_finite()) {
-        return Err(Error::Usage("--step and --turn must be finite numbers".into()));
+    if !(step.is_finite() && turn.is_finite() && time_step.is_finite()) {
+        return Err(Error::Usage("--step, --turn and --time-step must be finite numbers".into()));
     }
-    let (frame, w, h) = args.frame(view)?;
+    let (w, h) = view.size()?;
+    let mut scene = args.setup().build()?;
+    args::print_warnings(&scene);
+    let frame = FrameInputs::from_first_camera(&scene)?;
     let specs: Vec<TechniqueSpec> = techniques.iter().map(|t| TechniqueSpec::parse(t)).collect::<Result<_, _>>()?;
     let mut renderer = Renderer::new(TechniqueRegistry::builtin());
     for spec in &specs {
@@ -344,7 +347,21 @@ fn flicker(
     check_availability(&renderer, &specs, "cpu")?;
     let path = walk(&frame.camera, frames, step, turn.to_radians());
     let bar = progress_bar((frames * specs.len()) as u64);
-    let walk = FlickerWalk::new(&mut renderer, &frame, &path, (w, h))?;
+    let walk = if time_step == 0.0 {
+        FlickerWalk::new(&mut renderer, &frame, &path, (w, h))?
+    } else {
+        if scene.animations().next().is_none() {
+            return Err(Error::Usage(format!("--time-step {time_step}: {} has no animations to step", args.scene)));
+        }
+        // The scene posed a step later at every frame, from --time (or its start).
+        let start = args.time.unwrap_or(0.0);
+        let mut posed = Vec::with_capacity(frames);
+        for (k, camera) in path.iter().enumerate() {
+            scene.pose(start + time_step * k as f32).map_err(|e| Error::Usage(e.to_string()))?;
+            posed.push(FrameInputs { camera: *camera, ..FrameInputs::from_first_camera(&scene)? });
+        }
+        FlickerWalk::through(&mut renderer, posed, (w, h))?
+    };
     let mut rows = Vec::new();
     for spec in &specs {
         let f = walk.flicker(&mut renderer, spec, |k| report_progress(&bar, &format!("{spec} frame {k}")))?;
@@ -353,7 +370,8 @@ fn flicker(
     if let Some(b) = bar {
         b.finish_and_clear();
     }
-    out!("{frames} frames, {step} per frame, {turn} degrees per frame, {w}x{h}, on the cpu");
+    let time = if time_step == 0.0 { String::new() } else { format!(", {time_step} s of the animation per frame") };
+    out!("{frames} frames, {step} per frame, {turn} degrees per frame{time}, {w}x{h}, on the cpu");
     out!("{:<48} {:>10}", "technique", "flicker");
     for (name, f) in rows {
         out!("{name:<48} {:>9.4}%", f * 100.0);
