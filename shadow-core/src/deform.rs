@@ -21,13 +21,21 @@ pub struct SkinWeights {
 
 impl SkinWeights {
     /// Joints and weights of every vertex; the weights are normalized to sum to one (glTF asks files to
-    /// store them so, and many store them nearly so).
+    /// store them so, and many store them nearly so), and a joint of weight zero is named 0 (as glTF
+    /// asks: it moves nothing).
     ///
     /// # Errors
     /// Counts that differ, or a vertex whose weights are negative, not finite or sum to zero: says which.
-    pub fn new(joints: Vec<[u16; 4]>, mut weights: Vec<[f32; 4]>) -> Result<Self, String> {
+    pub fn new(mut joints: Vec<[u16; 4]>, mut weights: Vec<[f32; 4]>) -> Result<Self, String> {
         if joints.len() != weights.len() {
             return Err(format!("{} vertices of joints but {} of weights", joints.len(), weights.len()));
+        }
+        for (j, w) in joints.iter_mut().zip(&weights) {
+            for (j, w) in j.iter_mut().zip(w) {
+                if *w == 0.0 {
+                    *j = 0;
+                }
+            }
         }
         for (v, w) in weights.iter_mut().enumerate() {
             if w.iter().any(|x| !(x.is_finite() && *x >= 0.0)) {

@@ -1,10 +1,11 @@
 //! Writing a scene as glTF 2.0, binary (.glb) or JSON (.gltf with its buffer and images beside it):
 //! every drawn mesh (shared meshes written once) with its texture coordinates, its material's base colour
 //! and alpha, base-colour texture (level 0 as a PNG, with its sampler and `KHR_texture_transform`),
-//! alpha mode and cutoff and sidedness, the node hierarchy flattened to world matrices (skinned and
-//! morphed meshes as posed), the cameras and the lights (KHR_lights_punctual), so it opens in Blender or
-//! any glTF viewer and loads back through [`super::load`] with the same texels. The scene is written as it
-//! stands: its animations are not.
+//! alpha mode and cutoff and sidedness, the cameras and the lights (KHR_lights_punctual), so it opens in
+//! Blender or any glTF viewer and loads back through [`super::load`] with the same texels. A still scene's
+//! node hierarchy is flattened to world matrices (morphed meshes as posed); one with animations or skins
+//! keeps its hierarchy, skins, morph targets and animations ([`moving`]) and plays again where it loads.
+//! Cameras and lights are written where they stand.
 
 use std::collections::HashMap;
 use std::io::Write;
@@ -17,6 +18,8 @@ use crate::material::{AlphaMode, Filter, Sampler, TextureRef, Wrap};
 use crate::mesh::Mesh;
 use crate::scene::{Light, LightKind, Material, MeshKey, Scene, TextureKey};
 use crate::shading;
+
+mod moving;
 
 /// Why a scene could not be written.
 #[derive(Debug, thiserror::Error)]
@@ -76,25 +79,15 @@ pub fn glb_bytes(scene: &Scene) -> Vec<u8> {
 
 fn document(scene: &Scene) -> Document {
     let mut parts = MeshParts::default();
-    let mut nodes = vec![];
-    let mut mesh_index: HashMap<(MeshKey, String), usize> = HashMap::new();
-    for (key, node, mesh_key, material) in scene.drawables() {
-        let Some(mesh) = scene.mesh(mesh_key) else { continue };
-        // A skinned or morphed mesh is written as it stands posed, a mesh of its own.
-        let (mi, m) = match scene.deformed(key) {
-            Some(Ok(posed)) => (parts.mesh(scene, &posed.mesh, material), posed.world_from_local),
-            _ => {
-                let entry = mesh_index.entry((mesh_key, material.name.clone()));
-                (*entry.or_insert_with(|| parts.mesh(scene, mesh, material)), node.world_transform())
-            }
-        };
-        let mut n = json!({"name": node.name(), "mesh": mi});
-        // glTF asks that the identity be left out rather than written.
-        if m != Mat4::IDENTITY {
-            n["matrix"] = json!(m.to_cols_array());
-        }
-        nodes.push(n);
-    }
+    let moves = scene.animations().next().is_some() || scene.skins().next().is_some();
+    let (mut nodes, mut roots, skins, animations) = if moves {
+        let m = moving::hierarchy(scene, &mut parts);
+        (m.nodes, m.roots, m.skins, m.animations)
+    } else {
+        let nodes = flattened(scene, &mut parts);
+        let roots = (0..nodes.len()).collect();
+        (nodes, roots, Vec::new(), Vec::new())
+    };
     let mut cameras = vec![];
     for (_, c) in scene.cameras() {
         cameras.push(json!({"type": "perspective", "perspective": {"yfov": c.fov_y, "znear": c.near}}));
@@ -103,6 +96,7 @@ fn document(scene: &Scene) -> Document {
             o.insert("name".into(), json!("camera"));
             o.insert("camera".into(), json!(cameras.len() - 1));
         }
+        roots.push(nodes.len());
         nodes.push(n);
     }
     let mut lights = vec![];
@@ -114,6 +108,7 @@ fn document(scene: &Scene) -> Document {
             o.insert("name".into(), json!("light"));
             o.insert("extensions".into(), json!({"KHR_lights_punctual": {"light": lights.len() - 1}}));
         }
+        roots.push(nodes.len());
         nodes.push(n);
     }
     let MeshParts { bin, views, accessors, meshes, materials, images, textures, samplers, transformed, pngs, .. } =
@@ -121,7 +116,7 @@ fn document(scene: &Scene) -> Document {
     let mut doc = json!({
         "asset": {"version": "2.0", "generator": "shadowlab"},
         "scene": 0,
-        "scenes": [{"nodes": (0..nodes.len()).collect::<Vec<_>>()}],
+        "scenes": [{"nodes": roots}],
         "nodes": nodes,
         "meshes": meshes,
         "materials": materials,
@@ -131,6 +126,12 @@ fn document(scene: &Scene) -> Document {
     if let Some(o) = doc.as_object_mut() {
         if !cameras.is_empty() {
             o.insert("cameras".into(), json!(cameras));
+        }
+        if !skins.is_empty() {
+            o.insert("skins".into(), json!(skins));
+        }
+        if !animations.is_empty() {
+            o.insert("animations".into(), json!(animations));
         }
         if !images.is_empty() {
             o.insert("images".into(), json!(images));
@@ -150,6 +151,30 @@ fn document(scene: &Scene) -> Document {
         }
     }
     Document { doc, bin, pngs }
+}
+
+/// The drawn nodes of a still scene, each with its world matrix (a morphed mesh as posed, a mesh of its
+/// own; shared meshes written once).
+fn flattened(scene: &Scene, parts: &mut MeshParts) -> Vec<Value> {
+    let mut nodes = vec![];
+    let mut mesh_index: HashMap<(MeshKey, String), usize> = HashMap::new();
+    for (key, node, mesh_key, material) in scene.drawables() {
+        let Some(mesh) = scene.mesh(mesh_key) else { continue };
+        let (mi, m) = match scene.deformed(key) {
+            Some(Ok(posed)) => (parts.mesh(scene, &posed.mesh, material), posed.world_from_local),
+            _ => {
+                let entry = mesh_index.entry((mesh_key, material.name.clone()));
+                (*entry.or_insert_with(|| parts.mesh(scene, mesh, material)), node.world_transform())
+            }
+        };
+        let mut n = json!({"name": node.name(), "mesh": mi});
+        // glTF asks that the identity be left out rather than written.
+        if m != Mat4::IDENTITY {
+            n["matrix"] = json!(m.to_cols_array());
+        }
+        nodes.push(n);
+    }
+    nodes
 }
 
 /// The binary buffer and the glTF arrays describing the meshes written into it.
@@ -227,7 +252,13 @@ impl MeshParts {
                 self.materials.len() - 1
             }
         };
-        self.meshes.push(json!({"primitives": [{"attributes": attributes, "indices": indices, "material": material}]}));
+        let mut primitive = json!({"attributes": attributes, "indices": indices, "material": material});
+        if let Some(d) = mesh.deformers()
+            && let Some(targets) = self.deformers(d, &mut primitive["attributes"])
+        {
+            primitive["targets"] = targets;
+        }
+        self.meshes.push(json!({"primitives": [primitive]}));
         self.meshes.len() - 1
     }
 

@@ -134,6 +134,12 @@ impl Scene {
         Ok(())
     }
 
+    /// A node's morph target weights at rest (empty where it has none).
+    #[must_use]
+    pub fn rest_morph_weights(&self, node: NodeKey) -> &[f32] {
+        self.rest_weights.get(node).map_or(&[], Vec::as_slice)
+    }
+
     /// A node's morph target weights as posed (empty where it has none: every target at zero).
     #[must_use]
     pub fn morph_weights(&self, node: NodeKey) -> &[f32] {

@@ -552,11 +552,6 @@ fn export(args: &SceneArgs, out: &Path) -> Result<(), Error> {
     }
     let scene = args.setup().build()?;
     args::print_warnings(&scene);
-    let animations = scene.animations().count();
-    if animations > 0 {
-        let pose = args.time.map_or_else(|| "at rest".to_string(), |t| format!("posed at {t} s"));
-        eprintln!("warning: the scene's {animations} animation(s) are not written: the file holds it {pose}");
-    }
     shadow_core::assets::export::export(&scene, out)
         .map_err(|e| Error::Write { path: e.path.into(), why: e.source.to_string() })?;
     out!("wrote {} ({} triangles)", out.display(), scene.triangle_count());
