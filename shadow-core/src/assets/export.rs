@@ -4,7 +4,7 @@
 //! alpha mode and cutoff and sidedness, the cameras and the lights (KHR_lights_punctual), so it opens in
 //! Blender or any glTF viewer and loads back through [`super::load`] with the same texels. A still scene's
 //! node hierarchy is flattened to world matrices (morphed meshes as posed); one with animations or skins
-//! keeps its hierarchy, skins, morph targets and animations ([`moving`]) and plays again where it loads.
+//! keeps its hierarchy, skins, morph targets and animations, and plays again where it loads.
 //! Cameras and lights are written where they stand.
 
 use std::collections::HashMap;
