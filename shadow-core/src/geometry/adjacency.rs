@@ -157,7 +157,25 @@ impl Adjacency {
         let component_bounds =
             component_bounds(&self.triangles, &self.component, self.component_bounds.len(), &positions);
         let facing_runs = FacingRuns::new(&planes, &self.manifold_faces);
-        Self { positions, planes, component_bounds, facing_runs, ..self.clone() }
+        // The topology is copied field by field: the rest mesh's positions and planes are not copied only
+        // to be dropped.
+        Self {
+            positions,
+            planes,
+            component_bounds,
+            facing_runs,
+            remap: self.remap.clone(),
+            triangles: self.triangles.clone(),
+            degenerate: self.degenerate.clone(),
+            manifold: self.manifold.clone(),
+            manifold_faces: self.manifold_faces.clone(),
+            boundary: self.boundary.clone(),
+            boundary_faces: self.boundary_faces.clone(),
+            complex: self.complex.clone(),
+            non_manifold_edges: self.non_manifold_edges,
+            inconsistent_edges: self.inconsistent_edges,
+            component: self.component.clone(),
+        }
     }
 
     /// Welded positions.
