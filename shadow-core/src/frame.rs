@@ -18,7 +18,7 @@ use crate::image::Image;
 use crate::light::{LightView, LightViewError};
 use crate::material::{AlphaMode, Footprint, Material, Texture};
 use crate::mesh::Mesh;
-use crate::scene::{Camera, CameraKey, Light, LightShadow, MeshKey, NodeKey, Scene, SceneError};
+use crate::scene::{Camera, CameraKey, Light, LightShadow, MeshKey, NodeKey, Pose, Scene, SceneError};
 use crate::stats::Counters;
 
 /// One drawn mesh in world space.
@@ -35,6 +35,8 @@ pub struct Instance {
     pub mesh: Arc<Mesh>,
     /// Its adjacency (cached by the scene per mesh; over the posed positions for a posed mesh).
     pub adjacency: Arc<Adjacency>,
+    /// What a skinned or morphed mesh was posed from (`None` for a mesh drawn as it is).
+    pub pose: Option<Arc<Pose>>,
     /// Mesh space to world space.
     pub world_from_local: Mat4,
     /// World space to mesh space.
@@ -174,14 +176,15 @@ impl FrameInputs {
             .drawables()
             .filter_map(|(node, n, mesh_key, material)| {
                 // A skinned or morphed mesh is drawn as posed; every other as it stands, where its node is.
-                let (mesh, adjacency, mesh_version, world) = match scene.deformed(node) {
-                    Some(Ok(d)) => (d.mesh, d.adjacency, d.version, d.world_from_local),
+                let (mesh, adjacency, mesh_version, world, pose) = match scene.deformed(node) {
+                    Some(Ok(d)) => (d.mesh, d.adjacency, d.version, d.world_from_local, Some(d.pose)),
                     Some(Err(e)) => return Some(Err(e)),
                     None => (
                         scene.mesh(mesh_key)?.clone(),
                         scene.adjacency(mesh_key)?,
                         scene.mesh_version(mesh_key)?,
                         n.world_transform(),
+                        None,
                     ),
                 };
                 Some(Ok(Instance {
@@ -189,6 +192,7 @@ impl FrameInputs {
                     mesh_key,
                     mesh_version,
                     adjacency,
+                    pose,
                     world_from_local: world,
                     local_from_world: crate::affine::inverse(world),
                     mirrored: world.determinant() < 0.0,

@@ -310,7 +310,7 @@ pub fn draw_textured(
 ) {
     for (i, inst) in frame.instances.iter().enumerate().filter(|(_, i)| keep(i)) {
         let Some(texture) = read_texture(inst).and_then(|t| cx.cache.textures.get(t)) else { continue };
-        let Some((m, uvs)) = cx.cache.mesh(inst.mesh_key).and_then(|m| Some((m, m.uvs.as_ref()?))) else { continue };
+        let Some((m, uvs)) = cx.cache.mesh(inst).and_then(|m| Some((m, m.uvs?))) else { continue };
         pass.set_bind_group(2, &texture.group, &[]);
         pass.set_vertex_buffer(if normals { 2 } else { 1 }, uvs.slice(..));
         draw_mesh(pass, m, i, normals);
@@ -326,13 +326,13 @@ pub fn draw_instances(
     normals: bool,
 ) {
     for (i, inst) in frame.instances.iter().enumerate().filter(|(_, i)| keep(i)) {
-        let Some(m) = cx.cache.mesh(inst.mesh_key) else { continue };
+        let Some(m) = cx.cache.mesh(inst) else { continue };
         draw_mesh(pass, m, i, normals);
     }
 }
 
 /// Draws mesh `m` as instance `i`: its positions in slot 0 (and its normals in slot 1, with `normals`).
-fn draw_mesh(pass: &mut wgpu::RenderPass<'_>, m: &crate::upload::MeshGpu, i: usize, normals: bool) {
+fn draw_mesh(pass: &mut wgpu::RenderPass<'_>, m: crate::upload::MeshView<'_>, i: usize, normals: bool) {
     pass.set_vertex_buffer(0, m.positions.slice(..));
     if normals {
         pass.set_vertex_buffer(1, m.normals.slice(..));

@@ -15,6 +15,7 @@ pub mod host_wgsl;
 pub mod passes;
 pub mod pipeline_cache;
 pub mod pipelines;
+pub mod posing;
 pub mod readback;
 pub mod record;
 pub mod resources;

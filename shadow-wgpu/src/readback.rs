@@ -65,6 +65,24 @@ pub fn map_read(cx: &WgpuContext, buffer: &wgpu::Buffer, during: &str) -> Result
     Ok(bytes)
 }
 
+/// A buffer's bytes (its usage must include COPY_SRC).
+///
+/// # Errors
+/// A GPU failure, or [`WgpuError::NotRecordable`] inside a frame recorded into a host's encoder.
+pub fn read_buffer(cx: &WgpuContext, buffer: &wgpu::Buffer, during: &str) -> Result<Vec<u8>, WgpuError> {
+    cx.may_wait(during)?;
+    let staging = cx.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("readback"),
+        size: buffer.size(),
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    let mut enc = cx.encoder("readback");
+    enc.copy_buffer_to_buffer(buffer, 0, &staging, 0, buffer.size());
+    cx.submit(enc);
+    map_read(cx, &staging, during)
+}
+
 /// A single-channel f32 texture (R32Float or Depth32Float) as an image.
 ///
 /// # Errors

@@ -87,6 +87,12 @@ pub fn extrusion() -> String {
     format!("{}\n{}", shadow_volume(), include_str!("shaders/extrude.wgsl"))
 }
 
+/// The pose of skinned and morphed meshes (`crate::posing`).
+#[must_use]
+pub fn pose() -> String {
+    include_str!("shaders/pose.wgsl").to_string()
+}
+
 /// Every shader of the backend, by name, for validation.
 #[must_use]
 pub fn all() -> Vec<(&'static str, String)> {
@@ -97,6 +103,7 @@ pub fn all() -> Vec<(&'static str, String)> {
         ("shadow_map", shadow_map()),
         ("shadow_volume", shadow_volume()),
         ("extrusion", extrusion()),
+        ("pose", pose()),
         ("texel", TEXEL.to_string()),
         // The host modules, each before a host's shader that uses it.
         (

@@ -1,16 +1,22 @@
 //! Scene upload, cached: vertex and index buffers per [`MeshKey`] (refreshed when the mesh's version
-//! changes), the adjacency the GPU's shadow-volume extrusion reads (per mesh, on first use), the
-//! materials' textures ([`crate::textures`]), and the per-instance data of a frame (rewritten in place
-//! when an instance changes, made anew only when their number does).
+//! changes), the adjacency the GPU's shadow-volume extrusion reads (per mesh, on first use), skinned and
+//! morphed meshes posed per node ([`crate::posing`]), the materials' textures ([`crate::textures`]), and
+//! the per-instance data of a frame (rewritten in place when an instance changes, made anew only when
+//! their number does).
+//!
+//! Passes reach an instance's buffers through [`SceneCache::mesh`] and [`SceneCache::adjacency`], which
+//! hand a posed instance its node's posed positions, normals, welded positions and planes beside its
+//! rest mesh's indices, texture coordinates and topology.
 
 use std::collections::HashMap;
 
 use bytemuck::{Pod, Zeroable};
 use glam::Mat4;
 use shadow_core::geometry::adjacency::{Adjacency, FaceUse};
-use shadow_core::{FrameInputs, MeshKey};
+use shadow_core::{FrameInputs, Instance, MeshKey, NodeKey};
 
 use crate::context::{WgpuContext, WgpuError};
+use crate::posing::Posing;
 use crate::textures::{DeviceTextures, TexelRuleRaw, read_texture};
 
 /// A mesh on the GPU.
@@ -27,6 +33,55 @@ pub struct MeshGpu {
     pub indices: wgpu::Buffer,
     /// Number of indices.
     pub index_count: u32,
+}
+
+/// An instance's mesh as the passes draw it: its positions and normals (its node's posed ones for a
+/// posed instance), texture coordinates and indices.
+#[derive(Clone, Copy)]
+pub struct MeshView<'a> {
+    /// Homogeneous positions (w = 1), one `vec4<f32>` per vertex.
+    pub positions: &'a wgpu::Buffer,
+    /// Normals, one `vec4<f32>` per vertex.
+    pub normals: &'a wgpu::Buffer,
+    /// Texture coordinates, one `vec2<f32>` per vertex, where the mesh has them.
+    pub uvs: Option<&'a wgpu::Buffer>,
+    /// Triangle indices (index and storage usage).
+    pub indices: &'a wgpu::Buffer,
+    /// Number of indices.
+    pub index_count: u32,
+}
+
+/// An instance's adjacency as the extrusion reads it: the welded positions and face planes (its node's
+/// posed ones for a posed instance) and the mesh's topology ([`AdjacencyGpu`]).
+#[derive(Clone, Copy)]
+pub struct AdjacencyView<'a> {
+    /// Welded positions, `vec4<f32>` with w = 1.
+    pub welded: &'a wgpu::Buffer,
+    /// Per face, its plane `(n, d)` (`vec4<f32>`).
+    pub planes: &'a wgpu::Buffer,
+    /// The rest of it: edges, uses and counts.
+    pub topology: &'a AdjacencyGpu,
+}
+
+/// What identifies the buffers an instance is drawn from: its mesh and that mesh's version, and for a
+/// posed instance its node (whose posed buffers it reads) with its rest mesh's version. Equal keys, equal
+/// buffers: a pass that binds them may keep its bind groups while the key holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct BuffersKey {
+    mesh: MeshKey,
+    version: u64,
+    posed: Option<NodeKey>,
+}
+
+impl BuffersKey {
+    /// The key of `inst`'s buffers.
+    #[must_use]
+    pub fn of(inst: &Instance) -> Self {
+        match &inst.pose {
+            Some(pose) => Self { mesh: inst.mesh_key, version: pose.rest_version, posed: Some(inst.node) },
+            None => Self { mesh: inst.mesh_key, version: inst.mesh_version, posed: None },
+        }
+    }
 }
 
 /// GPU twin of `Instance` in common.wgsl.
@@ -129,18 +184,32 @@ pub struct SceneCache {
     adjacency: HashMap<MeshKey, AdjacencyGpu>,
     /// The instance buffers, one per frame that may be in flight, each with what it holds.
     instances: Vec<(Vec<InstanceRaw>, wgpu::Buffer)>,
+    /// Deformed meshes' rest data and posed nodes' buffers.
+    pub(crate) posing: Posing,
     /// The materials' textures.
     pub textures: DeviceTextures,
 }
 
+/// The mesh an instance is drawn from at rest, and that mesh's version: a posed instance's rest mesh.
+fn rest_mesh(inst: &Instance) -> (&shadow_core::Mesh, u64) {
+    match &inst.pose {
+        Some(pose) => (&pose.rest, pose.rest_version),
+        None => (&inst.mesh, inst.mesh_version),
+    }
+}
+
 impl SceneCache {
-    /// Uploads every instance's mesh that is missing or stale.
+    /// Uploads every instance's mesh that is missing or stale (a posed instance's rest mesh), and poses
+    /// the posed instances whose pose changed ([`crate::posing`]).
     pub fn upload_meshes(&mut self, cx: &WgpuContext, frame: &FrameInputs) {
         for inst in &frame.instances {
-            if self.meshes.get(&inst.mesh_key).is_some_and(|m| m.version == inst.mesh_version) {
+            let (m, version) = rest_mesh(inst);
+            if self.meshes.get(&inst.mesh_key).is_some_and(|m| m.version == version) {
                 continue;
             }
-            let m = &inst.mesh;
+            // The pose reads a deformed mesh's rest positions and normals as storage.
+            let posable =
+                if m.deformers().is_some() { wgpu::BufferUsages::STORAGE } else { wgpu::BufferUsages::empty() };
             let positions: Vec<[f32; 4]> = m.positions().iter().map(|p| p.extend(1.0).to_array()).collect();
             let normals: Vec<[f32; 4]> = m.normals().iter().map(|n| n.extend(0.0).to_array()).collect();
             let indices: Vec<u32> = m.triangles().iter().flatten().copied().collect();
@@ -150,9 +219,13 @@ impl SceneCache {
             self.meshes.insert(
                 inst.mesh_key,
                 MeshGpu {
-                    version: inst.mesh_version,
-                    positions: make("positions", bytemuck::cast_slice(&positions), wgpu::BufferUsages::VERTEX),
-                    normals: make("normals", bytemuck::cast_slice(&normals), wgpu::BufferUsages::VERTEX),
+                    version,
+                    positions: make(
+                        "positions",
+                        bytemuck::cast_slice(&positions),
+                        wgpu::BufferUsages::VERTEX | posable,
+                    ),
+                    normals: make("normals", bytemuck::cast_slice(&normals), wgpu::BufferUsages::VERTEX | posable),
                     uvs: m.uvs().map(|uvs| make("uvs", bytemuck::cast_slice(uvs), wgpu::BufferUsages::VERTEX)),
                     indices: make(
                         "indices",
@@ -163,28 +236,48 @@ impl SceneCache {
                 },
             );
         }
+        let meshes = &self.meshes;
+        self.posing.pose(cx, &frame.instances, |key| meshes.get(&key).map(|m| (&m.positions, &m.normals)));
     }
 
-    /// The mesh of an instance (after [`SceneCache::upload_meshes`]).
+    /// The mesh an instance is drawn from (after [`SceneCache::upload_meshes`]): a posed instance's
+    /// positions and normals are its node's posed ones.
     #[must_use]
-    pub fn mesh(&self, key: MeshKey) -> Option<&MeshGpu> {
-        self.meshes.get(&key)
+    pub fn mesh(&self, inst: &Instance) -> Option<MeshView<'_>> {
+        let m = self.meshes.get(&inst.mesh_key)?;
+        let (positions, normals) = match &inst.pose {
+            Some(_) => self.posing.posed(inst).map(|p| (&p.positions, &p.normals))?,
+            None => (&m.positions, &m.normals),
+        };
+        Some(MeshView { positions, normals, uvs: m.uvs.as_ref(), indices: &m.indices, index_count: m.index_count })
     }
 
-    /// Uploads the adjacency of every casting instance's mesh that is missing or stale.
+    /// Uploads the adjacency of every casting instance's mesh that is missing or stale (a posed
+    /// instance's rest adjacency: its pose gives the welded positions and planes).
     pub fn upload_adjacency(&mut self, cx: &WgpuContext, frame: &FrameInputs) {
         for inst in frame.instances.iter().filter(|i| i.casts_shadow) {
-            if self.adjacency.get(&inst.mesh_key).is_some_and(|a| a.version == inst.mesh_version) {
+            let (adjacency, version) = match &inst.pose {
+                Some(pose) => (&pose.rest_adjacency, pose.rest_version),
+                None => (&inst.adjacency, inst.mesh_version),
+            };
+            if self.adjacency.get(&inst.mesh_key).is_some_and(|a| a.version == version) {
                 continue;
             }
-            self.adjacency.insert(inst.mesh_key, AdjacencyGpu::upload(cx, &inst.adjacency, inst.mesh_version));
+            self.adjacency.insert(inst.mesh_key, AdjacencyGpu::upload(cx, adjacency, version));
         }
     }
 
-    /// The adjacency of an instance's mesh (after [`SceneCache::upload_adjacency`]).
+    /// The adjacency an instance's extrusion reads (after [`SceneCache::upload_adjacency`] and
+    /// [`SceneCache::upload_meshes`]): a posed instance's welded positions and planes are its node's
+    /// posed ones.
     #[must_use]
-    pub fn adjacency(&self, key: MeshKey) -> Option<&AdjacencyGpu> {
-        self.adjacency.get(&key)
+    pub fn adjacency(&self, inst: &Instance) -> Option<AdjacencyView<'_>> {
+        let topology = self.adjacency.get(&inst.mesh_key)?;
+        let (welded, planes) = match &inst.pose {
+            Some(_) => self.posing.posed(inst).map(|p| (&p.welded, &p.planes))?,
+            None => (&topology.welded, &topology.planes),
+        };
+        Some(AdjacencyView { welded, planes, topology })
     }
 
     /// The frame's instance data, in the buffer of this frame's turn (a few are used in turn, as the

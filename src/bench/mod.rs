@@ -1,6 +1,7 @@
 //! `bench`: frames with the light moving every frame (nothing light-dependent can be cached), a warm-up,
 //! then per phase the median, minimum and maximum over the measured frames, with the counters of the
-//! last frame (DESIGN 11). `--sweep` repeats it over a parameter.
+//! last frame (DESIGN 11). `--sweep` repeats it over a parameter; `--animate` plays the scene's clip
+//! through the frames instead of moving the light ([`Clip`]).
 //!
 //! On each backend in turn, the techniques take turns frame by frame (frame 1 of every technique, then
 //! frame 2, ...), so a machine that slows down or speeds up during a run moves them all alike and their
@@ -15,11 +16,12 @@ use std::sync::Arc;
 
 use glam::{Mat3, Vec3};
 use serde::Serialize;
-use shadow_core::FrameInputs;
+use shadow_core::frame::FrameError;
 use shadow_core::geometry::adjacency::Adjacency;
 use shadow_core::scene::{Light, LightKind};
 use shadow_core::stats::{Phase, Summary};
 use shadow_core::technique::{FrameStats, TechniqueSpec};
+use shadow_core::{FrameInputs, Scene};
 
 use crate::Error;
 use crate::renderer::{BackendKind, Prepared, Renderer};
@@ -46,6 +48,47 @@ pub struct BenchJob<'a> {
     /// ray-casting BVH), so its cost is measured: the adjacency as its own `adjacency` time, the BVH in
     /// the build phase of the techniques that cast rays.
     pub rebuild: bool,
+    /// The scene's clip played through the frames, in place of the moving light.
+    pub clip: Option<&'a Clip>,
+}
+
+/// A scene's animations played through a bench's frames (`bench --animate`): frame `k` is the scene
+/// posed `k` steps after the start, seen from its first camera under its own lights (which follow their
+/// nodes). Every frame is posed before the bench runs, and the host's time to pose each (the scene's
+/// nodes, skins and morph weights, then the frame's inputs gathered, the CPU's posed meshes and their
+/// adjacency included) is kept apart from the frames' own times.
+#[derive(Clone, Debug)]
+pub struct Clip {
+    frames: Vec<FrameInputs>,
+    pose_ms: Vec<f64>,
+}
+
+impl Clip {
+    /// `count` frames of `scene`'s animations, from `start` seconds, `step` seconds apart.
+    ///
+    /// # Errors
+    /// A scene without animations, or a pose or frame that fails (naming its time).
+    pub fn play(scene: &mut Scene, start: f32, step: f32, count: u32) -> Result<Self, Error> {
+        if scene.animations().next().is_none() {
+            return Err(Error::Usage("--animate: the scene has no animations to play".into()));
+        }
+        let mut clip = Self { frames: Vec::with_capacity(count as usize), pose_ms: Vec::new() };
+        for k in 0..count {
+            let t = start + step * k as f32;
+            let at = std::time::Instant::now();
+            let posed = scene.pose(t).map_err(FrameError::from).and_then(|()| FrameInputs::from_first_camera(scene));
+            let frame = posed.map_err(|e| Error::Usage(format!("--animate: the pose at {t} s: {e}")))?;
+            clip.pose_ms.push(shadow_core::stats::ms(at.elapsed()));
+            clip.frames.push(frame);
+        }
+        Ok(clip)
+    }
+
+    /// The host's time to pose each frame, in ms.
+    #[must_use]
+    pub fn pose_ms(&self) -> &[f64] {
+        &self.pose_ms
+    }
 }
 
 /// Median, minimum and maximum, in milliseconds.
@@ -106,9 +149,13 @@ pub fn moved_light(light: &Light, center: Vec3, k: u32, n: u32) -> Light {
 }
 
 impl BenchJob<'_> {
-    /// The frame of run frame `k` of `total`: the lights turned a `k / total` part of a quarter turn.
+    /// The frame of run frame `k` of `total`: the clip's `k`-th pose (the last one past its end), or the
+    /// lights turned a `k / total` part of a quarter turn.
     #[must_use]
     pub fn frame_at(&self, k: u32, total: u32) -> FrameInputs {
+        if let Some(frame) = self.clip.and_then(|c| c.frames.get(k as usize).or(c.frames.last())) {
+            return frame.clone();
+        }
         let center = self.frame.bounds.center();
         let mut frame = self.frame.clone();
         frame.lights = self.frame.lights.iter().map(|l| moved_light(l, center, k, total)).collect();
@@ -318,6 +365,7 @@ mod tests {
             techniques: specs.to_vec(),
             backends: vec![BackendKind::Cpu, BackendKind::Cpu],
             rebuild: false,
+            clip: None,
         };
         let mut renderer = Renderer::new(TechniqueRegistry::builtin());
         let mut steps = Vec::new();
@@ -331,6 +379,39 @@ mod tests {
             assert!(total.min > 0.0 && total.min <= total.median && total.median <= total.max, "{e:?}");
             assert!(e.counters.contains_key("covered_pixels"), "{e:?}");
         }
+    }
+
+    /// A clip's frames are the scene posed step after step (the walker's posed mesh changes from frame
+    /// to frame, its light stays), each with its host time, and a bench runs them.
+    #[test]
+    fn a_clip_plays_through_the_frames() {
+        let mut scene = scenes::build("walker", &SceneParams::default()).expect("a built-in scene");
+        let clip = Clip::play(&mut scene, 0.2, 0.1, 3).expect("a clip");
+        let frame = FrameInputs::from_first_camera(&scene).expect("a frame");
+        let job = BenchJob {
+            scene: "walker".into(),
+            frame: &frame,
+            width: 24,
+            height: 16,
+            frames: 2,
+            warmup: 1,
+            techniques: vec![TechniqueSpec::named("shadow-map")],
+            backends: vec![BackendKind::Cpu],
+            rebuild: false,
+            clip: Some(&clip),
+        };
+        let frames: Vec<FrameInputs> = (0..4).map(|k| job.frame_at(k, 3)).collect();
+        let versions: Vec<Vec<u64>> =
+            frames.iter().map(|f| f.instances.iter().map(|i| i.mesh_version).collect()).collect();
+        assert!(versions[0] != versions[1] && versions[1] != versions[2], "{versions:?}");
+        assert_eq!(versions[3], versions[2], "past its end the clip holds its last frame");
+        assert_eq!(frames[0].lights[0].kind, frames[2].lights[0].kind, "the light stays");
+        assert!(clip.pose_ms().len() == 3 && clip.pose_ms().iter().all(|&t| t > 0.0), "{:?}", clip.pose_ms());
+        let report = run_bench(&mut Renderer::new(TechniqueRegistry::builtin()), &job, |_| {}).expect("bench");
+        assert!(report.results[0].timings_ms["total"].min > 0.0);
+        let mut still = scenes::build("cubes", &SceneParams::default()).expect("a built-in scene");
+        let e = Clip::play(&mut still, 0.0, 0.1, 2).expect_err("no animations");
+        assert!(e.to_string().contains("no animations"), "{e}");
     }
 
     #[test]
@@ -349,6 +430,7 @@ mod tests {
                 techniques: vec![TechniqueSpec::named("ray-traced")],
                 backends: vec![BackendKind::Cpu],
                 rebuild,
+                clip: None,
             };
             let report = run_bench(&mut renderer, &job, |_| {}).expect("bench");
             let e = &report.results[0];

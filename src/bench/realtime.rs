@@ -57,6 +57,9 @@ pub struct RealtimeReport {
     pub adapter: String,
     /// Frames in flight.
     pub in_flight: usize,
+    /// With a clip played (`--animate`), the host's time to pose the scene and gather a frame's inputs,
+    /// per frame, in ms: what an application spends on the pose before it records the frame.
+    pub pose_ms: Option<Stat>,
     /// One entry per technique.
     pub results: Vec<RealtimeEntry>,
 }
@@ -132,6 +135,7 @@ pub fn run_realtime_bench(
         frames: job.frames,
         adapter,
         in_flight: IN_FLIGHT,
+        pose_ms: job.clip.map(|c| stat(c.pose_ms())),
         results,
     })
 }
@@ -258,6 +262,12 @@ pub fn realtime_table(r: &RealtimeReport) -> String {
         "{} at {}x{} on {}, {} frames, {} in flight (ms; median, min..max in brackets)\n",
         r.scene, r.width, r.height, r.adapter, r.frames, r.in_flight
     );
+    if let Some(p) = &r.pose_ms {
+        s.push_str(&format!(
+            "clip played: posing a frame on the host (CPU) {:.3} ms [{:.3}..{:.3}]; recording it below\n",
+            p.median, p.min, p.max
+        ));
+    }
     s.push_str(&format!(
         "{:<24} {:>20} {:>10} {:>8} {:>20} {:>20}\n",
         "technique", "instrumented", "real-time", "ratio", "record (CPU)", "GPU"

@@ -1,6 +1,7 @@
 //! The animated scenes' part of the results ([`scenes::ANIMATED`]): each technique's error against its
-//! reference on the CPU backend with the scene at rest and posed at ten times spread over its clip, the
-//! largest of the ten over the error at rest, and each technique's flicker as the animation plays.
+//! reference on each backend with the scene at rest and posed at ten times spread over its clip, the
+//! largest of the ten over the error at rest, the backends' largest disagreement over the ten, and each
+//! technique's flicker on the CPU as the animation plays.
 
 use std::fmt::Write as _;
 
@@ -35,19 +36,22 @@ struct SceneReport {
 pub struct AnimatedReport {
     scenes: Vec<SceneReport>,
     size: (u32, u32),
+    backends: Vec<BackendKind>,
 }
 
 fn frame_of(scene: &Scene) -> Result<FrameInputs, Error> {
     Ok(FrameInputs::from_first_camera(scene)?)
 }
 
-/// Measures every animated scene at rest and at ten times of its clip, and its flicker as it plays.
+/// Measures every animated scene at rest and at ten times of its clip on `backends`, and its flicker on
+/// the CPU as it plays.
 ///
 /// # Errors
 /// A scene that cannot be built or posed, or a rendering failure.
 pub fn run_animated(
     renderer: &mut Renderer,
     size: (u32, u32),
+    backends: &[BackendKind],
     mut progress: impl FnMut(&str),
 ) -> Result<AnimatedReport, Error> {
     let mut out = Vec::new();
@@ -67,7 +71,7 @@ pub fn run_animated(
                 techniques,
                 reference,
                 soft_reference,
-                backends: vec![BackendKind::Cpu],
+                backends: backends.to_vec(),
                 out_dir: None,
             };
             run_compare(renderer, &job, |m| progress(&format!("{name} {when}: {m}")))
@@ -86,7 +90,8 @@ pub fn run_animated(
         }
         let walked = FlickerWalk::through(renderer, walk, walk_size)?;
         let mut flicker = Vec::new();
-        for e in rest.results.iter().filter(|e| e.reference == shadow_hard::RayTraced::NAME) {
+        let cpu = BackendKind::Cpu.name();
+        for e in rest.results.iter().filter(|e| e.reference == shadow_hard::RayTraced::NAME && e.backend == cpu) {
             progress(&format!("{name}: flicker of {}", e.technique));
             let spec = if e.settings.is_empty() {
                 TechniqueSpec::named(&e.technique)
@@ -97,7 +102,7 @@ pub fn run_animated(
         }
         out.push(SceneReport { name, duration, rest, posed, flicker });
     }
-    Ok(AnimatedReport { scenes: out, size })
+    Ok(AnimatedReport { scenes: out, size, backends: backends.to_vec() })
 }
 
 /// A result's error: the mismatch for a hard technique (a fraction), the RMSE for a soft one.
@@ -108,29 +113,40 @@ fn error(e: &ResultEntry) -> f64 {
 /// The markdown section.
 pub fn markdown(s: &mut String, r: &AnimatedReport) {
     let _ = writeln!(s, "\n## Animated scenes\n");
+    let backends: Vec<&str> = r.backends.iter().map(|b| b.name()).collect();
     let _ = writeln!(
         s,
-        "{}x{}, on the CPU backend: the scenes whose casters move (`mill`: a rotor turned by node animation; \
-         `walker`: a skinned figure). Each technique's error at rest (the scene as built), then posed at the \
-         middles of the ten tenths of its clip: the least, the median and the most of the ten, and the most \
-         over the error at rest. Hard techniques by mismatch, soft ones (marked RMSE) by RMSE; each light \
-         kind's techniques only (`mill`'s sun leaves the soft ones out). Flicker: the share of measured \
-         points and frame pairs where the technique's lit state changes and the reference's does not, or \
-         the other way round, over {} frames of {} s of the clip at {}x{} (the camera still, the points \
-         the receivers of the first frame that do not move).\n",
-        r.size.0, r.size.1, WALK.0, WALK.1, WALK.2.0, WALK.2.1
+        "{}x{}, on {}: the scenes whose casters move (`mill`: a rotor turned by node animation; `walker`: a \
+         skinned figure, posed by a compute pass on wgpu). Each technique's error at rest (the scene as built), \
+         then posed at the middles of the ten tenths of its clip: the least, the median and the most of the \
+         ten, and the most over the error at rest. Hard techniques by mismatch, soft ones (marked RMSE) by \
+         RMSE; each light kind's techniques only (`mill`'s sun leaves the soft ones out). Across: the most \
+         the two backends' visibilities disagree (lit against shadowed) at rest or at any of the ten times. \
+         Flicker, on the CPU: the share of measured points and frame pairs where the technique's lit state \
+         changes and the reference's does not, or the other way round, over {} frames of {} s of the clip \
+         at {}x{} (the camera still, the points the receivers of the first frame that do not move).\n",
+        r.size.0,
+        r.size.1,
+        backends.join(" and "),
+        WALK.0,
+        WALK.1,
+        WALK.2.0,
+        WALK.2.1
     );
     for sc in &r.scenes {
         let _ = writeln!(s, "### {} ({:.1} s clip)\n", sc.name, sc.duration);
-        let _ = writeln!(s, "| technique | at rest | least | median | most | most / rest | flicker |");
-        let _ = writeln!(s, "|---|---:|---:|---:|---:|---:|---:|");
+        let _ =
+            writeln!(s, "| technique | backend | at rest | least | median | most | most / rest | across | flicker |");
+        let _ = writeln!(s, "|---|---|---:|---:|---:|---:|---:|---:|---:|");
         for e in &sc.rest.results {
             let soft = e.reference != shadow_hard::RayTraced::NAME;
             let show = |v: f64| if soft { format!("{v:.4}") } else { format!("{:.3}%", v * 100.0) };
             let mut posed: Vec<f64> = sc
                 .posed
                 .iter()
-                .filter_map(|p| p.results.iter().find(|x| x.technique == e.technique).map(error))
+                .filter_map(|p| {
+                    p.results.iter().find(|x| x.technique == e.technique && x.backend == e.backend).map(error)
+                })
                 .collect();
             posed.sort_by(f64::total_cmp);
             let (Some(least), Some(most)) = (posed.first(), posed.last()) else { continue };
@@ -140,13 +156,19 @@ pub fn markdown(s: &mut String, r: &AnimatedReport) {
             let flicker = sc
                 .flicker
                 .iter()
-                .find(|(n, _)| *n == e.technique)
+                .find(|(n, _)| *n == e.technique && e.backend == BackendKind::Cpu.name())
                 .map_or("-".into(), |(_, f)| format!("{:.3}%", f * 100.0));
+            let across = std::iter::once(&sc.rest)
+                .chain(&sc.posed)
+                .filter_map(|p| p.cross_backend.iter().find(|c| c.technique == e.technique).map(|c| c.mismatch))
+                .reduce(f64::max)
+                .map_or("-".into(), |m| format!("{:.3}%", m * 100.0));
             let _ = writeln!(
                 s,
-                "| `{}`{} | {} | {} | {} | {} | {ratio} | {flicker} |",
+                "| `{}`{} | {} | {} | {} | {} | {} | {ratio} | {across} | {flicker} |",
                 e.technique,
                 if soft { " (RMSE)" } else { "" },
+                e.backend,
                 show(rest),
                 show(*least),
                 show(median),

@@ -104,6 +104,7 @@ pub fn run_results(renderer: &mut Renderer, job: &ResultsJob, mut progress: impl
         techniques,
         backends: job.backends.clone(),
         rebuild: false,
+        clip: None,
     };
     let timing = run_bench(renderer, &bench, |m| progress(&format!("{}: {m}", job.bench_scene)))?;
     // The real-time path where there is a GPU adapter: the same frames recorded, two in flight.
@@ -121,7 +122,7 @@ pub fn run_results(renderer: &mut Renderer, job: &ResultsJob, mut progress: impl
     let cutout_job =
         cutouts::CutoutJob { size: job.size, backends: job.backends.clone(), pictures: job.pictures.clone() };
     let cutouts = cutouts::run_cutouts(renderer, &cutout_job, &mut progress)?;
-    let animated = animated::run_animated(renderer, job.size, &mut progress)?;
+    let animated = animated::run_animated(renderer, job.size, &job.backends, &mut progress)?;
     let kernels = kernels::run_kernels(&mut progress)?;
     let mut text = markdown(renderer, job, &reports, (&timing, realtime.as_ref()));
     outdoor::markdown(&mut text, &outdoor);

@@ -5,6 +5,7 @@
 //! that shadowlab's shadows share ([`crate::realtime::RealtimeShadows`] on the viewer's device). The 3D
 //! view is a texture the UI draws (`view::View`); a script ([`script`]) can stand in for the user.
 
+mod clip;
 mod overlay;
 mod panel;
 pub mod rig;
@@ -69,15 +70,51 @@ struct Scene {
     light: Option<LightRig>,
     /// The rigs as the scene gave them, for a reset.
     home: (Orbit, Option<LightRig>),
+    /// The timeline of a scene with animations.
+    clip: Option<clip::Clip>,
 }
 
 impl Scene {
     fn open(setup: SceneSetup) -> Result<Self, Error> {
-        let frame = FrameInputs::from_first_camera(&setup.build()?)?;
+        let scene = setup.build()?;
+        let frame = FrameInputs::from_first_camera(&scene)?;
         let orbit = Orbit::around(&frame.camera);
         let radius = 0.5 * frame.bounds.size().length();
         let light = frame.lights.first().map(|l| LightRig::around(l, frame.bounds.center(), radius));
-        Ok(Self { setup, frame, orbit, light, home: (orbit, light) })
+        let clip = clip::Clip::of(scene, setup.time);
+        let mut opened = Self { setup, frame, orbit, light, home: (orbit, light), clip };
+        opened.pose()?;
+        Ok(opened)
+    }
+
+    /// Runs the timeline on by `dt` seconds while it plays, posing the frame anew when its time moved.
+    ///
+    /// # Errors
+    /// A pose that fails.
+    fn advance(&mut self, dt: f32) -> Result<(), Error> {
+        if self.clip.as_mut().is_some_and(|c| c.advance(dt)) { self.pose() } else { Ok(()) }
+    }
+
+    /// Stops the timeline at `t` seconds and poses the frame there.
+    ///
+    /// # Errors
+    /// A pose that fails.
+    fn scrub(&mut self, t: f32) -> Result<(), Error> {
+        if self.clip.as_mut().is_some_and(|c| c.scrub(t)) { self.pose() } else { Ok(()) }
+    }
+
+    /// The frame of the scene posed at the timeline's time, each light's shadow as the panel set it.
+    fn pose(&mut self) -> Result<(), Error> {
+        let Some(clip) = &mut self.clip else { return Ok(()) };
+        let mut frame = clip.frame()?;
+        frame.shadows = std::mem::take(&mut self.frame.shadows);
+        self.frame = frame;
+        Ok(())
+    }
+
+    /// The time the timeline shows, for a scene with one.
+    fn time(&self) -> Option<f32> {
+        self.clip.as_ref().map(clip::Clip::time)
     }
 
     /// This frame's inputs: the scene's, seen through the orbit, lit by the rig's light first.

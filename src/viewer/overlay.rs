@@ -18,6 +18,8 @@ use crate::{BackendKind, Renderer, TechniqueRegistry};
 #[derive(Clone, Debug, PartialEq)]
 pub(super) struct ViewKey {
     pub scene: String,
+    /// The timeline's time, for a scene with animations.
+    pub time: Option<f32>,
     pub camera: Camera,
     pub lights: Vec<Light>,
     pub shadows: Vec<LightShadow>,

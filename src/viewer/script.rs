@@ -4,6 +4,7 @@
 //! A script is steps separated by `;` or new lines:
 //! `orbit YAW PITCH` and `light YAW PITCH` turn the camera or the light (degrees), `zoom FACTOR`,
 //! `fly FORWARD RIGHT UP` (scene units), `technique SPEC`, `backend wgpu|cpu`, `scene NAME|FILE`,
+//! `time SECONDS` (stops a scene's animations at that time), `play` and `pause` (its timeline),
 //! `wait FRAMES`, `screenshot FILE.png`, `command` (prints the `shadowlab render` command of the view),
 //! `memory` (prints the buffers and textures alive on the device), `compare` (compares the view with the
 //! reference and prints its score as `compare` scores it; the script waits for it), `inspect` (prints an
@@ -12,8 +13,8 @@
 use std::path::PathBuf;
 
 /// Every step's verb.
-const STEPS: &str =
-    "orbit, light, zoom, fly, technique, backend, scene, wait, screenshot, command, memory, compare, inspect, quit";
+const STEPS: &str = "orbit, light, zoom, fly, technique, backend, scene, time, play, pause, wait, screenshot, command, \
+                     memory, compare, inspect, quit";
 
 /// One step.
 #[derive(Clone, Debug, PartialEq)]
@@ -32,6 +33,10 @@ pub enum Step {
     Backend(String),
     /// Open a scene.
     Scene(String),
+    /// Stop the scene's animations at this time (seconds).
+    Time(f32),
+    /// Play (`true`) or pause the scene's animations.
+    Play(bool),
     /// Draw this many frames before the next step.
     Wait(u32),
     /// Write the view as PNG.
@@ -82,6 +87,12 @@ fn step(text: &str) -> Result<Step, String> {
             _ => return Err("wgpu or cpu".into()),
         },
         "scene" => Step::Scene(word()?),
+        "time" => match numbers(1)?[0] {
+            t if t >= 0.0 => Step::Time(t),
+            _ => return Err("the time must be 0 or more".into()),
+        },
+        "play" if rest.is_empty() => Step::Play(true),
+        "pause" if rest.is_empty() => Step::Play(false),
         "wait" => Step::Wait(rest.parse().map_err(|_| format!("'{rest}' is not a frame count"))?),
         "screenshot" => Step::Screenshot(word()?.into()),
         "command" if rest.is_empty() => Step::Command,
@@ -89,7 +100,9 @@ fn step(text: &str) -> Result<Step, String> {
         "compare" if rest.is_empty() => Step::Compare,
         "inspect" if rest.is_empty() => Step::Inspect,
         "quit" if rest.is_empty() => Step::Quit,
-        "command" | "memory" | "compare" | "inspect" | "quit" => return Err("takes nothing".into()),
+        "command" | "memory" | "compare" | "inspect" | "quit" | "play" | "pause" => {
+            return Err("takes nothing".into());
+        }
         _ => return Err(format!("unknown step ({STEPS})")),
     })
 }
@@ -102,13 +115,14 @@ mod tests {
     fn steps_parse_and_bad_ones_are_named() {
         let steps = parse(
             "orbit 30 -10; zoom 0.5\nfly 1 0 0.5; technique pcss:light_size=0.2; backend cpu; wait 3;\
-                           screenshot out/a.png; command; quit",
+                           screenshot out/a.png; command; time 1.5; play; pause; quit",
         )
         .unwrap();
-        assert_eq!(steps.len(), 9);
+        assert_eq!(steps.len(), 12);
+        assert_eq!(steps[8..11], [Step::Time(1.5), Step::Play(true), Step::Play(false)]);
         assert_eq!(steps[0], Step::Orbit(30.0, -10.0));
         assert_eq!(steps[3], Step::Technique("pcss:light_size=0.2".into()));
-        assert_eq!(steps[8], Step::Quit);
+        assert_eq!(steps[11], Step::Quit);
         for (bad, why) in [
             ("orbit 30", "takes 2 numbers"),
             ("orbit 30 x", "'x' is not a number"),
@@ -116,6 +130,8 @@ mod tests {
             ("backend vulkan", "wgpu or cpu"),
             ("jump", "unknown step"),
             ("wait -1", "frame count"),
+            ("time -2", "0 or more"),
+            ("pause 3", "takes nothing"),
             ("technique", "takes a value"),
         ] {
             let e = parse(&format!("wait 1; {bad}")).unwrap_err();

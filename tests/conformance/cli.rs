@@ -100,6 +100,8 @@ fn bad_inputs_give_one_line_and_the_right_status() {
         (&["bench", "--sweep", "res=256,-3", "--backend", "cpu"], 2, "positive whole numbers"),
         (&["bench", "--realtime", "--backend", "cpu"], 2, "--realtime runs on the wgpu backend, not 'cpu'"),
         (&["bench", "--realtime", "--sweep", "res=256"], 2, "--realtime does not sweep"),
+        (&["bench", "--animate", "--sweep", "res=256", "--backend", "cpu"], 2, "--animate plays the scene's own clip"),
+        (&["bench", "--animate", "--backend", "cpu"], 2, "--animate: the scene has no animations to play"),
         // A sphere of 2 billion vertices, refused before it is allocated.
         (
             &["bench", "--sweep", "tris=4000000000", "--backend", "cpu"],

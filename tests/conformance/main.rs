@@ -1,6 +1,7 @@
 //! The one integration-test binary (DESIGN 9): the command line, and cross-backend conformance of every
 //! registered technique, the example's runtime-registered one included.
 
+mod animated;
 mod cache;
 mod cli;
 mod cutouts;

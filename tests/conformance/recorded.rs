@@ -12,7 +12,7 @@ use shadowlab::{BackendKind, TechniqueRegistry};
 
 /// The techniques that read the GPU's results back within a frame: volume reconstruction rebuilds its
 /// volume on the CPU from the depth map it reads back.
-const NOT_RECORDABLE: [&str; 1] = ["volume-reconstruction"];
+pub(crate) const NOT_RECORDABLE: [&str; 1] = ["volume-reconstruction"];
 
 /// A colour target of `format`, `w x h`, that can be read back.
 fn color_target(cx: &WgpuContext, format: wgpu::TextureFormat, w: u32, h: u32) -> wgpu::Texture {
@@ -151,18 +151,27 @@ fn a_moving_light_and_node_allocate_nothing_after_the_first_frame() {
         // What was reused holds this frame's data, not a stale one's: the last frame as a fresh render.
         let (w, h) = (target.width(), target.height());
         let fresh = renderer.run(BackendKind::Wgpu, &last, w, h, &TechniqueSpec::named(entry.name)).expect("a frame");
-        let differ = visibility.data().iter().zip(fresh.visibility[0].data()).filter(|(a, b)| a != b).count();
-        let shadowed = visibility.data().iter().filter(|&&v| crate::shadowed(v)).count();
-        if differ > 0 || shadowed == 0 {
-            failures.push(format!(
-                "{}: the last of {FRAMES} frames has {shadowed} shadowed pixels, {differ} unlike a fresh render's",
-                entry.name
-            ));
-        }
+        failures.extend(stale_or_unshadowed(entry.name, FRAMES, &visibility, &fresh.visibility[0]));
         checked += 1;
     }
     assert!(failures.is_empty(), "made after the first frame:\n{}", failures.join("\n"));
     assert!(checked >= 10, "only {checked} techniques checked");
+}
+
+/// What is wrong, if anything, with the visibility of the last of `frames` recorded frames of technique
+/// `name`: no shadow in it, or pixels unlike `fresh`, a fresh render of the same frame (what was reused
+/// holds a stale frame's data).
+pub(crate) fn stale_or_unshadowed(
+    name: &str,
+    frames: u32,
+    visibility: &shadow_core::Image<f32>,
+    fresh: &shadow_core::Image<f32>,
+) -> Option<String> {
+    let differ = visibility.data().iter().zip(fresh.data()).filter(|(a, b)| a != b).count();
+    let shadowed = visibility.data().iter().filter(|&&v| crate::shadowed(v)).count();
+    (differ > 0 || shadowed == 0).then(|| {
+        format!("{name}: the last of {frames} frames has {shadowed} shadowed pixels, {differ} unlike a fresh render's")
+    })
 }
 
 /// Casters and receivers cut out by their texture in recorded frames: on `foliage`, the leaves' texture goes

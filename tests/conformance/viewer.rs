@@ -55,6 +55,17 @@ fn view(scene: &str, size: &str, script: &str) -> (String, String) {
     (stdout, stderr)
 }
 
+/// Runs a `shadowlab render` command the viewer printed with its picture written to `out`: the command's
+/// arguments as run, the place of `--out`'s value among them, and the picture.
+fn render_printed(command: &str, out: &Path) -> (Vec<String>, usize, Image<Rgb8>) {
+    let mut args: Vec<String> = command.split_whitespace().skip(1).map(str::to_string).collect();
+    let out_at = args.iter().position(|a| a == "--out").expect("--out") + 1;
+    args[out_at] = out.display().to_string();
+    let run = Command::new(env!("CARGO_BIN_EXE_shadowlab")).args(&args).output().expect("render runs");
+    assert!(run.status.success(), "{command}: {}", String::from_utf8_lossy(&run.stderr));
+    (args, out_at, Image::<Rgb8>::load_png(out).expect("the render"))
+}
+
 #[test]
 fn a_scripted_view_matches_its_render_command_on_both_backends() {
     if !can_view("the scripted view") {
@@ -85,13 +96,7 @@ fn a_scripted_view_matches_its_render_command_on_both_backends() {
     assert_eq!(commands.len(), 2, "{stdout}\n{stderr}");
     for (n, command) in (1..).zip(commands) {
         let viewed = Image::<Rgb8>::load_png(shot(n)).expect("the screenshot");
-        let rendered = dir.join(format!("render-{n}.png"));
-        let mut args: Vec<String> = command.split_whitespace().skip(1).map(str::to_string).collect();
-        let out_at = args.iter().position(|a| a == "--out").expect("--out") + 1;
-        args[out_at] = rendered.display().to_string();
-        let run = Command::new(env!("CARGO_BIN_EXE_shadowlab")).args(&args).output().expect("render runs");
-        assert!(run.status.success(), "{command}: {}", String::from_utf8_lossy(&run.stderr));
-        let offline = Image::<Rgb8>::load_png(&rendered).expect("the render");
+        let (args, out_at, offline) = render_printed(command, &dir.join(format!("render-{n}.png")));
         if n == 1 {
             // `compare` on the view the viewer compared (its reference at the GPU's own pixels, where the
             // viewer's is at the CPU's: a few pixels of the G-buffers differ).
@@ -177,4 +182,52 @@ fn a_hundred_switches_leave_no_more_alive_on_the_device_than_the_first_rounds() 
         "buffers, buffer bytes, texture bytes: {early:?} early, {late:?} late"
     );
     assert!(!stderr.contains("error"), "{stderr}");
+}
+
+/// The timeline on `walker`: stopped at two times by the script, each screenshot matches the render
+/// command the viewer prints for it (which names its time) and the two show different poses; the
+/// comparison with the reference on the paused pose scores it as posed (a reference of another pose
+/// would put the figure's shadow elsewhere); played on, the figure moves.
+#[test]
+fn the_timeline_stops_plays_and_is_compared_where_it_stands() {
+    if !can_view("the viewer's timeline") {
+        return;
+    }
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("viewer-timeline");
+    std::fs::create_dir_all(&dir).expect("a folder");
+    let shot = |n: u32| dir.join(format!("view-{n}.png"));
+    let script = format!(
+        "wait 1; time 1.3; wait 2; screenshot {}; command; compare; time 2.2; wait 2; screenshot {}; command; \
+         play; wait 20; screenshot {}; quit",
+        shot(1).display(),
+        shot(2).display(),
+        shot(3).display()
+    );
+    let (stdout, stderr) = view("walker", "720x480", &script);
+    let scored = stderr.lines().find(|l| l.starts_with("mismatch ")).unwrap_or_else(|| panic!("no score: {stderr}"));
+    let mismatch: f64 =
+        scored.split(['%', ' ']).nth(1).and_then(|v| v.parse().ok()).unwrap_or_else(|| panic!("{scored}"));
+    assert!(scored.contains("against ray-traced") && mismatch < 0.5, "the paused pose scored {scored}");
+    let commands: Vec<&str> = stdout.lines().filter(|l| l.starts_with("shadowlab render ")).collect();
+    assert_eq!(commands.len(), 2, "{stdout}\n{stderr}");
+    let mut shots = Vec::new();
+    for ((n, command), time) in (1..).zip(commands).zip(["--time 1.3 ", "--time 2.2 "]) {
+        assert!(command.contains(time), "{command}");
+        let viewed = Image::<Rgb8>::load_png(shot(n)).expect("the screenshot");
+        let (_, _, offline) = render_printed(command, &dir.join(format!("render-{n}.png")));
+        let error = flip(&viewed, &offline);
+        assert!(error <= MAX_FLIP, "screenshot {n} against `{command}`: FLIP {error:.4}");
+        shots.push(viewed);
+    }
+    // Another pose moves the figure and its shadow: a good share of the picture changes by far more
+    // than the backends ever differ.
+    let moved = |a: &Image<Rgb8>, b: &Image<Rgb8>| {
+        let far = a.data().iter().zip(b.data()).filter(|(p, q)| p.iter().zip(*q).any(|(x, y)| x.abs_diff(*y) > 40));
+        far.count() as f64 / a.data().len() as f64
+    };
+    let played = Image::<Rgb8>::load_png(shot(3)).expect("the screenshot");
+    let (stopped, ran) = (moved(&shots[0], &shots[1]), moved(&shots[1], &played));
+    eprintln!("pixels changed: {:.2}% between the two times, {:.2}% played on", 100.0 * stopped, 100.0 * ran);
+    assert!(stopped > 0.01, "the two times show the same pose");
+    assert!(ran > 0.001, "played on, the figure did not move");
 }

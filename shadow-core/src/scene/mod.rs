@@ -28,7 +28,7 @@ pub use animation::{Animation, AnimationKey, Channel, Interpolation, Keyframes, 
 pub use camera::Camera;
 pub use light::{Light, LightKind, LightShadow};
 use placed::Placed;
-pub use skin::{Deformed, Skin, SkinKey};
+pub use skin::{Deformed, Pose, Skin, SkinKey};
 
 slotmap::new_key_type! {
     /// A node of the hierarchy.

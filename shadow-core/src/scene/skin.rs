@@ -45,6 +45,25 @@ pub struct Deformed {
     /// Posed mesh space to world space: the identity for a skinned mesh (its joints place it), the
     /// node's world transform for one that only morphs.
     pub world_from_local: Mat4,
+    /// What it was posed from, for a backend that poses meshes on its own.
+    pub pose: Arc<Pose>,
+}
+
+/// What a posed mesh is posed from: the rest mesh with its deformers and adjacency, and the joint
+/// matrices and morph weights of the pose. A backend that poses meshes itself (the GPU's compute pass)
+/// uploads the rest mesh once and these numbers every frame, and must give what [`deform::pose`] gives.
+#[derive(Clone, Debug)]
+pub struct Pose {
+    /// The mesh at rest, with its [`deform::Deformers`].
+    pub rest: Arc<Mesh>,
+    /// The rest mesh's adjacency (its topology is the posed mesh's).
+    pub rest_adjacency: Arc<Adjacency>,
+    /// The rest mesh's version ([`Scene::mesh_version`]).
+    pub rest_version: u64,
+    /// Each joint's world transform times its inverse bind matrix, for a skinned mesh.
+    pub joint_matrices: Option<Vec<Mat4>>,
+    /// The morph targets' weights (missing ones count as zero).
+    pub weights: Vec<f32>,
 }
 
 impl Scene {
@@ -180,13 +199,21 @@ impl Scene {
         }
         weights.iter().map(|w| w.to_bits()).for_each(|w| w.hash(&mut h));
         let posed = mesh.posed(positions, normals);
-        let adjacency = Arc::new(self.adjacency(mesh_key)?.posed(posed.positions()));
+        let rest_adjacency = self.adjacency(mesh_key)?;
+        let adjacency = Arc::new(rest_adjacency.posed(posed.positions()));
         Some(Ok(Deformed {
             mesh: Arc::new(posed),
             adjacency,
             // Counted versions start at 1 and count up; a pose's has its top bit set.
             version: h.finish() | 1 << 63,
             world_from_local: if joints.is_some() { Mat4::IDENTITY } else { n.world },
+            pose: Arc::new(Pose {
+                rest: Arc::clone(mesh),
+                rest_adjacency,
+                rest_version: entry.version,
+                joint_matrices: joints,
+                weights: weights.to_vec(),
+            }),
         }))
     }
 }

@@ -230,7 +230,7 @@ fn render_projection(
         pass.set_bind_group(0, &group0, &[]);
         pass.set_bind_group(1, group, &[]);
         for (i, inst) in frame.instances.iter().enumerate().filter(|(_, i)| i.casts_shadow) {
-            let Some(m) = cx.cache.mesh(inst.mesh_key) else { continue };
+            let Some(m) = cx.cache.mesh(inst) else { continue };
             let cutout = match inst.coverage() {
                 Coverage::Solid => false,
                 Coverage::Cutout => true,
@@ -238,7 +238,7 @@ fn render_projection(
             };
             if cutout {
                 let texture = read_texture(inst).and_then(|t| cx.cache.textures.get(t));
-                let (Some(texture), Some(uvs)) = (texture, &m.uvs) else { continue };
+                let (Some(texture), Some(uvs)) = (texture, m.uvs) else { continue };
                 pass.set_bind_group(2, &texture.group, &[]);
                 pass.set_vertex_buffer(1, uvs.slice(..));
             }

@@ -15,13 +15,14 @@
 use shadow_core::geometry::LightSource;
 use shadow_core::geometry::volume::{Caps, VolumeCounting};
 use shadow_core::light::LightView;
-use shadow_core::{FrameInputs, MeshKey};
+use shadow_core::{FrameInputs, Instance};
 
 use super::volumes::{Query, StencilVertex, count_all, counting_state, occlusion_query, stencil_pipeline};
 use crate::context::{WgpuContext, WgpuError};
 use crate::gbuffer::GpuGBuffer;
 use crate::pipelines::POSITION_LAYOUT;
 use crate::shaders;
+use crate::upload::BuffersKey;
 
 /// Words of one instance's draw arguments (`extrude.wgsl`'s `ARG_*`): sides, near caps as wound, near
 /// caps turned around, far caps, and the silhouette-edge counter.
@@ -53,8 +54,8 @@ pub struct GpuExtrusion {
 
 /// The extrusion of every casting instance of a frame, in the buffers they share.
 struct Jobs {
-    /// What the buffers were made for: each casting instance with its mesh and the mesh's version.
-    key: Vec<(usize, MeshKey, u64)>,
+    /// What the buffers were made for: each casting instance with the key of the buffers it binds.
+    key: Vec<(usize, BuffersKey)>,
     list: Vec<Job>,
     args: wgpu::Buffer,
     /// The arguments every light starts from: no triangles, each list's first index.
@@ -75,7 +76,6 @@ struct Jobs {
 #[derive(Clone, Copy)]
 struct Job {
     instance: usize,
-    mesh: MeshKey,
     faces: u32,
     edges: u32,
     bergeron: bool,
@@ -252,7 +252,8 @@ impl GpuExtrusion {
             let jobs =
                 self.jobs.iter().flat_map(|jobs| jobs.list.iter().enumerate().map(move |(j, job)| (jobs, j, job)));
             for (jobs, j, job) in jobs {
-                let (Some(mesh), Some(inst)) = (cx.cache.mesh(job.mesh), frame.instances.get(job.instance)) else {
+                let Some((inst, mesh)) = frame.instances.get(job.instance).and_then(|i| Some((i, cx.cache.mesh(i)?)))
+                else {
                     continue;
                 };
                 let m = inst.mirrored;
@@ -311,16 +312,16 @@ impl Jobs {
         frame: &FrameInputs,
         slots: usize,
     ) -> Result<&'a Self, WgpuError> {
-        let key: Vec<(usize, MeshKey, u64)> = frame
+        let key: Vec<(usize, BuffersKey)> = frame
             .instances
             .iter()
             .enumerate()
             .filter(|(_, inst)| inst.casts_solid_shadow())
-            .map(|(i, inst)| (i, inst.mesh_key, inst.mesh_version))
+            .map(|(i, inst)| (i, BuffersKey::of(inst)))
             .collect();
         if !slot.as_ref().is_some_and(|j| j.key == key && j.slots >= slots) {
             *slot = None;
-            *slot = Some(Self::new(cx, layouts, key, slots)?);
+            *slot = Some(Self::new(cx, layouts, frame, key, slots)?);
         }
         match slot {
             Some(jobs) => Ok(jobs),
@@ -332,20 +333,22 @@ impl Jobs {
     fn new(
         cx: &WgpuContext,
         [compute_layout, draw_layout]: [&wgpu::BindGroupLayout; 2],
-        key: Vec<(usize, MeshKey, u64)>,
+        frame: &FrameInputs,
+        key: Vec<(usize, BuffersKey)>,
         slots: usize,
     ) -> Result<Self, WgpuError> {
         let mut list = Vec::with_capacity(key.len());
         let (mut records, mut weights, mut caps) = (0u64, 0u64, 0u64);
-        for &(instance, mesh, _) in &key {
+        for &(instance, _) in &key {
             // A job is made only for a mesh whose vertices and adjacency are both uploaded: the groups
             // below bind them.
-            let (Some(adj), Some(_)) = (cx.cache.adjacency(mesh), cx.cache.mesh(mesh)) else { continue };
+            let inst = &frame.instances[instance];
+            let (Some(adj), Some(_)) = (cx.cache.adjacency(inst), cx.cache.mesh(inst)) else { continue };
+            let adj = adj.topology;
             let faces = u64::from(adj.faces);
             let at = |n: u64| u32::try_from(n).map_err(|_| too_large("the extrusion's lists", 4 * n, u64::MAX));
             list.push(Job {
                 instance,
-                mesh,
                 faces: adj.faces,
                 edges: adj.edge_count,
                 bergeron: !adj.closed,
@@ -404,12 +407,15 @@ impl Jobs {
             list,
         };
         let turns = 0..jobs.uniforms.len();
-        jobs.compute_groups = turns
-            .clone()
-            .map(|t| jobs.list.iter().map(|job| jobs.compute_group(cx, compute_layout, job, t)).collect())
-            .collect();
-        jobs.draw_groups =
-            turns.map(|t| jobs.list.iter().map(|job| jobs.draw_group(cx, draw_layout, job, t)).collect()).collect();
+        for t in turns {
+            let groups = jobs
+                .list
+                .iter()
+                .map(|job| jobs.groups(cx, [compute_layout, draw_layout], &frame.instances[job.instance], t));
+            let (compute, draw): (Vec<_>, Vec<_>) = groups.unzip();
+            jobs.compute_groups.push(compute);
+            jobs.draw_groups.push(draw);
+        }
         Ok(jobs)
     }
 
@@ -427,41 +433,36 @@ impl Jobs {
         })
     }
 
-    fn compute_group(
+    /// Job `inst`'s groups for frame turn `turn`: the compute passes' (the uniform, the mesh's planes,
+    /// edges, uses and indices, then the lists they write) and the draws' (the uniform, the welded
+    /// positions, the edges and the side records).
+    fn groups(
         &self,
         cx: &WgpuContext,
-        layout: &wgpu::BindGroupLayout,
-        job: &Job,
+        [compute_layout, draw_layout]: [&wgpu::BindGroupLayout; 2],
+        inst: &Instance,
         turn: usize,
-    ) -> wgpu::BindGroup {
-        let (Some(adj), Some(mesh)) = (cx.cache.adjacency(job.mesh), cx.cache.mesh(job.mesh)) else {
+    ) -> (wgpu::BindGroup, wgpu::BindGroup) {
+        let (Some(adj), Some(mesh)) = (cx.cache.adjacency(inst), cx.cache.mesh(inst)) else {
             unreachable!("a job is made only for an uploaded mesh")
         };
-        let buffers =
-            [&adj.planes, &adj.edges, &adj.uses, &mesh.indices, &self.weights, &self.records, &self.caps, &self.args];
-        let mut entries = vec![wgpu::BindGroupEntry { binding: 0, resource: self.uniform_binding(turn) }];
-        entries.extend(
-            buffers
-                .iter()
-                .zip(1..)
-                .map(|(b, binding)| wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() }),
-        );
-        cx.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("extrusion"), layout, entries: &entries })
-    }
-
-    fn draw_group(&self, cx: &WgpuContext, layout: &wgpu::BindGroupLayout, job: &Job, turn: usize) -> wgpu::BindGroup {
-        let Some(adj) = cx.cache.adjacency(job.mesh) else { unreachable!("a job is made only for an uploaded mesh") };
-        let entries = [
-            wgpu::BindGroupEntry { binding: 1, resource: self.uniform_binding(turn) },
-            wgpu::BindGroupEntry { binding: 2, resource: adj.welded.as_entire_binding() },
-            wgpu::BindGroupEntry { binding: 3, resource: adj.edges.as_entire_binding() },
-            wgpu::BindGroupEntry { binding: 4, resource: self.records.as_entire_binding() },
-        ];
-        cx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("extruded volumes"),
-            layout,
-            entries: &entries,
-        })
+        let group = |label, layout, first: u32, buffers: &[&wgpu::Buffer]| {
+            let mut entries = vec![wgpu::BindGroupEntry { binding: first, resource: self.uniform_binding(turn) }];
+            entries.extend(
+                buffers
+                    .iter()
+                    .zip(first + 1..)
+                    .map(|(b, binding)| wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() }),
+            );
+            cx.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(label), layout, entries: &entries })
+        };
+        let t = adj.topology;
+        let lists = [&self.weights, &self.records, &self.caps, &self.args];
+        let compute = [adj.planes, &t.edges, &t.uses, mesh.indices].into_iter().chain(lists).collect::<Vec<_>>();
+        (
+            group("extrusion", compute_layout, 0, &compute),
+            group("extruded volumes", draw_layout, 1, &[adj.welded, &t.edges, &self.records]),
+        )
     }
 }
 
@@ -469,8 +470,9 @@ fn too_large(what: &str, bytes: u64, most: u64) -> WgpuError {
     WgpuError::TooLarge { what: what.to_string(), bytes, most }
 }
 
-/// Workgroups covering `items`, spilling into y past `most` along x.
-fn groups(items: u32, most: u32) -> (u32, u32) {
+/// Workgroups of 64 invocations covering `items`, spilling into y past `most` along x (the extrusion's
+/// and the pose's kernels find their item the same way).
+pub(crate) fn groups(items: u32, most: u32) -> (u32, u32) {
     let n = items.div_ceil(WORKGROUP);
     if n <= most { (n, 1) } else { (most, n.div_ceil(most)) }
 }

@@ -351,7 +351,7 @@ impl<'a> VolumePass<'a> {
                 pass.set_scissor_rect(x, y, w, h);
                 for d in draws {
                     pass.set_pipeline(if d.cw { self.cw } else { self.ccw });
-                    let mesh = frame.instances.get(d.instance as usize).and_then(|i| cx.cache.mesh(i.mesh_key));
+                    let mesh = frame.instances.get(d.instance as usize).and_then(|i| cx.cache.mesh(i));
                     match (&d.vertices, d.mesh_vertices, mesh) {
                         (Some(v), _, _) => pass.set_vertex_buffer(0, v.slice()),
                         (None, true, Some(m)) => pass.set_vertex_buffer(0, m.positions.slice(..)),

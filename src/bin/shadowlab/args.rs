@@ -220,6 +220,11 @@ pub(crate) enum Command {
         /// so its cost is measured: the adjacency as its own time, the BVH in the build phase.
         #[arg(long)]
         rebuild: bool,
+        /// Play the scene's animations through the frames, a thirtieth of a second apart from --time (or
+        /// 0), with its lights where the clip puts them, instead of turning the light; with --realtime,
+        /// reports the host's time to pose each frame beside the time to record it.
+        #[arg(long)]
+        animate: bool,
         /// Repeat over a parameter: res=256,512,... (map side) or tris=10000,100000,... (a sphere of that
         /// many triangles on the ground); writes sweep.csv and sweep.png.
         #[arg(long)]

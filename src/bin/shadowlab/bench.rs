@@ -20,6 +20,7 @@ pub(crate) struct BenchArgs {
     pub(crate) json: bool,
     pub(crate) realtime: bool,
     pub(crate) rebuild: bool,
+    pub(crate) animate: bool,
     pub(crate) sweep: Option<String>,
     pub(crate) out_dir: Option<PathBuf>,
 }
@@ -48,6 +49,9 @@ pub(crate) fn bench(args: &SceneArgs, view: &ViewArgs, b: BenchArgs) -> Result<(
     if b.realtime && sweep.is_some() {
         return Err(Error::Usage("--realtime does not sweep: leave out --sweep".into()));
     }
+    if b.animate && sweep.is_some() {
+        return Err(Error::Usage("--animate plays the scene's own clip: leave out --sweep".into()));
+    }
     if b.realtime && b.rebuild {
         return Err(Error::Usage("--rebuild times the instrumented frames: leave out --realtime".into()));
     }
@@ -67,12 +71,19 @@ pub(crate) fn bench(args: &SceneArgs, view: &ViewArgs, b: BenchArgs) -> Result<(
             sweep_scenes.push(sweep_scene(v).map_err(|e| Error::Usage(format!("--sweep tris={v}: {e}")))?);
         }
     }
+    let clip = if b.animate {
+        let mut scene = args.setup().build()?;
+        let start = args.time.unwrap_or(0.0);
+        Some(shadowlab::bench::Clip::play(&mut scene, start, 1.0 / 30.0, b.warmup + b.frames)?)
+    } else {
+        None
+    };
     let backend = if b.realtime { "wgpu" } else { &b.choice.backend };
     backend_choice(backend)?;
     say_left_out(&left);
     let kinds = backends(&mut renderer, backend)?;
     match sweep {
-        None => bench_once(&mut renderer, (args, first), specs, kinds, &b),
+        None => bench_once(&mut renderer, (args, first), specs, kinds, &b, clip.as_ref()),
         Some((key, values)) => {
             let sweep = Sweep { key, values, scenes: sweep_scenes };
             bench_sweep(&mut renderer, (args, view), &sweep, specs, kinds, &b)
@@ -88,6 +99,7 @@ fn bench_once(
     specs: Vec<TechniqueSpec>,
     kinds: Vec<shadowlab::BackendKind>,
     b: &BenchArgs,
+    clip: Option<&shadowlab::bench::Clip>,
 ) -> Result<(), Error> {
     use shadowlab::bench::realtime::{realtime_steps, realtime_table, run_realtime_bench};
     use shadowlab::bench::{BenchJob, bench_table, run_bench};
@@ -101,6 +113,7 @@ fn bench_once(
         techniques: specs,
         backends: kinds,
         rebuild: b.rebuild,
+        clip,
     };
     let bar = progress_bar(if b.realtime { realtime_steps(&job) } else { job.steps() });
     let (json, table) = if b.realtime {
@@ -181,6 +194,7 @@ fn bench_sweep(
             techniques: with_value,
             backends: kinds.clone(),
             rebuild: b.rebuild,
+            clip: None,
         };
         let r = run_bench(renderer, &job, |m| report_progress(&bar, &format!("{key}={v}: {m}")))?;
         for e in &r.results {

@@ -6,8 +6,8 @@ use shadow_core::glam::Vec3;
 use super::Viewer;
 
 impl Viewer {
-    /// The `shadowlab render` command that draws this view offline: the scene, the camera and first
-    /// light as they are now (the light by position and aim; its colour, cone and radius are the
+    /// The `shadowlab render` command that draws this view offline: the scene (posed at the timeline's
+    /// time, for one with animations), the camera and first light as they are now (the light by position and aim; its colour, cone and radius are the
     /// scene's), the technique with its settings, the backend and the view's size.
     pub(super) fn command(&self) -> String {
         let setup = &self.scene.setup;
@@ -22,6 +22,9 @@ impl Viewer {
         }
         if setup.file_access == shadow_core::assets::FileAccess::Anywhere {
             words.push("--allow-outside-files".into());
+        }
+        if let Some(t) = self.scene.time() {
+            words.push(format!("--time {t}"));
         }
         let c = frame.camera;
         words.push(format!("--camera eye={},target={},fov={}", v(c.eye), v(c.target), c.fov_y.to_degrees()));

@@ -32,6 +32,7 @@ impl Viewer {
         ui.separator();
         self.technique_controls(ui);
         ui.separator();
+        self.clip_controls(ui);
         self.light_controls(ui);
         ui.checkbox(&mut self.animate, "Turn the light (L)");
         if ui.button("Reset camera and light (R)").clicked() {
@@ -156,6 +157,26 @@ impl Viewer {
             let values: Vec<String> = self.settings.iter().map(|(k, v)| format!("{k}={v}")).collect();
             self.set_technique(&format!("{name}:{}", values.join(",")));
         }
+    }
+
+    /// The timeline of a scene with animations: play or pause it, and scrub it.
+    fn clip_controls(&mut self, ui: &mut egui::Ui) {
+        let Some(clip) = &mut self.scene.clip else { return };
+        let mut scrubbed = None;
+        ui.horizontal(|ui| {
+            if ui.button(if clip.playing { "Pause (space)" } else { "Play (space)" }).clicked() {
+                clip.playing = !clip.playing;
+            }
+            let mut t = clip.time();
+            let slider = Slider::new(&mut t, 0.0..=clip.duration()).suffix(" s").max_decimals(2);
+            if ui.add(slider).on_hover_text("the animations' time: drag to scrub (pauses)").changed() {
+                scrubbed = Some(t);
+            }
+        });
+        if let Some(t) = scrubbed {
+            self.scrub(t);
+        }
+        ui.separator();
     }
 
     /// Each light's shadow: whether it casts, and the technique that shadows it (the frame's, or one of

@@ -66,7 +66,7 @@ impl Viewer {
                 down(Key::ArrowRight) - down(Key::ArrowLeft),
                 down(Key::ArrowUp) - down(Key::ArrowDown),
             ];
-            (i.stable_dt.min(0.1), axes, [Key::R, Key::L, Key::P].map(|k| i.key_pressed(k)))
+            (i.stable_dt.min(0.1), axes, [Key::R, Key::L, Key::P, Key::Space].map(|k| i.key_pressed(k)))
         });
         let speed = 0.5 * self.scene.orbit.distance * dt;
         self.scene.orbit.fly(speed * down[0], speed * down[1], speed * down[2]);
@@ -82,7 +82,13 @@ impl Viewer {
         if pressed[2] {
             self.next_screenshot();
         }
-        if down.iter().any(|&a| a != 0.0) || self.animate {
+        if pressed[3]
+            && let Some(clip) = &mut self.scene.clip
+        {
+            clip.playing = !clip.playing;
+        }
+        let playing = self.scene.clip.as_ref().is_some_and(|c| c.playing);
+        if down.iter().any(|&a| a != 0.0) || self.animate || playing {
             ui.ctx().request_repaint();
         }
     }

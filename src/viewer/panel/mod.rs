@@ -138,6 +138,12 @@ impl Viewer {
                     m.buffers, m.buffer_bytes, m.texture_bytes
                 );
             }
+            Step::Time(t) => self.scrub(t),
+            Step::Play(playing) => {
+                if let Some(clip) = &mut self.scene.clip {
+                    clip.playing = playing;
+                }
+            }
             Step::Compare => self.compare_asked = true,
             Step::Inspect => self.inspect_asked = true,
             Step::Quit => self.quit = true,
@@ -150,11 +156,14 @@ impl Viewer {
         painter: (&Gpu, &mut egui_wgpu::Renderer, &egui::Context),
         encoder: &mut wgpu::CommandEncoder,
     ) {
-        if self.animate {
-            let dt = painter.2.input(|i| i.stable_dt).min(0.1);
-            if let Some(rig) = &mut self.scene.light {
-                rig.turn(LIGHT_TURN_RATE * dt, 0.0);
-            }
+        let dt = painter.2.input(|i| i.stable_dt).min(0.1);
+        if self.animate
+            && let Some(rig) = &mut self.scene.light
+        {
+            rig.turn(LIGHT_TURN_RATE * dt, 0.0);
+        }
+        if let Err(e) = self.scene.advance(dt) {
+            self.fail(e.to_string());
         }
         let frame = self.scene.frame();
         let key = self.key(&frame);
@@ -247,6 +256,7 @@ impl Viewer {
     fn key(&self, frame: &FrameInputs) -> ViewKey {
         ViewKey {
             scene: self.scene.setup.source.clone(),
+            time: self.scene.time(),
             camera: frame.camera,
             lights: frame.lights.clone(),
             shadows: frame.shadows.clone(),
@@ -270,6 +280,13 @@ impl Viewer {
             Err(e) => self.fail(e.to_string()),
         }
         self.reset_settings();
+    }
+
+    /// Stops the timeline at `t` seconds; on an error the error line says why.
+    fn scrub(&mut self, t: f32) {
+        if let Err(e) = self.scene.scrub(t) {
+            self.fail(e.to_string());
+        }
     }
 
     fn set_backend(&mut self, backend: BackendKind) {
