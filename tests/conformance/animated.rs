@@ -4,9 +4,10 @@
 //! line and pass, unless SHADOWLAB_REQUIRE_GPU=1.
 
 use shadow_core::deform::{Deformers, MorphTarget};
-use shadow_core::glam::{Vec3, Vec4};
+use shadow_core::glam::{Mat4, Quat, Vec3, Vec4};
 use shadow_core::mesh::{face_normal, power_of_two_unit};
 use shadow_core::metrics::compare_visibility;
+use shadow_core::scene::Skin;
 use shadow_core::scenes::{self, SceneParams};
 use shadow_core::technique::TechniqueSpec;
 use shadow_core::{FrameInputs, Image, Scene};
@@ -20,8 +21,10 @@ fn tenths(duration: f32) -> impl Iterator<Item = f32> {
 
 /// `walker` with two morph targets added to its skinned body, so a pose runs both deformers: a swell
 /// along the normals (with normal displacements that tilt them) and a lean that grows with height; their
-/// weights are set per time by [`morph_weights`].
-fn morphed_walker() -> (Scene, shadow_core::NodeKey) {
+/// weights are set per time by [`morph_weights`]. Beside it, a twin drawing the same mesh through a skin
+/// of its own (the same joints, bound a step to the side) and a morphed ball that is not skinned, placed
+/// by its node: three nodes posed in three ways, two of them sharing one mesh.
+fn morphed_walker() -> (Scene, [shadow_core::NodeKey; 3]) {
     let mut scene = scenes::build("walker", &SceneParams::default()).expect("walker");
     let (node, _, mesh_key, _) =
         scene.drawables().find(|(k, ..)| scene.node_skin(*k).is_some()).expect("a skinned node");
@@ -37,52 +40,81 @@ fn morphed_walker() -> (Scene, shadow_core::NodeKey) {
     };
     let morphed = body.with_deformers(Deformers { skin, morph_targets: vec![swell, lean] }).expect("deformers");
     scene.replace_mesh(mesh_key, morphed).expect("mesh");
-    (scene, node)
+    let material = scene.node(node).and_then(|n| n.mesh()).expect("a drawn node").1;
+    let twin = scene.add_instance("twin", mesh_key, material, Mat4::IDENTITY).expect("twin");
+    let skin = scene.node_skin(node).and_then(|k| scene.skin(k)).expect("the figure's skin").clone();
+    let aside = Mat4::from_translation(Vec3::new(-0.6, 0.0, 0.2));
+    let inverse_bind_matrices = skin.inverse_bind_matrices.iter().map(|m| *m * aside).collect();
+    let skin = scene.add_skin(Skin { name: "twin".into(), inverse_bind_matrices, ..skin }).expect("skin");
+    scene.set_skin(twin, Some(skin)).expect("bound");
+    let ball = shadow_core::procedural::sphere(0.2, 24, 12).expect("a ball");
+    let bulge = MorphTarget {
+        positions: ball.positions().iter().map(|p| Vec3::new(p.x * 0.8, 0.0, 0.0)).collect(),
+        normals: Some(ball.normals().iter().map(|n| Vec3::new(-0.5 * n.x, 0.0, 0.0)).collect()),
+    };
+    let ball = ball.with_deformers(Deformers { skin: None, morph_targets: vec![bulge] }).expect("deformers");
+    let ball = scene.add_mesh(ball);
+    let place = Mat4::from_rotation_translation(Quat::from_rotation_y(0.7), Vec3::new(0.8, 0.4, 0.3));
+    let ball = scene.add_instance("ball", ball, material, place).expect("ball");
+    (scene, [node, twin, ball])
 }
 
-/// The morph weights at `t`: both move, one of them through zero (skipped, as the CPU skips it).
-fn morph_weights(t: f32) -> Vec<f32> {
-    vec![(2.0 * t).sin().max(0.0), 0.5 + 0.5 * (3.0 * t).cos()]
+/// The morph weights of the three nodes at `t`: the figure's two move, one of them through zero
+/// (skipped, as the CPU skips it); the twin's stand still; the ball's swells and shrinks, never to zero
+/// (at zero it would stand unposed).
+fn morph_weights(t: f32) -> [Vec<f32>; 3] {
+    [vec![(2.0 * t).sin().max(0.0), 0.5 + 0.5 * (3.0 * t).cos()], vec![0.3, 0.0], vec![1.1 + t.sin()]]
 }
 
-/// The GPU's pose of a skinned and morphed figure against the CPU's at ten times over its clip: posed
-/// positions within 1e-5 of the figure's size, normals within 1e-5, welded positions where their mesh
-/// vertices are, and each face's plane the CPU's rule over the GPU's welded positions.
+/// The GPU's pose of a skinned and morphed figure, its twin and a morphed ball ([`morphed_walker`])
+/// against the CPU's at ten times over the clip: posed positions within 1e-5 of the mesh's size, normals
+/// within 1e-5, welded positions where their mesh vertices are, and each face's plane the CPU's rule over
+/// the GPU's welded positions.
 #[test]
 fn the_gpu_poses_meshes_as_the_cpu_does() {
     if crate::with_wgpu("GPU posing").is_none() {
         return;
     }
     let mut cx = WgpuContext::new(&shadow_wgpu::AdapterChoice { name: None, allow_software: true }).expect("context");
-    let (mut scene, node) = morphed_walker();
+    let (mut scene, nodes) = morphed_walker();
     let duration = scene.animation_duration();
     assert!(duration > 1.0, "walker's clip lasts {duration} s");
     let mut worst = [0.0f32; 3];
     for t in tenths(duration) {
         scene.pose(t).expect("pose");
-        scene.set_morph_weights(node, morph_weights(t)).expect("weights");
+        for (node, weights) in nodes.iter().zip(morph_weights(t)) {
+            scene.set_morph_weights(*node, weights).expect("weights");
+        }
         let frame = FrameInputs::from_first_camera(&scene).expect("frame");
         cx.upload_meshes(&frame);
-        let inst = frame.instances.iter().find(|i| i.node == node).expect("the figure");
-        assert!(inst.pose.is_some(), "t = {t}: the figure is not posed");
-        let gpu = cx.read_posed(inst).expect("read back").expect("posed on the GPU");
-        let cpu = &inst.mesh;
-        let size = cpu.bounds().size().length();
-        let far = |a: &[Vec3], b: &[Vec3]| a.iter().zip(b).map(|(x, y)| (*x - *y).length()).fold(0.0, f32::max);
-        assert_eq!(gpu.positions.len(), cpu.positions().len(), "t = {t}");
-        let positions = far(&gpu.positions, cpu.positions()) / size;
-        let normals = far(&gpu.normals, cpu.normals());
-        let welded = far(&gpu.welded, inst.adjacency.positions()) / size;
-        assert!(positions <= 1e-5, "t = {t}: a posed position {positions:e} of the size away from the CPU's");
-        assert!(normals <= 1e-5, "t = {t}: a posed normal {normals:e} away from the CPU's");
-        assert!(welded <= 1e-5, "t = {t}: a welded position {welded:e} of the size away from the CPU's");
-        for (f, (plane, tri)) in gpu.planes.iter().zip(inst.adjacency.triangles()).enumerate() {
-            let n = power_of_two_unit(face_normal(tri.map(|v| gpu.welded[v as usize])));
-            let want = if n == Vec3::ZERO { Vec4::ZERO } else { n.extend(-n.dot(gpu.welded[tri[0] as usize])) };
-            let off = (*plane - want).abs().max_element() / want.abs().max_element().max(1.0);
-            assert!(off <= 1e-5, "t = {t}: face {f}'s plane {plane} is not {want}");
+        for node in nodes {
+            let inst = frame.instances.iter().find(|i| i.node == node).expect("a posed node");
+            let name = scene.node(node).expect("node").name();
+            let case = format!("{name} at {t} s");
+            assert!(inst.pose.is_some(), "{case}: not posed");
+            let gpu = cx.read_posed(inst).expect("read back").expect("posed on the GPU");
+            let cpu = &inst.mesh;
+            let size = cpu.bounds().size().length();
+            let far = |a: &[Vec3], b: &[Vec3]| a.iter().zip(b).map(|(x, y)| (*x - *y).length()).fold(0.0, f32::max);
+            assert_eq!(gpu.positions.len(), cpu.positions().len(), "{case}");
+            let positions = far(&gpu.positions, cpu.positions()) / size;
+            let normals = far(&gpu.normals, cpu.normals());
+            let welded = far(&gpu.welded, inst.adjacency.positions()) / size;
+            assert!(positions <= 1e-5, "{case}: a posed position {positions:e} of the size away from the CPU's");
+            assert!(normals <= 1e-5, "{case}: a posed normal {normals:e} away from the CPU's");
+            assert!(welded <= 1e-5, "{case}: a welded position {welded:e} of the size away from the CPU's");
+            for (f, (plane, tri)) in gpu.planes.iter().zip(inst.adjacency.triangles()).enumerate() {
+                let n = power_of_two_unit(face_normal(tri.map(|v| gpu.welded[v as usize])));
+                let want = if n == Vec3::ZERO { Vec4::ZERO } else { n.extend(-n.dot(gpu.welded[tri[0] as usize])) };
+                let off = (*plane - want).abs().max_element() / want.abs().max_element().max(1.0);
+                assert!(off <= 1e-5, "{case}: face {f}'s plane {plane} is not {want}");
+            }
+            worst = [worst[0].max(positions), worst[1].max(normals), worst[2].max(welded)];
         }
-        worst = [worst[0].max(positions), worst[1].max(normals), worst[2].max(welded)];
+        // The two nodes of one mesh stand apart: each was posed into buffers of its own.
+        let [figure, twin] = [nodes[0], nodes[1]].map(|n| frame.instances.iter().find(|i| i.node == n).expect("node"));
+        let apart = figure.mesh.positions().iter().zip(twin.mesh.positions()).map(|(a, b)| (*a - *b).length());
+        assert!(apart.fold(0.0, f32::max) > 0.3, "at {t} s the twin stands where the figure does");
     }
     eprintln!(
         "GPU pose vs CPU over ten times: positions {:e}, normals {:e}, welded {:e}",

@@ -16,15 +16,20 @@ fn cached(r: &RunOutput) -> f64 {
     r.stats.counters.extra.get("cached_builds").copied().unwrap_or(0.0)
 }
 
-#[test]
-fn unchanged_lights_keep_their_builds_until_something_moves() {
-    let mut renderer = Renderer::new(TechniqueRegistry::builtin());
+/// A renderer, the backends to run (wgpu where there is an adapter) and a frame of `primitives`.
+fn primitives() -> (Renderer, Vec<BackendKind>, FrameInputs) {
     let mut backends = vec![BackendKind::Cpu];
     if super::with_wgpu("the static-light cache").is_some() {
         backends.push(BackendKind::Wgpu);
     }
     let scene = scenes::build("primitives", &SceneParams::default()).expect("scene");
     let frame = FrameInputs::from_first_camera(&scene).expect("frame");
+    (Renderer::new(TechniqueRegistry::builtin()), backends, frame)
+}
+
+#[test]
+fn unchanged_lights_keep_their_builds_until_something_moves() {
+    let (mut renderer, backends, frame) = primitives();
     let mut moved_light = frame.clone();
     if let LightKind::Spot { position, .. } = &mut moved_light.lights[0].kind {
         *position += Vec3::new(0.3, 0.0, 0.0);
@@ -59,4 +64,60 @@ fn unchanged_lights_keep_their_builds_until_something_moves() {
     renderer.run_prepared(&mut p, &frame, SIZE, SIZE).expect("a frame");
     let again = renderer.run_prepared(&mut p, &frame, SIZE, SIZE).expect("a frame");
     assert_eq!(cached(&again), 0.0, "hybrid kept a build");
+}
+
+/// A caster moving outside a light's view leaves the builds that only draw casters into that view (the
+/// shadow map, its depth layers, PCSS and moment maps) as they were, giving what a fresh build gives; the volumes, which extrude every
+/// caster, build afresh; moved into the view, it is built again everywhere. On both backends.
+#[test]
+fn a_caster_moving_outside_a_lights_view_keeps_the_maps_it_is_not_in() {
+    let (mut renderer, backends, frame) = primitives();
+    let LightKind::Spot { position, direction, cone_angle } = frame.lights[0].kind else {
+        panic!("primitives' light is a spot")
+    };
+    // A half-size copy of the smallest caster, moved across the light's axis by `reach` times the cone's
+    // radius at its depth (the view's corners reach √2 of it) and its size: its corners' depths along the
+    // axis stay within that caster's, so the fitted projection is the same wherever it goes.
+    let size = |i: &&shadow_core::Instance| i.bounds.size().length();
+    let first = frame.instances.iter().filter(|i| i.casts_shadow).min_by(|a, b| size(a).total_cmp(&size(b)));
+    let first = first.expect("a caster").clone();
+    let (centre, size) = (first.bounds.center(), first.bounds.size().length());
+    let dir = direction.normalize();
+    let across = dir.any_orthonormal_vector();
+    let radius = (centre - position).dot(dir) * (cone_angle * 0.5).tan() + size;
+    let with_copy = |reach: f32| {
+        let place = Mat4::from_translation(centre + across * radius * reach)
+            * Mat4::from_scale(Vec3::splat(0.5))
+            * Mat4::from_translation(-centre);
+        let mut f = frame.clone();
+        let mut copy = first.clone();
+        copy.world_from_local = place * first.world_from_local;
+        copy.local_from_world = copy.world_from_local.inverse();
+        copy.bounds = first.bounds.transformed(place);
+        f.instances.push(copy);
+        f
+    };
+    let (outside, further, inside) = (with_copy(2.0), with_copy(3.0), with_copy(0.0));
+    for backend in backends {
+        let maps = ["shadow-map", "second-depth-shadow-map", "pcss", "variance-shadow-map"].map(|name| (name, true));
+        for (name, keeps) in maps.into_iter().chain([("shadow-volume-zfail", false)]) {
+            let what = format!("{name} on {backend:?}");
+            let spec = TechniqueSpec::named(name);
+            let mut p = renderer.prepare(backend, &spec).expect("technique");
+            let mut run = |p: &mut shadowlab::renderer::Prepared, f: &FrameInputs| {
+                renderer.run_prepared(p, f, SIZE, SIZE).expect("a frame")
+            };
+            run(&mut p, &outside);
+            let moved = run(&mut p, &further);
+            assert_eq!(cached(&moved), if keeps { 1.0 } else { 0.0 }, "{what}: a caster moved outside the view");
+            assert!(moved.visibility[0].data().contains(&0.0), "{what}: nothing in shadow");
+            let mut fresh = renderer.prepare(backend, &spec).expect("technique");
+            let fresh = renderer.run_prepared(&mut fresh, &further, SIZE, SIZE).expect("a frame");
+            assert!(moved.visibility[0].data() == fresh.visibility[0].data(), "{what}: the kept build differs");
+            let mut run = |p: &mut shadowlab::renderer::Prepared, f: &FrameInputs| {
+                renderer.run_prepared(p, f, SIZE, SIZE).expect("a frame")
+            };
+            assert_eq!(cached(&run(&mut p, &inside)), 0.0, "{what}: a caster moved into the view kept the build");
+        }
+    }
 }

@@ -19,7 +19,7 @@ pub mod psm;
 
 use glam::camera::rh::proj::directx;
 use glam::camera::rh::view::look_to_mat4;
-use glam::{Mat4, Vec2, Vec3, Vec3Swizzles, Vec4Swizzles};
+use glam::{Mat4, Vec2, Vec3, Vec3Swizzles, Vec4, Vec4Swizzles};
 
 use crate::bounds::Aabb;
 use crate::geometry::LightSource;
@@ -214,6 +214,16 @@ fn perspective_range(eye: Vec3, dir: Vec3, boxes: &[Aabb]) -> (f32, f32) {
     (near, far)
 }
 
+/// Whether part of box `b` may lie in the frustum of `clip_from_world` (x and y within w, depth within
+/// [0, w]): false only where all its corners lie beyond one plane, by a ten-thousandth of the clip volume
+/// against rounding. Each plane is a plane of world space, so the test holds behind the eye too.
+fn frustum_may_hold(clip_from_world: Mat4, b: Aabb) -> bool {
+    let clip = b.corners().map(|c| clip_from_world * c.extend(1.0));
+    let planes: [fn(Vec4) -> f32; 6] =
+        [|c| c.w + c.x, |c| c.w - c.x, |c| c.w + c.y, |c| c.w - c.y, |c| c.z, |c| c.w - c.z];
+    !planes.iter().any(|inside| clip.iter().all(|&c| inside(c) < -1e-4 * c.w.abs()))
+}
+
 impl LightView {
     /// Fits the light's projections to the given world-space boxes (one per instance keeps it tight).
     ///
@@ -280,6 +290,13 @@ impl LightView {
             })
             .collect();
         Self { projections, ..self.clone() }
+    }
+
+    /// Whether part of `bounds` may lie in one of the light's views: false only for a box that lies wholly
+    /// outside every projection's frustum, whose triangles no pass drawn in the light's views rasterizes.
+    #[must_use]
+    pub fn sees(&self, bounds: Aabb) -> bool {
+        !bounds.is_empty() && self.projections.iter().any(|p| frustum_may_hold(p.clip_from_world, bounds))
     }
 
     /// The light as the geometry kernels take it, in world space.

@@ -117,13 +117,26 @@ pub struct LightPass<'a> {
     pub stats: &'a mut FrameStats,
 }
 
+/// Which instances a light's build reads ([`ShadowTechnique::build_reads`]): the cache of static lights
+/// keeps a light's build while none of them changes, whatever else moves.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum BuildReads {
+    /// Every instance of the frame: a build that extrudes casters' silhouettes or casts rays reads casters
+    /// wherever they are.
+    #[default]
+    EveryInstance,
+    /// The instances in the light's views ([`LightView::sees`]): a build that only rasterizes casters into
+    /// the light's projections reads nothing outside them.
+    LightViews,
+}
+
 impl LightPass<'_> {
     /// A digest of what a light's build reads: the light's position (or direction), its radius and its
-    /// fitted projections (which hold its cone), and every
-    /// instance's mesh, version, placement and shadow flags (the camera is not among them: a build that
-    /// reads it is not kept, see [`ShadowTechnique::build_is_reusable`]).
+    /// fitted projections (which hold its cone), and each instance's index, mesh, version, placement and shadow
+    /// flags, of every instance or of those in the light's views as `reads` says (the camera is not among
+    /// them: a build that reads it is not kept, see [`ShadowTechnique::build_is_reusable`]).
     #[must_use]
-    pub fn build_key(&self) -> u64 {
+    pub fn build_key(&self, reads: BuildReads) -> u64 {
         use std::hash::{Hash, Hasher};
         let mut h = std::collections::hash_map::DefaultHasher::new();
         let floats = |h: &mut std::collections::hash_map::DefaultHasher, v: &[f32]| {
@@ -134,8 +147,9 @@ impl LightPass<'_> {
         for p in &self.light.projections {
             floats(&mut h, &p.clip_from_world.to_cols_array());
         }
-        for inst in &self.frame.instances {
-            (inst.mesh_key, inst.mesh_version, inst.casts_shadow, inst.receives_shadow).hash(&mut h);
+        let read = |inst: &crate::frame::Instance| reads == BuildReads::EveryInstance || self.light.sees(inst.bounds);
+        for (i, inst) in self.frame.instances.iter().enumerate().filter(|(_, inst)| read(inst)) {
+            (i, inst.mesh_key, inst.mesh_version, inst.casts_shadow, inst.receives_shadow).hash(&mut h);
             floats(&mut h, &inst.world_from_local.to_cols_array());
         }
         h.finish()
@@ -237,6 +251,13 @@ pub trait ShadowTechnique<B: Backend>: Send + Sync {
         true
     }
 
+    /// Which instances a light's build reads (default: every one). A technique whose build only
+    /// rasterizes casters into the light's projections says [`BuildReads::LightViews`], and a light's
+    /// build is kept while casters outside its views move.
+    fn build_reads(&self) -> BuildReads {
+        BuildReads::EveryInstance
+    }
+
     /// Pictures of the internals after the last build (default: none).
     ///
     /// # Errors
@@ -330,7 +351,7 @@ impl<B: Backend, T: ShadowTechnique<B>> DynShadowTechnique<B> for Stateful<B, T>
         if !self.lights.takes(&pass.light.light) {
             return Err(TechniqueError::unsupported_light(self.technique.name(), &pass.light.light).into());
         }
-        let reads = self.technique.build_is_reusable(pass.frame).then(|| pass.build_key());
+        let reads = self.technique.build_is_reusable(pass.frame).then(|| pass.build_key(self.technique.build_reads()));
         if self.slots.len() <= pass.slot {
             self.slots.resize_with(pass.slot + 1, || None);
         }

@@ -13,7 +13,7 @@ use rayon::prelude::*;
 
 use super::{DepthLayers, LayerCulling};
 use shadow_core::light::LightProjection;
-use shadow_core::technique::LightPass;
+use shadow_core::technique::{BuildReads, LightPass};
 use shadow_core::technique::{DebugView, ShadowTechnique, TechniqueError};
 use shadow_core::{FrameInputs, Image};
 
@@ -138,6 +138,11 @@ impl ShadowTechnique<CpuBackend> for DepthLayers {
     /// With cascades the maps follow the camera, which the build key does not hold.
     fn build_is_reusable(&self, _: &FrameInputs) -> bool {
         self.cascades == 0
+    }
+
+    /// Its build peels casters' layers in the light's maps and reads nothing else of the frame.
+    fn build_reads(&self) -> BuildReads {
+        BuildReads::LightViews
     }
 
     fn debug_views(&self, _: &mut CpuContext, state: &State) -> Result<Vec<DebugView>, CpuError> {

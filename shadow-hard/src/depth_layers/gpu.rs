@@ -9,8 +9,8 @@ use bytemuck::{Pod, Zeroable};
 use shadow_core::FrameInputs;
 use shadow_core::frame::Coverage;
 use shadow_core::light::LightProjection;
-use shadow_core::technique::LightPass;
 use shadow_core::technique::settings::Filter;
+use shadow_core::technique::{BuildReads, LightPass};
 use shadow_core::technique::{ShadowTechnique, TechniqueError};
 
 use shadow_wgpu::frame::{GpuVisibility, layer_view};
@@ -315,6 +315,11 @@ impl ShadowTechnique<WgpuBackend> for DepthLayers {
     /// With cascades the maps follow the camera, which the build key does not hold.
     fn build_is_reusable(&self, _: &FrameInputs) -> bool {
         self.cascades == 0
+    }
+
+    /// Its build peels casters' layers in the light's maps and reads nothing else of the frame.
+    fn build_reads(&self) -> BuildReads {
+        BuildReads::LightViews
     }
 }
 

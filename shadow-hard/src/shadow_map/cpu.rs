@@ -2,7 +2,7 @@
 //! compared at each receiver through the map filter (`passes::maps`).
 
 use shadow_core::Image;
-use shadow_core::technique::LightPass;
+use shadow_core::technique::{BuildReads, LightPass};
 use shadow_core::technique::{DebugView, ShadowTechnique, TechniqueError};
 use shadow_cpu::passes::maps::{depth_views, query_maps, render_depth_maps};
 use shadow_cpu::{CpuBackend, CpuContext, CpuError, GBuffer};
@@ -20,6 +20,11 @@ impl ShadowTechnique<CpuBackend> for ShadowMap {
 
     fn name(&self) -> &'static str {
         Self::NAME
+    }
+
+    /// Its build draws casters into the light's map and reads nothing else of the frame.
+    fn build_reads(&self) -> BuildReads {
+        BuildReads::LightViews
     }
 
     fn create_state(&self, _: &mut CpuContext) -> Result<State, CpuError> {

@@ -2,7 +2,7 @@
 //! pipeline's depth bias into one layer per projection; the query runs `shadow_lookup` of shadow_map.wgsl
 //! over the G-buffer, with the hardware comparison sampler for bilinear taps.
 
-use shadow_core::technique::LightPass;
+use shadow_core::technique::{BuildReads, LightPass};
 use shadow_core::technique::{ShadowTechnique, TechniqueError};
 use shadow_wgpu::passes::maps::{DepthMaps, LookupParams, MapQuery, QueryExtras};
 use shadow_wgpu::{GpuGBuffer, GpuVisibility, WgpuBackend, WgpuContext, WgpuError, shaders};
@@ -20,6 +20,11 @@ impl ShadowTechnique<WgpuBackend> for ShadowMap {
 
     fn name(&self) -> &'static str {
         Self::NAME
+    }
+
+    /// Its build draws casters into the light's map and reads nothing else of the frame.
+    fn build_reads(&self) -> BuildReads {
+        BuildReads::LightViews
     }
 
     fn create_state(&self, cx: &mut WgpuContext) -> Result<State, WgpuError> {

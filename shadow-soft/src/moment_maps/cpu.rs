@@ -5,7 +5,7 @@ use shadow_core::Image;
 use shadow_core::glam::Vec2;
 use shadow_core::light::LightProjection;
 use shadow_core::lookup::on_map;
-use shadow_core::technique::{DebugView, LightPass, ShadowTechnique, TechniqueError};
+use shadow_core::technique::{BuildReads, DebugView, LightPass, ShadowTechnique, TechniqueError};
 use shadow_cpu::passes::maps::{map_position, render_depth_maps};
 use shadow_cpu::passes::per_receiver;
 use shadow_cpu::{CpuBackend, CpuContext, CpuError, GBuffer};
@@ -138,6 +138,11 @@ impl ShadowTechnique<CpuBackend> for MomentMap {
 
     fn name(&self) -> &'static str {
         MomentMap::name(self)
+    }
+
+    /// Its build draws casters into the light's map and reads nothing else of the frame.
+    fn build_reads(&self) -> BuildReads {
+        BuildReads::LightViews
     }
 
     fn create_state(&self, _: &mut CpuContext) -> Result<State, CpuError> {

@@ -6,7 +6,7 @@
 //! its own maths.
 
 use bytemuck::{Pod, Zeroable};
-use shadow_core::technique::{DebugView, LightPass, ShadowTechnique, TechniqueError};
+use shadow_core::technique::{BuildReads, DebugView, LightPass, ShadowTechnique, TechniqueError};
 use shadow_wgpu::passes::full_screen;
 use shadow_wgpu::passes::maps::{DepthMaps, LookupParams, MapQuery, QueryExtras};
 use shadow_wgpu::pipelines::{
@@ -202,6 +202,11 @@ impl ShadowTechnique<WgpuBackend> for MomentMap {
 
     fn name(&self) -> &'static str {
         MomentMap::name(self)
+    }
+
+    /// Its build draws casters into the light's map and reads nothing else of the frame.
+    fn build_reads(&self) -> BuildReads {
+        BuildReads::LightViews
     }
 
     fn create_state(&self, cx: &mut WgpuContext) -> Result<State, WgpuError> {

@@ -4,7 +4,7 @@
 use shadow_core::Image;
 use shadow_core::glam::Vec2;
 use shadow_core::lookup::{POISSON16, compare_bilinear, floor_vec2, hash_unit, on_map, pixel_hash};
-use shadow_core::technique::LightPass;
+use shadow_core::technique::{BuildReads, LightPass};
 use shadow_core::technique::{DebugView, ShadowTechnique, TechniqueError};
 use shadow_cpu::passes::maps::{map_position, render_depth_maps};
 use shadow_cpu::passes::per_receiver;
@@ -77,6 +77,11 @@ impl ShadowTechnique<CpuBackend> for Pcss {
 
     fn name(&self) -> &'static str {
         Self::NAME
+    }
+
+    /// Its build draws casters into the light's map and reads nothing else of the frame.
+    fn build_reads(&self) -> BuildReads {
+        BuildReads::LightViews
     }
 
     fn create_state(&self, _: &mut CpuContext) -> Result<State, CpuError> {

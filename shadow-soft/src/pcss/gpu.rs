@@ -1,7 +1,7 @@
 //! `pcss` on the wgpu backend, through its public API: `shadow-map`'s light pass, then a query over the
 //! G-buffer with `shadow-map`'s bindings and the geometric normals (query.wgsl).
 
-use shadow_core::technique::LightPass;
+use shadow_core::technique::{BuildReads, LightPass};
 use shadow_core::technique::{DebugView, ShadowTechnique, TechniqueError};
 use shadow_wgpu::passes::maps::{DepthMaps, LookupParams, MapQuery, QueryExtras};
 use shadow_wgpu::pipelines::{FragmentEntry, attribute_entry};
@@ -21,6 +21,11 @@ impl ShadowTechnique<WgpuBackend> for Pcss {
 
     fn name(&self) -> &'static str {
         Self::NAME
+    }
+
+    /// Its build draws casters into the light's map and reads nothing else of the frame.
+    fn build_reads(&self) -> BuildReads {
+        BuildReads::LightViews
     }
 
     fn create_state(&self, cx: &mut WgpuContext) -> Result<State, WgpuError> {
