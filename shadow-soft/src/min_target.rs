@@ -5,7 +5,7 @@
 
 use shadow_wgpu::frame::layer_view;
 use shadow_wgpu::pipelines::{buffer_entry, depth_array_entry, depth_pass, min_depth_pipeline};
-use shadow_wgpu::{Transient, WgpuContext};
+use shadow_wgpu::{Transient, TransientRing, WgpuContext};
 
 /// A pipeline drawing `vertices` through `vertex` and `fragment` of `module`, whose fragment depth is the
 /// value kept (shadow-wgpu's `min_depth_pipeline` with a fragment stage).
@@ -73,9 +73,16 @@ pub fn bind(
     })
 }
 
-/// `vertices` in the frame's transient buffer, with their count; `None` when there are none (a pass
-/// then only clears).
+/// `vertices` in this frame's buffer of `ring` (the pass's own: their number follows the casters'
+/// silhouettes), with their count; `None` when there are none (a pass then only clears).
 #[must_use]
-pub fn vertex_buffer<V: bytemuck::Pod>(cx: &WgpuContext, vertices: &[V]) -> Option<(Transient, u32)> {
-    (!vertices.is_empty()).then(|| (cx.transient(bytemuck::cast_slice(vertices)), vertices.len() as u32))
+pub fn vertex_buffer<V: bytemuck::Pod>(
+    cx: &WgpuContext,
+    ring: &mut TransientRing,
+    vertices: &[V],
+) -> Option<(Transient, u32)> {
+    (!vertices.is_empty()).then(|| {
+        let [slice] = ring.write(cx, [bytemuck::cast_slice(vertices)]);
+        (slice, vertices.len() as u32)
+    })
 }

@@ -30,5 +30,5 @@ pub use gbuffer::{GpuGBuffer, HostSurfaces};
 pub use host_maps::HostMap;
 pub use pipeline_cache::PipelineCache;
 pub use record::{ColorTarget, FrameRecorder};
-pub use resources::{Created, Transient};
+pub use resources::{Created, Transient, TransientRing};
 pub use timer::{FrameTimer, FrameTimes};

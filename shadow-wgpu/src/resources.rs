@@ -8,7 +8,9 @@
 //! order since the frame began. A frame recorded into one command buffer sees all its writes land before
 //! its first command, so each piece needs a place of its own. Consecutive frames write different buffers,
 //! a few in turn, so a frame's writes do not wait for the frames still in flight to finish reading. The
-//! buffers are made again, twice as large, only when a frame needs more than one holds.
+//! buffers are made again, twice as large, only when a frame needs more than one holds. A pass whose data
+//! grows and shrinks from frame to frame (geometry around a moving figure's silhouette) keeps a
+//! [`TransientRing`] of its own, sized by its own frames, not by what else the frame holds.
 
 use std::cell::{Cell, RefCell};
 
@@ -165,6 +167,24 @@ impl WgpuContext {
     pub fn transient(&self, bytes: &[u8]) -> Transient {
         // Bindings and writes are whole words; an empty storage binding is not allowed.
         let size = (bytes.len() as u64).max(4).next_multiple_of(4);
+        self.transient_frame();
+        let mut arena = self.resources.transient.borrow_mut();
+        let local = arena.used.next_multiple_of(arena.align);
+        let offset = if !arena.buffers.is_empty() && local + size <= arena.size {
+            local
+        } else {
+            arena.size = (2 * (local + size)).max(MIN_TRANSIENT).min(arena.max_size);
+            arena.buffers = self.transient_buffers("transient", arena.size);
+            0
+        };
+        arena.used = offset + size;
+        let buffer = arena.buffers[arena.frame as usize % FRAMES].clone();
+        self.write_transient(buffer, offset, bytes)
+    }
+
+    /// The frame under way (counted from the context's first), the offset alignment of transient
+    /// slices (the device's for uniform and storage bindings) and the largest buffer the device makes.
+    fn transient_frame(&self) -> (u64, u64, u64) {
         let mut arena = self.resources.transient.borrow_mut();
         if arena.align == 0 {
             let limits = self.device.limits();
@@ -172,26 +192,71 @@ impl WgpuContext {
                 u64::from(limits.min_uniform_buffer_offset_alignment.max(limits.min_storage_buffer_offset_alignment));
             arena.max_size = limits.max_buffer_size;
         }
-        let local = arena.used.next_multiple_of(arena.align);
-        let offset = if !arena.buffers.is_empty() && local + size <= arena.size {
-            local
-        } else {
-            arena.size = (2 * (local + size)).max(MIN_TRANSIENT).min(arena.max_size);
-            let usage = wgpu::BufferUsages::UNIFORM
-                | wgpu::BufferUsages::STORAGE
-                | wgpu::BufferUsages::VERTEX
-                | wgpu::BufferUsages::INDEX
-                | wgpu::BufferUsages::COPY_DST;
-            let desc =
-                wgpu::BufferDescriptor { label: Some("transient"), size: arena.size, usage, mapped_at_creation: false };
-            arena.buffers = (0..FRAMES).map(|_| self.create_buffer(&desc)).collect();
-            0
-        };
-        arena.used = offset + size;
-        let buffer = arena.buffers[arena.frame as usize % FRAMES].clone();
+        (arena.frame, arena.align, arena.max_size)
+    }
+
+    /// [`FRAMES`] buffers of `size` bytes for transient slices of every use.
+    fn transient_buffers(&self, label: &str, size: u64) -> Vec<wgpu::Buffer> {
+        let usage = wgpu::BufferUsages::UNIFORM
+            | wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::VERTEX
+            | wgpu::BufferUsages::INDEX
+            | wgpu::BufferUsages::COPY_DST;
+        let desc = wgpu::BufferDescriptor { label: Some(label), size, usage, mapped_at_creation: false };
+        (0..FRAMES).map(|_| self.create_buffer(&desc)).collect()
+    }
+
+    /// `bytes`, padded to whole words, written at `offset` of `buffer`: the slice there.
+    fn write_transient(&self, buffer: wgpu::Buffer, offset: u64, bytes: &[u8]) -> Transient {
+        let size = (bytes.len() as u64).max(4).next_multiple_of(4);
         let mut padded = bytes.to_vec();
         padded.resize(size as usize, 0);
         self.queue.write_buffer(&buffer, offset, &padded);
         Transient { buffer, offset, size }
+    }
+}
+
+/// Transient buffers a pass keeps for itself ([`FRAMES`] used in turn, like the context's): each frame's
+/// data is written into that frame's buffer, and when a frame's data outgrows it the buffers are made
+/// again at twice the frame's size so far. Data that varies from frame to frame (a moving silhouette's
+/// geometry) so costs an allocation only when it outgrows twice its largest frame so far, whatever
+/// else the frame holds.
+pub struct TransientRing {
+    label: &'static str,
+    buffers: Vec<wgpu::Buffer>,
+    size: u64,
+    frame: u64,
+    used: u64,
+}
+
+impl TransientRing {
+    /// An empty ring, its buffers labelled `label`; nothing is made until the first write.
+    #[must_use]
+    pub fn new(label: &'static str) -> Self {
+        Self { label, buffers: Vec::new(), size: 0, frame: 0, used: 0 }
+    }
+
+    /// `parts`, each in a slice of its own (to bind as uniform or read-only storage, or to draw as
+    /// vertices or indices), after what this frame wrote before.
+    pub fn write<const N: usize>(&mut self, cx: &WgpuContext, parts: [&[u8]; N]) -> [Transient; N] {
+        let (frame, align, max_size) = cx.transient_frame();
+        if frame != self.frame {
+            (self.frame, self.used) = (frame, 0);
+        }
+        let sizes = parts.map(|p| (p.len() as u64).max(4).next_multiple_of(align));
+        let need: u64 = sizes.iter().sum();
+        if self.buffers.is_empty() || self.used + need > self.size {
+            // Slices written before this frame's growth stay in the buffers they were written to; the
+            // new ones have room for twice the frame so far.
+            self.size = (2 * (self.used + need)).min(max_size.max(need));
+            self.buffers = cx.transient_buffers(self.label, self.size);
+            self.used = 0;
+        }
+        let buffer = &self.buffers[frame as usize % FRAMES];
+        std::array::from_fn(|i| {
+            let slice = cx.write_transient(buffer.clone(), self.used, parts[i]);
+            self.used += sizes[i];
+            slice
+        })
     }
 }

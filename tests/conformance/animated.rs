@@ -159,13 +159,8 @@ fn moving_scenes_agree_across_backends() {
     eprintln!("{}", rows.join("\n"));
 }
 
-/// Techniques whose geometry the CPU still builds from its pose each frame and hands to the GPU in the
-/// transient buffers: penumbra wedges' list grows and shrinks with the silhouette as the figure moves,
-/// and the transient buffers grow with it.
-const BUILT_ON_THE_CPU: [&str; 1] = ["penumbra-wedges"];
-
 /// Recorded frames of `walker` as its clip plays, 100 of them a thirtieth of a second apart, for every
-/// technique that can be recorded but [`BUILT_ON_THE_CPU`]: nothing is made after the first frame, and
+/// technique that can be recorded: nothing is made after the first frame, and
 /// the last frame's visibility is a fresh render's of that pose.
 #[test]
 fn a_playing_clip_allocates_nothing_after_the_first_frame() {
@@ -180,7 +175,7 @@ fn a_playing_clip_allocates_nothing_after_the_first_frame() {
     let mut failures = Vec::new();
     let mut checked = 0;
     let registry = renderer.registry().clone();
-    let recordable = |name: &str| !crate::recorded::NOT_RECORDABLE.contains(&name) && !BUILT_ON_THE_CPU.contains(&name);
+    let recordable = |name: &str| !crate::recorded::NOT_RECORDABLE.contains(&name);
     for entry in registry.entries().iter().filter(|e| e.wgpu.is_some() && recordable(e.name)) {
         let mut scene = crate::scene_taken_by("walker", entry.lights);
         let spec = TechniqueSpec::named(entry.name);

@@ -10,7 +10,7 @@ use shadow_core::technique::{DebugView, ShadowTechnique, TechniqueError};
 use shadow_wgpu::frame::{layer_view, layered};
 use shadow_wgpu::passes::maps::{DepthMaps, LookupParams, MapQuery, QueryExtras};
 use shadow_wgpu::pipelines::{FragmentEntry, MAP_DEPTH, depth_entry};
-use shadow_wgpu::{GpuGBuffer, GpuVisibility, WgpuBackend, WgpuContext, WgpuError, readback, shaders};
+use shadow_wgpu::{GpuGBuffer, GpuVisibility, TransientRing, WgpuBackend, WgpuContext, WgpuError, readback, shaders};
 
 use super::PenumbraMap;
 use super::geometry::PenumbraTriangle;
@@ -46,6 +46,8 @@ pub struct State {
     query: MapQuery,
     /// The penumbra map: a one-layer depth texture holding the values.
     penumbra: Option<wgpu::Texture>,
+    /// The cones' and sheets' vertices, each frame's (their number follows the silhouettes).
+    vertices: TransientRing,
 }
 
 fn vertices(triangles: &[PenumbraTriangle]) -> Vec<ConeVertex> {
@@ -77,7 +79,7 @@ impl State {
         };
         let group = min_target::bind(cx, &self.build_layout, "penumbra map", &params, maps);
         let data = vertices(triangles);
-        let vertices = min_target::vertex_buffer(cx, &data);
+        let vertices = min_target::vertex_buffer(cx, &mut self.vertices, &data);
         let mut enc = cx.encoder("penumbra map");
         min_target::draw(&mut enc, penumbra, &self.build, &group, vertices.as_ref());
         cx.submit(enc);
@@ -102,7 +104,8 @@ impl ShadowTechnique<WgpuBackend> for PenumbraMap {
             let entry = FragmentEntry::from("fs_penumbra_query");
             let lookup = LookupParams { radius: 0.0, receiver_offset: self.depth.receiver_offset() };
             let query = MapQuery::with_entry(cx, &query_module, entry, &[depth_entry(4)]).with_lookup(lookup);
-            State { map, build_layout, build, query, penumbra: None }
+            let vertices = TransientRing::new("penumbra-map cones");
+            State { map, build_layout, build, query, penumbra: None, vertices }
         })
     }
 

@@ -8,12 +8,11 @@ use shadow_core::glam::Vec4;
 use shadow_core::technique::LightPass;
 use shadow_core::technique::{ShadowTechnique, TechniqueError};
 use shadow_wgpu::pipelines::{VISIBILITY, attribute_entry, buffer_entry, full_screen_pipeline};
-use shadow_wgpu::{GpuGBuffer, GpuVisibility, WgpuBackend, WgpuContext, WgpuError, passes, shaders};
+use shadow_wgpu::{GpuGBuffer, GpuVisibility, TransientRing, WgpuBackend, WgpuContext, WgpuError, passes, shaders};
 
 use super::PenumbraWedges;
 use super::coverage::SphereLight;
 use super::geometry::{LAYERS, PixelScale, QUAD_DEPTH_BIAS, WedgeEdge, WedgeGeometry};
-use crate::min_target;
 use shadow_wgpu::passes::maps::CutoutMaps;
 
 /// GPU twin of `WedgeParams` in wedges.wgsl.
@@ -67,6 +66,9 @@ pub struct State {
     wedges: wgpu::RenderPipeline,
     resolve: wgpu::RenderPipeline,
     built: Option<Built>,
+    /// Each frame's edges, side quads and wedges: their number follows the silhouette, so they have
+    /// buffers of their own, which a figure's silhouette growing as it moves seldom outgrows.
+    geometry: TransientRing,
     /// The per-pixel sums, one view's worth per layer, kept while the view's size does not change.
     occluded: Option<wgpu::Buffer>,
     /// The cut-out casters' map, and, made by the first frame with such casters, the resolve that
@@ -188,6 +190,7 @@ impl ShadowTechnique<WgpuBackend> for PenumbraWedges {
                 wedges,
                 resolve,
                 built: None,
+                geometry: TransientRing::new("penumbra-wedge geometry"),
                 occluded: None,
                 cutouts: CutoutMaps::default(),
                 cutout_resolve: None,
@@ -237,10 +240,13 @@ impl ShadowTechnique<WgpuBackend> for PenumbraWedges {
             })),
         };
         let quads = vertices(&built.geometry.side_quads(PixelScale::of(&g.camera, g.height)), |t| (t / 2) as u32);
-        let draw_wedges = self.wedges.is_on();
+        let wedges: &[EdgeVertex] = if self.wedges.is_on() { &built.wedges } else { &[] };
+        let geometry = &mut state.geometry;
         cx.scoped("the penumbra wedges", |cx| {
             let uniform = cx.transient(bytemuck::bytes_of(&params));
-            let edges = cx.transient(bytemuck::cast_slice(&built.edges));
+            let parts =
+                [bytemuck::cast_slice(&built.edges), bytemuck::cast_slice(&quads), bytemuck::cast_slice(wedges)];
+            let [edges, quad_vertices, wedge_vertices] = geometry.write(cx, parts);
             let mut entries = vec![
                 wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&g.position) },
                 wgpu::BindGroupEntry { binding: 1, resource: occluded.as_entire_binding() },
@@ -274,13 +280,11 @@ impl ShadowTechnique<WgpuBackend> for PenumbraWedges {
                 });
                 pass.set_bind_group(0, &g.frame_group, &[]);
                 pass.set_bind_group(1, &group, &[]);
-                let wedges: &[EdgeVertex] = if draw_wedges { &built.wedges } else { &[] };
-                for (pipeline, data) in [(&state.quads, &quads[..]), (&state.wedges, wedges)] {
-                    if let Some((vertices, count)) = min_target::vertex_buffer(cx, data) {
-                        pass.set_pipeline(pipeline);
-                        pass.set_vertex_buffer(0, vertices.slice());
-                        pass.draw(0..count, 0..1);
-                    }
+                let draws = [(&state.quads, quad_vertices, quads.len()), (&state.wedges, wedge_vertices, wedges.len())];
+                for (pipeline, vertices, count) in draws.into_iter().filter(|(.., count)| *count > 0) {
+                    pass.set_pipeline(pipeline);
+                    pass.set_vertex_buffer(0, vertices.slice());
+                    pass.draw(0..count as u32, 0..1);
                 }
             }
             cx.submit(enc);

@@ -10,7 +10,7 @@ use shadow_core::technique::{DebugView, ShadowTechnique, TechniqueError};
 use shadow_wgpu::frame::{layer_view, layered};
 use shadow_wgpu::passes::maps::{DepthMaps, LookupParams, MapQuery, QueryExtras};
 use shadow_wgpu::pipelines::{FragmentEntry, MAP_DEPTH, buffer_entry, depth_entry};
-use shadow_wgpu::{GpuGBuffer, GpuVisibility, WgpuBackend, WgpuContext, WgpuError, readback, shaders};
+use shadow_wgpu::{GpuGBuffer, GpuVisibility, TransientRing, WgpuBackend, WgpuContext, WgpuError, readback, shaders};
 
 use super::geometry::{Ramp, SmoothieTriangle};
 use super::{FalloffTable, Smoothies};
@@ -49,6 +49,8 @@ pub struct State {
     falloff: wgpu::Buffer,
     /// Nearest smoothie depth and minimum alpha, each a one-layer depth texture.
     buffer: Option<[wgpu::Texture; 2]>,
+    /// The smoothies' vertices, each frame's (their number follows the silhouettes).
+    vertices: TransientRing,
 }
 
 fn vertices(triangles: &[SmoothieTriangle]) -> Vec<SmoothieVertex> {
@@ -85,7 +87,7 @@ impl State {
         };
         let group = min_target::bind(cx, &self.buffer_layout, "smoothie buffer", &params, maps);
         let data = vertices(triangles);
-        let vertices = min_target::vertex_buffer(cx, &data);
+        let vertices = min_target::vertex_buffer(cx, &mut self.vertices, &data);
         let mut enc = cx.encoder("smoothies");
         for (target, pipeline) in buffer.iter().zip([&self.depth_pass, &self.alpha_pass]) {
             min_target::draw(&mut enc, target, pipeline, &group, vertices.as_ref());
@@ -123,7 +125,8 @@ impl ShadowTechnique<WgpuBackend> for Smoothies {
                 contents: bytemuck::cast_slice(falloff.samples()),
                 usage: wgpu::BufferUsages::STORAGE,
             });
-            State { map, buffer_layout, depth_pass, alpha_pass, query, falloff, buffer: None }
+            let vertices = TransientRing::new("smoothie vertices");
+            State { map, buffer_layout, depth_pass, alpha_pass, query, falloff, buffer: None, vertices }
         })
     }
 
