@@ -172,6 +172,7 @@ impl FrameInputs {
         for l in &lights {
             l.validate()?;
         }
+        scene.build_adjacencies();
         let instances: Vec<Instance> = scene
             .drawables()
             .filter_map(|(node, n, mesh_key, material)| {

@@ -156,6 +156,7 @@ impl Inspection {
                 }
             }
         }
+        scene.build_adjacencies();
         for (_, _, mesh, _) in scene.drawables() {
             let (Some(m), Some(adj)) = (scene.mesh(mesh), scene.adjacency(mesh)) else { continue };
             out.triangles += m.triangle_count();
@@ -166,16 +167,20 @@ impl Inspection {
             out.non_manifold_edges += adj.non_manifold_edge_count();
             out.inconsistent_edges += adj.inconsistent_edge_count();
         }
-        let light = scene.lights().next().map(|(_, l)| l);
-        let camera = crate::scene::Camera::look_at(glam::Vec3::ONE, glam::Vec3::ZERO, 45.0);
-        if let Some(light) = light
-            && let Ok(frame) = FrameInputs::new(scene, camera, vec![light])
-            && let Ok(view) = frame.light_view(&light)
-        {
-            let volumes = frame.shadow_volumes(&view, crate::geometry::volume::Caps::None);
-            out.silhouette_edges = Some(volumes.iter().map(|v| v.silhouette_edges).sum());
-        }
+        out.silhouette_edges = Self::silhouette_edges_of(scene);
         out
+    }
+
+    /// The silhouette edges of `scene`'s casters from its first light ([`Inspection::silhouette_edges`]);
+    /// `None` without a light.
+    #[must_use]
+    pub fn silhouette_edges_of(scene: &Scene) -> Option<usize> {
+        let light = scene.lights().next().map(|(_, l)| l)?;
+        let camera = crate::scene::Camera::look_at(glam::Vec3::ONE, glam::Vec3::ZERO, 45.0);
+        let frame = FrameInputs::new(scene, camera, vec![light]).ok()?;
+        let view = frame.light_view(&light).ok()?;
+        let volumes = frame.shadow_volumes(&view, crate::geometry::volume::Caps::None);
+        Some(volumes.iter().map(|v| v.silhouette_edges).sum())
     }
 }
 

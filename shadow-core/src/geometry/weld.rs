@@ -27,6 +27,11 @@ fn weld_hash(key: [u32; 3]) -> u64 {
 /// count over those firsts then numbers them in order of first appearance, as one table in position
 /// order would. Every step runs on all threads.
 pub(super) fn weld(positions: &[Vec3]) -> (Vec<Vec3>, Vec<u32>) {
+    if positions.len() <= WELD_ALONE { weld_alone(positions) } else { weld_in_parts(positions) }
+}
+
+/// [`weld`] in parts, on all threads.
+fn weld_in_parts(positions: &[Vec3]) -> (Vec<Vec3>, Vec<u32>) {
     let n = positions.len();
     // Each run of positions sorts its own into the parts (with its keys, so a part's table reads its
     // keys in order, not from all over the positions), all runs at once; a part's members are then its
@@ -96,6 +101,39 @@ pub(super) fn weld(positions: &[Vec3]) -> (Vec<Vec3>, Vec<u32>) {
     (welded, remap)
 }
 
+/// [`weld`] of a few positions, on this thread: one table, in position order, numbering each new key as
+/// it comes (the parts and the threads cost more than they save on a small mesh, and a scene of many
+/// small meshes pays that cost per mesh).
+fn weld_alone(positions: &[Vec3]) -> (Vec<Vec3>, Vec<u32>) {
+    const EMPTY: u32 = u32::MAX;
+    let size = (2 * positions.len()).next_power_of_two().max(16);
+    let mut table = vec![[0, 0, 0, EMPTY]; size];
+    let mut welded = Vec::new();
+    let remap = positions
+        .iter()
+        .map(|&p| {
+            let key @ [x, y, z] = weld_key(p);
+            let mut slot = weld_hash(key) as usize & (size - 1);
+            loop {
+                match table[slot] {
+                    [_, _, _, EMPTY] => {
+                        let number = welded.len() as u32;
+                        table[slot] = [x, y, z, number];
+                        welded.push(p);
+                        break number;
+                    }
+                    [a, b, c, number] if [a, b, c] == key => break number,
+                    _ => slot = (slot + 1) & (size - 1),
+                }
+            }
+        })
+        .collect();
+    (welded, remap)
+}
+
+/// The most positions [`weld`] welds on one thread, in one table that stays in the cache.
+const WELD_ALONE: usize = 4096;
+
 /// For each of one part's `count` members (`[key, position]`, in position order), the first position with
 /// the same key, stored at the member's position in `first`: an open addressing table with linear
 /// probing, at most half full, holding each key beside its first position so a probe reads no other
@@ -123,3 +161,30 @@ fn weld_part<'a>(members: impl Iterator<Item = &'a [u32; 4]>, count: usize, firs
 
 /// How many parts [`weld`] splits the positions into: one per value of the hash's top byte.
 const WELD_PARTS: usize = 256;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Alone and in parts, the same welding: random positions drawn from a few, with `-0.0` among them.
+    #[test]
+    fn welding_alone_is_welding_in_parts() {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = move |k: u64| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state % k) as f32
+        };
+        for (count, distinct) in [(0, 1), (1, 1), (7, 3), (3000, 500), (4096, 4000), (20_000, 900)] {
+            let positions: Vec<Vec3> = (0..count)
+                .map(|_| Vec3::new(next(distinct) - 1.0, if next(2) == 0.0 { 0.0 } else { -0.0 }, next(3) * 0.5))
+                .collect();
+            let (alone, in_parts) = (weld_alone(&positions), weld_in_parts(&positions));
+            assert_eq!(alone.1, in_parts.1, "{count} positions");
+            let bits = |w: &[Vec3]| w.iter().map(|p| p.to_array().map(f32::to_bits)).collect::<Vec<_>>();
+            assert_eq!(bits(&alone.0), bits(&in_parts.0), "{count} positions");
+            assert!(alone.0.len() < count.max(1) || count < 8, "{count} positions: nothing welded");
+        }
+    }
+}

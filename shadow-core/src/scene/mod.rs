@@ -235,6 +235,19 @@ impl Scene {
         Some(e.adjacency.get_or_init(|| Arc::new(Adjacency::build(&e.mesh))).clone())
     }
 
+    /// Builds the adjacency of every mesh that has none cached yet, the meshes side by side on all
+    /// threads. A scene of many small meshes built one mesh at a time would pay for starting the thread
+    /// pool's work on each (most of the time of a mesh of a few triangles); from a worker thread, each
+    /// build's own parallel steps cost next to nothing. [`FrameInputs::new`](crate::FrameInputs::new)
+    /// calls it.
+    pub fn build_adjacencies(&self) {
+        use rayon::prelude::*;
+        let missing: Vec<&MeshEntry> = self.meshes.values().filter(|e| e.adjacency.get().is_none()).collect();
+        missing.par_iter().for_each(|e| {
+            e.adjacency.get_or_init(|| Arc::new(Adjacency::build(&e.mesh)));
+        });
+    }
+
     /// True when the mesh's adjacency is already cached.
     #[must_use]
     pub fn has_cached_adjacency(&self, key: MeshKey) -> bool {

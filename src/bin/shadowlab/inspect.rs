@@ -26,7 +26,7 @@ pub(crate) fn inspect(target: &str, json: bool, allow_outside_files: bool) -> Re
         // Staged in place rather than loaded again: its images are decoded once.
         let mut staged = raw;
         scenes::stage_model(&mut staged, false);
-        Inspection { silhouette_edges: Inspection::of(&staged).silhouette_edges, ..of_file }
+        Inspection { silhouette_edges: Inspection::silhouette_edges_of(&staged), ..of_file }
     } else {
         Inspection::of(&SceneSetup::new(target).build()?)
     };
