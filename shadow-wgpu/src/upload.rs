@@ -1,5 +1,6 @@
 //! Scene upload, cached: vertex and index buffers per [`MeshKey`] (refreshed when the mesh's version
-//! changes), the adjacency the GPU's shadow-volume extrusion reads (per mesh, on first use), skinned and
+//! changes), the adjacency the GPU's shadow-volume extrusion reads (per mesh, on first use, the meshes
+//! that arrive together sharing buffers: see [`SceneCache::upload_adjacency`]), skinned and
 //! morphed meshes posed per node ([`crate::posing`]), the materials' textures ([`crate::textures`]), and
 //! the per-instance data of a frame (rewritten in place when an instance changes, made anew only when
 //! their number does).
@@ -56,9 +57,9 @@ pub struct MeshView<'a> {
 #[derive(Clone, Copy)]
 pub struct AdjacencyView<'a> {
     /// Welded positions, `vec4<f32>` with w = 1.
-    pub welded: &'a wgpu::Buffer,
+    pub welded: BufferRange<'a>,
     /// Per face, its plane `(n, d)` (`vec4<f32>`).
-    pub planes: &'a wgpu::Buffer,
+    pub planes: BufferRange<'a>,
     /// The rest of it: edges, uses and counts.
     pub topology: &'a AdjacencyGpu,
 }
@@ -109,20 +110,59 @@ impl InstanceRaw {
     }
 }
 
+/// A range of a buffer, to bind as storage: an array of one mesh in a buffer that many share, or the
+/// whole of a buffer of its own.
+#[derive(Clone, Copy, Debug)]
+pub struct BufferRange<'a> {
+    /// The buffer.
+    pub buffer: &'a wgpu::Buffer,
+    /// Where the range starts (a multiple of the device's storage offset alignment).
+    pub offset: u64,
+    /// Its length in bytes.
+    pub size: u64,
+}
+
+impl<'a> BufferRange<'a> {
+    /// All of `buffer`.
+    #[must_use]
+    pub fn whole(buffer: &'a wgpu::Buffer) -> Self {
+        Self { buffer, offset: 0, size: buffer.size() }
+    }
+
+    /// The range as a binding.
+    #[must_use]
+    pub fn binding(self) -> wgpu::BindingResource<'a> {
+        wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+            buffer: self.buffer,
+            offset: self.offset,
+            size: wgpu::BufferSize::new(self.size),
+        })
+    }
+}
+
+/// One array of a mesh's adjacency: where it lies in a buffer the meshes uploaded with it share.
+struct Shared {
+    buffer: wgpu::Buffer,
+    offset: u64,
+    size: u64,
+}
+
+impl Shared {
+    fn range(&self) -> BufferRange<'_> {
+        BufferRange { buffer: &self.buffer, offset: self.offset, size: self.size }
+    }
+}
+
 /// A mesh's adjacency on the GPU, as the shadow-volume extrusion reads it (twin: shadow-core's
 /// `Adjacency`).
 pub struct AdjacencyGpu {
     version: u64,
-    /// Welded positions, `vec4<f32>` with w = 1.
-    pub welded: wgpu::Buffer,
-    /// Per face, its plane `(n, d)` as the adjacency scaled it (`vec4<f32>`).
-    pub planes: wgpu::Buffer,
-    /// Per edge `(a, b, first use, uses)`, `vec4<u32>`: its welded vertices (a < b) and its run of
-    /// [`Self::uses`]. Manifold edges first, then boundary edges, then the rest, as the CPU's silhouette
-    /// reads them.
-    pub edges: wgpu::Buffer,
-    /// The faces' uses of the edges, `face << 1 | reversed` (shadow-core's `FaceUse`).
-    pub uses: wgpu::Buffer,
+    /// Welded positions, `vec4<f32>` with w = 1; per face, its plane `(n, d)` as the adjacency scaled it
+    /// (`vec4<f32>`); per edge `(a, b, first use, uses)`, `vec4<u32>`: its welded vertices (a < b) and
+    /// its run of uses (manifold edges first, then boundary edges, then the rest, as the CPU's
+    /// silhouette reads them); the faces' uses of the edges, `face << 1 | reversed` (shadow-core's
+    /// `FaceUse`).
+    arrays: [Shared; 4],
     /// Number of faces.
     pub faces: u32,
     /// Number of edges.
@@ -135,7 +175,37 @@ pub struct AdjacencyGpu {
 }
 
 impl AdjacencyGpu {
-    fn upload(cx: &WgpuContext, adj: &Adjacency, version: u64) -> Self {
+    /// Per face, its plane.
+    #[must_use]
+    pub fn planes(&self) -> BufferRange<'_> {
+        self.arrays[1].range()
+    }
+
+    /// Per edge, its welded vertices and its run of uses.
+    #[must_use]
+    pub fn edges(&self) -> BufferRange<'_> {
+        self.arrays[2].range()
+    }
+
+    /// The faces' uses of the edges.
+    #[must_use]
+    pub fn uses(&self) -> BufferRange<'_> {
+        self.arrays[3].range()
+    }
+}
+
+/// A mesh's adjacency as the GPU reads it, on its way to a shared buffer: its four arrays (welded
+/// positions, planes, edges, uses), its counts and whether it is closed.
+struct Arrays {
+    key: MeshKey,
+    version: u64,
+    arrays: [Vec<u8>; 4],
+    counts: [u32; 3],
+    closed: bool,
+}
+
+impl Arrays {
+    fn of(key: MeshKey, version: u64, adj: &Adjacency) -> Self {
         let welded: Vec<[f32; 4]> = adj.positions().iter().map(|p| p.extend(1.0).to_array()).collect();
         let planes: Vec<[f32; 4]> = adj.planes().iter().map(|p| p.to_array()).collect();
         let mut edges: Vec<[u32; 4]> = Vec::with_capacity(adj.edge_count());
@@ -154,28 +224,80 @@ impl AdjacencyGpu {
         for e in adj.complex_edges() {
             push(e.v, &mut e.uses.iter().copied());
         }
-        // Storage bindings may not be empty: a mesh without edges still binds one word.
-        let storage = |label, contents: &[u8]| {
-            let padded = [0u8; 16];
-            cx.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(label),
-                contents: if contents.is_empty() { &padded } else { contents },
+        let counts = [planes.len() as u32, edges.len() as u32, uses.len() as u32];
+        let bytes = |words: &[u8]| words.to_vec();
+        let arrays = [
+            bytes(bytemuck::cast_slice(&welded)),
+            bytes(bytemuck::cast_slice(&planes)),
+            bytes(bytemuck::cast_slice(&edges)),
+            bytes(bytemuck::cast_slice(&uses)),
+        ];
+        Self { key, version, arrays, counts, closed: adj.closed() }
+    }
+
+    /// An array's length as bound: storage bindings may not be empty, so an empty array (a mesh
+    /// without edges) still takes four words.
+    fn bound(array: &[u8]) -> u64 {
+        (array.len() as u64).max(16)
+    }
+
+    /// The bytes its arrays take in a shared buffer, each at an offset a multiple of `align`.
+    fn bytes(&self, align: u64) -> u64 {
+        self.arrays.iter().map(|a| Self::bound(a).next_multiple_of(align)).sum()
+    }
+
+    /// Its arrays each in a buffer of its own (a large mesh's, each as large as a binding may be).
+    fn upload_alone(self, cx: &WgpuContext) -> AdjacencyGpu {
+        let arrays = self.arrays.map(|array| {
+            let size = Self::bound(&array);
+            let mut contents = array;
+            contents.resize(size as usize, 0);
+            let buffer = cx.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("adjacency"),
+                contents: &contents,
                 usage: wgpu::BufferUsages::STORAGE,
+            });
+            Shared { buffer, offset: 0, size }
+        });
+        let [faces, edge_count, use_count] = self.counts;
+        AdjacencyGpu { version: self.version, arrays, faces, edge_count, use_count, closed: self.closed }
+    }
+
+    /// `group`'s arrays in one buffer of `bytes`, one after another at offsets a multiple of `align`.
+    fn upload(cx: &WgpuContext, group: Vec<Self>, bytes: u64, align: u64) -> Vec<(MeshKey, AdjacencyGpu)> {
+        let mut contents = vec![0u8; bytes as usize];
+        let mut at = 0u64;
+        let placed: Vec<_> = group
+            .into_iter()
+            .map(|a| {
+                let ranges = a.arrays.each_ref().map(|array| {
+                    let offset = at;
+                    contents[offset as usize..][..array.len()].copy_from_slice(array);
+                    at = (offset + Self::bound(array)).next_multiple_of(align);
+                    (offset, Self::bound(array))
+                });
+                (a, ranges)
             })
-        };
-        Self {
-            version,
-            welded: storage("welded positions", bytemuck::cast_slice(&welded)),
-            planes: storage("face planes", bytemuck::cast_slice(&planes)),
-            edges: storage("edges", bytemuck::cast_slice(&edges)),
-            uses: storage("face uses", bytemuck::cast_slice(&uses)),
-            faces: planes.len() as u32,
-            edge_count: edges.len() as u32,
-            use_count: uses.len() as u32,
-            closed: adj.closed(),
-        }
+            .collect();
+        let buffer = cx.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("adjacency"),
+            contents: &contents,
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        placed
+            .into_iter()
+            .map(|(a, ranges)| {
+                let arrays = ranges.map(|(offset, size)| Shared { buffer: buffer.clone(), offset, size });
+                let [faces, edge_count, use_count] = a.counts;
+                (a.key, AdjacencyGpu { version: a.version, arrays, faces, edge_count, use_count, closed: a.closed })
+            })
+            .collect()
     }
 }
+
+/// The most bytes of adjacency the meshes uploaded together put in one shared buffer (a mesh's own
+/// past it get a buffer per array).
+const SHARED_ADJACENCY: u64 = 64 << 20;
 
 /// What the backend keeps uploaded between frames.
 #[derive(Default)]
@@ -254,16 +376,43 @@ impl SceneCache {
 
     /// Uploads the adjacency of every casting instance's mesh that is missing or stale (a posed
     /// instance's rest adjacency: its pose gives the welded positions and planes).
+    ///
+    /// The meshes uploaded together share buffers, each array of each mesh at an offset of its own: a
+    /// scene of many small meshes makes a few buffers, not four per mesh (a device allocator's cost per
+    /// buffer grows with the buffers it holds). A shared buffer is let go when every mesh in it has
+    /// been replaced or dropped.
     pub fn upload_adjacency(&mut self, cx: &WgpuContext, frame: &FrameInputs) {
+        let mut missing: Vec<(MeshKey, &Adjacency, u64)> = Vec::new();
+        let mut listed = std::collections::HashSet::new();
         for inst in frame.instances.iter().filter(|i| i.casts_shadow) {
             let (adjacency, version) = match &inst.pose {
                 Some(pose) => (&pose.rest_adjacency, pose.rest_version),
                 None => (&inst.adjacency, inst.mesh_version),
             };
-            if self.adjacency.get(&inst.mesh_key).is_some_and(|a| a.version == version) {
+            let stale = self.adjacency.get(&inst.mesh_key).is_none_or(|a| a.version != version);
+            if stale && listed.insert(inst.mesh_key) {
+                missing.push((inst.mesh_key, adjacency, version));
+            }
+        }
+        let align = u64::from(cx.device.limits().min_storage_buffer_offset_alignment);
+        let mut group: Vec<Arrays> = Vec::new();
+        let mut bytes = 0u64;
+        for (key, adjacency, version) in missing {
+            let arrays = Arrays::of(key, version, adjacency);
+            let own = arrays.bytes(align);
+            if own > SHARED_ADJACENCY {
+                self.adjacency.insert(key, arrays.upload_alone(cx));
                 continue;
             }
-            self.adjacency.insert(inst.mesh_key, AdjacencyGpu::upload(cx, adjacency, version));
+            if bytes > 0 && bytes + own > SHARED_ADJACENCY {
+                self.adjacency.extend(Arrays::upload(cx, std::mem::take(&mut group), bytes, align));
+                bytes = 0;
+            }
+            group.push(arrays);
+            bytes += own;
+        }
+        if bytes > 0 {
+            self.adjacency.extend(Arrays::upload(cx, group, bytes, align));
         }
     }
 
@@ -274,8 +423,10 @@ impl SceneCache {
     pub fn adjacency(&self, inst: &Instance) -> Option<AdjacencyView<'_>> {
         let topology = self.adjacency.get(&inst.mesh_key)?;
         let (welded, planes) = match &inst.pose {
-            Some(_) => self.posing.posed(inst).map(|p| (&p.welded, &p.planes))?,
-            None => (&topology.welded, &topology.planes),
+            Some(_) => {
+                self.posing.posed(inst).map(|p| (BufferRange::whole(&p.welded), BufferRange::whole(&p.planes)))?
+            }
+            None => (topology.arrays[0].range(), topology.arrays[1].range()),
         };
         Some(AdjacencyView { welded, planes, topology })
     }

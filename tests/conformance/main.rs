@@ -12,6 +12,7 @@ mod head_on;
 mod host;
 mod host_shading;
 mod hybrid;
+mod many;
 mod moment_maps;
 mod own_pixels;
 mod penumbra_wedges;

@@ -22,7 +22,7 @@ use crate::context::{WgpuContext, WgpuError};
 use crate::gbuffer::GpuGBuffer;
 use crate::pipelines::POSITION_LAYOUT;
 use crate::shaders;
-use crate::upload::BuffersKey;
+use crate::upload::{BufferRange, BuffersKey};
 
 /// Words of one instance's draw arguments (`extrude.wgsl`'s `ARG_*`): sides, near caps as wound, near
 /// caps turned around, far caps, and the silhouette-edge counter.
@@ -446,22 +446,22 @@ impl Jobs {
         let (Some(adj), Some(mesh)) = (cx.cache.adjacency(inst), cx.cache.mesh(inst)) else {
             unreachable!("a job is made only for an uploaded mesh")
         };
-        let group = |label, layout, first: u32, buffers: &[&wgpu::Buffer]| {
+        let group = |label, layout, first: u32, ranges: &[BufferRange<'_>]| {
             let mut entries = vec![wgpu::BindGroupEntry { binding: first, resource: self.uniform_binding(turn) }];
             entries.extend(
-                buffers
+                ranges
                     .iter()
                     .zip(first + 1..)
-                    .map(|(b, binding)| wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() }),
+                    .map(|(r, binding)| wgpu::BindGroupEntry { binding, resource: r.binding() }),
             );
             cx.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(label), layout, entries: &entries })
         };
         let t = adj.topology;
-        let lists = [&self.weights, &self.records, &self.caps, &self.args];
-        let compute = [adj.planes, &t.edges, &t.uses, mesh.indices].into_iter().chain(lists).collect::<Vec<_>>();
+        let lists = [&self.weights, &self.records, &self.caps, &self.args].map(BufferRange::whole);
+        let compute = [adj.planes, t.edges(), t.uses(), BufferRange::whole(mesh.indices)];
         (
-            group("extrusion", compute_layout, 0, &compute),
-            group("extruded volumes", draw_layout, 1, &[adj.welded, &t.edges, &self.records]),
+            group("extrusion", compute_layout, 0, &[compute, lists].concat()),
+            group("extruded volumes", draw_layout, 1, &[adj.welded, t.edges(), BufferRange::whole(&self.records)]),
         )
     }
 }
