@@ -216,7 +216,7 @@ impl WgpuContext {
     }
 }
 
-/// Transient buffers a pass keeps for itself ([`FRAMES`] used in turn, like the context's): each frame's
+/// Transient buffers a pass keeps for itself (a few used in turn, like the context's): each frame's
 /// data is written into that frame's buffer, and when a frame's data outgrows it the buffers are made
 /// again at twice the frame's size so far. Data that varies from frame to frame (a moving silhouette's
 /// geometry) so costs an allocation only when it outgrows twice its largest frame so far, whatever
