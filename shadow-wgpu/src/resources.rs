@@ -219,8 +219,8 @@ impl WgpuContext {
 /// Transient buffers a pass keeps for itself (a few used in turn, like the context's): each frame's
 /// data is written into that frame's buffer, and when a frame's data outgrows it the buffers are made
 /// again at twice the frame's size so far. Data that varies from frame to frame (a moving silhouette's
-/// geometry) so costs an allocation only when it outgrows twice its largest frame so far, whatever
-/// else the frame holds.
+/// geometry) so costs an allocation only when a frame needs more than twice what the frame that last
+/// grew the buffers had written, whatever else the frame holds.
 pub struct TransientRing {
     label: &'static str,
     buffers: Vec<wgpu::Buffer>,
