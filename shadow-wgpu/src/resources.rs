@@ -167,6 +167,7 @@ impl WgpuContext {
     pub fn transient(&self, bytes: &[u8]) -> Transient {
         // Bindings and writes are whole words; an empty storage binding is not allowed.
         let size = (bytes.len() as u64).max(4).next_multiple_of(4);
+        // Reads the device's alignment and largest buffer on the first use.
         self.transient_frame();
         let mut arena = self.resources.transient.borrow_mut();
         let local = arena.used.next_multiple_of(arena.align);

@@ -105,27 +105,17 @@ fn weld_in_parts(positions: &[Vec3]) -> (Vec<Vec3>, Vec<u32>) {
 /// it comes (the parts and the threads cost more than they save on a small mesh, and a scene of many
 /// small meshes pays that cost per mesh).
 fn weld_alone(positions: &[Vec3]) -> (Vec<Vec3>, Vec<u32>) {
-    const EMPTY: u32 = u32::MAX;
-    let size = (2 * positions.len()).next_power_of_two().max(16);
-    let mut table = vec![[0, 0, 0, EMPTY]; size];
+    let mut table = WeldTable::with_room(positions.len());
     let mut welded = Vec::new();
     let remap = positions
         .iter()
         .map(|&p| {
-            let key @ [x, y, z] = weld_key(p);
-            let mut slot = weld_hash(key) as usize & (size - 1);
-            loop {
-                match table[slot] {
-                    [_, _, _, EMPTY] => {
-                        let number = welded.len() as u32;
-                        table[slot] = [x, y, z, number];
-                        welded.push(p);
-                        break number;
-                    }
-                    [a, b, c, number] if [a, b, c] == key => break number,
-                    _ => slot = (slot + 1) & (size - 1),
-                }
+            let key = weld_key(p);
+            let number = table.get_or_insert(key, weld_hash(key), welded.len() as u32);
+            if number as usize == welded.len() {
+                welded.push(p);
             }
+            number
         })
         .collect();
     (welded, remap)
@@ -135,27 +125,44 @@ fn weld_alone(positions: &[Vec3]) -> (Vec<Vec3>, Vec<u32>) {
 const WELD_ALONE: usize = 4096;
 
 /// For each of one part's `count` members (`[key, position]`, in position order), the first position with
-/// the same key, stored at the member's position in `first`: an open addressing table with linear
-/// probing, at most half full, holding each key beside its first position so a probe reads no other
-/// memory.
+/// the same key, stored at the member's position in `first`.
 fn weld_part<'a>(members: impl Iterator<Item = &'a [u32; 4]>, count: usize, first: &[AtomicU32]) {
-    const EMPTY: u32 = u32::MAX;
-    let size = (2 * count).next_power_of_two().max(16);
-    let mut table = vec![[0, 0, 0, EMPTY]; size];
+    let mut table = WeldTable::with_room(count);
     for &[x, y, z, i] in members {
         // The bits below the part's: the top ones chose the part, so they are the same for all.
-        let mut slot = (weld_hash([x, y, z]) >> 24) as usize & (size - 1);
-        let f = loop {
-            match table[slot] {
-                [_, _, _, EMPTY] => {
-                    table[slot] = [x, y, z, i];
-                    break i;
-                }
-                [a, b, c, f] if [a, b, c] == [x, y, z] => break f,
-                _ => slot = (slot + 1) & (size - 1),
-            }
-        };
+        let f = table.get_or_insert([x, y, z], weld_hash([x, y, z]) >> 24, i);
         first[i as usize].store(f, Ordering::Relaxed);
+    }
+}
+
+/// Weld keys with a value each (a first position, or a number): an open addressing table with linear
+/// probing, at most half full, holding each key beside its value so a probe reads no other memory.
+struct WeldTable {
+    slots: Vec<[u32; 4]>,
+}
+
+impl WeldTable {
+    const EMPTY: u32 = u32::MAX;
+
+    /// A table for up to `count` keys.
+    fn with_room(count: usize) -> Self {
+        Self { slots: vec![[0, 0, 0, Self::EMPTY]; (2 * count).next_power_of_two().max(16)] }
+    }
+
+    /// The value `key` holds, or else `value`, stored for it; the probe starts at `hash`'s low bits.
+    fn get_or_insert(&mut self, [x, y, z]: [u32; 3], hash: u64, value: u32) -> u32 {
+        let mask = self.slots.len() - 1;
+        let mut slot = hash as usize & mask;
+        loop {
+            match self.slots[slot] {
+                [_, _, _, Self::EMPTY] => {
+                    self.slots[slot] = [x, y, z, value];
+                    return value;
+                }
+                [a, b, c, held] if [a, b, c] == [x, y, z] => return held,
+                _ => slot = (slot + 1) & mask,
+            }
+        }
     }
 }
 
