@@ -5,17 +5,19 @@
 
 mod build;
 pub mod cutout;
+mod instanced;
 mod wide;
 
 use std::hash::{Hash, Hasher};
 
 use glam::{Vec3, Vec3A};
 use rayon::prelude::*;
-use shadow_core::FrameInputs;
+use shadow_core::{FrameInputs, Instance};
 
 use self::build::STACK;
 use self::cutout::{Cutouts, Table};
-use self::wide::{Child, LEAF, NONE, Node8, Ray, Tri8};
+use self::instanced::{Instanced, Visit, walk_tree};
+use self::wide::{Child, NONE, Node8, Ray, Tri8};
 use shadow_core::frame::Coverage;
 
 /// The casters of a frame, ready for shadow rays.
@@ -27,6 +29,8 @@ pub struct SceneBvh {
     /// The leaves' alpha-tested triangles, where the frame casts any.
     cutouts: Option<Cutouts>,
     triangles: usize,
+    /// The casters whose mesh another caster shares, each mesh kept once, where there are any.
+    instanced: Option<Instanced>,
     /// Whether this CPU runs AVX2 (and the bit scans the walk uses).
     #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
     avx2: bool,
@@ -47,23 +51,39 @@ impl SceneBvh {
         h.finish()
     }
 
-    /// Builds the BVH of every casting triangle in world space.
+    /// Builds the BVH of every casting triangle: a mesh cast by more than one instance (and cut out by
+    /// no texture) once in its own space under a tree of its instances, every other triangle in world
+    /// space. Either way a ray gets the same answer (see `instanced`).
     #[must_use]
     pub fn build(frame: &FrameInputs) -> Self {
-        let Casters { tris, cutout, table } = casting_triangles(frame);
-        if tris.is_empty() {
-            return Self { nodes: Vec::new(), leaves: Vec::new(), cutouts: None, triangles: 0, avx2: false };
-        }
-        let (nodes, leaves, members) = build::build(&tris);
-        let cutouts = (!table.is_empty()).then(|| Cutouts::new(&members, &cutout, table));
-        Self { nodes, leaves, cutouts, triangles: tris.len(), avx2: avx2() }
+        let casters = casters(frame);
+        let kept = instanced::kept(&casters);
+        let (shared, flat): (Vec<_>, Vec<_>) = casters.into_iter().zip(kept).partition(|(_, k)| *k);
+        let shared: Vec<&Instance> = shared.into_iter().map(|((inst, _), _)| inst).collect();
+        let flat: Vec<(&Instance, Coverage)> = flat.into_iter().map(|(c, _)| c).collect();
+        let instanced = (!shared.is_empty()).then(|| Instanced::build(&shared));
+        let Casters { tris, cutout, table } = casting_triangles(&flat);
+        let (nodes, leaves, cutouts) = if tris.is_empty() {
+            (Vec::new(), Vec::new(), None)
+        } else {
+            let (nodes, leaves, members) = build::build(&tris);
+            (nodes, leaves, (!table.is_empty()).then(|| Cutouts::new(&members, &cutout, table)))
+        };
+        let triangles = tris.len() + instanced.as_ref().map_or(0, Instanced::triangle_count);
+        Self { nodes, leaves, cutouts, triangles, instanced, avx2: avx2() }
     }
 
     /// Number of triangles (those of masked casters with no texture to read and an alpha below the
-    /// cutoff left out: they are nowhere).
+    /// cutoff left out: they are nowhere), counting each instance's.
     #[must_use]
     pub fn triangle_count(&self) -> usize {
         self.triangles
+    }
+
+    /// How many meshes are kept once for the instances that share them, and how many instances.
+    #[must_use]
+    pub fn instanced(&self) -> (usize, usize) {
+        self.instanced.as_ref().map_or((0, 0), Instanced::counts)
     }
 
     /// True when some triangle blocks the segment from `origin` along unit `dir` for `tmax`.
@@ -81,47 +101,74 @@ impl SceneBvh {
     /// more (the walk passes that leaf by).
     #[must_use]
     pub fn occluded_after(&self, walker: &mut Walker, origin: Vec3, dir: Vec3, tmax: f32) -> bool {
-        if self.nodes.is_empty() {
+        if self.nodes.is_empty() && self.instanced.is_none() {
             return false;
         }
         let ray = Ray::new(origin.into(), dir.into(), 0.0, tmax);
-        let blocker = 'walk: {
-            #[cfg(target_arch = "x86_64")]
-            if self.avx2 {
-                // SAFETY: `avx2` is set only where `is_x86_feature_detected!` found every feature
-                // `walk_avx2` enables (see [`avx2`]).
-                #[allow(unsafe_code)]
-                break 'walk unsafe {
-                    if self.cutouts.is_some() {
-                        self.walk_avx2::<true>(&ray, walker.last, &mut walker.stack)
-                    } else {
-                        self.walk_avx2::<false>(&ray, walker.last, &mut walker.stack)
-                    }
-                };
-            }
-            if self.cutouts.is_some() {
-                self.walk::<true>(&ray, walker.last, &mut walker.stack)
-            } else {
-                self.walk::<false>(&ray, walker.last, &mut walker.stack)
-            }
-        };
-        if blocker.is_some() {
-            walker.last = blocker;
+        #[cfg(target_arch = "x86_64")]
+        if self.avx2 {
+            // SAFETY: `avx2` is set only where `is_x86_feature_detected!` found every feature
+            // `trace_avx2` enables (see [`avx2`]).
+            #[allow(unsafe_code)]
+            return unsafe {
+                if self.cutouts.is_some() {
+                    self.trace_avx2::<true>(&ray, walker)
+                } else {
+                    self.trace_avx2::<false>(&ray, walker)
+                }
+            };
         }
-        blocker.is_some()
+        if self.cutouts.is_some() {
+            self.trace::<true, false>(&ray, walker)
+        } else {
+            self.trace::<false, false>(&ray, walker)
+        }
     }
 
-    /// [`Self::walk`] compiled for AVX2: each eight-lane test is one 256-bit operation instead of two
+    /// [`Self::trace`] compiled for AVX2: each eight-lane test is one 256-bit operation instead of two
     /// 128-bit ones. The operations and their order are the same, so the answers are too.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,bmi1,bmi2,lzcnt")]
-    fn walk_avx2<const CUTOUTS: bool>(
-        &self,
-        ray: &Ray,
-        first: Option<Child>,
-        stack: &mut [Child; STACK],
-    ) -> Option<Child> {
-        self.walk::<CUTOUTS>(ray, first, stack)
+    fn trace_avx2<const CUTOUTS: bool>(&self, ray: &Ray, walker: &mut Walker) -> bool {
+        self.trace::<CUTOUTS, true>(ray, walker)
+    }
+
+    /// Whether something blocks `ray`: the world tree, then the instances, each first trying the leaf
+    /// that blocked the last ray `walker` saw blocked there, which it then remembers. `AVX2` says the
+    /// walk runs where [`avx2`] found the features, so the instances are walked with them too.
+    #[inline(always)]
+    fn trace<const CUTOUTS: bool, const AVX2: bool>(&self, ray: &Ray, walker: &mut Walker) -> bool {
+        if let (Some(instanced), Some(last)) = (&self.instanced, walker.last_instance)
+            && instanced.blocks(last, ray)
+        {
+            return true;
+        }
+        if !self.nodes.is_empty()
+            && let Some(leaf) = self.walk::<CUTOUTS>(ray, walker.last, &mut walker.stack)
+        {
+            walker.last = Some(leaf);
+            return true;
+        }
+        let Some(instanced) = &self.instanced else { return false };
+        let stacks = (&mut walker.stack, &mut walker.inner);
+        #[cfg(target_arch = "x86_64")]
+        let hit = if AVX2 {
+            // SAFETY: `AVX2` is set only by `trace_avx2`, which runs only where `avx2` found every
+            // feature `walk_avx2` enables.
+            #[allow(unsafe_code)]
+            unsafe {
+                instanced.walk_avx2(ray, stacks)
+            }
+        } else {
+            instanced.walk(ray, stacks)
+        };
+        #[cfg(not(target_arch = "x86_64"))]
+        let hit = instanced.walk(ray, stacks);
+        if let Some(hit) = hit {
+            walker.last_instance = Some(hit);
+            return true;
+        }
+        false
     }
 
     /// The leaf that blocks `ray`, trying leaf `first` before walking the tree (whose walk then passes it
@@ -133,40 +180,7 @@ impl SceneBvh {
         if first != NONE && self.blocks::<CUTOUTS>(first, ray) {
             return Some(first);
         }
-        let mut top = 0;
-        let mut at = 0u32;
-        loop {
-            if at & LEAF != 0 {
-                let leaf = at & !LEAF;
-                if leaf != first && self.blocks::<CUTOUTS>(leaf, ray) {
-                    return Some(leaf);
-                }
-            } else {
-                let node = &self.nodes[at as usize];
-                let mut enter = node.enter(ray);
-                // The child nearest along the node's axis is pushed last, so it is opened first: a
-                // blocked ray is most likely blocked by what it meets first.
-                if ray.dir[node.axis as usize] < 0.0 {
-                    while enter != 0 {
-                        stack[top] = node.child[enter.trailing_zeros() as usize];
-                        top += 1;
-                        enter &= enter - 1;
-                    }
-                } else {
-                    while enter != 0 {
-                        let k = 31 - enter.leading_zeros() as usize;
-                        stack[top] = node.child[k];
-                        top += 1;
-                        enter &= !(1 << k);
-                    }
-                }
-            }
-            if top == 0 {
-                return None;
-            }
-            top -= 1;
-            at = stack[top];
-        }
+        walk_tree(&self.nodes, ray, stack, &mut WorldLeaves::<CUTOUTS> { bvh: self, ray, first })
     }
 
     /// Whether leaf `leaf` blocks `ray`: one of its triangles meets it, and where that one is
@@ -181,19 +195,42 @@ impl SceneBvh {
     }
 }
 
+/// The leaves of the world tree, but for `first`, which the walk has tried already.
+struct WorldLeaves<'a, const CUTOUTS: bool> {
+    bvh: &'a SceneBvh,
+    ray: &'a Ray,
+    first: Child,
+}
+
+impl<const CUTOUTS: bool> Visit for WorldLeaves<'_, CUTOUTS> {
+    #[inline(always)]
+    fn enter(&self, node: &Node8) -> u32 {
+        node.enter(self.ray)
+    }
+
+    #[inline(always)]
+    fn blocks(&mut self, leaf: Child) -> bool {
+        leaf != self.first && self.bvh.blocks::<CUTOUTS>(leaf, self.ray)
+    }
+}
+
 /// What a run of shadow rays carries from ray to ray ([`SceneBvh::occluded_after`]), one per thread, in
-/// the order of their pixels: the leaf that blocked the last blocked ray, and the room the walks keep
-/// their stack in. A stack of its own would be cleared at every walk, and clearing its 2 KiB cost a
-/// sixth of a shadow ray's time.
+/// the order of their pixels: the leaf that blocked the last blocked ray (in the world tree and among
+/// the instances), and the room the walks keep their stacks in. A stack of its own would be cleared at
+/// every walk, and clearing its 2 KiB cost a sixth of a shadow ray's time.
 #[derive(Clone, Debug)]
 pub struct Walker {
     last: Option<Child>,
+    /// An instance and a leaf of its mesh's tree.
+    last_instance: Option<(u32, Child)>,
     stack: [Child; STACK],
+    /// The stack of the walk through one instance's mesh, inside the walk through the instances.
+    inner: [Child; STACK],
 }
 
 impl Default for Walker {
     fn default() -> Self {
-        Self { last: None, stack: [0; STACK] }
+        Self { last: None, last_instance: None, stack: [0; STACK], inner: [0; STACK] }
     }
 }
 
@@ -221,20 +258,24 @@ struct Casters {
     table: Table,
 }
 
-/// Every triangle of the frame that can block light, in world space, and the alpha-tested ones among them.
-fn casting_triangles(frame: &FrameInputs) -> Casters {
-    let casters: Vec<(&shadow_core::Instance, Coverage)> = frame
+/// The instances of the frame that can block light, with how much of them does.
+fn casters(frame: &FrameInputs) -> Vec<(&Instance, Coverage)> {
+    frame
         .instances
         .iter()
         .filter(|i| i.casts_shadow)
         .map(|i| (i, i.coverage()))
         .filter(|(_, c)| *c != Coverage::Absent)
-        .collect();
+        .collect()
+}
+
+/// Every triangle of `casters` in world space, and the alpha-tested ones among them.
+fn casting_triangles(casters: &[(&Instance, Coverage)]) -> Casters {
     let any_cutout = casters.iter().any(|(_, c)| *c == Coverage::Cutout);
     let mut out = Casters { tris: Vec::new(), cutout: Vec::new(), table: Table::default() };
     // Instance by instance, each one's vertices and triangles split among the threads: a scene is
     // often one large mesh and a few small ones.
-    for (inst, coverage) in casters {
+    for &(inst, coverage) in casters {
         let m = inst.world_from_local;
         let world: Vec<Vec3A> =
             inst.mesh.positions().par_iter().with_min_len(4096).map(|&p| m.transform_point3(p).into()).collect();
@@ -306,7 +347,7 @@ mod tests {
         let bvh = SceneBvh::build(&frame);
         // The same tree walked without AVX2, as CPUs without it walk it.
         let portable = SceneBvh { avx2: false, ..SceneBvh::build(&frame) };
-        let tris = casting_triangles(&frame).tris;
+        let tris = casting_triangles(&casters(&frame)).tris;
         let g = crate::gbuffer::render(&frame, 48, 36).unwrap();
         // The offset `ray-traced` uses by default (shadow-hard's `epsilon`).
         let origins = crate::passes::rays::RayOrigins::new(&g, &frame, 5e-7);
@@ -351,7 +392,7 @@ mod tests {
         }
         tris.push([Vec3A::ONE; 3]);
         let (nodes, leaves, _) = build::build(&tris);
-        let bvh = SceneBvh { nodes, leaves, cutouts: None, triangles: tris.len(), avx2: avx2() };
+        let bvh = SceneBvh { nodes, leaves, cutouts: None, triangles: tris.len(), instanced: None, avx2: avx2() };
         let (mut cast, mut blocked) = (0, 0);
         for _ in 0..8000 {
             let origin = Vec3::new(rand() * 6.0 - 3.0, rand() * 6.0 - 3.0, rand() * 6.0 - 3.0);
@@ -373,6 +414,89 @@ mod tests {
             blocked > cast / 4 && blocked < cast * 3 / 4,
             "{blocked} of {cast} rays blocked: both answers are checked"
         );
+    }
+
+    /// Meshes shared by many instances, turned, scaled unevenly, mirrored and placed far from the origin
+    /// (so the rays carried into their space round as much as they can), among a mesh of its own: the
+    /// shared meshes are kept once, and every ray gets the answer that testing every triangle in world
+    /// space gives, with or without the last blocker tried first, with or without AVX2.
+    #[test]
+    fn instanced_meshes_are_kept_once_and_answer_as_their_triangles_do() {
+        use shadow_core::procedural;
+        let mut rng = scenes::Rng::new(17);
+        let mut scene = shadow_core::Scene::new();
+        let material = scene.add_material(shadow_core::scene::Material::default());
+        let shapes = [
+            procedural::cuboid(Vec3::new(1.0, 0.5, 0.3)).unwrap(),
+            procedural::sphere(0.5, 12, 8).unwrap(),
+            procedural::torus(0.6, 0.2, 16, 8).unwrap(),
+        ];
+        let meshes: Vec<_> = shapes.into_iter().map(|m| scene.add_mesh(m)).collect();
+        let far = Vec3::new(3000.0, -20.0, 1500.0);
+        for i in 0..300 {
+            let axis = Vec3::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(0.1, 1.0)).normalize();
+            let mut scale = Vec3::new(rng.range(0.3, 2.0), rng.range(0.3, 2.0), rng.range(0.3, 2.0));
+            if i % 7 == 0 {
+                scale.x = -scale.x;
+            }
+            let at = far + Vec3::new(rng.range(-8.0, 8.0), rng.range(-8.0, 8.0), rng.range(-8.0, 8.0));
+            let transform = glam::Mat4::from_scale_rotation_translation(
+                scale,
+                glam::Quat::from_axis_angle(axis, rng.range(0.0, 6.0)),
+                at,
+            );
+            scene.add_instance(&format!("prop {i}"), meshes[i % 3], material, transform).unwrap();
+        }
+        let lone = scene.add_mesh(procedural::cuboid(Vec3::new(4.0, 0.2, 4.0)).unwrap());
+        scene.add_instance("lone", lone, material, glam::Mat4::from_translation(far)).unwrap();
+        scene.add_camera(shadow_core::scene::Camera::look_at(far + Vec3::new(0.0, 2.0, 30.0), far, 45.0));
+        let frame = FrameInputs::from_first_camera(&scene).unwrap();
+        let bvh = SceneBvh::build(&frame);
+        assert_eq!(bvh.instanced(), (3, 300), "three meshes kept once for their 300 instances");
+        let portable = SceneBvh { avx2: false, ..SceneBvh::build(&frame) };
+        let tris = casting_triangles(&casters(&frame)).tris;
+        assert_eq!(bvh.triangle_count(), tris.len());
+        let mut walkers = (Walker::default(), Walker::default());
+        let (mut cast, mut blocked) = (0, 0);
+        for _ in 0..20_000 {
+            // From near the props or from far off, aimed at a point of a triangle (or just past its
+            // edge), stopping short of it a third of the time.
+            let spread = if cast % 2 == 0 { 10.0 } else { 400.0 };
+            let origin = far + Vec3::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(-1.0, 1.0)) * spread;
+            let [a, b, c] = tris[(rng.unit() * tris.len() as f32) as usize % tris.len()];
+            let (u, v) = (rng.range(-0.01, 1.0), rng.range(-0.01, 1.0));
+            let (u, v) = if u + v > 1.0 { (1.0 - u, 1.0 - v) } else { (u, v) };
+            let target = Vec3::from(a + (b - a) * u + (c - a) * v);
+            let dir = (target - origin).normalize();
+            let tmax = (target - origin).length() * 1.5 * rng.unit();
+            let ray = Ray::new(origin.into(), dir.map(|c| if c == 0.0 { 0.0 } else { c }).into(), 0.0, tmax);
+            let any = tris.iter().any(|&[v0, v1, v2]| Triangle { v0, v1, v2 }.intersect(&ray) < tmax);
+            assert_answer((&bvh, &portable), &mut walkers, (origin, dir, tmax), any, "");
+            cast += 1;
+            blocked += usize::from(any);
+        }
+        assert!(blocked > cast / 5 && blocked < cast * 4 / 5, "{blocked} of {cast} rays blocked");
+    }
+
+    /// Triangles carried into another space lane by lane make the block that carrying each corner with
+    /// glam's `transform_point3` and building it with [`Tri8::new`] makes, bit for bit.
+    #[test]
+    fn triangles_carried_lane_by_lane_are_those_carried_one_by_one() {
+        let mut rng = scenes::Rng::new(9);
+        let point = |rng: &mut scenes::Rng, size: f32| {
+            Vec3::new(rng.range(-size, size), rng.range(-size, size), rng.range(-size, size))
+        };
+        for _ in 0..200 {
+            let m = glam::Mat4::from_scale_rotation_translation(
+                point(&mut rng, 3.0),
+                glam::Quat::from_axis_angle(point(&mut rng, 1.0).normalize(), rng.range(0.0, 6.0)),
+                point(&mut rng, 5000.0),
+            );
+            let tris: Vec<[Vec3; 3]> = (0..8).map(|_| [(); 3].map(|()| point(&mut rng, 2.0))).collect();
+            let local = wide::Corners8::new(|k| tris[k].map(Vec3A::from));
+            let one_by_one = Tri8::new(8, |k| tris[k].map(|p| Vec3A::from(m.transform_point3(p))));
+            assert!(local.placed(&m) == one_by_one, "{m}");
+        }
     }
 
     /// A lane reports where the ray meets its triangle as `(1 - u - v) v0 + u v1 + v v2`, the weights the
@@ -408,7 +532,7 @@ mod tests {
         let frame = FrameInputs::from_first_camera(&scene).unwrap();
         let bvh = SceneBvh::build(&frame);
         let portable = SceneBvh { avx2: false, ..SceneBvh::build(&frame) };
-        let Casters { tris, cutout, table } = casting_triangles(&frame);
+        let Casters { tris, cutout, table } = casting_triangles(&casters(&frame));
         assert!(bvh.cutouts.is_some() && !table.is_empty());
         // Testing every triangle: each one alone in a block, its texel read where it is met.
         let every = |ray: &wide::Ray| {
@@ -504,7 +628,7 @@ mod tests {
     fn the_tree_is_the_same_on_any_number_of_threads() {
         let scene = scenes::build("tree", &SceneParams::default()).expect("tree");
         let frame = FrameInputs::from_first_camera(&scene).expect("frame");
-        let tris = casting_triangles(&frame).tris;
+        let tris = casting_triangles(&casters(&frame)).tris;
         let on = |threads| {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("a pool");
             pool.install(|| build::build(&tris))
