@@ -177,6 +177,9 @@ pub struct SceneSetup {
     pub file_access: FileAccess,
     /// Pose the scene's animations at this time in seconds; at rest (as built or loaded) without one.
     pub time: Option<f32>,
+    /// Give every node a copy of its own of a mesh other nodes draw too
+    /// ([`shadow_core::Scene::unshare_meshes`]): the scene without instancing, to measure against.
+    pub unshare: bool,
 }
 
 impl SceneSetup {
@@ -191,6 +194,7 @@ impl SceneSetup {
             light: None,
             file_access: FileAccess::default(),
             time: None,
+            unshare: false,
         }
     }
 
@@ -201,6 +205,9 @@ impl SceneSetup {
     pub fn build(&self) -> Result<Scene, SetupError> {
         let options = LoadOptions { file_access: self.file_access, ..LoadOptions::default() };
         let mut scene = load_scene_with(&self.source, &self.params, self.ground, &options)?;
+        if self.unshare {
+            scene.unshare_meshes();
+        }
         if let Some(t) = self.time {
             if scene.animations().next().is_none() {
                 scene.add_warning(format!("{}: no animations to pose at {t} s; shown as it stands", self.source));

@@ -32,6 +32,13 @@ pub struct Inspection {
     pub materials: Vec<MaterialStats>,
     /// Meshes drawn, each counted once however many instances draw it.
     pub meshes: usize,
+    /// Nodes that draw a mesh.
+    pub instances: usize,
+    /// Bytes the drawn meshes' geometry holds, each mesh once ([`crate::Mesh::geometry_bytes`]).
+    pub mesh_bytes: usize,
+    /// Bytes it would hold were every instance's mesh a copy of its own: what sharing saves is the
+    /// difference.
+    pub unshared_mesh_bytes: usize,
     /// Of those, the meshes that carry texture coordinates.
     pub meshes_with_uvs: usize,
     /// The scene's animations, in the order they were added.
@@ -102,6 +109,9 @@ impl Inspection {
             textures: Vec::new(),
             materials: Vec::new(),
             meshes: 0,
+            instances: 0,
+            mesh_bytes: 0,
+            unshared_mesh_bytes: 0,
             meshes_with_uvs: 0,
             animations: Vec::new(),
             skins: scene.skins().map(|(_, s)| (s.name.clone(), s.joints.len())).collect(),
@@ -147,8 +157,12 @@ impl Inspection {
             .collect();
         let mut seen = std::collections::HashSet::new();
         for (_, _, mesh, _) in scene.drawables() {
+            let bytes = scene.mesh(mesh).map_or(0, |m| m.geometry_bytes());
+            out.instances += 1;
+            out.unshared_mesh_bytes += bytes;
             if seen.insert(mesh) {
                 out.meshes += 1;
+                out.mesh_bytes += bytes;
                 out.meshes_with_uvs += usize::from(scene.mesh(mesh).is_some_and(|m| m.uvs().is_some()));
                 let targets = scene.mesh(mesh).and_then(|m| m.deformers()).map_or(0, |d| d.morph_targets.len());
                 if targets > 0 {

@@ -251,6 +251,13 @@ impl Mesh {
         self.triangles.len()
     }
 
+    /// Bytes its geometry holds: positions, normals, texture coordinates and triangles.
+    #[must_use]
+    pub fn geometry_bytes(&self) -> usize {
+        let vertex = 2 * size_of::<Vec3>() + self.uvs.as_ref().map_or(0, |_| size_of::<Vec2>());
+        self.positions.len() * vertex + self.triangles.len() * size_of::<[u32; 3]>()
+    }
+
     /// The three corner positions of triangle `t`.
     #[must_use]
     pub fn triangle_positions(&self, t: usize) -> [Vec3; 3] {

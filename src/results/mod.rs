@@ -5,12 +5,14 @@
 //! disagreement between the backends, the frame time per phase on one scene (`bench`), on a GPU adapter
 //! the real-time path on that scene (`bench --realtime`), perspective aliasing on the outdoor street
 //! ([`outdoor`]), the soft techniques against the area light ([`soft`]), the scenes of cut-out casters
-//! ([`cutouts`]), the animated scenes at rest and posed ([`animated`]), and the kernels under them all
-//! timed on their own ([`kernels`]).
+//! ([`cutouts`]), the animated scenes at rest and posed ([`animated`]), the scenes of many objects with
+//! their meshes shared and unshared ([`many`]), and the kernels under them all timed on their own
+//! ([`kernels`]).
 
 pub mod animated;
 pub mod cutouts;
 pub mod kernels;
+pub mod many;
 pub mod outdoor;
 pub mod soft;
 
@@ -123,12 +125,14 @@ pub fn run_results(renderer: &mut Renderer, job: &ResultsJob, mut progress: impl
         cutouts::CutoutJob { size: job.size, backends: job.backends.clone(), pictures: job.pictures.clone() };
     let cutouts = cutouts::run_cutouts(renderer, &cutout_job, &mut progress)?;
     let animated = animated::run_animated(renderer, job.size, &job.backends, &mut progress)?;
+    let many = many::run_many(renderer, job.bench_size, &job.backends, &mut progress)?;
     let kernels = kernels::run_kernels(&mut progress)?;
     let mut text = markdown(renderer, job, &reports, (&timing, realtime.as_ref()));
     outdoor::markdown(&mut text, &outdoor);
     soft::markdown(&mut text, &soft);
     cutouts::markdown(&mut text, &cutouts);
     animated::markdown(&mut text, &animated);
+    many::markdown(&mut text, &many);
     kernels::markdown(&mut text, &kernels);
     Ok(text)
 }

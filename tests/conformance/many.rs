@@ -61,3 +61,103 @@ fn many_meshes_share_their_adjacency_buffers_and_cast_right() {
     let shadowed = run.visibility[0].data().iter().filter(|&&v| v == 0.0).count();
     assert!(shadowed > 500, "only {shadowed} pixels in the tetrahedra's shadows");
 }
+
+/// The `props` scene, whose three meshes are drawn by thousands of instances, casts what the same scene
+/// with a copy of each mesh per instance casts: the references (whose ray casting keeps each shared
+/// mesh once, under a tree of its instances) and the rasterized techniques, on each backend, for each
+/// light, pixel for pixel.
+#[test]
+fn instances_cast_what_copies_of_their_meshes_cast() {
+    let Some(mut renderer) = crate::with_wgpu("props against its unshared copy") else { return };
+    let params = scenes::SceneParams::default();
+    let shared = scenes::build("props", &params).expect("props");
+    let mut unshared = scenes::build("props", &params).expect("props");
+    assert!(unshared.unshare_meshes() > 3000, "every instance but the first of each mesh gets a copy");
+    let frames = [&shared, &unshared].map(|s| FrameInputs::from_first_camera(s).expect("frame"));
+    assert_eq!(frames[0].lights.len(), 2, "a sun and a spot light");
+    let runs = [
+        (BackendKind::Cpu, "ray-traced"),
+        (BackendKind::Cpu, "shadow-map"),
+        (BackendKind::Wgpu, "shadow-map"),
+        (BackendKind::Cpu, "shadow-volume-zfail"),
+        (BackendKind::Wgpu, "shadow-volume-zfail"),
+    ];
+    for (backend, technique) in runs {
+        let spec = TechniqueSpec::named(technique);
+        let [a, b] = frames.each_ref().map(|f| renderer.run(backend, f, 160, 120, &spec).expect("a frame"));
+        for (light, (a, b)) in a.visibility.iter().zip(&b.visibility).enumerate() {
+            let shadowed = a.data().iter().filter(|&&v| v == 0.0).count();
+            let what = format!("{technique} on {}, light {light}", backend.name());
+            assert!(shadowed > a.data().len() / 100, "{what}: {shadowed} pixels in shadow");
+            assert!(a.data() == b.data(), "{what}: the pictures differ");
+        }
+    }
+}
+
+/// z-pass draws no caps, so it keeps no room for them: a scene whose cap lists (nine indices a face)
+/// would pass the device's largest storage binding still casts its volumes on the GPU, as the CPU
+/// casts them.
+#[test]
+fn z_pass_keeps_no_room_for_caps_it_never_draws() {
+    let Some(mut renderer) = crate::with_wgpu("z-pass over millions of faces") else { return };
+    let cx = WgpuContext::new(&shadow_wgpu::AdapterChoice { name: None, allow_software: true }).expect("context");
+    let limits = cx.device.limits();
+    let most = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
+    let ball = shadow_core::procedural::sphere(0.3, 32, 16).expect("sphere");
+    let faces = ball.triangle_count() as u64;
+    // Enough balls that their caps would not fit, while their side records (three a face) do.
+    let count = (most / (4 * 9 * faces) + 1) as usize;
+    assert!(4 * 3 * faces * count as u64 <= most, "the side records fit");
+    let mut s = Scene::new();
+    let material = s.add_material(Material::default());
+    let mesh = s.add_mesh(ball);
+    let side = (count as f32).sqrt().ceil() as usize;
+    for i in 0..count {
+        let at = Vec3::new((i % side) as f32, 0.3, (i / side) as f32);
+        s.add_instance(&format!("ball {i}"), mesh, material, Mat4::from_translation(at)).expect("instance");
+    }
+    scenes::stage_model(&mut s, true);
+    let frame = FrameInputs::from_first_camera(&s).expect("frame");
+    let spec = TechniqueSpec::named("shadow-volume-zpass");
+    let gpu = renderer.run(BackendKind::Wgpu, &frame, 128, 128, &spec).expect("z-pass on the GPU");
+    let cpu = renderer.run(BackendKind::Cpu, &frame, 128, 128, &spec).expect("z-pass on the CPU");
+    let (gpu, cpu) = (gpu.visibility[0].data(), cpu.visibility[0].data());
+    let shadowed = gpu.iter().filter(|&&v| v == 0.0).count();
+    assert!(shadowed > gpu.len() / 100, "{shadowed} pixels in shadow");
+    let differ = gpu.iter().zip(cpu).filter(|(a, b)| a != b).count();
+    assert!(differ <= gpu.len() / 200, "{differ} of {} pixels differ from the CPU's", gpu.len());
+}
+
+/// Ten thousand instances of one thousand-triangle mesh: the GPU holds the mesh and its adjacency once
+/// (a few buffers, not some per instance), and the CPU's ray-casting BVH keeps it once under a tree of
+/// its instances.
+#[test]
+fn ten_thousand_instances_of_one_mesh_hold_one_copy() {
+    if crate::with_wgpu("ten thousand instances' uploads").is_none() {
+        return;
+    }
+    let ball = shadow_core::procedural::sphere(0.3, 32, 16).expect("sphere");
+    assert!((900..1100).contains(&ball.triangle_count()), "{} triangles", ball.triangle_count());
+    let mut s = Scene::new();
+    let material = s.add_material(Material::default());
+    let mesh = s.add_mesh(ball);
+    for i in 0..10_000 {
+        let at = Vec3::new((i % 100) as f32, 0.3, (i / 100) as f32);
+        s.add_instance(&format!("ball {i}"), mesh, material, Mat4::from_translation(at)).expect("instance");
+    }
+    scenes::stage_model(&mut s, true);
+    let frame = FrameInputs::from_first_camera(&s).expect("frame");
+    let mut cx = WgpuContext::new(&shadow_wgpu::AdapterChoice { name: None, allow_software: true }).expect("context");
+    let before = cx.created();
+    let t0 = std::time::Instant::now();
+    cx.upload_meshes(&frame);
+    cx.upload_adjacency(&frame);
+    let made = cx.created().since(before).buffers;
+    println!("uploaded in {:.1} ms: {made} buffers", t0.elapsed().as_secs_f64() * 1e3);
+    assert!(made <= 12, "{made} buffers for two meshes drawn by {} instances", frame.instances.len());
+    let t0 = std::time::Instant::now();
+    let bvh = shadow_cpu::bvh::SceneBvh::build(&frame);
+    println!("BVH built in {:.1} ms", t0.elapsed().as_secs_f64() * 1e3);
+    assert_eq!(bvh.instanced(), (1, 10_000), "the ball is kept once for its instances");
+    assert_eq!(bvh.triangle_count(), frame.triangle_count(), "every instance's triangles cast");
+}

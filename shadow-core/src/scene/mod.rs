@@ -399,6 +399,25 @@ impl Scene {
         Ok(())
     }
 
+    /// Gives every node that draws a mesh an earlier node draws too a copy of its own, so no two nodes
+    /// share one: the scene as it would stand without instancing, drawing and casting the same. Returns
+    /// how many copies it made.
+    pub fn unshare_meshes(&mut self) -> usize {
+        let mut seen = std::collections::HashSet::new();
+        let mut copies = 0;
+        for node in self.depth_first() {
+            let Some((mesh, material)) = self.nodes[node].mesh else { continue };
+            if seen.insert(mesh) {
+                continue;
+            }
+            let copy = Mesh::clone(&self.meshes[mesh].mesh);
+            let key = self.add_mesh(copy);
+            self.nodes[node].mesh = Some((key, material));
+            copies += 1;
+        }
+        copies
+    }
+
     /// Sets a node's shadow flags.
     ///
     /// # Errors

@@ -8,7 +8,7 @@ use glam::{Mat4, Quat, Vec2, Vec3};
 use super::{Rng, SceneParams, built};
 use crate::mesh::Mesh;
 use crate::procedural;
-use crate::scene::{Camera, Light, Material, MeshKey, Scene};
+use crate::scene::{Camera, Light, Material, MaterialKey, MeshKey, Scene};
 
 /// A scene under construction.
 pub(super) struct Stage {
@@ -31,12 +31,24 @@ impl Stage {
         self.scene.add_mesh(mesh)
     }
 
-    /// Places an instance of a mesh added with [`Stage::mesh`].
+    /// Places an instance of a mesh added with [`Stage::mesh`], in a material of its own.
     fn place(&mut self, name: &str, mesh: MeshKey, color: Vec3, transform: Mat4) {
         let mat = self.scene.add_material(Material::colored(name, color));
         if let Err(e) = self.scene.add_instance(name, mesh, mat, transform) {
             panic!("built-in scene: {e}");
         }
+    }
+
+    /// Places an instance of a mesh added with [`Stage::mesh`] in a material of [`Stage::material`].
+    fn place_in(&mut self, name: &str, mesh: MeshKey, material: MaterialKey, transform: Mat4) {
+        if let Err(e) = self.scene.add_instance(name, mesh, material, transform) {
+            panic!("built-in scene: {e}");
+        }
+    }
+
+    /// Adds a material for [`Stage::place_in`].
+    fn material(&mut self, name: &str, color: Vec3) -> MaterialKey {
+        self.scene.add_material(Material::colored(name, color))
     }
 
     pub(super) fn ground(mut self, size: f32) -> Self {
@@ -458,4 +470,71 @@ pub(super) fn outdoor_behind(p: &SceneParams) -> Scene {
 
 pub(super) fn outdoor_facing(p: &SceneParams) -> Scene {
     outdoor_with(p, Sun::Facing)
+}
+
+/// Props: 3000 rocks, crates and posts strewn over a 70 m field, each kind one mesh placed again and again
+/// (turned, scaled, crates sometimes stacked), under a low sun and a spot light over the middle.
+pub(super) fn props(p: &SceneParams) -> Scene {
+    const COUNT: usize = 3000;
+    const HALF: f32 = 35.0;
+    let mut rng = Rng::new(p.seed);
+    let mut s = Stage::new().ground(2.0 * HALF + 10.0);
+    let rock = s.mesh(rock());
+    let crate_mesh = s.mesh(built(procedural::cuboid(Vec3::splat(0.8))));
+    let post = s.mesh(built(procedural::cylinder(0.08, 1.6, 10)));
+    let stone = s.material("rock", Vec3::new(0.55, 0.52, 0.48));
+    let wood = s.material("crate", Vec3::new(0.62, 0.46, 0.3));
+    let metal = s.material("post", Vec3::splat(0.4));
+    for i in 0..COUNT {
+        let (x, z) = (rng.range(-HALF, HALF), rng.range(-HALF, HALF));
+        let turn = Quat::from_rotation_y(rng.range(0.0, std::f32::consts::TAU));
+        match i % 10 {
+            0..5 => {
+                let size = rng.range(0.3, 1.1);
+                let scale = Vec3::new(size * rng.range(0.8, 1.3), size * rng.range(0.5, 0.9), size);
+                let tilt = Quat::from_rotation_x(rng.range(-0.3, 0.3));
+                let shape = Mat4::from_scale_rotation_translation(scale, turn * tilt, Vec3::new(x, 0.1 * size, z));
+                s.place_in("rock", rock, stone, shape);
+            }
+            5..8 => {
+                let stacked = rng.unit() < 0.25;
+                s.place_in("crate", crate_mesh, wood, Mat4::from_rotation_translation(turn, Vec3::new(x, 0.4, z)));
+                if stacked {
+                    let top = turn * Quat::from_rotation_y(rng.range(-0.4, 0.4));
+                    s.place_in("crate", crate_mesh, wood, Mat4::from_rotation_translation(top, Vec3::new(x, 1.2, z)));
+                }
+            }
+            _ => {
+                let lean = Quat::from_rotation_z(rng.range(-0.12, 0.12));
+                s.place_in("post", post, metal, Mat4::from_rotation_translation(turn * lean, Vec3::new(x, 0.0, z)));
+            }
+        }
+    }
+    // The sun from behind the camera's left, so the shadows run across the view towards it.
+    let elevation = 30f32.to_radians();
+    let sun = Vec3::new(0.87, 0.0, 0.5) * elevation.cos() - Vec3::Y * elevation.sin();
+    let mut scene = s.finish(
+        Camera::look_at(Vec3::new(0.0, 9.0, HALF + 4.0), Vec3::new(0.0, 0.0, 6.0), 55.0),
+        Light::directional(sun),
+    );
+    scene.add_light(Light::spot(Vec3::new(3.0, 12.0, 22.0), Vec3::new(0.0, 0.0, 17.0), 70.0));
+    scene
+}
+
+/// A rock: a coarse sphere pushed in and out by a smooth function of where each vertex lies, so
+/// vertices at one place (the seams) move together and the rock stays closed.
+fn rock() -> Mesh {
+    let sphere = built(procedural::sphere(0.5, 12, 8));
+    let bumpy: Vec<Vec3> = sphere
+        .positions()
+        .iter()
+        .map(|&q| {
+            let bump = (7.1 * q.x + 1.7).sin() * (8.3 * q.y + 0.3).sin() * (6.7 * q.z + 2.1).sin();
+            q * (1.0 + 0.3 * bump)
+        })
+        .collect();
+    built(
+        Mesh::new(bumpy, sphere.triangles().to_vec())
+            .map_err(|source| procedural::ShapeError::Mesh { shape: "rock", source }),
+    )
 }

@@ -1,8 +1,8 @@
 //! The built-in scenes of DESIGN 7: the papers' test scenes, built procedurally so nothing is downloaded.
 //!
-//! Each has a default camera and light; [`SceneParams`] swaps the light type and seeds the random
-//! placement (the same seed always gives the same scene). [`stage_model`] puts a loaded model on a ground
-//! plane with the default spotlight and camera of DESIGN 11.
+//! Each has a default camera and light (those of many objects a second light); [`SceneParams`] swaps the
+//! light type and seeds the random placement (the same seed always gives the same scene). [`stage_model`]
+//! puts a loaded model on a ground plane with the default spotlight and camera of DESIGN 11.
 
 pub mod animated;
 mod builders;
@@ -189,10 +189,20 @@ pub const ANIMATED: &[SceneInfo] = &[
     },
 ];
 
+/// The scenes of many objects: a few meshes placed thousands of times, which a backend keeps once and
+/// draws as instances. Apart from [`ALL`], as their worth is measured against the same scene with every
+/// mesh copied ([`crate::Scene::unshare_meshes`]).
+pub const MANY: &[SceneInfo] = &[SceneInfo {
+    name: "props",
+    after: "instancing",
+    description: "3000 rocks, crates and posts, instances of three meshes, on a field under a sun and a spot light",
+    build: builders::props,
+}];
+
 /// Every built-in scene: the papers' ([`ALL`]), the outdoor ones ([`OUTDOOR`]), those of cutouts
-/// ([`CUTOUT`]), then the animated ones ([`ANIMATED`]).
+/// ([`CUTOUT`]), the animated ones ([`ANIMATED`]), then those of many objects ([`MANY`]).
 pub fn every() -> impl Iterator<Item = &'static SceneInfo> {
-    ALL.iter().chain(OUTDOOR).chain(CUTOUT).chain(ANIMATED)
+    ALL.iter().chain(OUTDOOR).chain(CUTOUT).chain(ANIMATED).chain(MANY)
 }
 
 /// Why a scene could not be built.
@@ -354,7 +364,9 @@ mod tests {
             assert_eq!(a.triangle_count(), b.triangle_count(), "{}", info.name);
             assert_eq!(a.bounds(), b.bounds(), "{}", info.name);
             assert_eq!(a.cameras().count(), 1, "{}", info.name);
-            assert_eq!(a.lights().count(), 1, "{}", info.name);
+            // One light, but under the sun of the scenes of many objects a spot light too.
+            let lights = if MANY.iter().any(|m| m.name == info.name) { 2 } else { 1 };
+            assert_eq!(a.lights().count(), lights, "{}", info.name);
             for (_, l) in a.lights() {
                 l.validate().unwrap();
             }

@@ -64,6 +64,8 @@ struct Jobs {
     uniforms: Vec<wgpu::Buffer>,
     stride: u64,
     slots: usize,
+    /// Whether `caps` has room for every instance's caps.
+    with_caps: bool,
     weights: wgpu::Buffer,
     records: wgpu::Buffer,
     caps: wgpu::Buffer,
@@ -149,7 +151,8 @@ impl GpuExtrusion {
         cx.upload_meshes(frame);
         cx.upload_adjacency(frame);
         let slots = frame.lights.len().max(slot + 1);
-        let jobs = Jobs::for_frame(&mut self.jobs, cx, [&self.compute_layout, &self.draw_layout], frame, slots)?;
+        let layouts = [&self.compute_layout, &self.draw_layout];
+        let jobs = Jobs::for_frame(&mut self.jobs, cx, layouts, frame, slots, caps == Caps::Both)?;
         let world = light.source();
         let uniforms: Vec<u8> = jobs
             .list
@@ -261,6 +264,9 @@ impl GpuExtrusion {
                 pass.set_bind_group(1, &jobs.draw_groups[self.built_turn][j], &[jobs.offset(slot, j) as u32]);
                 pass.set_pipeline(pick(0, m));
                 pass.draw_indirect(&jobs.args, args(0));
+                if !jobs.with_caps {
+                    continue;
+                }
                 pass.set_vertex_buffer(0, mesh.positions.slice(..));
                 pass.set_index_buffer(jobs.caps.slice(..), wgpu::IndexFormat::Uint32);
                 // Faces cast turned around are drawn with fronts and backs swapped, not re-wound, so their
@@ -302,15 +308,16 @@ impl Job {
 }
 
 impl Jobs {
-    /// The buffers in `slot` for `frame`'s casting instances with uniforms for `slots` lights: those of
-    /// the last frame while its casting instances and their meshes are the same and it had room for as
-    /// many lights, made anew otherwise.
+    /// The buffers in `slot` for `frame`'s casting instances with uniforms for `slots` lights, and room
+    /// for their caps where `caps` asks for them: those of the last frame while its casting instances
+    /// and their meshes are the same and it had room for as many lights (and caps), made anew otherwise.
     fn for_frame<'a>(
         slot: &'a mut Option<Self>,
         cx: &WgpuContext,
         layouts: [&wgpu::BindGroupLayout; 2],
         frame: &FrameInputs,
         slots: usize,
+        caps: bool,
     ) -> Result<&'a Self, WgpuError> {
         let key: Vec<(usize, BuffersKey)> = frame
             .instances
@@ -319,9 +326,9 @@ impl Jobs {
             .filter(|(_, inst)| inst.casts_solid_shadow())
             .map(|(i, inst)| (i, BuffersKey::of(inst)))
             .collect();
-        if !slot.as_ref().is_some_and(|j| j.key == key && j.slots >= slots) {
+        if !slot.as_ref().is_some_and(|j| j.key == key && j.slots >= slots && (j.with_caps || !caps)) {
             *slot = None;
-            *slot = Some(Self::new(cx, layouts, frame, key, slots)?);
+            *slot = Some(Self::new(cx, layouts, frame, key, slots, caps)?);
         }
         match slot {
             Some(jobs) => Ok(jobs),
@@ -329,13 +336,16 @@ impl Jobs {
         }
     }
 
-    /// Lays the casting instances `key` out in shared buffers, with uniforms for `slots` lights.
+    /// Lays the casting instances `key` out in shared buffers, with uniforms for `slots` lights, and
+    /// lists for their caps where `with_caps` asks for them (z-pass draws none: a scene of many
+    /// triangles would need room for nine indices a face it never writes).
     fn new(
         cx: &WgpuContext,
         [compute_layout, draw_layout]: [&wgpu::BindGroupLayout; 2],
         frame: &FrameInputs,
         key: Vec<(usize, BuffersKey)>,
         slots: usize,
+        with_caps: bool,
     ) -> Result<Self, WgpuError> {
         let mut list = Vec::with_capacity(key.len());
         let (mut records, mut weights, mut caps) = (0u64, 0u64, 0u64);
@@ -355,11 +365,13 @@ impl Jobs {
                 args: list.len() as u32 * ARG_WORDS,
                 records: at(records)?,
                 weights: at(weights)?,
-                caps: [at(caps)?, at(caps + 3 * faces)?, at(caps + 6 * faces)?],
+                caps: if with_caps { [at(caps)?, at(caps + 3 * faces)?, at(caps + 6 * faces)?] } else { [0; 3] },
             });
             records += u64::from(adj.use_count);
             weights += faces;
-            caps += 9 * faces;
+            if with_caps {
+                caps += 9 * faces;
+            }
         }
         let limits = cx.device.limits();
         let most = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
@@ -405,6 +417,7 @@ impl Jobs {
             draw_groups: Vec::new(),
             key,
             list,
+            with_caps,
         };
         let turns = 0..jobs.uniforms.len();
         for t in turns {

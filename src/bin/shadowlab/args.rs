@@ -52,6 +52,10 @@ pub(crate) struct SceneArgs {
     /// without it the scene stands at rest, as built or loaded.
     #[arg(long, value_name = "SECONDS", value_parser = parse_time)]
     pub(crate) time: Option<f32>,
+    /// Give every node its own copy of a mesh that other nodes draw too: the scene without instancing,
+    /// to measure against (the pictures are the same).
+    #[arg(long)]
+    pub(crate) unshare: bool,
 }
 
 /// A time in seconds: a finite number.
@@ -139,6 +143,7 @@ impl SceneArgs {
             light: self.light.clone(),
             file_access: if self.allow_outside_files { FileAccess::Anywhere } else { FileAccess::ModelFolder },
             time: self.time,
+            unshare: self.unshare,
         }
     }
 

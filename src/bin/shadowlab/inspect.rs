@@ -42,6 +42,9 @@ pub(crate) fn inspect(target: &str, json: bool, allow_outside_files: bool) -> Re
             "bounds": {"min": i.bounds.min.to_array(), "max": i.bounds.max.to_array()},
             "silhouette_edges": i.silhouette_edges,
             "meshes": i.meshes,
+            "instances": i.instances,
+            "mesh_bytes": i.mesh_bytes,
+            "unshared_mesh_bytes": i.unshared_mesh_bytes,
             "meshes_with_texture_coordinates": i.meshes_with_uvs,
             "materials": i.materials.iter().map(material_json).collect::<Vec<_>>(),
             "textures": i.textures.iter().map(|t| json!({
@@ -69,6 +72,13 @@ pub(crate) fn inspect(target: &str, json: bool, allow_outside_files: bool) -> Re
         Some(n) => out!("  silhouette edges    {n} (default light)"),
         None => out!("  silhouette edges    - (no light)"),
     }
+    out!(
+        "  meshes              {} drawn by {} instances ({} of geometry; {} saved by sharing)",
+        i.meshes,
+        i.instances,
+        in_units(i.mesh_bytes),
+        in_units(i.unshared_mesh_bytes - i.mesh_bytes)
+    );
     out!("  texture coordinates {} of {} meshes", i.meshes_with_uvs, i.meshes);
     let count = |mode: &str| i.materials.iter().filter(|m| m.alpha_mode.name() == mode).count();
     let sides = i.materials.iter().filter(|m| m.double_sided).count();
@@ -136,4 +146,10 @@ fn material_json(m: &MaterialStats) -> serde_json::Value {
         });
     }
     j
+}
+
+/// A number of bytes in KiB or MiB, one decimal.
+fn in_units(bytes: usize) -> String {
+    let kib = bytes as f64 / 1024.0;
+    if kib < 1024.0 { format!("{kib:.1} KiB") } else { format!("{:.1} MiB", kib / 1024.0) }
 }
