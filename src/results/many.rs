@@ -16,8 +16,11 @@ use crate::Error;
 use crate::bench::{BenchJob, BenchReport, run_bench};
 use crate::renderer::{BackendKind, Renderer};
 
-/// The techniques timed: the reference (whose BVH keeps each shared mesh once), a map and a volume.
-const TECHNIQUES: &[&str] = &["ray-traced", "shadow-map", "shadow-volume-zfail"];
+/// The techniques timed beside the reference (whose BVH keeps each shared mesh once, on the CPU): a map
+/// and a volume.
+const TECHNIQUES: &[&str] = &["shadow-map", "shadow-volume-zfail"];
+/// The reference timed, on the CPU alone.
+const REFERENCE: &str = "ray-traced";
 /// Frames timed (after two unmeasured ones), and BVH builds timed.
 const FRAMES: u32 = 5;
 const BUILDS: usize = 3;
@@ -83,7 +86,16 @@ pub fn run_many(
                 clip: None,
             };
             let what = if shared { "shared" } else { "unshared" };
-            let bench = run_bench(renderer, &job, |m| progress(&format!("{name} {what}: {m}")))?;
+            let mut bench = run_bench(renderer, &job, |m| progress(&format!("{name} {what}: {m}")))?;
+            if backends.contains(&BackendKind::Cpu) {
+                let job = BenchJob {
+                    techniques: vec![TechniqueSpec::named(REFERENCE)],
+                    backends: vec![BackendKind::Cpu],
+                    ..job
+                };
+                let reference = run_bench(renderer, &job, |m| progress(&format!("{name} {what}: {m}")))?;
+                bench.results.splice(0..0, reference.results);
+            }
             Ok(Variant { shared, inspection: Inspection::of(&scene), bvh_ms: builds[BUILDS / 2], bench })
         };
         out.push((name, [measure(true)?, measure(false)?]));

@@ -73,9 +73,10 @@ pub(crate) fn inspect(target: &str, json: bool, allow_outside_files: bool) -> Re
         None => out!("  silhouette edges    - (no light)"),
     }
     out!(
-        "  meshes              {} drawn by {} instances ({} of geometry; {} saved by sharing)",
+        "  meshes              {} drawn by {} instance{} ({} of geometry; {} saved by sharing)",
         i.meshes,
         i.instances,
+        if i.instances == 1 { "" } else { "s" },
         in_units(i.mesh_bytes),
         in_units(i.unshared_mesh_bytes - i.mesh_bytes)
     );
