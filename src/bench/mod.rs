@@ -15,6 +15,7 @@ use std::collections::BTreeMap;
 use std::sync::Arc;
 
 use glam::{Mat3, Vec3};
+use rayon::prelude::*;
 use serde::Serialize;
 use shadow_core::frame::FrameError;
 use shadow_core::geometry::adjacency::Adjacency;
@@ -224,20 +225,21 @@ pub fn run_bench(
 }
 
 /// Builds the adjacency of every mesh of `frame` afresh (each mesh once, however many instances draw
-/// it), as a scene does when a mesh changes; returns the milliseconds it took.
+/// it, the meshes side by side on every thread, as [`Scene::build_adjacencies`] builds them), as a scene
+/// does when a mesh changes; returns the milliseconds it took.
 fn rebuild_adjacency(frame: &mut FrameInputs) -> f64 {
     let start = std::time::Instant::now();
-    let mut built: Vec<(*const shadow_core::Mesh, Arc<Adjacency>)> = Vec::new();
+    let mut index: std::collections::HashMap<*const shadow_core::Mesh, usize> = std::collections::HashMap::new();
+    let mut meshes: Vec<&Arc<shadow_core::Mesh>> = Vec::new();
+    for inst in &frame.instances {
+        index.entry(Arc::as_ptr(&inst.mesh)).or_insert_with(|| {
+            meshes.push(&inst.mesh);
+            meshes.len() - 1
+        });
+    }
+    let built: Vec<Arc<Adjacency>> = meshes.par_iter().map(|mesh| Arc::new(Adjacency::build(mesh))).collect();
     for inst in &mut frame.instances {
-        let mesh = Arc::as_ptr(&inst.mesh);
-        inst.adjacency = match built.iter().find(|(m, _)| *m == mesh) {
-            Some((_, adj)) => adj.clone(),
-            None => {
-                let adj = Arc::new(Adjacency::build(&inst.mesh));
-                built.push((mesh, adj.clone()));
-                adj
-            }
-        };
+        inst.adjacency = Arc::clone(&built[index[&Arc::as_ptr(&inst.mesh)]]);
     }
     start.elapsed().as_secs_f64() * 1e3
 }
@@ -346,6 +348,25 @@ mod tests {
     use super::*;
     use crate::TechniqueRegistry;
     use shadow_core::scenes::{self, SceneParams};
+
+    /// Rebuilding gives every instance the adjacency of its own mesh, built once for the instances that
+    /// share it: new, and the same as the scene's.
+    #[test]
+    fn a_rebuilt_adjacency_is_built_once_a_mesh() {
+        let scene = scenes::build("props", &SceneParams::default()).expect("a built-in scene");
+        let mut frame = FrameInputs::from_first_camera(&scene).expect("a frame");
+        let before: Vec<Arc<Adjacency>> = frame.instances.iter().map(|i| Arc::clone(&i.adjacency)).collect();
+        rebuild_adjacency(&mut frame);
+        let mut distinct: Vec<*const Adjacency> = frame.instances.iter().map(|i| Arc::as_ptr(&i.adjacency)).collect();
+        distinct.sort_unstable();
+        distinct.dedup();
+        assert_eq!(distinct.len(), 4, "one adjacency for each of the ground, rock, crate and post");
+        for (inst, old) in frame.instances.iter().zip(&before) {
+            assert!(!Arc::ptr_eq(&inst.adjacency, old), "{:?}: not rebuilt", inst.mesh_key);
+            assert_eq!(inst.adjacency.triangles(), old.triangles());
+            assert_eq!(inst.adjacency.planes(), old.planes());
+        }
+    }
 
     #[test]
     fn every_lane_runs_every_frame_and_results_list_technique_by_technique() {
