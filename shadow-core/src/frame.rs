@@ -62,7 +62,7 @@ pub struct Instance {
 }
 
 /// How much of an instance's surface is there to block light or to be seen: its material's alpha test.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Coverage {
     /// All of it: opaque and blended materials (a blended surface blocks as an opaque one for now), and
     /// masked ones whose alpha passes with no texture to read.

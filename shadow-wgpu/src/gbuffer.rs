@@ -1,6 +1,8 @@
 //! The camera G-buffer on the GPU: the context's depth-stencil format plus world position (w: receives shadow),
 //! shading normal and albedo (w: covered), all f32 so shading matches the CPU's.
 
+use std::ops::Range;
+
 use shadow_core::frame::{Coverage, Surfaces};
 use shadow_core::glam::Vec3;
 use shadow_core::scene::Camera;
@@ -300,7 +302,10 @@ fn fill(
 
 /// Draws every instance whose material reads a texture ([`read_texture`]) and that passes `keep`, with
 /// its own mesh, its texture coordinates in the slot after the positions (and the normals, with
-/// `normals`) and its texture's group as group 2 (instance index = frame instance index).
+/// `normals`) and its texture's group as group 2: one instanced draw a run of the [`DrawOrder`]
+/// (instance index = slot).
+///
+/// [`DrawOrder`]: crate::draw_order::DrawOrder
 pub fn draw_textured(
     cx: &WgpuContext,
     pass: &mut wgpu::RenderPass<'_>,
@@ -308,16 +313,20 @@ pub fn draw_textured(
     keep: impl Fn(&shadow_core::Instance) -> bool,
     normals: bool,
 ) {
-    for (i, inst) in frame.instances.iter().enumerate().filter(|(_, i)| keep(i)) {
+    for (i, slots) in cx.cache.order().runs(frame, |i| keep(i) && read_texture(i).is_some()) {
+        let inst = &frame.instances[i];
         let Some(texture) = read_texture(inst).and_then(|t| cx.cache.textures.get(t)) else { continue };
         let Some((m, uvs)) = cx.cache.mesh(inst).and_then(|m| Some((m, m.uvs?))) else { continue };
         pass.set_bind_group(2, &texture.group, &[]);
         pass.set_vertex_buffer(if normals { 2 } else { 1 }, uvs.slice(..));
-        draw_mesh(pass, m, i, normals);
+        draw_mesh(pass, m, slots, normals);
     }
 }
 
-/// Draws every instance that passes `keep` with its own mesh (instance index = frame instance index).
+/// Draws every instance that passes `keep` with its own mesh: one instanced draw a run of the
+/// [`DrawOrder`] (instance index = slot).
+///
+/// [`DrawOrder`]: crate::draw_order::DrawOrder
 pub fn draw_instances(
     cx: &WgpuContext,
     pass: &mut wgpu::RenderPass<'_>,
@@ -325,18 +334,19 @@ pub fn draw_instances(
     keep: impl Fn(&shadow_core::Instance) -> bool,
     normals: bool,
 ) {
-    for (i, inst) in frame.instances.iter().enumerate().filter(|(_, i)| keep(i)) {
-        let Some(m) = cx.cache.mesh(inst) else { continue };
-        draw_mesh(pass, m, i, normals);
+    for (i, slots) in cx.cache.order().runs(frame, keep) {
+        let Some(m) = cx.cache.mesh(&frame.instances[i]) else { continue };
+        draw_mesh(pass, m, slots, normals);
     }
 }
 
-/// Draws mesh `m` as instance `i`: its positions in slot 0 (and its normals in slot 1, with `normals`).
-fn draw_mesh(pass: &mut wgpu::RenderPass<'_>, m: crate::upload::MeshView<'_>, i: usize, normals: bool) {
+/// Draws mesh `m` as the instances in `slots`: its positions in slot 0 (and its normals in slot 1, with
+/// `normals`).
+fn draw_mesh(pass: &mut wgpu::RenderPass<'_>, m: crate::upload::MeshView<'_>, slots: Range<u32>, normals: bool) {
     pass.set_vertex_buffer(0, m.positions.slice(..));
     if normals {
         pass.set_vertex_buffer(1, m.normals.slice(..));
     }
     pass.set_index_buffer(m.indices.slice(..), wgpu::IndexFormat::Uint32);
-    pass.draw_indexed(0..m.index_count, 0, i as u32..i as u32 + 1);
+    pass.draw_indexed(0..m.index_count, 0, slots);
 }

@@ -8,6 +8,7 @@
 
 pub mod clock;
 pub mod context;
+pub mod draw_order;
 pub mod frame;
 pub mod gbuffer;
 pub mod host_maps;

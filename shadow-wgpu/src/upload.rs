@@ -17,6 +17,7 @@ use shadow_core::geometry::adjacency::{Adjacency, FaceUse};
 use shadow_core::{FrameInputs, Instance, MeshKey, NodeKey};
 
 use crate::context::{WgpuContext, WgpuError};
+use crate::draw_order::DrawOrder;
 use crate::posing::Posing;
 use crate::textures::{DeviceTextures, TexelRuleRaw, read_texture};
 
@@ -97,14 +98,15 @@ pub struct InstanceRaw {
 }
 
 impl InstanceRaw {
-    fn of(inst: &shadow_core::Instance) -> Self {
+    /// The instance `index` of its frame.
+    fn of(inst: &shadow_core::Instance, index: usize) -> Self {
         let n = Mat4::from_mat3(shadow_core::affine::normal_matrix(inst.world_from_local));
         let texel = read_texture(inst).and_then(|_| TexelRuleRaw::of(&inst.material)).unwrap_or_default();
         Self {
             world_from_local: inst.world_from_local.to_cols_array_2d(),
             normal_from_local: n.to_cols_array_2d(),
             color: inst.base_color.extend(if inst.two_sided { 1.0 } else { 0.0 }).to_array(),
-            flags: [u32::from(inst.receives_shadow), u32::from(inst.mirrored), 0, 0],
+            flags: [u32::from(inst.receives_shadow), u32::from(inst.mirrored), index as u32, 0],
             texel,
         }
     }
@@ -306,6 +308,8 @@ pub struct SceneCache {
     adjacency: HashMap<MeshKey, AdjacencyGpu>,
     /// The instance buffers, one per frame that may be in flight, each with what it holds.
     instances: Vec<(Vec<InstanceRaw>, wgpu::Buffer)>,
+    /// The slot of each of the last frame's instances in its instance buffer.
+    order: DrawOrder,
     /// Deformed meshes' rest data and posed nodes' buffers.
     pub(crate) posing: Posing,
     /// The materials' textures.
@@ -434,9 +438,11 @@ impl SceneCache {
     /// The frame's instance data, in the buffer of this frame's turn (a few are used in turn, as the
     /// transient buffers are, so a frame's writes never wait for a frame in flight that reads): the
     /// instances that changed since that buffer's last frame are written in place. The buffers are made
-    /// anew only when the number of instances changes.
+    /// anew only when the number of instances changes. The instances are laid out in their
+    /// [`DrawOrder`], which [`SceneCache::order`] then gives.
     pub fn instances(&mut self, cx: &WgpuContext, frame: &FrameInputs) -> &wgpu::Buffer {
-        let raw: Vec<InstanceRaw> = frame.instances.iter().map(InstanceRaw::of).collect();
+        self.order = DrawOrder::of(frame);
+        let raw: Vec<InstanceRaw> = self.order.instances().map(|i| InstanceRaw::of(&frame.instances[i], i)).collect();
         if self.instances.first().is_none_or(|(old, _)| old.len() != raw.len()) {
             let desc = wgpu::util::BufferInitDescriptor {
                 label: Some("instances"),
@@ -455,6 +461,12 @@ impl SceneCache {
             }
         }
         buf
+    }
+
+    /// Where the instances of the frame last given to [`SceneCache::instances`] sit in its buffer.
+    #[must_use]
+    pub fn order(&self) -> &DrawOrder {
+        &self.order
     }
 }
 

@@ -81,6 +81,8 @@ fn instances_cast_what_copies_of_their_meshes_cast() {
         (BackendKind::Wgpu, "shadow-map"),
         (BackendKind::Cpu, "shadow-volume-zfail"),
         (BackendKind::Wgpu, "shadow-volume-zfail"),
+        (BackendKind::Wgpu, "volume-reconstruction"),
+        (BackendKind::Wgpu, "second-depth-shadow-map"),
     ];
     for (backend, technique) in runs {
         let spec = TechniqueSpec::named(technique);
@@ -91,6 +93,36 @@ fn instances_cast_what_copies_of_their_meshes_cast() {
             assert!(shadowed > a.data().len() / 100, "{what}: {shadowed} pixels in shadow");
             assert!(a.data() == b.data(), "{what}: the pictures differ");
         }
+    }
+}
+
+/// The GPU draws the instances of a mesh together, one draw a run of them, though the frame lists
+/// `props`' rocks, crates and posts mixed: the instance buffer holds each mesh's instances side by side,
+/// and names each instance by its index in the frame.
+#[test]
+fn instances_of_a_mesh_are_drawn_together() {
+    if crate::with_wgpu("props' draws").is_none() {
+        return;
+    }
+    let mut cx = WgpuContext::new(&shadow_wgpu::AdapterChoice { name: None, allow_software: true }).expect("context");
+    let scene = scenes::build("props", &scenes::SceneParams::default()).expect("props");
+    let frame = FrameInputs::from_first_camera(&scene).expect("frame");
+    let meshes: std::collections::HashSet<_> = frame.instances.iter().map(|i| i.mesh_key).collect();
+    let changes = frame.instances.windows(2).filter(|w| w[0].mesh_key != w[1].mesh_key).count();
+    assert!(changes > 100, "the frame lists its instances mixed ({changes} changes of mesh)");
+    cx.upload_meshes(&frame);
+    cx.instances(&frame);
+    let order = cx.cache.order();
+    let runs = order.runs(&frame, |i| i.casts_shadow);
+    assert_eq!(runs.len(), meshes.len(), "a draw a mesh, for {} instances", frame.instances.len());
+    let mut slots: Vec<u32> = (0..frame.instances.len()).map(|i| order.slot(i)).collect();
+    let listed: Vec<usize> = order.instances().collect();
+    assert!(listed.iter().enumerate().all(|(s, &i)| slots[i] == s as u32), "slots and instances disagree");
+    slots.sort_unstable();
+    assert!(slots.iter().enumerate().all(|(s, &t)| t == s as u32), "every instance in a slot of its own");
+    for (first, run) in runs {
+        let mesh = frame.instances[first].mesh_key;
+        assert!(listed[run.start as usize..run.end as usize].iter().all(|&i| frame.instances[i].mesh_key == mesh));
     }
 }
 

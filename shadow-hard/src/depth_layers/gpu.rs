@@ -229,13 +229,12 @@ fn render_projection(
         let mut pass = depth_pass(&mut enc, target, if peeling { "second layer" } else { "first layer" });
         pass.set_bind_group(0, &group0, &[]);
         pass.set_bind_group(1, group, &[]);
-        for (i, inst) in frame.instances.iter().enumerate().filter(|(_, i)| i.casts_shadow) {
+        // A run's instances share a mesh, a texture, a coverage and a winding (`DrawOrder`).
+        let keep = |i: &shadow_core::Instance| i.casts_shadow && i.coverage() != Coverage::Absent;
+        for (i, slots) in cx.cache.order().runs(frame, keep) {
+            let inst = &frame.instances[i];
             let Some(m) = cx.cache.mesh(inst) else { continue };
-            let cutout = match inst.coverage() {
-                Coverage::Solid => false,
-                Coverage::Cutout => true,
-                Coverage::Absent => continue,
-            };
+            let cutout = inst.coverage() == Coverage::Cutout;
             if cutout {
                 let texture = read_texture(inst).and_then(|t| cx.cache.textures.get(t));
                 let (Some(texture), Some(uvs)) = (texture, m.uvs) else { continue };
@@ -246,7 +245,7 @@ fn render_projection(
             pass.set_pipeline(state.pass(cx, Pass { peel: peeling, cull, cw: inst.mirrored, cutout }));
             pass.set_vertex_buffer(0, m.positions.slice(..));
             pass.set_index_buffer(m.indices.slice(..), wgpu::IndexFormat::Uint32);
-            pass.draw_indexed(0..m.index_count, 0, i as u32..i as u32 + 1);
+            pass.draw_indexed(0..m.index_count, 0, slots);
         }
     }
     {

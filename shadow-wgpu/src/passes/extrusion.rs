@@ -159,7 +159,8 @@ impl GpuExtrusion {
             .iter()
             .flat_map(|job| {
                 let local = world.transformed(frame.instances[job.instance].local_from_world);
-                let mut bytes = bytemuck::bytes_of(&job.uniform(local, caps)).to_vec();
+                let slot = cx.cache.order().slot(job.instance);
+                let mut bytes = bytemuck::bytes_of(&job.uniform(local, caps, slot)).to_vec();
                 bytes.resize(jobs.stride as usize, 0);
                 bytes
             })
@@ -289,11 +290,11 @@ impl GpuExtrusion {
 }
 
 impl Job {
-    /// Its uniform for a light, given in its mesh's space.
-    fn uniform(&self, light: LightSource, caps: Caps) -> Uniform {
+    /// Its uniform for a light, given in its mesh's space, with its instance's slot in the instance buffer.
+    fn uniform(&self, light: LightSource, caps: Caps, slot: u32) -> Uniform {
         Uniform {
             light: light.homogeneous().to_array(),
-            counts: [self.instance as u32, self.faces, self.edges, u32::from(self.bergeron)],
+            counts: [slot, self.faces, self.edges, u32::from(self.bergeron)],
             bases: [u32::from(caps == Caps::Both), self.args, self.records, self.weights],
             caps: [self.caps[0], self.caps[1], self.caps[2], 0],
         }

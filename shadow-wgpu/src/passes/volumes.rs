@@ -22,6 +22,7 @@ pub struct VolumeDraw {
     vertices: Option<Transient>,
     indices: Option<(Transient, u32)>,
     count: u32,
+    /// The instance's index in the frame.
     instance: u32,
     /// Front faces wind clockwise (a mirrored instance, or faces cast turned around).
     cw: bool,
@@ -352,6 +353,7 @@ impl<'a> VolumePass<'a> {
                 for d in draws {
                     pass.set_pipeline(if d.cw { self.cw } else { self.ccw });
                     let mesh = frame.instances.get(d.instance as usize).and_then(|i| cx.cache.mesh(i));
+                    let slot = cx.cache.order().slot(d.instance as usize);
                     match (&d.vertices, d.mesh_vertices, mesh) {
                         (Some(v), _, _) => pass.set_vertex_buffer(0, v.slice()),
                         (None, true, Some(m)) => pass.set_vertex_buffer(0, m.positions.slice(..)),
@@ -360,9 +362,9 @@ impl<'a> VolumePass<'a> {
                     match &d.indices {
                         Some((ib, n)) => {
                             pass.set_index_buffer(ib.slice(), wgpu::IndexFormat::Uint32);
-                            pass.draw_indexed(0..*n, 0, d.instance..d.instance + 1);
+                            pass.draw_indexed(0..*n, 0, slot..slot + 1);
                         }
-                        None => pass.draw(0..d.count, d.instance..d.instance + 1),
+                        None => pass.draw(0..d.count, slot..slot + 1),
                     }
                 }
             }

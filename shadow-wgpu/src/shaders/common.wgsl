@@ -14,7 +14,8 @@ struct Instance {
     normal_from_local: mat4x4<f32>,
     // rgb albedo (linear), two-sided flag in w
     color: vec4<f32>,
-    // x: receives shadow, y: mirrored
+    // x: receives shadow, y: mirrored, z: its index in the frame (the buffer holds the instances in their
+    // draw order, `draw_order.rs`)
     flags: vec4<u32>,
     // How the material reads its base-colour texture, where the instance reads one: the fields of
     // texel.wgsl's `TexelRule`, in its order.

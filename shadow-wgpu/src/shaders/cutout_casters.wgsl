@@ -9,7 +9,7 @@
 struct CutoutOut {
     @invariant @builtin(position) pos: vec4<f32>,
     @location(0) uv: vec2<f32>,
-    // The instance's `TexelRule`, field by field, and its ID (1 + its index).
+    // The instance's `TexelRule`, field by field, and its ID (1 + its index in the frame).
     @location(1) @interpolate(flat) row_u: vec4<f32>,
     @location(2) @interpolate(flat) row_v: vec4<f32>,
     @location(3) @interpolate(flat) sampler: vec4<u32>,
@@ -22,7 +22,7 @@ fn vs_light_cutout(@location(0) p: vec4<f32>, @location(2) uv: vec2<f32>, @built
     let inst = instances[instance];
     return CutoutOut(
         clip_position(instance, p), uv, inst.texel_row_u, inst.texel_row_v, inst.texel_sampler, inst.texel_alpha,
-        instance + 1u,
+        inst.flags.z + 1u,
     );
 }
 

@@ -12,8 +12,9 @@ struct Extrusion {
     // The light in the instance's mesh space, homogeneous: a position (w = 1), or the direction parallel
     // light travels (w = 0).
     light: vec4<f32>,
-    // x: the instance, y: its mesh's faces, z: its edges, w: 1 when every face casts turned towards the
-    // light (Bergeron: an open mesh), 0 when lit faces alone cast (a closed one).
+    // x: the instance's slot in the instance buffer, y: its mesh's faces, z: its edges, w: 1 when every
+    // face casts turned towards the light (Bergeron: an open mesh), 0 when lit faces alone cast (a closed
+    // one).
     counts: vec4<u32>,
     // x: 1 when caps are built (z-fail), y: the first word of the instance's draw arguments, z: its first
     // side record, w: its first face weight.

@@ -47,13 +47,14 @@ struct IdOut {
     @location(0) @interpolate(flat) id: u32,
 };
 
-// The light pass with McCool's object-ID channel (volume-reconstruction's `ids`): 1 + the instance's index,
-// 0 (the clear value) where no caster is (twin: shadow-cpu's `render_depth_and_id_maps`).
+// The light pass with McCool's object-ID channel (volume-reconstruction's `ids`): 1 + the instance's index
+// in the frame (`flags.z`), 0 (the clear value) where no caster is (twin: shadow-cpu's
+// `render_depth_and_id_maps`).
 @vertex
 fn vs_light_id(@location(0) p: vec4<f32>, @builtin(instance_index) instance: u32) -> IdOut {
     var out: IdOut;
     out.pos = clip_position(instance, p);
-    out.id = instance + 1u;
+    out.id = instances[instance].flags.z + 1u;
     return out;
 }
 
