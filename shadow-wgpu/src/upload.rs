@@ -333,7 +333,8 @@ impl SceneCache {
             if self.meshes.get(&inst.mesh_key).is_some_and(|m| m.version == version) {
                 continue;
             }
-            // The pose reads a deformed mesh's rest positions and normals as storage.
+            // The pose reads a deformed mesh's rest positions and normals as storage; the extrusion reads
+            // every mesh's positions and indices so.
             let posable =
                 if m.deformers().is_some() { wgpu::BufferUsages::STORAGE } else { wgpu::BufferUsages::empty() };
             let positions: Vec<[f32; 4]> = m.positions().iter().map(|p| p.extend(1.0).to_array()).collect();
@@ -349,7 +350,7 @@ impl SceneCache {
                     positions: make(
                         "positions",
                         bytemuck::cast_slice(&positions),
-                        wgpu::BufferUsages::VERTEX | posable,
+                        wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::STORAGE,
                     ),
                     normals: make("normals", bytemuck::cast_slice(&normals), wgpu::BufferUsages::VERTEX | posable),
                     uvs: m.uvs().map(|uvs| make("uvs", bytemuck::cast_slice(uvs), wgpu::BufferUsages::VERTEX)),

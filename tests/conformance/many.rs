@@ -126,9 +126,9 @@ fn instances_of_a_mesh_are_drawn_together() {
     }
 }
 
-/// z-pass draws no caps, so it keeps no room for them: a scene whose cap lists (nine indices a face)
-/// would pass the device's largest storage binding still casts its volumes on the GPU, as the CPU
-/// casts them.
+/// z-pass draws no caps, so it keeps no room for them: a scene whose side and cap records together
+/// (eight bytes each, three of each a face at most) would pass the device's largest storage binding
+/// still casts its volumes on the GPU, as the CPU casts them.
 #[test]
 fn z_pass_keeps_no_room_for_caps_it_never_draws() {
     let Some(mut renderer) = crate::with_wgpu("z-pass over millions of faces") else { return };
@@ -137,9 +137,9 @@ fn z_pass_keeps_no_room_for_caps_it_never_draws() {
     let most = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
     let ball = shadow_core::procedural::sphere(0.3, 32, 16).expect("sphere");
     let faces = ball.triangle_count() as u64;
-    // Enough balls that their caps would not fit, while their side records (three a face) do.
-    let count = (most / (4 * 9 * faces) + 1) as usize;
-    assert!(4 * 3 * faces * count as u64 <= most, "the side records fit");
+    // Enough balls that their caps would not fit beside their side records, while the side records do.
+    let count = (most / (8 * 6 * faces) + 1) as usize;
+    assert!(8 * 3 * faces * count as u64 <= most, "the side records fit");
     let mut s = Scene::new();
     let material = s.add_material(Material::default());
     let mesh = s.add_mesh(ball);

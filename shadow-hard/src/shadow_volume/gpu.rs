@@ -117,7 +117,7 @@ impl ShadowTechnique<WgpuBackend> for ShadowVolume {
         let cutouts = state.cutouts.query(cx, g, out)?;
         let passed = cx.scoped("the shadow-volume pass", |cx| {
             let q = match volumes {
-                Volumes::Gpu(extrusion) => extrusion.draw(cx, frame, g, &depth, slot, false),
+                Volumes::Gpu(extrusion) => extrusion.draw(cx, g, &depth, slot, false),
                 Volumes::Cpu { ccw, cw, draws, .. } => {
                     let counting = VolumePass {
                         label: "shadow volumes",
@@ -145,7 +145,7 @@ impl ShadowTechnique<WgpuBackend> for ShadowVolume {
         // after the resolve, so it does not disturb the result; its time lands in a separate sub-phase.
         let t = std::time::Instant::now();
         let all = cx.scoped("the volume fragment count", |cx| match volumes {
-            Volumes::Gpu(extrusion) => extrusion.draw(cx, frame, g, &depth, slot, true),
+            Volumes::Gpu(extrusion) => extrusion.draw(cx, g, &depth, slot, true),
             Volumes::Cpu { count_all, draws, .. } => {
                 VolumePass::count(count_all, "count volume fragments").run(cx, draws, frame, g, &depth)
             }
