@@ -14,6 +14,7 @@ use shadow_core::scene::Camera;
 use shadow_core::{FrameInputs, Image};
 
 use crate::alpha_test::{Drawn, draw_alpha_tested};
+pub use crate::clip_space::{ClipVertices, clip_vertices};
 use crate::context::{CpuError, check_size};
 use crate::raster::{Batch, DepthStencil, Fragment, Indexed, RasterState, draw_flat};
 
@@ -46,7 +47,7 @@ pub struct GBuffer {
     /// Pixels that show a surface receiving shadows.
     pub receiver: Image<bool>,
     /// Clip-space vertices of every instance, exactly as rasterized.
-    pub clip_vertices: Vec<Vec<Vec4>>,
+    pub clip_vertices: ClipVertices,
     /// The visibility buffer (each pixel's primitive in the frame's one draw, [`NO_INSTANCE`] for none),
     /// kept so a recycled G-buffer reuses its storage.
     visible: Vec<u32>,
@@ -92,11 +93,7 @@ impl GBuffer {
             albedo: s.albedo,
             instance,
             receiver: s.receiver,
-            clip_vertices: frame
-                .instances
-                .iter()
-                .map(|inst| clip_vertices(inst.mesh.positions(), clip_from_world * inst.world_from_local))
-                .collect(),
+            clip_vertices: ClipVertices::of(frame, clip_from_world),
             visible: Vec::new(),
         }
     }
@@ -193,12 +190,6 @@ impl Triangle {
         let footprint = Footprint { dx: uv(right) - at, dy: uv(down) - at };
         Some(inst.material.base_color_at(inst.base_color_texture.as_deref(), Some(at), footprint).truncate())
     }
-}
-
-/// Clip-space vertices of an instance under `clip_from_world`: the one transform every pass shares.
-#[must_use]
-pub fn clip_vertices(positions: &[Vec3], clip_from_local: Mat4) -> Vec<Vec4> {
-    positions.par_iter().with_min_len(4096).map(|&p| clip_from_local * p.extend(1.0)).collect()
 }
 
 /// Renders the G-buffer of a frame at `width x height`.
@@ -401,8 +392,12 @@ struct Surfaces {
 /// cleared first). The triangle's world corners and face normal are those of the pixel before on most
 /// pixels of a row, and four pixels in a row on one triangle are resolved together ([`surface_x4`]).
 fn resolve(frame: &FrameInputs, all: &Batch<'_>, visible: &[u32], eye_rays: &EyeRays, s: &mut Surfaces) {
-    let normal_from_local: Vec<Mat3> =
-        frame.instances.iter().map(|i| shadow_core::affine::normal_matrix(i.world_from_local)).collect();
+    let normal_from_local: Vec<Mat3> = frame
+        .instances
+        .par_iter()
+        .with_min_len(1024)
+        .map(|i| shadow_core::affine::normal_matrix(i.world_from_local))
+        .collect();
     let w = eye_rays.width as usize;
     s.position
         .par_chunks_mut(w)
@@ -477,11 +472,7 @@ pub fn render_reusing(
     check_size("view", u64::from(width), u64::from(height), u64::from(crate::context::MAX_TARGET_SIDE).pow(2))?;
     let camera = frame.camera;
     let clip_from_world = camera.clip_from_world(width as f32 / height as f32);
-    let clip: Vec<Vec<Vec4>> = frame
-        .instances
-        .iter()
-        .map(|inst| clip_vertices(inst.mesh.positions(), clip_from_world * inst.world_from_local))
-        .collect();
+    let clip = ClipVertices::of(frame, clip_from_world);
 
     let n = width as usize * height as usize;
     let mut old = spare.map(GBuffer::into_storage);
@@ -499,7 +490,7 @@ pub fn render_reusing(
     let receiver = overwritten(old.receiver, n, false);
     // Every instance in one draw, in order (the same fragments as a draw each), each pixel left with the id
     // of its primitive in the batch; the back faces of single-sided materials not drawn.
-    let all = Batch::new(frame.instances.iter().zip(&clip).map(|(inst, clip)| Indexed::seen(inst, clip)).collect())?;
+    let all = Batch::new(frame.instances.iter().enumerate().map(|(k, inst)| Indexed::seen(inst, &clip[k])).collect())?;
     let drawn = Drawn::sort(frame, |_| true);
     if drawn.solid.len() == frame.instances.len() {
         draw_flat(&mut ds, &mut visible, &all, &RasterState::default(), |prim| prim);

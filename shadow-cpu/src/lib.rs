@@ -8,6 +8,7 @@
 pub mod acne;
 pub mod alpha_test;
 pub mod bvh;
+pub mod clip_space;
 pub mod context;
 pub mod frame;
 pub mod gbuffer;

@@ -269,27 +269,47 @@ fn casters(frame: &FrameInputs) -> Vec<(&Instance, Coverage)> {
         .collect()
 }
 
+/// Meshes of at most this many triangles are carried to world space an instance to a thread, corner by
+/// corner; larger ones vertex by vertex, their vertices and triangles split among the threads.
+const SMALL_MESH: usize = 64;
+
 /// Every triangle of `casters` in world space, and the alpha-tested ones among them.
 fn casting_triangles(casters: &[(&Instance, Coverage)]) -> Casters {
     let any_cutout = casters.iter().any(|(_, c)| *c == Coverage::Cutout);
     let mut out = Casters { tris: Vec::new(), cutout: Vec::new(), table: Table::default() };
-    // Instance by instance, each one's vertices and triangles split among the threads: a scene is
-    // often one large mesh and a few small ones.
-    for &(inst, coverage) in casters {
-        let m = inst.world_from_local;
-        let world: Vec<Vec3A> =
-            inst.mesh.positions().par_iter().with_min_len(4096).map(|&p| m.transform_point3(p).into()).collect();
-        let triangles = inst.mesh.triangles();
-        out.tris.par_extend(triangles.par_iter().with_min_len(4096).map(|t| t.map(|v| world[v as usize])));
-        if any_cutout {
-            let ids = match coverage {
-                Coverage::Cutout => {
-                    let first = out.table.add(inst);
-                    (first..first + triangles.len() as u32).collect()
-                }
-                _ => vec![u32::MAX; triangles.len()],
-            };
-            out.cutout.extend(ids);
+    let small = |&(inst, coverage): &(&Instance, Coverage)| {
+        coverage == Coverage::Solid && inst.mesh.triangles().len() <= SMALL_MESH
+    };
+    // A scene is often one large mesh and a few small ones, or many small ones: a run of small solid
+    // casters is spread over the threads by the instance, each other caster by its own triangles.
+    for run in casters.chunk_by(|a, b| small(a) == small(b)) {
+        if small(&run[0]) {
+            let before = out.tris.len();
+            out.tris.par_extend(run.par_iter().with_min_len(256).flat_map_iter(|(inst, _)| {
+                let (m, positions) = (inst.world_from_local, inst.mesh.positions());
+                inst.mesh.triangles().iter().map(move |t| t.map(|v| m.transform_point3(positions[v as usize]).into()))
+            }));
+            if any_cutout {
+                out.cutout.resize(out.cutout.len() + out.tris.len() - before, u32::MAX);
+            }
+            continue;
+        }
+        for &(inst, coverage) in run {
+            let m = inst.world_from_local;
+            let world: Vec<Vec3A> =
+                inst.mesh.positions().par_iter().with_min_len(4096).map(|&p| m.transform_point3(p).into()).collect();
+            let triangles = inst.mesh.triangles();
+            out.tris.par_extend(triangles.par_iter().with_min_len(4096).map(|t| t.map(|v| world[v as usize])));
+            if any_cutout {
+                let ids = match coverage {
+                    Coverage::Cutout => {
+                        let first = out.table.add(inst);
+                        (first..first + triangles.len() as u32).collect()
+                    }
+                    _ => vec![u32::MAX; triangles.len()],
+                };
+                out.cutout.extend(ids);
+            }
         }
     }
     out

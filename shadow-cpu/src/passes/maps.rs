@@ -5,18 +5,19 @@
 //! [`CutoutMaps`] holds those casters alone, for the techniques built on silhouettes.
 
 use shadow_core::frame::FrameError;
-use shadow_core::glam::{Vec2, Vec3, Vec4};
+use shadow_core::glam::{Vec2, Vec3};
 use shadow_core::light::{LightProjection, LightView};
 use shadow_core::lookup::shadow_lookup;
 use shadow_core::technique::DebugView;
 use shadow_core::technique::maps::{Casters, CutoutMap};
 use shadow_core::technique::settings::{DepthBias, Filter};
-use shadow_core::{FrameInputs, Image};
+use shadow_core::{FrameInputs, Image, Instance};
 
 use super::per_receiver;
 use crate::alpha_test::{Drawn, draw_alpha_tested};
+use crate::clip_space::ClipVertices;
 use crate::context::{CpuError, MAX_MAP_TEXELS, check_size};
-use crate::gbuffer::{GBuffer, clip_vertices};
+use crate::gbuffer::GBuffer;
 use crate::raster::{
     Batch, CullMode, DepthState, DepthStencil, Fragment, Indexed, RasterCounters, RasterState, draw_depth, draw_flat,
 };
@@ -77,25 +78,21 @@ struct LightCasters<'a> {
     frame: &'a FrameInputs,
     drawn: Drawn<'a>,
     /// The clip-space vertices of each of `drawn.solid`, then of each of `drawn.cutout`.
-    clip: Vec<Vec<Vec4>>,
+    clip: ClipVertices,
 }
 
 impl<'a> LightCasters<'a> {
     fn new(frame: &'a FrameInputs, proj: &LightProjection, casters: Casters) -> Self {
         let drawn = Drawn::sort(frame, |i| casters.takes(i));
-        let clip = (drawn.solid.iter().chain(&drawn.cutout))
-            .map(|&k| {
-                let inst = &frame.instances[k];
-                clip_vertices(inst.mesh.positions(), proj.clip_from_world * inst.world_from_local)
-            })
-            .collect();
+        let casting: Vec<&Instance> = drawn.solid.iter().chain(&drawn.cutout).map(|&k| &frame.instances[k]).collect();
+        let clip = ClipVertices::of_instances(&casting, proj.clip_from_world);
         Self { frame, drawn, clip }
     }
 
     /// The instances `list` (whose clip-space vertices start at `clip[first]`) as one draw, in order.
     fn batch<'b>(&'b self, list: &[usize], first: usize) -> Result<Batch<'b>, FrameError> {
-        let part = |(&k, clip): (&usize, &'b Vec<Vec4>)| Indexed::instance(&self.frame.instances[k], clip);
-        Batch::new(list.iter().zip(&self.clip[first..]).map(part).collect())
+        let part = |(j, &k): (usize, &usize)| Indexed::instance(&self.frame.instances[k], &self.clip[first + j]);
+        Batch::new(list.iter().enumerate().map(part).collect())
     }
 
     /// The solid casters as one draw; its parts are in the order of `drawn.solid`.

@@ -69,9 +69,7 @@ fn count_each(
             );
             let mut setups: Vec<Setup> = Vec::new();
             for src in &draw.sources {
-                for i in 0..src.len() {
-                    setup(src.get(i), st, w, h, guard, &mut setups);
-                }
+                src.each(0..src.len(), &mut |t| setup(t, st, w, h, guard, &mut setups));
             }
             let mut c = RasterCounters { triangles: setups.len() as u64, ..RasterCounters::default() };
             let mut delta = vec![0u8; pixels.len()];

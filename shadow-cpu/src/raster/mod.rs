@@ -81,6 +81,8 @@ const ONE: i64 = 1 << SUBPIXEL_BITS;
 const HALF: i64 = ONE / 2;
 /// Triangles set up at once: bounds the memory of a draw whatever its size.
 const BATCH: usize = 1 << 15;
+/// Triangles a thread sets up in one go.
+const SETUP_JOB: usize = 256;
 
 /// A depth buffer with an 8-bit stencil, row-major from the top-left.
 #[derive(Clone, Debug, PartialEq)]
@@ -351,11 +353,11 @@ where
         let end = (start + BATCH).min(src.len());
         // Per-job lists joined with one copy (a `Setup` is some 300 bytes; a flattening collect moves each
         // twice more).
-        let parts: Vec<Vec<Setup>> = (start..end)
+        let parts: Vec<Vec<Setup>> = (0..(end - start).div_ceil(SETUP_JOB))
             .into_par_iter()
-            .with_min_len(256)
-            .fold(Vec::new, |mut acc, i| {
-                setup(src.get(i), st, w, h, guard, &mut acc);
+            .map(|job| {
+                let (first, mut acc) = (start + job * SETUP_JOB, Vec::new());
+                src.each(first..(first + SETUP_JOB).min(end), &mut |t| setup(t, st, w, h, guard, &mut acc));
                 acc
             })
             .collect();

@@ -1,6 +1,8 @@
 //! What a draw rasterizes: triangles by index, from indexed meshes ([`Indexed`], several as one
 //! [`Batch`]) or given corner by corner ([`Soup`]).
 
+use std::ops::Range;
+
 use glam::Vec4;
 use shadow_core::frame::{FrameError, Instance, MAX_FRAME_TRIANGLES};
 
@@ -23,6 +25,13 @@ pub trait TriangleSource: Sync {
     fn len(&self) -> usize;
     /// Triangle `i`.
     fn get(&self, i: usize) -> SourceTriangle;
+    /// Triangles `range` in order, each as [`Self::get`] gives it, to `f` (a source whose `get` searches
+    /// walks instead).
+    fn each(&self, range: Range<usize>, f: &mut dyn FnMut(SourceTriangle)) {
+        for i in range {
+            f(self.get(i));
+        }
+    }
     /// True when there are none.
     fn is_empty(&self) -> bool {
         self.len() == 0
@@ -132,6 +141,19 @@ impl TriangleSource for Batch<'_> {
     fn get(&self, i: usize) -> SourceTriangle {
         let (part, local) = self.part_of(i as u32);
         SourceTriangle { prim: i as u32, ..self.parts[part].get(local as usize) }
+    }
+    /// Searches for the first triangle's part only: a frame of many small meshes would otherwise pay a
+    /// search of its parts per triangle.
+    fn each(&self, range: Range<usize>, f: &mut dyn FnMut(SourceTriangle)) {
+        let Some(first) = range.clone().next() else { return };
+        let (mut part, _) = self.part_of(first as u32);
+        for i in range {
+            while self.starts[part + 1] as usize <= i {
+                part += 1;
+            }
+            let local = i - self.starts[part] as usize;
+            f(SourceTriangle { prim: i as u32, ..self.parts[part].get(local) });
+        }
     }
 }
 
