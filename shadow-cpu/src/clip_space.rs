@@ -10,7 +10,13 @@ use shadow_core::{FrameInputs, Instance};
 /// Clip-space vertices of an instance under `clip_from_local` (its world transform under the view's).
 #[must_use]
 pub fn clip_vertices(positions: &[Vec3], clip_from_local: Mat4) -> Vec<Vec4> {
-    positions.par_iter().with_min_len(4096).map(|&p| clip_from_local * p.extend(1.0)).collect()
+    positions.par_iter().with_min_len(JOB).map(|&p| to_clip(clip_from_local, p)).collect()
+}
+
+/// The transform itself, one vertex.
+#[inline]
+fn to_clip(clip_from_local: Mat4, p: Vec3) -> Vec4 {
+    clip_from_local * p.extend(1.0)
 }
 
 /// Vertices a thread transforms in one go.
@@ -63,7 +69,7 @@ impl ClipVertices {
             for inst in instances {
                 let (mine, tail) = std::mem::take(&mut out).split_at_mut(inst.mesh.positions().len());
                 let m = clip_from_world * inst.world_from_local;
-                let transform = |(v, &p): (&mut Vec4, &Vec3)| *v = m * p.extend(1.0);
+                let transform = |(v, &p): (&mut Vec4, &Vec3)| *v = to_clip(m, p);
                 if mine.len() > JOB {
                     mine.par_iter_mut().zip(inst.mesh.positions()).with_min_len(JOB).for_each(transform);
                 } else {
