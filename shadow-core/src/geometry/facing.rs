@@ -42,50 +42,44 @@ pub(crate) enum Facing {
     Mixed,
 }
 
-/// Per-mesh bounds for [`Facing`] decisions over runs of faces and of manifold edges.
-#[derive(Clone, Debug, Default)]
-pub(crate) struct FacingRuns {
-    /// Per run of faces, the least and the greatest value of each plane component.
-    planes: Vec<[Vec4; 2]>,
-    /// Per run of manifold edges, the face runs of its faces, the unused slots repeating the first
-    /// (so all of them can be checked without a count); `None` when they are more than [`SPREAD`].
-    edges: Vec<Option<[u32; SPREAD]>>,
+/// The face runs of one run of manifold edges, the unused slots repeating the first (so all of them
+/// can be checked without a count); `None` when they are more than [`SPREAD`].
+pub(crate) type EdgeRun = Option<[u32; SPREAD]>;
+
+/// The least and the greatest value of each plane component over one run of faces.
+pub(crate) fn face_run(run: &[Vec4]) -> [Vec4; 2] {
+    let (lo, hi) = run.iter().fold((Vec4::INFINITY, Vec4::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+    // A plane with an infinite or NaN component has a NaN facing value wherever a light component it
+    // meets is zero, and `min` and `max` pass NaN over: its run stays undecided.
+    if run.iter().all(|p| p.is_finite()) { [lo, hi] } else { [Vec4::NAN; 2] }
 }
 
-impl FacingRuns {
-    /// The bounds of a mesh's face planes, and the face runs of its manifold edges.
-    pub(crate) fn new(planes: &[Vec4], manifold_faces: &[[u32; 2]]) -> Self {
-        let planes = planes
-            .par_chunks(FACES)
-            .map(|run| {
-                let (lo, hi) =
-                    run.iter().fold((Vec4::INFINITY, Vec4::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
-                // A plane with an infinite or NaN component has a NaN facing value wherever a light
-                // component it meets is zero, and `min` and `max` pass NaN over: its run stays undecided.
-                if run.iter().all(|p| p.is_finite()) { [lo, hi] } else { [Vec4::NAN; 2] }
-            })
-            .collect();
-        let edges = manifold_faces
-            .par_chunks(EDGES)
-            .map(|run| {
-                let mut runs = [(run[0][0] as usize / FACES) as u32; SPREAD];
-                let mut len = 1;
-                for f in run.iter().flatten() {
-                    let r = (*f as usize / FACES) as u32;
-                    if !runs[..len].contains(&r) {
-                        if len == SPREAD {
-                            return None;
-                        }
-                        runs[len] = r;
-                        len += 1;
-                    }
-                }
-                Some(runs)
-            })
-            .collect();
-        Self { planes, edges }
+/// The face runs of the faces of one run of manifold edges.
+pub(crate) fn edge_run(run: &[[u32; 2]]) -> EdgeRun {
+    let mut runs = [(run[0][0] as usize / FACES) as u32; SPREAD];
+    let mut len = 1;
+    for f in run.iter().flatten() {
+        let r = (*f as usize / FACES) as u32;
+        if !runs[..len].contains(&r) {
+            if len == SPREAD {
+                return None;
+            }
+            runs[len] = r;
+            len += 1;
+        }
     }
+    Some(runs)
+}
 
+/// One mesh's bounds for [`Facing`] decisions over runs of faces and of manifold edges: per run of
+/// [`FACES`] faces, [`face_run`]; per run of [`EDGES`] manifold edges, [`edge_run`].
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct FacingRuns<'a> {
+    pub(crate) planes: &'a [[Vec4; 2]],
+    pub(crate) edges: &'a [EdgeRun],
+}
+
+impl FacingRuns<'_> {
     /// The facing of every run of faces towards `light`.
     pub(crate) fn facing(&self, light: LightSource) -> Vec<Facing> {
         // The facing value of a plane as a dot product with the light in homogeneous form: (l, 1) for a

@@ -216,6 +216,18 @@ proptest! {
         same_as_plainly(&mesh)?;
     }
 
+    /// Small meshes built together, on one thread into one store, are each the mesh built alone on
+    /// all threads.
+    #[test]
+    fn a_batch_of_small_meshes_is_each_mesh_built_alone(
+        meshes in prop::collection::vec(prop_oneof![closed_mesh(), open_mesh(), welded_mesh()], 1..6)
+    ) {
+        let refs: Vec<&Mesh> = meshes.iter().collect();
+        for (adj, mesh) in Adjacency::build_all(&refs).iter().zip(&meshes) {
+            prop_assert!(adj.same_lists(&Adjacency::build_on_all_threads(mesh)));
+        }
+    }
+
     #[test]
     fn closed_silhouettes_form_closed_loops(mesh in closed_mesh(), light in light()) {
         let adj = Adjacency::build(&mesh);

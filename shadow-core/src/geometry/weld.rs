@@ -105,24 +105,28 @@ fn weld_in_parts(positions: &[Vec3]) -> (Vec<Vec3>, Vec<u32>) {
 /// it comes (the parts and the threads cost more than they save on a small mesh, and a scene of many
 /// small meshes pays that cost per mesh).
 fn weld_alone(positions: &[Vec3]) -> (Vec<Vec3>, Vec<u32>) {
-    let mut table = WeldTable::with_room(positions.len());
-    let mut welded = Vec::new();
-    let remap = positions
-        .iter()
-        .map(|&p| {
-            let key = weld_key(p);
-            let number = table.get_or_insert(key, weld_hash(key), welded.len() as u32);
-            if number as usize == welded.len() {
-                welded.push(p);
-            }
-            number
-        })
-        .collect();
+    let (mut welded, mut remap) = (Vec::new(), Vec::new());
+    weld_alone_into(positions, &mut WeldTable::default(), &mut welded, &mut remap);
     (welded, remap)
 }
 
+/// [`weld_alone`], appending the welded positions to `welded` and each position's number among them to
+/// `remap`, with `table` reused from mesh to mesh (a batch of small meshes allocates it once).
+pub(super) fn weld_alone_into(positions: &[Vec3], table: &mut WeldTable, welded: &mut Vec<Vec3>, remap: &mut Vec<u32>) {
+    table.clear(positions.len());
+    let first = welded.len();
+    remap.extend(positions.iter().map(|&p| {
+        let key = weld_key(p);
+        let number = table.get_or_insert(key, weld_hash(key), (welded.len() - first) as u32);
+        if number as usize == welded.len() - first {
+            welded.push(p);
+        }
+        number
+    }));
+}
+
 /// The most positions [`weld`] welds on one thread, in one table that stays in the cache.
-const WELD_ALONE: usize = 4096;
+pub(super) const WELD_ALONE: usize = 4096;
 
 /// For each of one part's `count` members (`[key, position]`, in position order), the first position with
 /// the same key, stored at the member's position in `first`.
@@ -137,7 +141,8 @@ fn weld_part<'a>(members: impl Iterator<Item = &'a [u32; 4]>, count: usize, firs
 
 /// Weld keys with a value each (a first position, or a number): an open addressing table with linear
 /// probing, at most half full, holding each key beside its value so a probe reads no other memory.
-struct WeldTable {
+#[derive(Default)]
+pub(super) struct WeldTable {
     slots: Vec<[u32; 4]>,
 }
 
@@ -146,7 +151,15 @@ impl WeldTable {
 
     /// A table for up to `count` keys.
     fn with_room(count: usize) -> Self {
-        Self { slots: vec![[0, 0, 0, Self::EMPTY]; (2 * count).next_power_of_two().max(16)] }
+        let mut table = Self::default();
+        table.clear(count);
+        table
+    }
+
+    /// Empties the table and makes room for `count` keys, keeping its allocation where that is enough.
+    fn clear(&mut self, count: usize) {
+        self.slots.clear();
+        self.slots.resize((2 * count).next_power_of_two().max(16), [0, 0, 0, Self::EMPTY]);
     }
 
     /// The value `key` holds, or else `value`, stored for it; the probe starts at `hash`'s low bits.

@@ -235,17 +235,17 @@ impl Scene {
         Some(e.adjacency.get_or_init(|| Arc::new(Adjacency::build(&e.mesh))).clone())
     }
 
-    /// Builds the adjacency of every mesh that has none cached yet, the meshes side by side on all
-    /// threads. A scene of many small meshes built one mesh at a time would pay for starting the thread
-    /// pool's work on each (most of the time of a mesh of a few triangles); from a worker thread, each
-    /// build's own parallel steps cost next to nothing. [`FrameInputs::new`](crate::FrameInputs::new)
-    /// calls it.
+    /// Builds the adjacency of every mesh that has none cached yet, on all threads, small meshes in
+    /// batches ([`Adjacency::build_all`]): a scene of many small meshes built one mesh at a time would
+    /// pay a fixed cost per mesh larger than a small mesh's own.
+    /// [`FrameInputs::new`](crate::FrameInputs::new) calls it.
     pub fn build_adjacencies(&self) {
-        use rayon::prelude::*;
         let missing: Vec<&MeshEntry> = self.meshes.values().filter(|e| e.adjacency.get().is_none()).collect();
-        missing.par_iter().for_each(|e| {
-            e.adjacency.get_or_init(|| Arc::new(Adjacency::build(&e.mesh)));
-        });
+        let meshes: Vec<&Mesh> = missing.iter().map(|e| e.mesh.as_ref()).collect();
+        for (e, adjacency) in missing.iter().zip(Adjacency::build_all(&meshes)) {
+            // Set unless a caller on another thread has just set it, to the same adjacency.
+            let _ = e.adjacency.set(Arc::new(adjacency));
+        }
     }
 
     /// True when the mesh's adjacency is already cached.
