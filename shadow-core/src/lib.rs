@@ -14,6 +14,7 @@ pub mod bounds;
 pub mod deform;
 pub mod frame;
 pub mod geometry;
+pub mod hash;
 pub mod image;
 pub mod inspect;
 pub mod light;

@@ -7,6 +7,8 @@ use glam::{Mat4, Vec3, Vec4};
 use rayon::prelude::*;
 use shadow_core::{FrameInputs, Instance};
 
+use crate::runs;
+
 /// Clip-space vertices of an instance under `clip_from_local` (its world transform under the view's).
 #[must_use]
 pub fn clip_vertices(positions: &[Vec3], clip_from_local: Mat4) -> Vec<Vec4> {
@@ -44,29 +46,11 @@ impl ClipVertices {
     pub fn of_instances(instances: &[&Instance], clip_from_world: Mat4) -> Self {
         // Counted side by side: reading many small meshes' lengths is a wait on memory each.
         let counts: Vec<usize> = instances.par_iter().with_min_len(1024).map(|i| i.mesh.positions().len()).collect();
-        let starts: Vec<usize> = std::iter::once(0)
-            .chain(counts.iter().scan(0, |total, &n| {
-                *total += n;
-                Some(*total)
-            }))
-            .collect();
-        let total = starts[counts.len()];
-        let mut vertices = vec![Vec4::ZERO; total];
-        // Runs of consecutive instances of about a job's vertices each, a run to a thread; an instance
-        // larger than a job is a run of its own, split among the threads by its vertices.
-        let mut runs: Vec<(&[&Instance], &mut [Vec4])> = Vec::new();
-        let (mut rest, mut first) = (vertices.as_mut_slice(), 0);
-        for k in 1..=instances.len() {
-            let large = |i: usize| counts[i] > JOB;
-            if k == instances.len() || starts[k] - starts[first] >= JOB || large(k) || large(k - 1) {
-                let (run, tail) = std::mem::take(&mut rest).split_at_mut(starts[k] - starts[first]);
-                runs.push((&instances[first..k], run));
-                (rest, first) = (tail, k);
-            }
-        }
-        runs.into_par_iter().for_each(|(instances, out)| {
+        let starts = runs::starts(&counts);
+        let mut vertices = vec![Vec4::ZERO; starts[counts.len()]];
+        runs::for_each_run(&starts, &mut vertices, JOB, |run, out| {
             let mut out = out;
-            for inst in instances {
+            for inst in &instances[run] {
                 let (mine, tail) = std::mem::take(&mut out).split_at_mut(inst.mesh.positions().len());
                 let m = clip_from_world * inst.world_from_local;
                 let transform = |(v, &p): (&mut Vec4, &Vec3)| *v = to_clip(m, p);

@@ -14,6 +14,7 @@ pub mod frame;
 pub mod gbuffer;
 pub mod passes;
 pub mod raster;
+pub mod runs;
 pub mod shade;
 
 pub use context::{CpuBackend, CpuContext, CpuError};

@@ -138,21 +138,20 @@ impl LightPass<'_> {
     #[must_use]
     pub fn build_key(&self, reads: BuildReads) -> u64 {
         use std::hash::{Hash, Hasher};
+        let floats = |h: &mut dyn Hasher, v: &[f32]| v.iter().for_each(|x| h.write_u32(x.to_bits()));
         let mut h = std::collections::hash_map::DefaultHasher::new();
-        let floats = |h: &mut std::collections::hash_map::DefaultHasher, v: &[f32]| {
-            v.iter().for_each(|x| x.to_bits().hash(h));
-        };
         floats(&mut h, &self.light.source().homogeneous().to_array());
         floats(&mut h, &[self.light.light.radius]);
         for p in &self.light.projections {
             floats(&mut h, &p.clip_from_world.to_cols_array());
         }
         let read = |inst: &crate::frame::Instance| reads == BuildReads::EveryInstance || self.light.sees(inst.bounds);
-        for (i, inst) in self.frame.instances.iter().enumerate().filter(|(_, inst)| read(inst)) {
-            (i, inst.mesh_key, inst.mesh_version, inst.casts_shadow, inst.receives_shadow).hash(&mut h);
-            floats(&mut h, &inst.world_from_local.to_cols_array());
-        }
-        h.finish()
+        crate::hash::digest(h.finish(), &self.frame.instances, |i, inst, h| {
+            if read(inst) {
+                (i, inst.mesh_key, inst.mesh_version, inst.casts_shadow, inst.receives_shadow).hash(h);
+                floats(h, &inst.world_from_local.to_cols_array());
+            }
+        })
     }
 }
 

@@ -8,12 +8,12 @@
 //! products and sums as its `transform_point3` of the same positions, [`Corners8::placed`]) and tested
 //! against the world ray in the same lanes, so each triangle answers exactly what it answers there.
 
-use std::collections::HashMap;
 use std::sync::Arc;
 
 use glam::{Mat4, Vec3, Vec3A};
 use rayon::prelude::*;
 use shadow_core::frame::Coverage;
+use shadow_core::hash::WordMap;
 use shadow_core::{Instance, Mesh};
 
 use super::build::{self, STACK};
@@ -67,37 +67,30 @@ pub struct Instanced {
     triangles: usize,
 }
 
-/// Which of `casters` are kept as instances of their mesh: those that cast all of it (no texture cuts
-/// them out) with a mesh another such caster holds too (posed meshes, each its own, never are), and
-/// a transform that can carry a ray into the mesh's space (finite, with a finite inverse).
-pub fn kept(casters: &[(&Instance, Coverage)]) -> Vec<bool> {
-    let eligible: Vec<bool> = casters
-        .iter()
-        .map(|(inst, coverage)| {
-            *coverage == Coverage::Solid
-                && inst.world_from_local.is_finite()
-                && inst.local_from_world.is_finite()
-                && inst.world_from_local.determinant() != 0.0
-        })
-        .collect();
-    let mut uses: HashMap<*const Mesh, usize> = HashMap::new();
-    for ((inst, _), _) in casters.iter().zip(&eligible).filter(|(_, e)| **e) {
-        *uses.entry(Arc::as_ptr(&inst.mesh)).or_default() += 1;
+/// Whether a caster may be kept as an instance of its mesh: it casts all of it (no texture cuts it
+/// out), and its transform can carry a ray into the mesh's space (finite, with a finite inverse).
+pub fn keepable(inst: &Instance, coverage: Coverage) -> bool {
+    coverage == Coverage::Solid
+        && inst.world_from_local.is_finite()
+        && inst.local_from_world.is_finite()
+        && inst.world_from_local.determinant() != 0.0
+}
+
+/// Which casters are kept as instances of their mesh, given the mesh of each [`keepable`] one (by
+/// address): those whose mesh another keepable caster holds too (posed meshes, each its own, never
+/// are).
+pub fn kept(keepable_meshes: &[Option<usize>]) -> Vec<bool> {
+    let mut uses: WordMap<usize, u32> = WordMap::with_capacity_and_hasher(keepable_meshes.len(), Default::default());
+    for mesh in keepable_meshes.iter().flatten() {
+        *uses.entry(*mesh).or_default() += 1;
     }
-    casters
-        .iter()
-        .zip(&eligible)
-        .map(|((inst, _), &e)| {
-            let uses = uses.get(&Arc::as_ptr(&inst.mesh)).copied().unwrap_or(0);
-            e && uses > 1
-        })
-        .collect()
+    keepable_meshes.par_iter().with_min_len(1024).map(|mesh| mesh.is_some_and(|m| uses[&m] > 1)).collect()
 }
 
 impl Instanced {
     /// The trees of `instances` (at least one), each mesh's built once.
     pub fn build(instances: &[&Instance]) -> Self {
-        let mut index: HashMap<*const Mesh, u32> = HashMap::new();
+        let mut index: WordMap<*const Mesh, u32> = WordMap::default();
         let mut unique: Vec<&Arc<Mesh>> = Vec::new();
         let placed_mesh: Vec<u32> = instances
             .iter()

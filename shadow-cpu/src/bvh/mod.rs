@@ -8,7 +8,7 @@ pub mod cutout;
 mod instanced;
 mod wide;
 
-use std::hash::{Hash, Hasher};
+use std::hash::Hash;
 
 use glam::{Vec3, Vec3A};
 use rayon::prelude::*;
@@ -19,6 +19,8 @@ use self::cutout::{Cutouts, Table};
 use self::instanced::{Instanced, Visit, walk_tree};
 use self::wide::{Child, NONE, Node8, Ray, Tri8};
 use shadow_core::frame::Coverage;
+
+use crate::runs;
 
 /// The casters of a frame, ready for shadow rays.
 pub struct SceneBvh {
@@ -40,15 +42,15 @@ impl SceneBvh {
     /// A key that changes when any caster's mesh, transform or alpha test does.
     #[must_use]
     pub fn key(frame: &FrameInputs) -> u64 {
-        let mut h = std::collections::hash_map::DefaultHasher::new();
-        for inst in frame.instances.iter().filter(|i| i.casts_shadow) {
-            inst.mesh_version.hash(&mut h);
-            for v in inst.world_from_local.to_cols_array() {
-                v.to_bits().hash(&mut h);
+        shadow_core::hash::digest(0, &frame.instances, |_, inst, h| {
+            if inst.casts_shadow {
+                inst.mesh_version.hash(h);
+                for v in inst.world_from_local.to_cols_array() {
+                    v.to_bits().hash(h);
+                }
+                cutout::hash_alpha_test(inst, h);
             }
-            cutout::hash_alpha_test(inst, &mut h);
-        }
-        h.finish()
+        })
     }
 
     /// Builds the BVH of every casting triangle: a mesh cast by more than one instance (and cut out by
@@ -57,10 +59,10 @@ impl SceneBvh {
     #[must_use]
     pub fn build(frame: &FrameInputs) -> Self {
         let casters = casters(frame);
-        let kept = instanced::kept(&casters);
+        let kept = instanced::kept(&casters.iter().map(|c| c.keepable_mesh).collect::<Vec<_>>());
         let (shared, flat): (Vec<_>, Vec<_>) = casters.into_iter().zip(kept).partition(|(_, k)| *k);
-        let shared: Vec<&Instance> = shared.into_iter().map(|((inst, _), _)| inst).collect();
-        let flat: Vec<(&Instance, Coverage)> = flat.into_iter().map(|(c, _)| c).collect();
+        let shared: Vec<&Instance> = shared.into_iter().map(|(c, _)| c.inst).collect();
+        let flat: Vec<Caster> = flat.into_iter().map(|(c, _)| c).collect();
         let instanced = (!shared.is_empty()).then(|| Instanced::build(&shared));
         let Casters { tris, cutout, table } = casting_triangles(&flat);
         let (nodes, leaves, cutouts) = if tris.is_empty() {
@@ -258,57 +260,77 @@ struct Casters {
     table: Table,
 }
 
-/// The instances of the frame that can block light, with how much of them does.
-fn casters(frame: &FrameInputs) -> Vec<(&Instance, Coverage)> {
+/// An instance that can block light, and what the build reads of it, read in one pass: a frame of many
+/// small meshes waits on memory for each instance it reads.
+#[derive(Clone, Copy)]
+struct Caster<'a> {
+    inst: &'a Instance,
+    /// How much of it blocks light.
+    coverage: Coverage,
+    /// Its triangles.
+    triangles: usize,
+    /// Its mesh's address, where it may be kept as an instance of its mesh ([`instanced::keepable`]).
+    keepable_mesh: Option<usize>,
+}
+
+/// The instances of the frame that can block light.
+fn casters(frame: &FrameInputs) -> Vec<Caster<'_>> {
     frame
         .instances
-        .iter()
+        .par_iter()
+        .with_min_len(1024)
         .filter(|i| i.casts_shadow)
-        .map(|i| (i, i.coverage()))
-        .filter(|(_, c)| *c != Coverage::Absent)
+        .map(|inst| {
+            let coverage = inst.coverage();
+            let keepable_mesh =
+                instanced::keepable(inst, coverage).then_some(std::sync::Arc::as_ptr(&inst.mesh) as usize);
+            Caster { inst, coverage, triangles: inst.mesh.triangles().len(), keepable_mesh }
+        })
+        .filter(|c| c.coverage != Coverage::Absent)
         .collect()
 }
 
-/// Meshes of at most this many triangles are carried to world space an instance to a thread, corner by
-/// corner; larger ones vertex by vertex, their vertices and triangles split among the threads.
+/// About how many triangles a thread carries to world space in one go: small casters a run of them to a
+/// thread, a larger one alone, split among the threads by its vertices and triangles.
+const JOB: usize = 4096;
+
+/// Casters of at most this many triangles are carried corner by corner; larger ones vertex by vertex,
+/// then gathered (the same positions either way, as the transform is the same).
 const SMALL_MESH: usize = 64;
 
 /// Every triangle of `casters` in world space, and the alpha-tested ones among them.
-fn casting_triangles(casters: &[(&Instance, Coverage)]) -> Casters {
-    let any_cutout = casters.iter().any(|(_, c)| *c == Coverage::Cutout);
-    let mut out = Casters { tris: Vec::new(), cutout: Vec::new(), table: Table::default() };
-    let small = |&(inst, coverage): &(&Instance, Coverage)| {
-        coverage == Coverage::Solid && inst.mesh.triangles().len() <= SMALL_MESH
-    };
-    // A scene is often one large mesh and a few small ones, or many small ones: a run of small solid
-    // casters is spread over the threads by the instance, each other caster by its own triangles.
-    for run in casters.chunk_by(|a, b| small(a) == small(b)) {
-        if small(&run[0]) {
-            let before = out.tris.len();
-            out.tris.par_extend(run.par_iter().with_min_len(256).flat_map_iter(|(inst, _)| {
-                let (m, positions) = (inst.world_from_local, inst.mesh.positions());
-                inst.mesh.triangles().iter().map(move |t| t.map(|v| m.transform_point3(positions[v as usize]).into()))
-            }));
-            if any_cutout {
-                out.cutout.resize(out.cutout.len() + out.tris.len() - before, u32::MAX);
+fn casting_triangles(casters: &[Caster]) -> Casters {
+    let starts = runs::starts(&casters.iter().map(|c| c.triangles).collect::<Vec<_>>());
+    let mut tris = vec![[Vec3A::ZERO; 3]; starts[casters.len()]];
+    runs::for_each_run(&starts, &mut tris, JOB, |run, out| {
+        let mut out = out;
+        for Caster { inst, .. } in &casters[run] {
+            let (m, positions, triangles) = (inst.world_from_local, inst.mesh.positions(), inst.mesh.triangles());
+            let (mine, tail) = std::mem::take(&mut out).split_at_mut(triangles.len());
+            if triangles.len() <= SMALL_MESH {
+                for (o, t) in mine.iter_mut().zip(triangles) {
+                    *o = t.map(|v| m.transform_point3(positions[v as usize]).into());
+                }
+            } else {
+                let world: Vec<Vec3A> =
+                    positions.par_iter().with_min_len(JOB).map(|&p| m.transform_point3(p).into()).collect();
+                mine.par_iter_mut()
+                    .zip(triangles)
+                    .with_min_len(JOB)
+                    .for_each(|(o, t)| *o = t.map(|v| world[v as usize]));
             }
-            continue;
+            out = tail;
         }
-        for &(inst, coverage) in run {
-            let m = inst.world_from_local;
-            let world: Vec<Vec3A> =
-                inst.mesh.positions().par_iter().with_min_len(4096).map(|&p| m.transform_point3(p).into()).collect();
-            let triangles = inst.mesh.triangles();
-            out.tris.par_extend(triangles.par_iter().with_min_len(4096).map(|t| t.map(|v| world[v as usize])));
-            if any_cutout {
-                let ids = match coverage {
-                    Coverage::Cutout => {
-                        let first = out.table.add(inst);
-                        (first..first + triangles.len() as u32).collect()
-                    }
-                    _ => vec![u32::MAX; triangles.len()],
-                };
-                out.cutout.extend(ids);
+    });
+    let mut out = Casters { tris, cutout: Vec::new(), table: Table::default() };
+    if casters.iter().any(|c| c.coverage == Coverage::Cutout) {
+        out.cutout = vec![u32::MAX; out.tris.len()];
+        for (&Caster { inst, coverage, .. }, w) in casters.iter().zip(starts.windows(2)) {
+            if coverage == Coverage::Cutout {
+                let first = out.table.add(inst);
+                for (id, c) in (first..).zip(&mut out.cutout[w[0]..w[1]]) {
+                    *c = id;
+                }
             }
         }
     }
