@@ -8,6 +8,7 @@
 //! Solid instances keep the passes' own loops; only the cut-out ones take the per-fragment path, drawn
 //! after them. Instances with nothing there ([`Coverage::Absent`]) are not drawn at all.
 
+use rayon::prelude::*;
 use shadow_core::frame::{Coverage, Instance};
 use shadow_core::glam::Vec2;
 use shadow_core::material::Footprint;
@@ -30,10 +31,14 @@ impl<'a> Drawn<'a> {
     /// The instances of `frame` that `keep` takes (every one for the camera, the casters for a light),
     /// sorted.
     #[must_use]
-    pub fn sort(frame: &'a FrameInputs, keep: impl Fn(&Instance) -> bool) -> Self {
+    pub fn sort(frame: &'a FrameInputs, keep: impl Fn(&Instance) -> bool + Sync) -> Self {
+        // Read side by side: a frame of many small meshes waits on memory for each instance.
+        let coverage: Vec<Option<Coverage>> =
+            frame.instances.par_iter().with_min_len(1024).map(|i| keep(i).then(|| i.coverage())).collect();
         let mut drawn = Self::default();
-        for (k, inst) in frame.instances.iter().enumerate().filter(|(_, i)| keep(i)) {
-            match inst.coverage() {
+        for (k, (inst, coverage)) in frame.instances.iter().zip(coverage).enumerate() {
+            let Some(coverage) = coverage else { continue };
+            match coverage {
                 Coverage::Solid => drawn.solid.push(k),
                 Coverage::Cutout => {
                     if let Some(test) = Cutout::of(inst) {

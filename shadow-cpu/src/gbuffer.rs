@@ -392,12 +392,6 @@ struct Surfaces {
 /// cleared first). The triangle's world corners and face normal are those of the pixel before on most
 /// pixels of a row, and four pixels in a row on one triangle are resolved together ([`surface_x4`]).
 fn resolve(frame: &FrameInputs, all: &Batch<'_>, visible: &[u32], eye_rays: &EyeRays, s: &mut Surfaces) {
-    let normal_from_local: Vec<Mat3> = frame
-        .instances
-        .par_iter()
-        .with_min_len(1024)
-        .map(|i| shadow_core::affine::normal_matrix(i.world_from_local))
-        .collect();
     let w = eye_rays.width as usize;
     s.position
         .par_chunks_mut(w)
@@ -414,6 +408,9 @@ fn resolve(frame: &FrameInputs, all: &Batch<'_>, visible: &[u32], eye_rays: &Eye
             dirs.clear();
             dirs.extend((0..w).map(|x| eye_rays.dir(x, y)));
             let mut last: Option<(u32, Triangle)> = None;
+            // The normal matrix of the last instance met, made when the row first meets it: a frame of
+            // many small meshes makes only those of the instances in view.
+            let mut normal: Option<(usize, Mat3)> = None;
             let mut x = 0;
             while x < w {
                 let prim = vis[x];
@@ -427,7 +424,12 @@ fn resolve(frame: &FrameInputs, all: &Batch<'_>, visible: &[u32], eye_rays: &Eye
                     Some((p, t)) if p == prim => t,
                     _ => {
                         let (k, triangle) = all.part_of(prim);
-                        let t = Triangle::new(frame, k, triangle as usize, normal_from_local[k]);
+                        let m = match normal {
+                            Some((i, m)) if i == k => m,
+                            _ => shadow_core::affine::normal_matrix(frame.instances[k].world_from_local),
+                        };
+                        normal = Some((k, m));
+                        let t = Triangle::new(frame, k, triangle as usize, m);
                         last = Some((prim, t));
                         t
                     }
@@ -490,7 +492,15 @@ pub fn render_reusing(
     let receiver = overwritten(old.receiver, n, false);
     // Every instance in one draw, in order (the same fragments as a draw each), each pixel left with the id
     // of its primitive in the batch; the back faces of single-sided materials not drawn.
-    let all = Batch::new(frame.instances.iter().enumerate().map(|(k, inst)| Indexed::seen(inst, &clip[k])).collect())?;
+    let all = Batch::new(
+        frame
+            .instances
+            .par_iter()
+            .enumerate()
+            .with_min_len(1024)
+            .map(|(k, inst)| Indexed::seen(inst, &clip[k]))
+            .collect(),
+    )?;
     let drawn = Drawn::sort(frame, |_| true);
     if drawn.solid.len() == frame.instances.len() {
         draw_flat(&mut ds, &mut visible, &all, &RasterState::default(), |prim| prim);

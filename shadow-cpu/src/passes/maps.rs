@@ -4,6 +4,7 @@
 //! by their texture discard the fragments of clear texels, each read over the footprint of one map texel.
 //! [`CutoutMaps`] holds those casters alone, for the techniques built on silhouettes.
 
+use rayon::prelude::*;
 use shadow_core::frame::FrameError;
 use shadow_core::glam::{Vec2, Vec3};
 use shadow_core::light::{LightProjection, LightView};
@@ -92,7 +93,7 @@ impl<'a> LightCasters<'a> {
     /// The instances `list` (whose clip-space vertices start at `clip[first]`) as one draw, in order.
     fn batch<'b>(&'b self, list: &[usize], first: usize) -> Result<Batch<'b>, FrameError> {
         let part = |(j, &k): (usize, &usize)| Indexed::instance(&self.frame.instances[k], &self.clip[first + j]);
-        Batch::new(list.iter().enumerate().map(part).collect())
+        Batch::new(list.par_iter().enumerate().with_min_len(1024).map(part).collect())
     }
 
     /// The solid casters as one draw; its parts are in the order of `drawn.solid`.
