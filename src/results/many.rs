@@ -1,15 +1,19 @@
 //! The scenes of many objects' part of the results ([`scenes::MANY`]): each as built, its meshes drawn by
 //! thousands of instances, beside the same scene with a copy of its mesh for every instance
 //! ([`shadow_core::Scene::unshare_meshes`]), so the two say what sharing a mesh is worth: the geometry
-//! held, the build of the CPU's ray-casting BVH, and the frame time per phase of a few techniques.
+//! held, the build of the CPU's ray-casting BVH, and the frame time per phase of a few techniques. Then
+//! a scene of many one-triangle meshes beside the same triangles as one mesh, so they say what a mesh
+//! costs beyond its triangles.
 
 use std::fmt::Write as _;
 use std::time::Instant;
 
-use shadow_core::FrameInputs;
+use shadow_core::geometry::adjacency::Adjacency;
+use shadow_core::glam::{Mat4, Vec3};
 use shadow_core::inspect::Inspection;
 use shadow_core::scenes::{self, SceneParams};
 use shadow_core::technique::TechniqueSpec;
+use shadow_core::{FrameInputs, Material, Mesh, Scene};
 use shadow_cpu::bvh::SceneBvh;
 
 use crate::Error;
@@ -34,10 +38,104 @@ struct Variant {
     bench: BenchReport,
 }
 
+/// The one-triangle meshes of the comparison of many small meshes against one.
+const SMALL_MESHES: u32 = 100_000;
+
+/// The same triangles as [`SMALL_MESHES`] meshes or as one, as built (`many`: each its own mesh).
+struct Triangles {
+    many: bool,
+    /// Medians over [`BUILDS`], in ms: every mesh's adjacency, and the ray-casting BVH.
+    adjacency_ms: f64,
+    bvh_ms: f64,
+    bench: BenchReport,
+}
+
 /// The measurements.
 pub struct ManyReport {
     scenes: Vec<(&'static str, [Variant; 2])>,
+    triangles: [Triangles; 2],
     size: (u32, u32),
+}
+
+/// [`SMALL_MESHES`] upright triangles strewn over a square (the same every time), each its own mesh or
+/// all of them one, staged on a ground under the model scenes' camera and light.
+fn triangles_scene(many: bool) -> Result<Scene, Error> {
+    let mut state = 0x9e37_79b9_7f4a_7c15u64;
+    let mut next = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 40) as f32 / (1u64 << 24) as f32 * 50.0
+    };
+    let corners: Vec<[Vec3; 3]> = (0..SMALL_MESHES)
+        .map(|_| {
+            let p = Vec3::new(next(), 0.5, next());
+            [p, p + Vec3::new(0.3, 0.0, 0.0), p + Vec3::new(0.0, 0.3, 0.3)]
+        })
+        .collect();
+    let mut scene = Scene::new();
+    let material = scene.add_material(Material::default());
+    let bad = |e: &dyn std::fmt::Display| Error::Usage(format!("the triangles scene: {e}"));
+    let mut add = |name: &str, corners: &[[Vec3; 3]]| -> Result<(), Error> {
+        let positions = corners.iter().flatten().copied().collect();
+        let triangles = (0..corners.len() as u32).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect();
+        let mesh = scene.add_mesh(Mesh::new(positions, triangles).map_err(|e| bad(&e))?);
+        scene.add_instance(name, mesh, material, Mat4::IDENTITY).map_err(|e| bad(&e))?;
+        Ok(())
+    };
+    if many {
+        for (k, c) in corners.iter().enumerate() {
+            add(&format!("t{k}"), std::slice::from_ref(c))?;
+        }
+    } else {
+        add("triangles", &corners)?;
+    }
+    scenes::stage_model(&mut scene, true);
+    Ok(scene)
+}
+
+/// The median of `f`'s time over [`BUILDS`] runs, in ms.
+fn median_ms(mut f: impl FnMut()) -> f64 {
+    let mut runs: Vec<f64> = (0..BUILDS)
+        .map(|_| {
+            let t0 = Instant::now();
+            f();
+            t0.elapsed().as_secs_f64() * 1e3
+        })
+        .collect();
+    runs.sort_by(f64::total_cmp);
+    runs[BUILDS / 2]
+}
+
+/// Measures the triangles as many meshes and as one: the adjacency and the BVH built from scratch, and a
+/// shadow map's frame on the CPU.
+fn run_triangles(
+    renderer: &mut Renderer,
+    size: (u32, u32),
+    many: bool,
+    progress: &mut impl FnMut(&str),
+) -> Result<Triangles, Error> {
+    let what = if many { "many meshes" } else { "one mesh" };
+    progress(&format!("triangles as {what}: building"));
+    let scene = triangles_scene(many)?;
+    let frame = FrameInputs::from_first_camera(&scene)?;
+    let meshes: Vec<&Mesh> = scene.meshes().map(|(_, m)| m.as_ref()).collect();
+    let adjacency_ms = median_ms(|| drop(std::hint::black_box(Adjacency::build_all(&meshes))));
+    let bvh_ms = median_ms(|| drop(std::hint::black_box(SceneBvh::build(&frame))));
+    let job = BenchJob {
+        scene: format!("{SMALL_MESHES} triangles as {what}"),
+        frame: &frame,
+        width: size.0,
+        height: size.1,
+        frames: FRAMES,
+        warmup: 2,
+        techniques: vec![TechniqueSpec::named("shadow-map")],
+        backends: vec![BackendKind::Cpu],
+        rebuild: false,
+        clip: None,
+    };
+    let bench = run_bench(renderer, &job, |m| progress(&format!("triangles as {what}: {m}")))?;
+    Ok(Triangles { many, adjacency_ms, bvh_ms, bench })
 }
 
 /// Measures every scene of many objects, as built and unshared, on `backends`.
@@ -100,7 +198,9 @@ pub fn run_many(
         };
         out.push((name, [measure(true)?, measure(false)?]));
     }
-    Ok(ManyReport { scenes: out, size })
+    let triangles =
+        [run_triangles(renderer, size, true, &mut progress)?, run_triangles(renderer, size, false, &mut progress)?];
+    Ok(ManyReport { scenes: out, triangles, size })
 }
 
 /// Appends the section.
@@ -153,4 +253,29 @@ pub fn markdown(s: &mut String, r: &ManyReport) {
             );
         }
     }
+    let _ = writeln!(
+        s,
+        "\n{SMALL_MESHES} one-triangle meshes, each drawn by its own instance, against the same triangles as \
+         one mesh, on a ground: every mesh's adjacency and the CPU's ray-casting BVH built from scratch \
+         (median of {BUILDS}), and `shadow-map`'s G-buffer and build on the CPU at {}x{} ({FRAMES} frames, \
+         median ms). Each kernel reads a mesh's few triangles where it would read a large one's many; \
+         the ratio is what the meshes cost beyond their triangles.\n",
+        r.size.0, r.size.1
+    );
+    let _ = writeln!(
+        s,
+        "| triangles as | adjacency | BVH build | G-buffer | shadow-map build |\n|---|---:|---:|---:|---:|"
+    );
+    let phase = |t: &Triangles, p: &str| {
+        t.bench.results.first().and_then(|e| e.timings_ms.get(p)).map_or(f64::NAN, |st| st.median)
+    };
+    let row = |t: &Triangles| [t.adjacency_ms, t.bvh_ms, phase(t, "gbuffer"), phase(t, "build")];
+    for t in &r.triangles {
+        let cells = row(t).map(|v| format!("{v:.1}")).join(" | ");
+        let _ =
+            writeln!(s, "| {} | {cells} |", if t.many { format!("{SMALL_MESHES} meshes") } else { "one mesh".into() });
+    }
+    let [many, one] = &r.triangles;
+    let ratios = row(many).iter().zip(row(one)).map(|(m, o)| format!("{:.2}x", m / o)).collect::<Vec<_>>().join(" | ");
+    let _ = writeln!(s, "| ratio | {ratios} |");
 }
