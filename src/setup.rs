@@ -180,6 +180,9 @@ pub struct SceneSetup {
     /// Give every node a copy of its own of a mesh other nodes draw too
     /// ([`shadow_core::Scene::unshare_meshes`]): the scene without instancing, to measure against.
     pub unshare: bool,
+    /// Give the scene this many lights ([`shadow_core::Scene::set_light_count`]): its first ones, or its
+    /// own and turned copies of them.
+    pub lights: Option<usize>,
 }
 
 impl SceneSetup {
@@ -195,6 +198,7 @@ impl SceneSetup {
             file_access: FileAccess::default(),
             time: None,
             unshare: false,
+            lights: None,
         }
     }
 
@@ -229,6 +233,14 @@ impl SceneSetup {
             scene.clear_lights();
             scene.add_light(light);
         }
+        if let Some(n) = self.lights {
+            let why = |e: shadow_core::scene::SceneError| OptionError {
+                flag: "--lights",
+                value: n.to_string(),
+                why: e.to_string(),
+            };
+            scene.set_light_count(n).map_err(why)?;
+        }
         Ok(scene)
     }
 }
@@ -247,6 +259,19 @@ pub enum SetupError {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_light_count_flag_sets_the_lights_or_names_itself() {
+        let setup = |n: usize| SceneSetup { lights: Some(n), ..SceneSetup::new("cylinder") };
+        assert_eq!(setup(3).build().expect("three lights").lights().count(), 3);
+        assert_eq!(
+            SceneSetup { lights: Some(5), ..SceneSetup::new("yard") }.build().expect("yard").lights().count(),
+            5
+        );
+        let Err(e) = setup(0).build() else { panic!("a scene of no lights") };
+        let e = e.to_string();
+        assert!(e.contains("--lights") && e.contains("at least 1"), "{e}");
+    }
 
     #[test]
     fn camera_and_light_flags() {

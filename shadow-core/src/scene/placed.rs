@@ -55,6 +55,45 @@ impl Scene {
         self.light_shadows.clear();
     }
 
+    /// Removes a light and how it casts shadows; answers the light as it was given.
+    pub fn remove_light(&mut self, key: LightKey) -> Option<Light> {
+        self.light_shadows.remove(key);
+        self.lights.remove(key).map(|p| p.value)
+    }
+
+    /// Gives the scene `count` lights, to measure how a frame grows with them: its first `count` lights,
+    /// or all of them and copies, the n-th round of copies turned about the vertical through the centre
+    /// of the scene's bounds by n golden angles (so copies spread out rather than pile up), each casting
+    /// as the light it copies. A copy stands in world space where its light stands now.
+    ///
+    /// # Errors
+    /// [`SceneError::Invalid`] for a count of zero, or for more lights than none where the scene has none.
+    pub fn set_light_count(&mut self, count: usize) -> Result<(), SceneError> {
+        if count == 0 {
+            return Err(SceneError::Invalid("a light count must be at least 1".into()));
+        }
+        let have: Vec<(LightKey, Light)> = self.lights().collect();
+        if have.is_empty() {
+            return Err(SceneError::Invalid(format!("the scene has no light to make {count} of")));
+        }
+        for &(key, _) in have.iter().skip(count) {
+            self.remove_light(key);
+        }
+        let centre = self.bounds().center();
+        let golden_angle = std::f32::consts::PI * (3.0 - 5f32.sqrt());
+        for k in have.len()..count {
+            let (key, light) = have[k % have.len()];
+            let round = (k / have.len()) as f32;
+            let turn = Mat4::from_translation(centre)
+                * Mat4::from_rotation_y(round * golden_angle)
+                * Mat4::from_translation(-centre);
+            let shadow = self.light_shadow(key);
+            let copy = self.add_light(light.transformed(turn));
+            self.light_shadows.insert(copy, shadow);
+        }
+        Ok(())
+    }
+
     /// Sets how a light casts shadows: whether it does, and with which technique and settings.
     ///
     /// # Errors

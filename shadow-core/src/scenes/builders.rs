@@ -521,6 +521,64 @@ pub(super) fn props(p: &SceneParams) -> Scene {
     scene
 }
 
+/// A yard of crates, posts and rocks (instances of three meshes) under 64 lights, spot and point lights
+/// in turn, over an 8 x 8 grid and reaching 5, 8 or 12 units; the camera, above one side, looks down on
+/// part of the yard and the lights over it.
+pub(super) fn yard(p: &SceneParams) -> Scene {
+    const COUNT: usize = 480;
+    const HALF: f32 = 30.0;
+    const SIDE: usize = 8;
+    let mut rng = Rng::new(p.seed);
+    let mut s = Stage::new().ground(2.0 * HALF + 10.0);
+    let crate_mesh = s.mesh(built(procedural::cuboid(Vec3::splat(0.8))));
+    let post = s.mesh(built(procedural::cylinder(0.08, 1.6, 10)));
+    let rock = s.mesh(rock());
+    let wood = s.material("crate", Vec3::new(0.62, 0.46, 0.3));
+    let metal = s.material("post", Vec3::splat(0.4));
+    let stone = s.material("rock", Vec3::new(0.55, 0.52, 0.48));
+    for i in 0..COUNT {
+        let (x, z) = (rng.range(-HALF, HALF), rng.range(-HALF, HALF));
+        let turn = Quat::from_rotation_y(rng.range(0.0, std::f32::consts::TAU));
+        match i % 4 {
+            0 | 1 => {
+                s.place_in("crate", crate_mesh, wood, Mat4::from_rotation_translation(turn, Vec3::new(x, 0.4, z)));
+                if rng.unit() < 0.25 {
+                    s.place_in("crate", crate_mesh, wood, Mat4::from_rotation_translation(turn, Vec3::new(x, 1.2, z)));
+                }
+            }
+            2 => s.place_in("post", post, metal, Mat4::from_rotation_translation(turn, Vec3::new(x, 0.0, z))),
+            _ => {
+                let size = rng.range(0.5, 1.2);
+                let shape = Mat4::from_scale_rotation_translation(Vec3::splat(size), turn, Vec3::new(x, 0.1 * size, z));
+                s.place_in("rock", rock, stone, shape);
+            }
+        }
+    }
+    let spacing = 2.0 * HALF / SIDE as f32;
+    let lights: Vec<Light> = (0..SIDE * SIDE)
+        .map(|k| {
+            let cell = |i: usize| -HALF + spacing * (i as f32 + 0.5);
+            let jitter = Vec3::new(rng.range(-1.0, 1.0), 0.0, rng.range(-1.0, 1.0));
+            let at = Vec3::new(cell(k % SIDE), rng.range(3.0, 6.0), cell(k / SIDE)) + jitter;
+            let mut light = if k % 2 == 0 {
+                let target = Vec3::new(at.x + rng.range(-1.5, 1.5), 0.0, at.z + rng.range(-1.5, 1.5));
+                Light::spot(at, target, rng.range(60.0, 100.0))
+            } else {
+                Light::point(at)
+            };
+            light.range = Some([5.0, 8.0, 12.0][k % 3]);
+            light.color = if k % 3 == 1 { Vec3::new(0.75, 0.85, 1.0) } else { Vec3::new(1.0, 0.85, 0.65) };
+            light.intensity = 0.6;
+            light
+        })
+        .collect();
+    let mut scene = s.finish(Camera::look_at(Vec3::new(-10.0, 7.0, 26.0), Vec3::new(-4.0, 0.0, 12.0), 45.0), lights[0]);
+    for &light in &lights[1..] {
+        scene.add_light(light);
+    }
+    scene
+}
+
 /// A rock: a coarse sphere pushed in and out by a smooth function of where each vertex lies, so
 /// vertices at one place (the seams) move together and the rock stays closed.
 fn rock() -> Mesh {

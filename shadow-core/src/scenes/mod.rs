@@ -199,10 +199,20 @@ pub const MANY: &[SceneInfo] = &[SceneInfo {
     build: builders::props,
 }];
 
+/// The scenes of many lights, each light reaching part of the scene, for measuring how a frame grows
+/// with its lights (`bench --lights N` keeps the first N).
+pub const LIGHTS: &[SceneInfo] = &[SceneInfo {
+    name: "yard",
+    after: "many lights",
+    description: "480 crates, posts and rocks under 64 spot and point lights of three ranges; the camera sees part of them",
+    build: builders::yard,
+}];
+
 /// Every built-in scene: the papers' ([`ALL`]), the outdoor ones ([`OUTDOOR`]), those of cutouts
-/// ([`CUTOUT`]), the animated ones ([`ANIMATED`]), then those of many objects ([`MANY`]).
+/// ([`CUTOUT`]), the animated ones ([`ANIMATED`]), those of many objects ([`MANY`]), then those of many
+/// lights ([`LIGHTS`]).
 pub fn every() -> impl Iterator<Item = &'static SceneInfo> {
-    ALL.iter().chain(OUTDOOR).chain(CUTOUT).chain(ANIMATED).chain(MANY)
+    ALL.iter().chain(OUTDOOR).chain(CUTOUT).chain(ANIMATED).chain(MANY).chain(LIGHTS)
 }
 
 /// Why a scene could not be built.
@@ -364,14 +374,39 @@ mod tests {
             assert_eq!(a.triangle_count(), b.triangle_count(), "{}", info.name);
             assert_eq!(a.bounds(), b.bounds(), "{}", info.name);
             assert_eq!(a.cameras().count(), 1, "{}", info.name);
-            // One light, but under the sun of the scenes of many objects a spot light too.
-            let lights = if MANY.iter().any(|m| m.name == info.name) { 2 } else { 1 };
+            // One light, but under the sun of the scenes of many objects a spot light too, and the scenes
+            // of many lights have 64.
+            let lights = if MANY.iter().any(|m| m.name == info.name) {
+                2
+            } else if LIGHTS.iter().any(|m| m.name == info.name) {
+                64
+            } else {
+                1
+            };
             assert_eq!(a.lights().count(), lights, "{}", info.name);
             for (_, l) in a.lights() {
                 l.validate().unwrap();
             }
         }
         assert!(build("nope", &SceneParams::default()).is_err());
+    }
+
+    /// The yard's lights are spot and point lights in turn, each with a range, and the camera sees some
+    /// of them but not most.
+    #[test]
+    fn the_yard_camera_sees_part_of_its_lights() {
+        let yard = build("yard", &SceneParams::default()).unwrap();
+        let camera = yard.cameras().next().unwrap().1;
+        let view = camera.clip_from_world(4.0 / 3.0);
+        let (mut spots, mut seen) = (0, 0);
+        for (_, l) in yard.lights() {
+            assert!(l.range.is_some());
+            spots += usize::from(matches!(l.kind, LightKind::Spot { .. }));
+            let c = view * l.position().unwrap().extend(1.0);
+            seen += usize::from(c.w > 0.0 && c.x.abs() < c.w && c.y.abs() < c.w);
+        }
+        assert_eq!(spots, 32);
+        assert!((8..32).contains(&seen), "{seen} of 64 lights in view");
     }
 
     #[test]

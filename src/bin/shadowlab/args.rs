@@ -56,6 +56,10 @@ pub(crate) struct SceneArgs {
     /// to measure against (the pictures are the same).
     #[arg(long)]
     pub(crate) unshare: bool,
+    /// Give the scene N lights, to measure how a frame grows with them: its first N, or its own and
+    /// copies of them turned about the scene's centre.
+    #[arg(long, value_name = "N")]
+    pub(crate) lights: Option<usize>,
 }
 
 /// A time in seconds: a finite number.
@@ -144,6 +148,7 @@ impl SceneArgs {
             file_access: if self.allow_outside_files { FileAccess::Anywhere } else { FileAccess::ModelFolder },
             time: self.time,
             unshare: self.unshare,
+            lights: self.lights,
         }
     }
 
