@@ -408,9 +408,6 @@ fn resolve(frame: &FrameInputs, all: &Batch<'_>, visible: &[u32], eye_rays: &Eye
             dirs.clear();
             dirs.extend((0..w).map(|x| eye_rays.dir(x, y)));
             let mut last: Option<(u32, Triangle)> = None;
-            // The normal matrix of the last instance met, made when the row first meets it: a frame of
-            // many small meshes makes only those of the instances in view.
-            let mut normal: Option<(usize, Mat3)> = None;
             let mut x = 0;
             while x < w {
                 let prim = vis[x];
@@ -424,11 +421,11 @@ fn resolve(frame: &FrameInputs, all: &Batch<'_>, visible: &[u32], eye_rays: &Eye
                     Some((p, t)) if p == prim => t,
                     _ => {
                         let (k, triangle) = all.part_of(prim);
-                        let m = match normal {
-                            Some((i, m)) if i == k => m,
+                        // Made as the row meets an instance: only those of instances in view are made.
+                        let m = match last {
+                            Some((_, t)) if t.instance == k => t.normal_from_local,
                             _ => shadow_core::affine::normal_matrix(frame.instances[k].world_from_local),
                         };
-                        normal = Some((k, m));
                         let t = Triangle::new(frame, k, triangle as usize, m);
                         last = Some((prim, t));
                         t

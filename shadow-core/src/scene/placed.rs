@@ -172,3 +172,39 @@ pub(super) struct Placed<T> {
     pub(super) value: T,
     pub(super) node: Option<NodeKey>,
 }
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+
+    use super::*;
+    use crate::Material;
+
+    /// A light count keeps the first lights, or adds turned copies casting as their lights do.
+    #[test]
+    fn a_light_count_keeps_the_first_lights_or_adds_turned_copies() {
+        let mut s = Scene::new();
+        let mesh = s.add_mesh(crate::procedural::cuboid(Vec3::ONE).expect("shape"));
+        let material = s.add_material(Material::default());
+        s.add_instance("box", mesh, material, Mat4::IDENTITY).expect("instance");
+        assert!(s.set_light_count(2).is_err(), "nothing to copy");
+        let spot = s.add_light(Light::spot(Vec3::new(3.0, 4.0, 0.0), Vec3::ZERO, 50.0));
+        s.set_light_shadow(spot, LightShadow::NONE).expect("a light");
+        s.add_light(Light::point(Vec3::new(0.0, 5.0, 2.0)));
+        assert!(s.set_light_count(0).is_err());
+        s.set_light_count(5).expect("copies");
+        let lights: Vec<(LightKey, Light)> = s.lights().collect();
+        assert_eq!(lights.len(), 5);
+        // The copies of the spot light (the first, third and fifth) cast no shadow, as it does not, and
+        // stand turned about the vertical through the centre, at its height and distance from it.
+        for (k, (key, l)) in lights.iter().enumerate() {
+            assert_eq!(s.light_shadow(*key).casts, k % 2 == 1, "light {k}");
+            let p = l.position().expect("a position");
+            assert_eq!(p.y, if k % 2 == 0 { 4.0 } else { 5.0 });
+        }
+        let (a, b) = (lights[0].1.position().unwrap(), lights[2].1.position().unwrap());
+        assert!((a.length() - b.length()).abs() < 1e-5 && a.distance(b) > 1.0, "{a} {b}");
+        s.set_light_count(1).expect("the first");
+        assert_eq!(s.lights().map(|(k, _)| k).collect::<Vec<_>>(), vec![spot]);
+    }
+}
