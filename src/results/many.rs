@@ -158,14 +158,7 @@ pub fn run_many(
                 scene.unshare_meshes();
             }
             let frame = FrameInputs::from_first_camera(&scene)?;
-            let mut builds: Vec<f64> = (0..BUILDS)
-                .map(|_| {
-                    let t0 = Instant::now();
-                    std::hint::black_box(SceneBvh::build(&frame));
-                    t0.elapsed().as_secs_f64() * 1e3
-                })
-                .collect();
-            builds.sort_by(f64::total_cmp);
+            let bvh_ms = median_ms(|| drop(std::hint::black_box(SceneBvh::build(&frame))));
             let (measurable, _) = renderer.registry().measurable(&frame);
             let techniques = measurable
                 .into_iter()
@@ -194,7 +187,7 @@ pub fn run_many(
                 let reference = run_bench(renderer, &job, |m| progress(&format!("{name} {what}: {m}")))?;
                 bench.results.splice(0..0, reference.results);
             }
-            Ok(Variant { shared, inspection: Inspection::of(&scene), bvh_ms: builds[BUILDS / 2], bench })
+            Ok(Variant { shared, inspection: Inspection::of(&scene), bvh_ms, bench })
         };
         out.push((name, [measure(true)?, measure(false)?]));
     }
