@@ -61,6 +61,9 @@ pub struct ResultEntry {
     pub timings_ms: BTreeMap<String, f64>,
     /// Measured counters only.
     pub counters: BTreeMap<String, f64>,
+    /// Per light, the side of the shadow-atlas tiles its maps had (`None`: maps of its own, at its
+    /// technique's size); empty where the frame had no atlas.
+    pub atlas_tiles: Vec<Option<u32>>,
     /// The reference this entry is measured against, as its spec reads.
     pub reference: String,
     /// Errors against the reference (fractions in [0, 1], RMSE and FLIP as they are).
@@ -415,6 +418,10 @@ fn measure(
         reference: reference.to_string(),
         timings_ms: timings_map(&run.stats),
         counters: run.stats.counters.entries().into_iter().collect(),
+        atlas_tiles: run
+            .atlas
+            .as_ref()
+            .map_or_else(Vec::new, |a| a.lights.iter().map(|t| t.as_ref().map(|t| t.side)).collect()),
         vs_reference,
         file,
         metrics,
@@ -618,6 +625,17 @@ pub fn report_markdown(r: &CompareReport) -> String {
     s.push_str("\nSettings:\n\n");
     for e in &r.results {
         s.push_str(&format!("- `{}` ({}): `{}`\n", e.technique, e.backend, e.settings));
+    }
+    let tiled: Vec<&ResultEntry> = r.results.iter().filter(|e| e.atlas_tiles.iter().any(Option::is_some)).collect();
+    if !tiled.is_empty() {
+        s.push_str(
+            "\nShadow-atlas tiles (the maps' side each light was given; the figures above are the first light's):\n\n",
+        );
+    }
+    for e in tiled {
+        let sides: Vec<String> =
+            e.atlas_tiles.iter().enumerate().filter_map(|(k, t)| t.map(|t| format!("{k}: {t}"))).collect();
+        s.push_str(&format!("- `{}` ({}): {}\n", e.technique, e.backend, sides.join(", ")));
     }
     if !r.cross_backend.is_empty() {
         s.push_str("\n| technique | cpu vs wgpu mismatch | RMSE | FLIP |\n|---|---:|---:|---:|\n");

@@ -1,6 +1,7 @@
 //! Runtime backend choice: one [`Renderer`] runs any registered technique on any available backend.
 
 use shadow_core::image::Rgb8;
+use shadow_core::light::AtlasPlan;
 use shadow_core::script::LightTechniques;
 use shadow_core::technique::{Backend, DebugView, DynShadowTechnique, FrameStats, TechniqueSpec};
 use shadow_core::{FrameInputs, Image};
@@ -56,6 +57,8 @@ pub struct RunOutput {
     pub color: Image<Rgb8>,
     /// Visibility of each light.
     pub visibility: Vec<Image<f32>>,
+    /// The shadow atlas: the tiles and their side each light was given.
+    pub atlas: Option<AtlasPlan>,
     /// Counters and timings.
     pub stats: FrameStats,
     /// Pictures of the technique's internals.
@@ -248,14 +251,14 @@ impl Renderer {
         width: u32,
         height: u32,
     ) -> Result<RunOutput, Error> {
-        let (backend, color, visibility, stats, debug_views) = match &mut p.technique {
+        let (backend, color, visibility, atlas, stats, debug_views) = match &mut p.technique {
             PreparedKind::Cpu(t, named) => {
                 name_techniques(frame, named, |s| Ok(self.registry.cpu(s)?))?;
                 let techniques = LightTechniques { frame: t.as_mut(), named };
                 let f = shadow_cpu::render_frame(&mut self.cpu, frame, width, height, techniques)?;
                 let views = t.debug_views(&mut self.cpu)?;
                 self.cpu.recycle(f.gbuffer);
-                (BackendKind::Cpu, f.color, f.visibility, f.stats, views)
+                (BackendKind::Cpu, f.color, f.visibility, f.atlas, f.stats, views)
             }
             PreparedKind::Wgpu(t, named) => {
                 name_techniques(frame, named, |s| Ok(self.registry.wgpu(s)?))?;
@@ -263,7 +266,7 @@ impl Renderer {
                 let techniques = LightTechniques { frame: t.as_mut(), named };
                 let f = shadow_wgpu::render_frame(g, frame, width, height, techniques)?;
                 let views = t.debug_views(g)?;
-                (BackendKind::Wgpu, f.color, f.visibility, f.stats, views)
+                (BackendKind::Wgpu, f.color, f.visibility, f.atlas, f.stats, views)
             }
         };
         Ok(RunOutput {
@@ -272,6 +275,7 @@ impl Renderer {
             backend,
             color,
             visibility,
+            atlas,
             stats,
             debug_views,
         })

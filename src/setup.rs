@@ -3,7 +3,7 @@
 
 use glam::Vec3;
 use shadow_core::Scene;
-use shadow_core::scene::{Camera, Light, LightKind};
+use shadow_core::scene::{Camera, Light, LightKind, LightShadow, ShadowUpdate};
 use shadow_core::scenes::{LightType, SceneParams};
 
 use shadow_core::assets::{FileAccess, LoadOptions};
@@ -183,6 +183,9 @@ pub struct SceneSetup {
     /// Give the scene this many lights ([`shadow_core::Scene::set_light_count`]): its first ones, or its
     /// own and turned copies of them.
     pub lights: Option<usize>,
+    /// When every light's shadow is built again ([`shadow_core::LightShadow::update`]); as the scene
+    /// has it without one.
+    pub shadow_update: Option<ShadowUpdate>,
 }
 
 impl SceneSetup {
@@ -199,6 +202,7 @@ impl SceneSetup {
             time: None,
             unshare: false,
             lights: None,
+            shadow_update: None,
         }
     }
 
@@ -240,6 +244,13 @@ impl SceneSetup {
                 why: e.to_string(),
             };
             scene.set_light_count(n).map_err(why)?;
+        }
+        if let Some(update) = self.shadow_update {
+            let keys: Vec<_> = scene.lights().map(|(k, _)| k).collect();
+            for k in keys {
+                let shadow = LightShadow { update, ..scene.light_shadow(k) };
+                scene.set_light_shadow(k, shadow).unwrap_or_else(|_| unreachable!("a light of the scene"));
+            }
         }
         Ok(scene)
     }

@@ -1,6 +1,7 @@
 //! The frame script (DESIGN 5), written once for every backend: the camera's G-buffer, then per light a
 //! build and a query into that light's visibility, then shading. Each light is shadowed by the frame's
-//! technique or by one of its own ([`LightTechniques`]); a light that casts no shadow is lit everywhere.
+//! technique or by one of its own ([`LightTechniques`]); a light that casts no shadow is lit everywhere, and so
+//! is one that reaches no pixel of the view ([`crate::light::Reach`]), which is neither built nor queried.
 //!
 //! A backend supplies the steps ([`FrameSteps`]) and [`run_frame`] puts them in order, times each phase
 //! and gathers the lights' stats. How the steps run is theirs to decide: the instrumented frame of each
@@ -10,10 +11,14 @@
 use std::time::Instant;
 
 use crate::frame::FrameInputs;
-use crate::light::LightView;
+use crate::light::{AtlasPlan, LightView, Reach, TileRequest};
+use crate::scene::LightKind;
 use crate::stats::{Phase, ms};
 use crate::technique::settings::TechniqueSpec;
 use crate::technique::{Backend, DynShadowTechnique, FrameStats, LightPass, TechniqueError};
+
+/// The counter of lights that reach no pixel of the view, which a frame neither builds nor queries.
+pub const OUT_OF_VIEW: &str = "lights_out_of_view";
 
 /// The steps of one frame on backend `B`, in the order [`run_frame`] calls them.
 pub trait FrameSteps<B: Backend> {
@@ -28,16 +33,16 @@ pub trait FrameSteps<B: Backend> {
     /// Backend failures, or a view size the backend cannot render.
     fn gbuffer(&mut self, cx: &mut B::Context, frame: &FrameInputs) -> Result<B::GBuffer, B::Error>;
 
-    /// The target light `k`'s visibility is queried into.
+    /// The target light `k`'s visibility is queried into, over the pixels of its `reach`.
     ///
     /// # Errors
     /// Backend failures.
-    fn visibility(&mut self, cx: &mut B::Context, k: usize) -> Result<B::Visibility, B::Error>;
+    fn visibility(&mut self, cx: &mut B::Context, k: usize, reach: &Reach) -> Result<B::Visibility, B::Error>;
 
     /// Takes light `k`'s visibility once its query is issued.
     fn keep(&mut self, k: usize, visibility: B::Visibility);
 
-    /// Fills a visibility with 1 (lit everywhere), for a light that casts no shadow.
+    /// Fills a visibility with 1 (lit everywhere), for a light that casts no shadow or reaches no pixel.
     ///
     /// # Errors
     /// Backend failures.
@@ -79,12 +84,15 @@ pub trait FrameSteps<B: Backend> {
     }
 }
 
-/// What [`run_frame`] returns: the steps' output, the fitted view of each light, and the stats.
+/// What [`run_frame`] returns: the steps' output, the fitted view of each light, the shadow atlas, and
+/// the stats.
 pub struct FrameRun<O> {
     /// The steps' output.
     pub output: O,
     /// The fitted view of each light, in the frame's light order.
     pub light_views: Vec<LightView>,
+    /// The frame's shadow atlas ([`crate::frame::Savings::atlas`]): each light's tiles and their side.
+    pub atlas: Option<AtlasPlan>,
     /// Counters summed over the lights, and phase times.
     pub stats: FrameStats,
 }
@@ -142,12 +150,21 @@ pub fn run_frame<'t, 'o: 't, B: Backend, S: FrameSteps<B>>(
     let gbuffer = phases.run(cx, Phase::GBuffer, |cx, steps| steps.gbuffer(cx, frame))?;
     let (width, height) = B::view_size(&gbuffer);
     let aspect = width as f32 / height.max(1) as f32;
+    let reaches: Vec<Reach> = frame.lights.iter().map(|l| frame.reach(l, width, height)).collect();
+    let atlas = match frame.savings.atlas {
+        Some(side) => Some(plan_atlas(frame, &reaches, side, &mut techniques)?),
+        None => None,
+    };
     let mut light_views = Vec::with_capacity(frame.lights.len());
-    for (k, light) in frame.lights.iter().enumerate() {
+    for (k, (light, &reach)) in frame.lights.iter().zip(&reaches).enumerate() {
         let view = frame.light_view(light)?;
         let shadow = frame.shadow(k);
-        let mut vis = phases.steps.visibility(cx, k)?;
-        if !shadow.casts {
+        let tiles = atlas.as_ref().and_then(|a| a.lights[k].as_ref());
+        let mut vis = phases.steps.visibility(cx, k, &reach)?;
+        if reach.is_empty() {
+            *phases.stats.counters.extra.entry(OUT_OF_VIEW.into()).or_insert(0.0) += 1.0;
+        }
+        if !shadow.casts || reach.is_empty() {
             phases.steps.lit(cx, &mut vis)?;
             phases.steps.keep(k, vis);
             light_views.push(view);
@@ -155,17 +172,18 @@ pub fn run_frame<'t, 'o: 't, B: Backend, S: FrameSteps<B>>(
         }
         let technique = techniques.pick(shadow.technique.as_ref())?;
         let mut light_stats = FrameStats::default();
-        phases.run(cx, Phase::Build, |cx, _| {
-            technique.build(cx, LightPass { frame, light: &view, slot: k, aspect, stats: &mut light_stats })
-        })?;
-        phases.run(cx, Phase::Query, |cx, _| {
-            technique.query(
-                cx,
-                LightPass { frame, light: &view, slot: k, aspect, stats: &mut light_stats },
-                &gbuffer,
-                &mut vis,
-            )
-        })?;
+        let mut pass = LightPass {
+            frame,
+            light: &view,
+            reach,
+            tiles,
+            update: shadow.update,
+            slot: k,
+            aspect,
+            stats: &mut light_stats,
+        };
+        phases.run(cx, Phase::Build, |cx, _| technique.build(cx, pass.reborrow()))?;
+        phases.run(cx, Phase::Query, |cx, _| technique.query(cx, pass, &gbuffer, &mut vis))?;
         phases.steps.keep(k, vis);
         phases.stats.add_light(light_stats);
         light_views.push(view);
@@ -174,7 +192,41 @@ pub fn run_frame<'t, 'o: 't, B: Backend, S: FrameSteps<B>>(
 
     stats.timings.total = ms(start.elapsed());
     let output = steps.finish(cx, gbuffer, shaded, &mut stats)?;
-    Ok(FrameRun { output, light_views, stats })
+    Ok(FrameRun { output, light_views, atlas, stats })
+}
+
+/// The frame's shadow atlas of `side` texels: a tile for each face of each spot and point light with a
+/// range that casts with a technique asking for one ([`crate::technique::ShadowTechnique::atlas_side`])
+/// and reaches some of the view, sized by the share of the view its reach's rectangle covers. A light
+/// without a range lights the whole scene: its maps stay its own, of its technique's size.
+fn plan_atlas<B: Backend>(
+    frame: &FrameInputs,
+    reaches: &[Reach],
+    side: u32,
+    techniques: &mut LightTechniques<'_, '_, B>,
+) -> Result<AtlasPlan, TechniqueError> {
+    let view = reaches.first().map_or(1, |r| r.view_area()).max(1) as f32;
+    let mut requests = Vec::with_capacity(frame.lights.len());
+    for (k, (light, reach)) in frame.lights.iter().zip(reaches).enumerate() {
+        let shadow = frame.shadow(k);
+        let faces = match light.kind {
+            LightKind::Spot { .. } => 1,
+            LightKind::Point { .. } => 6,
+            LightKind::Directional { .. } => 0,
+        };
+        let asked = if shadow.casts && !reach.is_empty() && !reach.is_everywhere() {
+            techniques.pick(shadow.technique.as_ref())?.atlas_side()
+        } else {
+            None
+        };
+        let coverage = reach.rect.area() as f32 / view;
+        requests.push(asked.map_or(TileRequest { faces: 0, side: 0, coverage }, |side| TileRequest {
+            faces,
+            side,
+            coverage,
+        }));
+    }
+    Ok(AtlasPlan::new(side, &requests)?)
 }
 
 /// The steps and the stats their phases are timed into.

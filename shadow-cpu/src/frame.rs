@@ -2,7 +2,7 @@
 //! The CPU runs each step to the end before returning, so every phase's time is its own.
 
 use shadow_core::image::Rgb8;
-use shadow_core::light::LightView;
+use shadow_core::light::{AtlasPlan, LightView, Reach};
 use shadow_core::script::{FrameRun, FrameSteps, LightTechniques, run_frame};
 use shadow_core::technique::FrameStats;
 use shadow_core::{FrameInputs, Image};
@@ -17,6 +17,8 @@ pub struct CpuFrame {
     pub gbuffer: GBuffer,
     /// The fitted view of each light.
     pub light_views: Vec<LightView>,
+    /// The shadow atlas: each light's tiles and their side.
+    pub atlas: Option<AtlasPlan>,
     /// Visibility per light, 1 lit, 0 shadowed (1 outside the receiver mask).
     pub visibility: Vec<Image<f32>>,
     /// The shaded image.
@@ -51,9 +53,9 @@ pub fn render_frame<'t, 'o: 't>(
     techniques: impl Into<LightTechniques<'t, 'o, CpuBackend>>,
 ) -> Result<CpuFrame, CpuError> {
     let steps = CpuSteps { width, height, given: None, visibility: Vec::with_capacity(frame.lights.len()) };
-    let FrameRun { output: (gbuffer, visibility, color), light_views, stats } =
+    let FrameRun { output: (gbuffer, visibility, color), light_views, atlas, stats } =
         run_frame(cx, frame, steps, techniques)?;
-    Ok(CpuFrame { gbuffer, light_views, visibility, color, stats })
+    Ok(CpuFrame { gbuffer, light_views, atlas, visibility, color, stats })
 }
 
 /// Renders a frame over receivers given as another view's G-buffer: the techniques build for `frame`
@@ -72,9 +74,9 @@ pub fn render_frame_over<'t, 'o: 't>(
     let (width, height) = (gbuffer.depth.width(), gbuffer.depth.height());
     let visibility = Vec::with_capacity(frame.lights.len());
     let steps = CpuSteps { width, height, given: Some(gbuffer.clone()), visibility };
-    let FrameRun { output: (gbuffer, visibility, color), light_views, stats } =
+    let FrameRun { output: (gbuffer, visibility, color), light_views, atlas, stats } =
         run_frame(cx, frame, steps, techniques)?;
-    Ok(CpuFrame { gbuffer, light_views, visibility, color, stats })
+    Ok(CpuFrame { gbuffer, light_views, atlas, visibility, color, stats })
 }
 
 /// The CPU's steps: images in memory, one per light's visibility.
@@ -97,7 +99,7 @@ impl FrameSteps<CpuBackend> for CpuSteps {
         }
     }
 
-    fn visibility(&mut self, _cx: &mut CpuContext, _k: usize) -> Result<Image<f32>, CpuError> {
+    fn visibility(&mut self, _cx: &mut CpuContext, _k: usize, _reach: &Reach) -> Result<Image<f32>, CpuError> {
         Ok(Image::new(self.width, self.height, 1.0))
     }
 
@@ -112,7 +114,7 @@ impl FrameSteps<CpuBackend> for CpuSteps {
 
     fn shade(&mut self, _cx: &mut CpuContext, frame: &FrameInputs, gbuffer: &GBuffer) -> Result<Image<Rgb8>, CpuError> {
         let refs: Vec<&Image<f32>> = self.visibility.iter().collect();
-        Ok(shade(gbuffer, &frame.lights, &refs))
+        Ok(shade(gbuffer, frame, &refs))
     }
 
     fn finish(

@@ -2,26 +2,34 @@
 
 use rayon::prelude::*;
 use shadow_core::image::{Rgb8, linear_rgb_to_srgb8};
-use shadow_core::scene::Light;
-use shadow_core::{Image, shading};
+use shadow_core::light::PixelRect;
+use shadow_core::{FrameInputs, Image, shading};
 
 use crate::gbuffer::{GBuffer, NO_INSTANCE};
 
-/// The shaded sRGB image of a G-buffer lit by `lights` with one visibility image per light.
+/// The shaded sRGB image of a G-buffer of `frame`'s view lit by its lights, with one visibility image per
+/// light. A light adds nothing to a pixel outside its reach's rectangle (its direct term there is 0), so
+/// the pixel does not evaluate it: the same sum, to the bit.
 #[must_use]
-pub fn shade(g: &GBuffer, lights: &[Light], visibility: &[&Image<f32>]) -> Image<Rgb8> {
-    let n = g.depth.data().len();
-    let terms: Vec<shading::LightTerms> = lights.iter().map(shading::LightTerms::new).collect();
-    let data: Vec<Rgb8> = (0..n)
+pub fn shade(g: &GBuffer, frame: &FrameInputs, visibility: &[&Image<f32>]) -> Image<Rgb8> {
+    let (width, height) = (g.width(), g.height());
+    let lights: Vec<(shading::LightTerms, PixelRect)> =
+        frame.lights.iter().map(|l| (shading::LightTerms::new(l), frame.reach(l, width, height).rect)).collect();
+    let data: Vec<Rgb8> = (0..g.depth.data().len())
         .into_par_iter()
         .with_min_len(1024)
         .map(|i| {
             if g.instance.data()[i] == NO_INSTANCE {
                 return linear_rgb_to_srgb8(shading::BACKGROUND);
             }
-            let lit = terms.iter().zip(visibility.iter().map(|v| v.data()[i]));
+            let (x, y) = ((i % width as usize) as u32, (i / width as usize) as u32);
+            let lit = lights
+                .iter()
+                .zip(visibility.iter().map(|v| v.data()[i]))
+                .filter(|((_, rect), _)| rect.contains(x, y))
+                .map(|((terms, _), v)| (terms, v));
             linear_rgb_to_srgb8(shading::shade(g.albedo.data()[i], g.position.data()[i], g.normal.data()[i], lit))
         })
         .collect();
-    Image::from_vec(g.width(), g.height(), data).unwrap_or_else(|| unreachable!("one entry per pixel"))
+    Image::from_vec(width, height, data).unwrap_or_else(|| unreachable!("one entry per pixel"))
 }

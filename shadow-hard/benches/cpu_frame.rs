@@ -2,14 +2,20 @@
 //! `cargo bench -p shadow-hard --bench cpu_frame`.
 
 use divan::Bencher;
-use shadow_core::FrameInputs;
 use shadow_core::scenes::{self, SceneParams};
 use shadow_core::technique::{FrameStats, LightPass, ShadowTechnique, TechniqueSettings};
+use shadow_core::{FrameInputs, LightView};
 use shadow_cpu::{CpuContext, gbuffer};
 use shadow_hard::{RayTraced, ShadowMap, ShadowVolume};
 
 fn main() {
     divan::main();
+}
+
+/// The pass of a frame's first light in a 1024x768 view, fitted as `view`.
+fn first_light<'a>(f: &'a FrameInputs, view: &'a LightView, stats: &'a mut FrameStats) -> LightPass<'a> {
+    let reach = f.reach(&f.lights[0], 1024, 768);
+    LightPass { frame: f, light: view, reach, tiles: None, update: Default::default(), slot: 0, aspect: 1.0, stats }
 }
 
 fn frame(name: &str) -> FrameInputs {
@@ -28,18 +34,11 @@ fn ray_traced_tree(b: Bencher) {
     let t = RayTraced::defaults();
     let mut state = t.create_state(&mut cx).expect("state");
     let mut stats = FrameStats::default();
-    t.build(&mut cx, &mut state, LightPass { frame: &f, light: &view, slot: 0, aspect: 1.0, stats: &mut stats })
-        .expect("build");
+    let mut pass = first_light(&f, &view, &mut stats);
+    t.build(&mut cx, &mut state, pass.reborrow()).expect("build");
     let mut out = shadow_core::Image::new(1024, 768, 1.0f32);
     b.counter(divan::counter::ItemsCount::new(g.covered_pixels())).bench_local(|| {
-        t.query(
-            &mut cx,
-            &mut state,
-            LightPass { frame: &f, light: &view, slot: 0, aspect: 1.0, stats: &mut stats },
-            &g,
-            &mut out,
-        )
-        .expect("query");
+        t.query(&mut cx, &mut state, pass.reborrow(), &g, &mut out).expect("query");
     });
 }
 
@@ -51,19 +50,12 @@ fn whole_frame<T: ShadowTechnique<shadow_cpu::CpuBackend>>(b: Bencher, t: T) {
     let mut spare = None;
     b.bench_local(|| {
         let mut stats = FrameStats::default();
+        let mut pass = first_light(&f, &view, &mut stats);
         let g = gbuffer::render_reusing(&f, 1024, 768, spare.take()).expect("gbuffer");
-        t.build(&mut cx, &mut state, LightPass { frame: &f, light: &view, slot: 0, aspect: 1.0, stats: &mut stats })
-            .expect("build");
+        t.build(&mut cx, &mut state, pass.reborrow()).expect("build");
         let mut out = shadow_core::Image::new(1024, 768, 1.0f32);
-        t.query(
-            &mut cx,
-            &mut state,
-            LightPass { frame: &f, light: &view, slot: 0, aspect: 1.0, stats: &mut stats },
-            &g,
-            &mut out,
-        )
-        .expect("query");
-        let color = shadow_cpu::shade::shade(&g, &f.lights, &[&out]);
+        t.query(&mut cx, &mut state, pass.reborrow(), &g, &mut out).expect("query");
+        let color = shadow_cpu::shade::shade(&g, &f, &[&out]);
         spare = Some(g);
         color
     });

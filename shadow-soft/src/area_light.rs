@@ -151,14 +151,14 @@ impl ShadowTechnique<CpuBackend> for AreaLightReference {
         g: &GBuffer,
         out: &mut Image<f32>,
     ) -> Result<(), CpuError> {
-        let LightPass { frame, light, stats, .. } = pass;
+        let LightPass { frame, light, stats, reach, .. } = pass;
         let bvh = state.bvh(self.name())?;
         let Some(centre) = light.light.position() else {
             return Err(TechniqueError::NotBuilt(self.name().into()).into());
         };
         let sphere = Sphere { centre, radius: light.light.radius };
         let origins = RayOrigins::new(g, frame, self.epsilon);
-        let rays = per_receiver_casting(g, out, |walker, x, y, i| {
+        let rays = per_receiver_casting(g, &reach, out, |walker, x, y, i| {
             let (origin, n) = origins.at(i);
             let (visible, cast) = sphere_visibility(bvh, walker, origin, n, sphere, self.samples, pixel_hash(x, y));
             (visible, u64::from(cast))

@@ -4,7 +4,7 @@
 //! results are read back into images.
 
 use shadow_core::image::Rgb8;
-use shadow_core::light::LightView;
+use shadow_core::light::{LightView, Reach};
 use shadow_core::script::{FrameRun, FrameSteps, LightTechniques, run_frame};
 use shadow_core::stats::Phase;
 use shadow_core::technique::FrameStats;
@@ -24,12 +24,17 @@ pub struct GpuVisibility {
     pub width: u32,
     /// Height.
     pub height: u32,
+    /// The pixels its light may reach ([`shadow_core::light::Reach::rect`]): a query need answer only
+    /// these ([`crate::passes::answer`]), the rest are 1.
+    pub rect: shadow_core::light::PixelRect,
 }
 
 /// Everything a GPU frame produced, read back.
 pub struct WgpuFrame {
     /// The fitted view of each light.
     pub light_views: Vec<LightView>,
+    /// The shadow atlas: each light's tiles and their side.
+    pub atlas: Option<shadow_core::light::AtlasPlan>,
     /// Visibility per light.
     pub visibility: Vec<Image<f32>>,
     /// The shaded image.
@@ -104,8 +109,8 @@ pub fn render_frame<'t, 'o: 't>(
     let steps = MeasuredSteps::new(cx, frame, width, height);
     let result = run_frame(cx, frame, steps, techniques);
     cx.clock = None;
-    let FrameRun { output: (visibility, color), light_views, stats } = result?;
-    Ok(WgpuFrame { light_views, visibility, color, stats })
+    let FrameRun { output: (visibility, color), light_views, atlas, stats } = result?;
+    Ok(WgpuFrame { light_views, atlas, visibility, color, stats })
 }
 
 /// The GPU's instrumented steps: each phase ends with the queue drained, so its wall-clock time is the
@@ -157,8 +162,9 @@ impl FrameSteps<WgpuBackend> for MeasuredSteps {
         gbuffer::render(cx, frame, self.width, self.height)
     }
 
-    fn visibility(&mut self, _cx: &mut WgpuContext, k: usize) -> Result<GpuVisibility, WgpuError> {
-        Ok(GpuVisibility { view: layer_view(&self.visibility, k as u32), width: self.width, height: self.height })
+    fn visibility(&mut self, _cx: &mut WgpuContext, k: usize, reach: &Reach) -> Result<GpuVisibility, WgpuError> {
+        let view = layer_view(&self.visibility, k as u32);
+        Ok(GpuVisibility { view, width: self.width, height: self.height, rect: reach.rect })
     }
 
     fn keep(&mut self, _k: usize, _visibility: GpuVisibility) {}

@@ -15,6 +15,7 @@
 
 use std::collections::HashMap;
 
+use shadow_core::light::Reach;
 use shadow_core::script::{FrameSteps, LightTechniques, run_frame};
 use shadow_core::technique::FrameStats;
 use shadow_core::{FrameInputs, LightView};
@@ -315,9 +316,10 @@ impl FrameSteps<WgpuBackend> for RecordSteps<'_> {
         Ok(g)
     }
 
-    fn visibility(&mut self, cx: &mut WgpuContext, k: usize) -> Result<GpuVisibility, WgpuError> {
+    fn visibility(&mut self, cx: &mut WgpuContext, k: usize, reach: &Reach) -> Result<GpuVisibility, WgpuError> {
         cx.host_maps.light(k);
-        Ok(GpuVisibility { view: layer_view(self.visibility, k as u32), width: self.width, height: self.height })
+        let view = layer_view(self.visibility, k as u32);
+        Ok(GpuVisibility { view, width: self.width, height: self.height, rect: reach.rect })
     }
 
     fn keep(&mut self, _k: usize, _visibility: GpuVisibility) {}

@@ -17,7 +17,7 @@ use std::sync::Arc;
 use glam::{Mat3, Vec3};
 use rayon::prelude::*;
 use serde::Serialize;
-use shadow_core::frame::FrameError;
+use shadow_core::frame::{FrameError, Savings};
 use shadow_core::geometry::adjacency::Adjacency;
 use shadow_core::scene::{Light, LightKind};
 use shadow_core::stats::{Phase, Summary};
@@ -51,6 +51,19 @@ pub struct BenchJob<'a> {
     pub rebuild: bool,
     /// The scene's clip played through the frames, in place of the moving light.
     pub clip: Option<&'a Clip>,
+    /// What the frames save ([`Savings`]): each technique is measured under each, side by side.
+    pub savings: Vec<Savings>,
+}
+
+/// The name of `savings` in reports: "all" or "none".
+#[must_use]
+pub fn savings_name(savings: Savings) -> &'static str {
+    if savings == Savings::NONE { "none" } else { "all" }
+}
+
+/// A technique's label in a table: with ", no savings" where it ran with none.
+fn label(technique: &str, savings: &str) -> String {
+    if savings == "none" { format!("{technique}, no savings") } else { technique.to_string() }
 }
 
 /// A scene's animations played through a bench's frames (`bench --animate`): frame `k` is the scene
@@ -112,6 +125,8 @@ pub struct BenchEntry {
     pub settings: String,
     /// Backend name.
     pub backend: String,
+    /// What the frames saved ([`savings_name`]).
+    pub savings: String,
     /// Per phase (and total), over the measured frames.
     pub timings_ms: BTreeMap<String, Stat>,
     /// Counters of the last frame.
@@ -150,24 +165,33 @@ pub fn moved_light(light: &Light, center: Vec3, k: u32, n: u32) -> Light {
 }
 
 impl BenchJob<'_> {
-    /// The frame of run frame `k` of `total`: the clip's `k`-th pose (the last one past its end), or the
-    /// lights turned a `k / total` part of a quarter turn.
+    /// The frame of run frame `k` of `total` with `savings`: the clip's `k`-th pose (the last one past its
+    /// end), or the lights turned a `k / total` part of a quarter turn.
     #[must_use]
-    pub fn frame_at(&self, k: u32, total: u32) -> FrameInputs {
-        if let Some(frame) = self.clip.and_then(|c| c.frames.get(k as usize).or(c.frames.last())) {
-            return frame.clone();
+    pub fn frame_at(&self, k: u32, total: u32, savings: Savings) -> FrameInputs {
+        let posed = self.clip.and_then(|c| c.frames.get(k as usize).or(c.frames.last()));
+        let mut frame = posed.unwrap_or(self.frame).clone();
+        if posed.is_none() {
+            let center = self.frame.bounds.center();
+            frame.lights = self.frame.lights.iter().map(|l| moved_light(l, center, k, total)).collect();
         }
-        let center = self.frame.bounds.center();
-        let mut frame = self.frame.clone();
-        frame.lights = self.frame.lights.iter().map(|l| moved_light(l, center, k, total)).collect();
+        frame.savings = savings;
         frame
+    }
+
+    /// Each technique under each of the job's savings, in the order they are measured and reported: its
+    /// place among the techniques, its spec and the savings.
+    #[must_use]
+    pub fn variants(&self) -> Vec<(usize, &TechniqueSpec, Savings)> {
+        let savings = if self.savings.is_empty() { vec![Savings::ALL] } else { self.savings.clone() };
+        self.techniques.iter().enumerate().flat_map(|(k, spec)| savings.iter().map(move |&s| (k, spec, s))).collect()
     }
 
     /// How many times [`run_bench`] reports progress: per backend, once per technique as it is prepared,
     /// then once per frame round (warm-up included).
     #[must_use]
     pub fn steps(&self) -> u64 {
-        self.backends.len() as u64 * (self.techniques.len() as u64 + u64::from(self.warmup + self.frames))
+        self.backends.len() as u64 * (self.variants().len() as u64 + u64::from(self.warmup + self.frames))
     }
 }
 
@@ -177,6 +201,7 @@ struct Lane {
     technique: usize,
     prepared: Prepared,
     backend: BackendKind,
+    savings: Savings,
     samples: BTreeMap<String, Vec<f64>>,
     counters: BTreeMap<String, f64>,
 }
@@ -194,20 +219,22 @@ pub fn run_bench(
     let mut lanes = Vec::new();
     for &backend in &job.backends {
         let first = lanes.len();
-        for (technique, spec) in job.techniques.iter().enumerate() {
+        for (technique, spec, savings) in job.variants() {
             progress(&format!("{spec} on {}", backend.name()));
             let prepared = renderer.prepare(backend, spec)?;
-            lanes.push(Lane { technique, prepared, backend, samples: BTreeMap::new(), counters: BTreeMap::new() });
+            let (samples, counters) = (BTreeMap::new(), BTreeMap::new());
+            lanes.push(Lane { technique, prepared, backend, savings, samples, counters });
         }
         for k in 0..total {
             let warm = if k < job.warmup { " (warm-up)" } else { "" };
             progress(&format!("{}: frame {} of {total}{warm}", backend.name(), k + 1));
-            let mut frame = job.frame_at(k, total);
+            let mut frame = job.frame_at(k, total, Savings::ALL);
             let adjacency = job.rebuild.then(|| rebuild_adjacency(&mut frame));
             for lane in &mut lanes[first..] {
                 if job.rebuild {
                     renderer.forget_caches();
                 }
+                frame.savings = lane.savings;
                 let run = renderer.run_prepared(&mut lane.prepared, &frame, job.width, job.height)?;
                 if k >= job.warmup {
                     lane.record(&run.stats);
@@ -274,6 +301,7 @@ impl Lane {
             technique: self.prepared.name().into(),
             settings: self.prepared.settings().into(),
             backend: self.backend.name().into(),
+            savings: savings_name(self.savings).into(),
             timings_ms,
             counters: self.counters,
         }
@@ -303,7 +331,7 @@ pub fn bench_table(r: &BenchReport) -> String {
                 cell(&format!("{prefix}shade")),
             )
         };
-        s.push_str(&row(&e.technique, &e.backend, "", cell("total")));
+        s.push_str(&row(&label(&e.technique, &e.savings), &e.backend, "", cell("total")));
         // Where the adapter has timestamp queries: the GPU's own time per phase, counters taken out.
         if e.timings_ms.contains_key("gpu_query") {
             let gpu: f64 = ["gbuffer", "build", "query", "shade"]
@@ -390,6 +418,7 @@ mod tests {
             backends: vec![BackendKind::Cpu, BackendKind::Cpu],
             rebuild: false,
             clip: None,
+            savings: vec![Savings::ALL],
         };
         let mut renderer = Renderer::new(TechniqueRegistry::builtin());
         let mut steps = Vec::new();
@@ -423,8 +452,9 @@ mod tests {
             backends: vec![BackendKind::Cpu],
             rebuild: false,
             clip: Some(&clip),
+            savings: vec![Savings::ALL],
         };
-        let frames: Vec<FrameInputs> = (0..4).map(|k| job.frame_at(k, 3)).collect();
+        let frames: Vec<FrameInputs> = (0..4).map(|k| job.frame_at(k, 3, Savings::ALL)).collect();
         let versions: Vec<Vec<u64>> =
             frames.iter().map(|f| f.instances.iter().map(|i| i.mesh_version).collect()).collect();
         assert!(versions[0] != versions[1] && versions[1] != versions[2], "{versions:?}");
@@ -455,6 +485,7 @@ mod tests {
                 backends: vec![BackendKind::Cpu],
                 rebuild,
                 clip: None,
+                savings: vec![Savings::ALL],
             };
             let report = run_bench(&mut renderer, &job, |_| {}).expect("bench");
             let e = &report.results[0];

@@ -11,6 +11,7 @@ use std::collections::VecDeque;
 use std::time::Instant;
 
 use serde::Serialize;
+use shadow_core::frame::Savings;
 use shadow_core::stats::{Summary, ms};
 use shadow_wgpu::{ColorTarget, FrameRecorder, WgpuContext, WgpuError};
 
@@ -28,6 +29,8 @@ pub struct RealtimeEntry {
     pub technique: String,
     /// Canonical settings.
     pub settings: String,
+    /// What the frames saved ([`super::savings_name`]).
+    pub savings: String,
     /// Wall time per frame with frames in flight: the measured frames' time over their count, in ms.
     pub frame_ms: Option<f64>,
     /// The host's time to record one frame (CPU), its submission left out, in ms.
@@ -67,7 +70,7 @@ pub struct RealtimeReport {
 /// How many times [`run_realtime_bench`] reports progress: twice per technique.
 #[must_use]
 pub fn realtime_steps(job: &BenchJob<'_>) -> u64 {
-    2 * job.techniques.len() as u64
+    2 * job.variants().len() as u64
 }
 
 /// Runs the job on the wgpu backend (whatever backends it names), technique by technique: its
@@ -81,13 +84,13 @@ pub fn run_realtime_bench(
     mut progress: impl FnMut(&str),
 ) -> Result<RealtimeReport, Error> {
     let mut results = Vec::new();
-    for spec in &job.techniques {
+    for (_, spec, savings) in job.variants() {
         progress(&format!("{spec}: instrumented frames"));
         let mut prepared = renderer.prepare(BackendKind::Wgpu, spec)?;
         let total = job.warmup + job.frames;
         let mut totals = Vec::new();
         for k in 0..total {
-            let run = renderer.run_prepared(&mut prepared, &job.frame_at(k, total), job.width, job.height)?;
+            let run = renderer.run_prepared(&mut prepared, &job.frame_at(k, total, savings), job.width, job.height)?;
             if k >= job.warmup {
                 totals.push(run.stats.timings.total);
             }
@@ -99,12 +102,13 @@ pub fn run_realtime_bench(
         let registry = renderer.registry();
         crate::renderer::name_techniques(job.frame, &mut named, |s| Ok(registry.wgpu(s)?))?;
         let cx = renderer.wgpu_context()?;
-        let entry = match realtime_frames(cx, job, technique.as_mut(), &mut named) {
+        let entry = match realtime_frames(cx, (job, savings), technique.as_mut(), &mut named) {
             Ok(times) => {
                 let frame_ms = times.wall_ms / f64::from(job.frames.max(1));
                 RealtimeEntry {
                     technique: prepared.name().into(),
                     settings: prepared.settings().into(),
+                    savings: super::savings_name(savings).into(),
                     frame_ms: Some(frame_ms),
                     record_ms: Some(stat(&times.record_ms)),
                     gpu_ms: (!times.gpu_ms.is_empty()).then(|| stat(&times.gpu_ms)),
@@ -116,6 +120,7 @@ pub fn run_realtime_bench(
             Err(e @ (WgpuError::NotRecordable { .. } | WgpuError::Technique(_))) => RealtimeEntry {
                 technique: prepared.name().into(),
                 settings: prepared.settings().into(),
+                savings: super::savings_name(savings).into(),
                 frame_ms: None,
                 record_ms: None,
                 gpu_ms: None,
@@ -152,11 +157,11 @@ struct Times {
     gpu_ms: Vec<f64>,
 }
 
-/// The job's frames of one technique (and of those its lights name, `named`) through the real-time path:
-/// warm-up frames each waited for, then the measured frames with at most [`IN_FLIGHT`] in flight.
+/// The job's frames of one technique (and of those its lights name, `named`) with `savings` through the
+/// real-time path: warm-up frames each waited for, then the measured frames with at most [`IN_FLIGHT`] in flight.
 fn realtime_frames(
     cx: &mut WgpuContext,
-    job: &BenchJob<'_>,
+    (job, savings): (&BenchJob<'_>, Savings),
     technique: &mut dyn shadow_core::technique::DynShadowTechnique<shadow_wgpu::WgpuBackend>,
     named: &mut crate::renderer::Named<shadow_wgpu::WgpuBackend>,
 ) -> Result<Times, WgpuError> {
@@ -170,7 +175,7 @@ fn realtime_frames(
     let mut times = Times { wall_ms: 0.0, record_ms: Vec::new(), gpu_ms: Vec::new() };
     let mut start = Instant::now();
     for k in 0..total {
-        let frame = job.frame_at(k, total);
+        let frame = job.frame_at(k, total, savings);
         let measured = k.checked_sub(job.warmup);
         if measured == Some(0) {
             cx.wait()?;
@@ -275,8 +280,9 @@ pub fn realtime_table(r: &RealtimeReport) -> String {
     let cell = |st: &Stat| format!("{:.2} [{:.2}..{:.2}]", st.median, st.min, st.max);
     // A technique run with more than one set of settings is told apart by them.
     let label = |e: &RealtimeEntry| {
-        let twice = r.results.iter().filter(|o| o.technique == e.technique).count() > 1;
-        if twice { format!("{}:{}", e.technique, e.settings) } else { e.technique.clone() }
+        let twice = r.results.iter().filter(|o| o.technique == e.technique && o.savings == e.savings).count() > 1;
+        let name = if twice { format!("{}:{}", e.technique, e.settings) } else { e.technique.clone() };
+        super::label(&name, &e.savings)
     };
     for e in &r.results {
         let inst = cell(&e.instrumented_ms);

@@ -133,6 +133,7 @@ fn run_triangles(
         backends: vec![BackendKind::Cpu],
         rebuild: false,
         clip: None,
+        savings: vec![shadow_core::frame::Savings::ALL],
     };
     let bench = run_bench(renderer, &job, |m| progress(&format!("triangles as {what}: {m}")))?;
     Ok(Triangles { many, adjacency_ms, bvh_ms, bench })
@@ -175,6 +176,7 @@ pub fn run_many(
                 backends: backends.to_vec(),
                 rebuild: false,
                 clip: None,
+                savings: vec![shadow_core::frame::Savings::ALL],
             };
             let what = if shared { "shared" } else { "unshared" };
             let mut bench = run_bench(renderer, &job, |m| progress(&format!("{name} {what}: {m}")))?;

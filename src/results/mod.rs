@@ -6,12 +6,13 @@
 //! the real-time path on that scene (`bench --realtime`), perspective aliasing on the outdoor street
 //! ([`outdoor`]), the soft techniques against the area light ([`soft`]), the scenes of cut-out casters
 //! ([`cutouts`]), the animated scenes at rest and posed ([`animated`]), the scenes of many objects with
-//! their meshes shared and unshared ([`many`]), and the kernels under them all timed on their own
-//! ([`kernels`]).
+//! their meshes shared and unshared ([`many`]), a scene of many lights ([`lights`]), and the kernels under
+//! them all timed on their own ([`kernels`]).
 
 pub mod animated;
 pub mod cutouts;
 pub mod kernels;
+pub mod lights;
 pub mod many;
 pub mod outdoor;
 pub mod soft;
@@ -27,6 +28,9 @@ use crate::bench::{BenchJob, BenchReport, run_bench};
 use crate::compare::{CompareJob, CompareReport, references_for, run_compare};
 use crate::renderer::{BackendKind, Renderer};
 use crate::{Error, TechniqueRegistry};
+
+/// The view size of the many-lights measurements.
+const LIGHTS_SIZE: (u32, u32) = (1024, 768);
 
 /// What to measure.
 pub struct ResultsJob {
@@ -107,6 +111,7 @@ pub fn run_results(renderer: &mut Renderer, job: &ResultsJob, mut progress: impl
         backends: job.backends.clone(),
         rebuild: false,
         clip: None,
+        savings: vec![shadow_core::frame::Savings::ALL],
     };
     let timing = run_bench(renderer, &bench, |m| progress(&format!("{}: {m}", job.bench_scene)))?;
     // The real-time path where there is a GPU adapter: the same frames recorded, two in flight.
@@ -126,6 +131,7 @@ pub fn run_results(renderer: &mut Renderer, job: &ResultsJob, mut progress: impl
     let cutouts = cutouts::run_cutouts(renderer, &cutout_job, &mut progress)?;
     let animated = animated::run_animated(renderer, job.size, &job.backends, &mut progress)?;
     let many = many::run_many(renderer, job.bench_size, &job.backends, &mut progress)?;
+    let lights = lights::run_lights(renderer, LIGHTS_SIZE, &job.backends, &mut progress)?;
     let kernels = kernels::run_kernels(&mut progress)?;
     let mut text = markdown(renderer, job, &reports, (&timing, realtime.as_ref()));
     outdoor::markdown(&mut text, &outdoor);
@@ -133,6 +139,7 @@ pub fn run_results(renderer: &mut Renderer, job: &ResultsJob, mut progress: impl
     cutouts::markdown(&mut text, &cutouts);
     animated::markdown(&mut text, &animated);
     many::markdown(&mut text, &many);
+    lights::markdown(&mut text, &lights);
     kernels::markdown(&mut text, &kernels);
     Ok(text)
 }

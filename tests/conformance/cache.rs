@@ -4,9 +4,10 @@
 //! builds. On both backends.
 
 use shadow_core::glam::{Mat4, Vec3};
+use shadow_core::scene::ShadowUpdate;
 use shadow_core::scenes::{self, SceneParams};
 use shadow_core::technique::TechniqueSpec;
-use shadow_core::{FrameInputs, LightKind};
+use shadow_core::{FrameInputs, LightKind, LightShadow};
 use shadowlab::renderer::RunOutput;
 use shadowlab::{BackendKind, Renderer, TechniqueRegistry};
 
@@ -119,5 +120,73 @@ fn a_caster_moving_outside_a_lights_view_keeps_the_maps_it_is_not_in() {
             };
             assert_eq!(cached(&run(&mut p, &inside)), 0.0, "{what}: a caster moved into the view kept the build");
         }
+    }
+}
+
+/// A light's update policy: every frame builds on every frame even when nothing moved; every third frame
+/// keeps its build over two frames whatever moved, then builds; once keeps its first build while the light
+/// moves (its shadow stays where it was); and a technique whose build reads the camera (hybrid on the GPU)
+/// builds every frame whatever the light says.
+#[test]
+fn each_light_is_built_again_as_its_update_policy_says() {
+    let (mut renderer, backends, frame) = primitives();
+    let with = |f: &FrameInputs, update: ShadowUpdate| FrameInputs {
+        shadows: vec![LightShadow { update, ..LightShadow::default() }; f.lights.len()],
+        ..f.clone()
+    };
+    let nudged = |k: u32| {
+        let mut f = frame.clone();
+        if let LightKind::Spot { position, .. } = &mut f.lights[0].kind {
+            *position += Vec3::new(0.1 * k as f32, 0.0, 0.0);
+        }
+        f
+    };
+    for backend in backends {
+        // hybrid's build on the GPU reads the camera (its mask is the view's); on the CPU it does not.
+        for (name, reusable) in [("shadow-map", true), ("hybrid", backend == BackendKind::Cpu)] {
+            let what = format!("{name} on {backend:?}");
+            let mut cached_over = |update: ShadowUpdate, frames: &[FrameInputs]| -> Vec<f64> {
+                let mut p = renderer.prepare(backend, &TechniqueSpec::named(name)).expect("technique");
+                frames
+                    .iter()
+                    .map(|f| cached(&renderer.run_prepared(&mut p, &with(f, update), SIZE, SIZE).expect("frame")))
+                    .collect()
+            };
+            let still = vec![frame.clone(); 4];
+            let moving: Vec<FrameInputs> = (0..7).map(nudged).collect();
+            let every = cached_over(ShadowUpdate::EveryFrame, &still);
+            assert_eq!(every, [0.0; 4], "{what}: every frame");
+            let third = cached_over(ShadowUpdate::Every(3), &moving);
+            let once = cached_over(ShadowUpdate::Once, &moving);
+            if reusable {
+                assert_eq!(third, [0.0, 1.0, 1.0, 0.0, 1.0, 1.0, 0.0], "{what}: every third frame");
+                assert_eq!(once, [0.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0], "{what}: once");
+            } else {
+                assert_eq!((third, once), (vec![0.0; 7], vec![0.0; 7]), "{what}: reads the camera");
+            }
+        }
+        // Built once, the shadow stays where the first frame's light cast it.
+        let mut p = renderer.prepare(backend, &TechniqueSpec::named("shadow-map")).expect("technique");
+        let first = renderer.run_prepared(&mut p, &with(&frame, ShadowUpdate::Once), SIZE, SIZE).expect("frame");
+        let kept = renderer.run_prepared(&mut p, &with(&nudged(6), ShadowUpdate::Once), SIZE, SIZE).expect("frame");
+        let mut fresh = renderer.prepare(backend, &TechniqueSpec::named("shadow-map")).expect("technique");
+        let moved = renderer.run_prepared(&mut fresh, &nudged(6), SIZE, SIZE).expect("frame");
+        assert!(
+            kept.visibility[0].data() != moved.visibility[0].data(),
+            "{backend:?}: the kept build followed the light"
+        );
+        assert!(first.visibility[0].data().contains(&0.0), "{backend:?}: nothing in shadow");
+    }
+}
+
+#[test]
+fn update_policies_parse_by_name() {
+    assert_eq!(ShadowUpdate::parse("every-frame"), Ok(ShadowUpdate::EveryFrame));
+    assert_eq!(ShadowUpdate::parse("on-change"), Ok(ShadowUpdate::OnChange));
+    assert_eq!(ShadowUpdate::parse("every-4"), Ok(ShadowUpdate::Every(4)));
+    assert_eq!(ShadowUpdate::parse("once"), Ok(ShadowUpdate::Once));
+    for bad in ["every-0", "every-x", "sometimes"] {
+        let e = ShadowUpdate::parse(bad).expect_err(bad);
+        assert!(e.to_string().contains(bad), "{e}");
     }
 }

@@ -18,6 +18,7 @@ mod own_pixels;
 mod penumbra_wedges;
 mod per_light;
 mod pipelines;
+mod reach;
 mod settings;
 mod silhouette_map;
 mod single_sided;

@@ -12,10 +12,12 @@
 //! ([`psm`]), the last two fitted to the part of the view the scene fills ([`focus`]). The view it renders then says how a receiver picks its projection
 //! ([`LightView::projection_index`]).
 
+pub mod atlas;
 pub mod cascades;
 pub mod focus;
 pub mod lispsm;
 pub mod psm;
+pub mod reach;
 
 use glam::camera::rh::proj::directx;
 use glam::camera::rh::view::look_to_mat4;
@@ -24,7 +26,9 @@ use glam::{Mat4, Vec2, Vec3, Vec3Swizzles, Vec4, Vec4Swizzles};
 use crate::bounds::Aabb;
 use crate::geometry::LightSource;
 use crate::scene::{Light, LightKind, SceneError};
+pub use atlas::{AtlasPlan, LightTiles, TileRequest};
 pub use cascades::{CascadeFit, CascadePick, Cascades, Stabilize};
+pub use reach::{PixelRect, Reach};
 
 /// Why a light view could not be made.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -68,6 +72,14 @@ impl LightProjection {
             far,
             orthographic,
         }
+    }
+
+    /// Whether part of box `b` may lie in this projection's frustum: false only where it lies wholly
+    /// outside one of its planes, so that none of its triangles is drawn into the map (casters so culled
+    /// change no texel).
+    #[must_use]
+    pub fn may_hold(&self, b: Aabb) -> bool {
+        !b.is_empty() && frustum_may_hold(self.clip_from_world, b)
     }
 
     /// Light NDC of a world point (x, y in [-1, 1] inside the view, z depth in [0, 1]).
@@ -329,17 +341,23 @@ impl LightView {
         self.cascades.as_ref().map(|c| c.pick(c.depth(p)))
     }
 
-    /// True where the light can reach at all: inside a spot light's cone, everywhere for the others.
-    /// Metrics leave the rest out: no technique has anything to say there.
+    /// True where the light can reach at all: inside a spot light's cone and within a light's range.
+    /// Metrics leave the rest out: no technique has anything to say there (a frame does not even ask, see
+    /// [`Reach`]).
     #[must_use]
     pub fn in_domain(&self, p: Vec3) -> bool {
-        match self.light.kind {
-            LightKind::Spot { position, direction, cone_angle } => {
-                let d = (p - position).normalize_or_zero();
-                d.dot(direction.normalize()) >= (cone_angle * 0.5).cos()
-            }
+        let within_range = match (self.light.range, self.light.position()) {
+            (Some(range), Some(position)) => (p - position).length() < range,
             _ => true,
-        }
+        };
+        within_range
+            && match self.light.kind {
+                LightKind::Spot { position, direction, cone_angle } => {
+                    let d = (p - position).normalize_or_zero();
+                    d.dot(direction.normalize()) >= (cone_angle * 0.5).cos()
+                }
+                _ => true,
+            }
     }
 }
 

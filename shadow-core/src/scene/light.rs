@@ -37,12 +37,55 @@ pub struct LightShadow {
     /// The technique that shadows it, with its settings (a map's size and bias where the technique has
     /// them); `None`: the frame's technique. Lights of one frame may each name another.
     pub technique: Option<TechniqueSpec>,
+    /// When its shadow is built again.
+    pub update: ShadowUpdate,
+}
+
+/// When a light's shadow is built again (its maps, volumes or whatever its technique builds); its query
+/// runs every frame whatever this says.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum ShadowUpdate {
+    /// Every frame.
+    EveryFrame,
+    /// When what its build reads changed: the light, the casters in its views and its atlas tiles (a
+    /// technique whose build reads the camera builds every frame).
+    #[default]
+    OnChange,
+    /// On its first frame and then every `n`th one, whatever changed in between (`n` of 0 or 1: every
+    /// frame).
+    Every(u32),
+    /// On its first frame only; its build is kept until the technique forgets it
+    /// ([`crate::technique::DynShadowTechnique::invalidate`]).
+    Once,
+}
+
+impl ShadowUpdate {
+    /// Parses `every-frame`, `on-change`, `every-N` or `once`.
+    ///
+    /// # Errors
+    /// Anything else, named.
+    pub fn parse(s: &str) -> Result<Self, SceneError> {
+        let bad = || {
+            SceneError::Invalid(format!("bad shadow update '{s}': expected every-frame, on-change, every-N or once"))
+        };
+        match s {
+            "every-frame" => Ok(Self::EveryFrame),
+            "on-change" => Ok(Self::OnChange),
+            "once" => Ok(Self::Once),
+            _ => s
+                .strip_prefix("every-")
+                .and_then(|n| n.parse().ok())
+                .filter(|&n| n > 0)
+                .map(Self::Every)
+                .ok_or_else(bad),
+        }
+    }
 }
 
 impl Default for LightShadow {
     /// Casting, with the frame's technique.
     fn default() -> Self {
-        Self { casts: true, technique: None }
+        Self { casts: true, technique: None, update: ShadowUpdate::OnChange }
     }
 }
 
@@ -50,11 +93,11 @@ impl LightShadow {
     /// Casting with `technique` (a spec such as `shadow-map:res=1024`).
     #[must_use]
     pub fn with(technique: TechniqueSpec) -> Self {
-        Self { casts: true, technique: Some(technique) }
+        Self { casts: true, technique: Some(technique), update: ShadowUpdate::OnChange }
     }
 
     /// Casting no shadow.
-    pub const NONE: Self = Self { casts: false, technique: None };
+    pub const NONE: Self = Self { casts: false, technique: None, update: ShadowUpdate::OnChange };
 }
 
 /// A light source.

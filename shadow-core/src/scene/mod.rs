@@ -26,7 +26,7 @@ mod skin;
 pub use crate::material::Material;
 pub use animation::{Animation, AnimationKey, Channel, Interpolation, Keyframes, Trs};
 pub use camera::Camera;
-pub use light::{Light, LightKind, LightShadow};
+pub use light::{Light, LightKind, LightShadow, ShadowUpdate};
 use placed::Placed;
 pub use skin::{Deformed, Pose, Skin, SkinKey};
 

@@ -21,8 +21,8 @@ pub mod settings;
 
 use crate::frame::FrameInputs;
 use crate::image::{Image, Rgb8};
-use crate::light::{LightView, LightViewError};
-use crate::scene::Light;
+use crate::light::{LightTiles, LightView, LightViewError, Reach};
+use crate::scene::{Light, ShadowUpdate};
 use crate::stats::{Counters, Timings};
 
 pub use registry::{CasterHandling, CasterKinds, LightKinds};
@@ -70,6 +70,9 @@ pub enum TechniqueError {
     /// A light names a technique the frame was not given.
     #[error("a light is shadowed by '{0}', which the frame was not given (make it from the registry)")]
     Unprepared(String),
+    /// The frame's shadow atlas cannot hold its lights' maps.
+    #[error(transparent)]
+    AtlasFull(#[from] crate::light::atlas::AtlasFull),
 }
 
 impl TechniqueError {
@@ -106,6 +109,14 @@ pub struct LightPass<'a> {
     pub frame: &'a FrameInputs,
     /// The light and its fitted projections.
     pub light: &'a LightView,
+    /// Where the light reaches in the view: a query need answer only the pixels within it (those outside are
+    /// lit, as its direct term there is 0), a build may leave out what lights nothing within it.
+    pub reach: Reach,
+    /// Where the light's maps lie in the frame's shadow atlas, and their side, for a technique that asks
+    /// for tiles ([`ShadowTechnique::atlas_side`]); `None`: its maps are its own, of its own size.
+    pub tiles: Option<&'a LightTiles>,
+    /// When the light's build is made again ([`crate::LightShadow::update`]).
+    pub update: ShadowUpdate,
     /// The light's place among the frame's lights. A device whose buffer writes all land before the
     /// frame's commands run (a frame recorded into one command buffer) needs the data of each light in
     /// a place of its own: techniques index it by this.
@@ -131,8 +142,23 @@ pub enum BuildReads {
 }
 
 impl LightPass<'_> {
-    /// A digest of what a light's build reads: the light's position (or direction), its radius and its
-    /// fitted projections (which hold its cone), and each instance's index, mesh, version, placement and shadow
+    /// The same pass with its stats borrowed for a shorter while: one pass handed to a build, then to a
+    /// query.
+    pub fn reborrow(&mut self) -> LightPass<'_> {
+        LightPass {
+            frame: self.frame,
+            light: self.light,
+            reach: self.reach,
+            tiles: self.tiles,
+            update: self.update,
+            slot: self.slot,
+            aspect: self.aspect,
+            stats: &mut *self.stats,
+        }
+    }
+
+    /// A digest of what a light's build reads: the light's position (or direction), its radius, its
+    /// fitted projections (which hold its cone) and its atlas tiles, and each instance's index, mesh, version, placement and shadow
     /// flags, of every instance or of those in the light's views as `reads` says (the camera is not among
     /// them: a build that reads it is not kept, see [`ShadowTechnique::build_is_reusable`]).
     #[must_use]
@@ -142,6 +168,7 @@ impl LightPass<'_> {
         let mut h = std::collections::hash_map::DefaultHasher::new();
         floats(&mut h, &self.light.source().homogeneous().to_array());
         floats(&mut h, &[self.light.light.radius]);
+        self.tiles.map(|t| (t.side, t.origins.iter().map(|o| o.to_array()).collect::<Vec<_>>())).hash(&mut h);
         for p in &self.light.projections {
             floats(&mut h, &p.clip_from_world.to_cols_array());
         }
@@ -264,6 +291,13 @@ pub trait ShadowTechnique<B: Backend>: Send + Sync {
     fn debug_views(&self, _cx: &mut B::Context, _state: &Self::State) -> Result<Vec<DebugView>, B::Error> {
         Ok(Vec::new())
     }
+
+    /// The map side a spot or point light shadowed by this technique asks of the frame's shadow atlas
+    /// ([`crate::light::atlas`]), which grants it that side or less as [`LightPass::tiles`]; `None` (the
+    /// default): the technique keeps maps of its own.
+    fn atlas_side(&self) -> Option<u32> {
+        None
+    }
 }
 
 /// The object-safe face of a technique with its state, for choosing at runtime.
@@ -296,23 +330,53 @@ pub trait DynShadowTechnique<B: Backend>: Send {
     /// Forgets every light's last build, so the next frame builds each light afresh (after a change the
     /// build cannot see: a mesh edited in place, say).
     fn invalidate(&mut self);
+    /// See [`ShadowTechnique::atlas_side`].
+    fn atlas_side(&self) -> Option<u32>;
 }
 
 /// A technique with its lazily created state, one per light of the frame ([`LightPass::slot`]): the
 /// standard [`DynShadowTechnique`].
 ///
-/// A light whose view, casters and meshes are what its last build read (and, for a technique whose build
-/// reads it, the camera) is not built again: its state still holds that build (the three.js
-/// `autoUpdate` idea, made automatic). The frame's counters say how many lights were spared
+/// A light is built again as its [`ShadowUpdate`] says. By default, one whose view, casters and meshes
+/// are what its last build read is not: its state still holds that build (the three.js `autoUpdate`
+/// idea, made automatic). A technique whose build cannot be kept ([`ShadowTechnique::build_is_reusable`])
+/// builds every frame whatever the light says. The frame's counters say how many lights were spared
 /// (`cached_builds`); [`DynShadowTechnique::invalidate`] forgets every build.
 pub struct Stateful<B: Backend, T: ShadowTechnique<B>> {
     technique: T,
     settings: String,
     lights: LightKinds,
-    /// Per light slot: its state, and what its last build read.
-    slots: Vec<Option<(T::State, Option<u64>)>>,
+    /// Per light slot.
+    slots: Vec<Option<Slot<T::State>>>,
     /// The slot last built or queried, for the debug views.
     last: usize,
+}
+
+/// One light's state and what its last build was.
+struct Slot<S> {
+    state: S,
+    /// What the last build read ([`LightPass::build_key`]), where it may be kept.
+    read: Option<u64>,
+    /// The state holds a whole build.
+    built: bool,
+    /// Frames its build has been kept since it was made.
+    kept: u32,
+}
+
+impl<S> Slot<S> {
+    /// Whether the build it holds serves a frame whose build would read `read` (`None`: a build that
+    /// cannot be kept), as `update` says.
+    fn keeps(&self, read: Option<u64>, update: ShadowUpdate) -> bool {
+        if !self.built || read.is_none() {
+            return false;
+        }
+        match update {
+            ShadowUpdate::EveryFrame => false,
+            ShadowUpdate::OnChange => self.read == read,
+            ShadowUpdate::Every(n) => self.kept + 1 < n,
+            ShadowUpdate::Once => true,
+        }
+    }
 }
 
 impl<B: Backend, T: ShadowTechnique<B>> Stateful<B, T> {
@@ -355,17 +419,18 @@ impl<B: Backend, T: ShadowTechnique<B>> DynShadowTechnique<B> for Stateful<B, T>
             self.slots.resize_with(pass.slot + 1, || None);
         }
         self.last = pass.slot;
-        let (state, built) = match &mut self.slots[pass.slot] {
+        let slot = match &mut self.slots[pass.slot] {
             Some(s) => s,
-            slot => slot.insert((self.technique.create_state(cx)?, None)),
+            slot => slot.insert(Slot { state: self.technique.create_state(cx)?, read: None, built: false, kept: 0 }),
         };
-        if reads.is_some() && *built == reads {
+        if slot.keeps(reads, pass.update) {
+            slot.kept += 1;
             *pass.stats.counters.extra.entry("cached_builds".into()).or_insert(0.0) += 1.0;
             return Ok(());
         }
-        *built = None;
-        self.technique.build(cx, state, pass)?;
-        *built = reads;
+        (slot.read, slot.built, slot.kept) = (None, false, 0);
+        self.technique.build(cx, &mut slot.state, pass)?;
+        (slot.read, slot.built) = (reads, true);
         Ok(())
     }
 
@@ -377,21 +442,25 @@ impl<B: Backend, T: ShadowTechnique<B>> DynShadowTechnique<B> for Stateful<B, T>
         out: &mut B::Visibility,
     ) -> Result<(), B::Error> {
         let not_built = || TechniqueError::NotBuilt(self.technique.name().into());
-        let (state, _) = self.slots.get_mut(pass.slot).and_then(Option::as_mut).ok_or_else(not_built)?;
+        let slot = self.slots.get_mut(pass.slot).and_then(Option::as_mut).ok_or_else(not_built)?;
         self.last = pass.slot;
-        self.technique.query(cx, state, pass, gbuffer, out)
+        self.technique.query(cx, &mut slot.state, pass, gbuffer, out)
     }
 
     fn debug_views(&mut self, cx: &mut B::Context) -> Result<Vec<DebugView>, B::Error> {
         match self.slots.get(self.last).and_then(Option::as_ref) {
-            Some((s, _)) => self.technique.debug_views(cx, s),
+            Some(s) => self.technique.debug_views(cx, &s.state),
             None => Ok(Vec::new()),
         }
     }
 
     fn invalidate(&mut self) {
-        for (_, built) in self.slots.iter_mut().flatten() {
-            *built = None;
+        for slot in self.slots.iter_mut().flatten() {
+            (slot.read, slot.built) = (None, false);
         }
+    }
+
+    fn atlas_side(&self) -> Option<u32> {
+        self.technique.atlas_side()
     }
 }

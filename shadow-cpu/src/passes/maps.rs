@@ -7,7 +7,7 @@
 use rayon::prelude::*;
 use shadow_core::frame::FrameError;
 use shadow_core::glam::{Vec2, Vec3};
-use shadow_core::light::{LightProjection, LightView};
+use shadow_core::light::{LightProjection, LightView, Reach};
 use shadow_core::lookup::shadow_lookup;
 use shadow_core::technique::DebugView;
 use shadow_core::technique::maps::{Casters, CutoutMap};
@@ -73,8 +73,9 @@ pub fn render_depth_map(
     Ok((ds.into_depth_image(), counters))
 }
 
-/// The shadow casters of a frame, sorted by their coverage (in frame order within each kind), with their
-/// vertices in the clip space of one light projection.
+/// The shadow casters of a frame that may lie in one light projection's frustum (the others, culled by
+/// their bounds where the frame saves so, would draw nothing), sorted by their coverage (in frame order within each kind), with
+/// their vertices in that projection's clip space.
 struct LightCasters<'a> {
     frame: &'a FrameInputs,
     drawn: Drawn<'a>,
@@ -84,7 +85,8 @@ struct LightCasters<'a> {
 
 impl<'a> LightCasters<'a> {
     fn new(frame: &'a FrameInputs, proj: &LightProjection, casters: Casters) -> Self {
-        let drawn = Drawn::sort(frame, |i| casters.takes(i));
+        let culling = frame.savings.culling;
+        let drawn = Drawn::sort(frame, |i| casters.takes(i) && (!culling || proj.may_hold(i.bounds)));
         let casting: Vec<&Instance> = drawn.solid.iter().chain(&drawn.cutout).map(|&k| &frame.instances[k]).collect();
         let clip = ClipVertices::of_instances(&casting, proj.clip_from_world);
         Self { frame, drawn, clip }
@@ -204,32 +206,26 @@ pub fn map_position(light: &LightView, mut p: Vec3, receiver_offset: f32) -> Map
     MapPosition { projection: k, uv, depth, world: p }
 }
 
-/// The lookup every map-based technique shares: each receiver (moved `receiver_offset` towards the light)
-/// projected into its map and compared through `filter`; with cascades, faded into the next cascade's
-/// answer over the blend band at its far end.
-pub fn query_maps(
-    maps: &[Image<f32>],
-    light: &LightView,
-    g: &GBuffer,
-    out: &mut Image<f32>,
-    filter: Filter,
-    radius: f32,
-    receiver_offset: f32,
-) {
-    let lookup = MapLookup { filter, radius, receiver_offset };
-    per_receiver(g, out, |x, y, i| lookup.visibility(maps, light, g.position.data()[i], (x, y)));
-}
-
-/// How a receiver reads a light's maps: the filter, its kernel radius in texels, and how far the receiver
-/// moves towards the light first (`bias=world`).
+/// How a receiver reads a light's maps, the lookup every map-based technique shares: the receiver moved
+/// `receiver_offset` towards the light (`bias=world`), projected into its map and compared through
+/// `filter` with a kernel of `radius` texels; with cascades, faded into the next cascade's answer over the
+/// blend band at its far end.
 #[derive(Clone, Copy, Debug)]
-struct MapLookup {
-    filter: Filter,
-    radius: f32,
-    receiver_offset: f32,
+pub struct MapLookup {
+    /// The filter.
+    pub filter: Filter,
+    /// Its kernel's radius in texels.
+    pub radius: f32,
+    /// How far a receiver moves towards the light before its lookup, in world units.
+    pub receiver_offset: f32,
 }
 
 impl MapLookup {
+    /// Every receiver within `reach` looked up in `maps` (one per projection of `light`) into `out`.
+    pub fn query(&self, maps: &[Image<f32>], light: &LightView, reach: &Reach, g: &GBuffer, out: &mut Image<f32>) {
+        per_receiver(g, reach, out, |x, y, i| self.visibility(maps, light, g.position.data()[i], (x, y)));
+    }
+
     /// The visibility of the receiver at `p`, seen at pixel `px`, through `maps` (one per projection of
     /// `light`); with cascades, faded into the next cascade's answer over the blend band at its far end.
     fn visibility(&self, maps: &[Image<f32>], light: &LightView, p: Vec3, px: (u32, u32)) -> f32 {

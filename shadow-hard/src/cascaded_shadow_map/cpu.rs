@@ -1,5 +1,5 @@
 //! `cascaded-shadow-map` on the CPU (twin: [`super::gpu`]): one depth map per cascade, looked up with the
-//! cascades' blending (shadow-cpu's `passes::maps::query_maps`).
+//! cascades' blending (shadow-cpu's `passes::maps::MapLookup`).
 
 use super::CascadedShadowMap;
 

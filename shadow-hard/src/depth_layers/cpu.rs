@@ -21,7 +21,7 @@ use shadow_core::frame::Coverage;
 use shadow_cpu::alpha_test::{Cutout, draw_alpha_tested};
 use shadow_cpu::gbuffer::{GBuffer, clip_vertices};
 use shadow_cpu::passes::maps::check_maps;
-use shadow_cpu::passes::maps::{depth_views, query_maps};
+use shadow_cpu::passes::maps::{MapLookup, depth_views};
 use shadow_cpu::raster::{
     Batch, CullMode, DepthState, DepthStencil, Fragment, Indexed, RasterState, draw_depth, draw_depth_peeled,
 };
@@ -125,13 +125,19 @@ impl ShadowTechnique<CpuBackend> for DepthLayers {
         g: &GBuffer,
         out: &mut Image<f32>,
     ) -> Result<(), CpuError> {
-        let LightPass { frame, light, aspect, .. } = pass;
+        let LightPass { frame, light, reach, aspect, .. } = pass;
         let view = self.view(frame, light, aspect);
         let light = &*view;
         if state.maps.len() != light.projections.len() {
             return Err(TechniqueError::NotBuilt(self.kind.name().into()).into());
         }
-        query_maps(&state.maps, light, g, out, self.filter, self.filter_radius, 0.0);
+        MapLookup { filter: self.filter, radius: self.filter_radius, receiver_offset: 0.0 }.query(
+            &state.maps,
+            light,
+            &reach,
+            g,
+            out,
+        );
         Ok(())
     }
 

@@ -177,7 +177,7 @@ impl ShadowTechnique<CpuBackend> for Hybrid {
         g: &GBuffer,
         out: &mut Image<f32>,
     ) -> Result<(), CpuError> {
-        let LightPass { frame, light, stats, .. } = pass;
+        let LightPass { frame, light, stats, reach, .. } = pass;
         let volumes = state.volumes.as_ref().ok_or_else(|| TechniqueError::NotBuilt(Self::NAME.into()))?;
         if state.maps.len() != light.projections.len() {
             return Err(TechniqueError::NotBuilt(Self::NAME.into()).into());
@@ -205,7 +205,7 @@ impl ShadowTechnique<CpuBackend> for Hybrid {
         stats.timings.extra.insert("volumes".into(), ms(t.elapsed()));
         // Lit where the hybrid's answer and the cut-out casters' map both say lit.
         let cutouts = &state.cutouts;
-        per_receiver(g, out, |x, y, i| {
+        per_receiver(g, &reach, out, |x, y, i| {
             let lit = match map_class.get(x, y) {
                 MapClass::Lit => true,
                 MapClass::Shadowed => false,

@@ -419,7 +419,7 @@ impl ShadowTechnique<WgpuBackend> for Hybrid {
     }
 
     fn build(&self, cx: &mut WgpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), WgpuError> {
-        let LightPass { frame, light, slot, aspect, stats } = pass;
+        let LightPass { frame, light, slot, aspect, stats, .. } = pass;
         state.map.render(cx, frame, light, self.depth.resolution)?;
         state.cutouts.render(cx, frame, &cutout_view(&self.cutouts, frame, light, aspect), &self.cutouts)?;
         cx.step("map");

@@ -34,10 +34,10 @@ impl ShadowTechnique<CpuBackend> for RayTraced {
         g: &GBuffer,
         out: &mut Image<f32>,
     ) -> Result<(), CpuError> {
-        let LightPass { frame, light, stats, .. } = pass;
+        let LightPass { frame, light, stats, reach, .. } = pass;
         let bvh = state.bvh(Self::NAME)?;
         let origins = RayOrigins::new(g, frame, self.epsilon);
-        let rays = per_receiver_casting(g, out, |walker, _, _, i| {
+        let rays = per_receiver_casting(g, &reach, out, |walker, _, _, i| {
             let (origin, n) = origins.at(i);
             let (dir, tmax) = towards(&light.light.kind, origin);
             // The light below the receiver's horizon: shadowed, and no ray to cast.

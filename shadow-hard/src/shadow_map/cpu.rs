@@ -4,7 +4,7 @@
 use shadow_core::Image;
 use shadow_core::technique::{BuildReads, LightPass};
 use shadow_core::technique::{DebugView, ShadowTechnique, TechniqueError};
-use shadow_cpu::passes::maps::{depth_views, query_maps, render_depth_maps};
+use shadow_cpu::passes::maps::{MapLookup, depth_views, render_depth_maps};
 use shadow_cpu::{CpuBackend, CpuContext, CpuError, GBuffer};
 
 use super::ShadowMap;
@@ -27,14 +27,20 @@ impl ShadowTechnique<CpuBackend> for ShadowMap {
         BuildReads::LightViews
     }
 
+    /// A map of its resolution, or the side the frame's atlas grants.
+    fn atlas_side(&self) -> Option<u32> {
+        Some(self.map().resolution)
+    }
+
     fn create_state(&self, _: &mut CpuContext) -> Result<State, CpuError> {
         Ok(State::default())
     }
 
     fn build(&self, _: &mut CpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), CpuError> {
-        let LightPass { frame, light, .. } = pass;
+        let LightPass { frame, light, tiles, .. } = pass;
         let map = self.map();
-        render_depth_maps(frame, light, map.resolution, map.depth_bias(), &mut state.maps)
+        let resolution = tiles.map_or(map.resolution, |t| t.side);
+        render_depth_maps(frame, light, resolution, map.depth_bias(), &mut state.maps)
     }
 
     fn query(
@@ -45,11 +51,16 @@ impl ShadowTechnique<CpuBackend> for ShadowMap {
         g: &GBuffer,
         out: &mut Image<f32>,
     ) -> Result<(), CpuError> {
-        let LightPass { light, .. } = pass;
+        let LightPass { light, reach, .. } = pass;
         if state.maps.len() != light.projections.len() {
             return Err(TechniqueError::NotBuilt(Self::NAME.into()).into());
         }
-        query_maps(&state.maps, light, g, out, self.filter, self.filter_radius, self.map().receiver_offset());
+        let lookup = MapLookup {
+            filter: self.filter,
+            radius: self.filter_radius,
+            receiver_offset: self.map().receiver_offset(),
+        };
+        lookup.query(&state.maps, light, &reach, g, out);
         Ok(())
     }
 

@@ -27,6 +27,11 @@ impl ShadowTechnique<WgpuBackend> for ShadowMap {
         BuildReads::LightViews
     }
 
+    /// A map of its resolution, or the side the frame's atlas grants.
+    fn atlas_side(&self) -> Option<u32> {
+        Some(self.map().resolution)
+    }
+
     fn create_state(&self, cx: &mut WgpuContext) -> Result<State, WgpuError> {
         cx.scoped("creating the shadow-map pipelines", |cx| {
             let module = cx.pipelines.module("shadow_map", shaders::shadow_map());
@@ -43,8 +48,8 @@ impl ShadowTechnique<WgpuBackend> for ShadowMap {
     }
 
     fn build(&self, cx: &mut WgpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), WgpuError> {
-        let LightPass { frame, light, .. } = pass;
-        state.maps.render(cx, frame, light, self.map().resolution)
+        let LightPass { frame, light, tiles, .. } = pass;
+        state.maps.render(cx, frame, light, tiles.map_or(self.map().resolution, |t| t.side))
     }
 
     fn query(

@@ -55,19 +55,15 @@ impl ShadowTechnique<CpuBackend> for ShadowVolume {
         g: &GBuffer,
         out: &mut Image<f32>,
     ) -> Result<(), CpuError> {
-        let LightPass { frame, stats, .. } = pass;
+        let LightPass { frame, stats, reach, .. } = pass;
         let volumes = state.volumes.as_ref().ok_or_else(|| TechniqueError::NotBuilt(self.name().into()))?;
         let mut ds = DepthStencil::from_depth(&g.depth, 0);
         let c = rasterize_volumes(frame, g, volumes, self.counting, &mut ds, None);
         // Lit where no volume holds the receiver and the cut-out casters leave it light.
         let cutouts = &state.cutouts;
-        per_receiver(
-            g,
-            out,
-            |x, y, i| {
-                if ds.stencil[i] == 0 { cutouts.visibility(g.position.data()[i], (x, y)) } else { 0.0 }
-            },
-        );
+        per_receiver(g, &reach, out, |x, y, i| {
+            if ds.stencil[i] == 0 { cutouts.visibility(g.position.data()[i], (x, y)) } else { 0.0 }
+        });
         let counters = &mut stats.counters;
         counters.volume_fragments = Some(c.fragments);
         counters.stencil_updates = Some(c.stencil_updates);

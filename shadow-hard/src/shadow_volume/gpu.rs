@@ -82,7 +82,7 @@ impl ShadowTechnique<WgpuBackend> for ShadowVolume {
     }
 
     fn build(&self, cx: &mut WgpuContext, state: &mut State, pass: LightPass<'_>) -> Result<(), WgpuError> {
-        let LightPass { frame, light, slot, aspect, stats } = pass;
+        let LightPass { frame, light, slot, aspect, stats, .. } = pass;
         match &mut state.volumes {
             Volumes::Gpu(extrusion) => {
                 extrusion.build(cx, frame, light, slot, self.caps())?;

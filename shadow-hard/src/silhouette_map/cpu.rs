@@ -72,7 +72,7 @@ impl ShadowTechnique<CpuBackend> for SilhouetteMap {
         g: &GBuffer,
         out: &mut Image<f32>,
     ) -> Result<(), CpuError> {
-        let LightPass { frame, light, stats, aspect, .. } = pass;
+        let LightPass { frame, light, stats, aspect, reach, .. } = pass;
         let view = self.view(frame, light, aspect);
         let light = &*view;
         if state.maps.len() != light.projections.len() || state.points.len() != state.maps.len() {
@@ -80,7 +80,7 @@ impl ShadowTechnique<CpuBackend> for SilhouetteMap {
         }
         let offset = self.depth.receiver_offset();
         let silhouette_pixels = AtomicU64::new(0);
-        per_receiver(g, out, |_, _, i| {
+        per_receiver(g, &reach, out, |_, _, i| {
             let m = map_position(light, g.position.data()[i], offset);
             let k = m.projection;
             let gradient = match self.corner_depth {

@@ -1,10 +1,11 @@
 //! View-fitted maps on the CPU (twin: [`super::gpu`]).
 
+use shadow_core::light::Reach;
 use shadow_core::technique::maps::MapSampling;
-use shadow_core::technique::settings::{DepthBias, Filter};
+use shadow_core::technique::settings::DepthBias;
 use shadow_core::technique::{DebugView, TechniqueError};
 use shadow_core::{FrameInputs, Image, LightView};
-use shadow_cpu::passes::maps::{depth_views, query_maps, render_depth_maps};
+use shadow_cpu::passes::maps::{MapLookup, depth_views, render_depth_maps};
 use shadow_cpu::{CpuError, GBuffer};
 
 /// The projections of the last build and their maps.
@@ -34,14 +35,13 @@ impl ViewMaps {
     pub fn query(
         &self,
         technique: &str,
+        lookup: MapLookup,
+        reach: &Reach,
         g: &GBuffer,
         out: &mut Image<f32>,
-        filter: Filter,
-        radius: f32,
-        receiver_offset: f32,
     ) -> Result<(), CpuError> {
         let view = self.view.as_ref().ok_or_else(|| TechniqueError::NotBuilt(technique.into()))?;
-        query_maps(&self.maps, view, g, out, filter, radius, receiver_offset);
+        lookup.query(&self.maps, view, reach, g, out);
         Ok(())
     }
 
@@ -82,11 +82,16 @@ macro_rules! view_fitted_on_cpu {
                 &self,
                 _: &mut shadow_cpu::CpuContext,
                 state: &mut Self::State,
-                _: shadow_core::technique::LightPass<'_>,
+                pass: shadow_core::technique::LightPass<'_>,
                 g: &shadow_cpu::GBuffer,
                 out: &mut shadow_core::Image<f32>,
             ) -> Result<(), shadow_cpu::CpuError> {
-                state.query(Self::NAME, g, out, self.filter, self.filter_radius, self.map.receiver_offset())
+                let lookup = shadow_cpu::passes::maps::MapLookup {
+                    filter: self.filter,
+                    radius: self.filter_radius,
+                    receiver_offset: self.map.receiver_offset(),
+                };
+                state.query(Self::NAME, lookup, &pass.reach, g, out)
             }
 
             fn build_is_reusable(&self, _: &shadow_core::FrameInputs) -> bool {

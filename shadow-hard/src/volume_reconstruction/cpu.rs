@@ -102,7 +102,7 @@ impl ShadowTechnique<CpuBackend> for VolumeReconstruction {
         g: &GBuffer,
         out: &mut Image<f32>,
     ) -> Result<(), CpuError> {
-        let LightPass { stats, .. } = pass;
+        let LightPass { stats, reach, .. } = pass;
         if state.projections.is_empty() {
             return Err(TechniqueError::NotBuilt(Self::NAME.into()).into());
         }
@@ -120,7 +120,7 @@ impl ShadowTechnique<CpuBackend> for VolumeReconstruction {
         let capped: Vec<[Vec4; 3]> = caps.iter().map(|t| cap_clip(eye, t)).collect();
         let always = DepthState { compare: CompareFn::Always, ..DepthState::LESS_READ };
         c += draw_depth(&mut ds, &Soup { triangles: &capped, prim_base: 0, flip: false }, &parity_state(always));
-        per_receiver(g, out, |_, _, i| if ds.stencil[i] & 1 == 0 { 1.0 } else { 0.0 });
+        per_receiver(g, &reach, out, |_, _, i| if ds.stencil[i] & 1 == 0 { 1.0 } else { 0.0 });
         let counters = &mut stats.counters;
         counters.volume_triangles = Some((sides.len() + capped.len()) as u64);
         counters.volume_fragments = Some(c.fragments);

@@ -166,12 +166,12 @@ impl ShadowTechnique<CpuBackend> for MomentMap {
         g: &GBuffer,
         out: &mut Image<f32>,
     ) -> Result<(), CpuError> {
-        let LightPass { light, .. } = pass;
+        let LightPass { light, reach, .. } = pass;
         let (Some(lens), false) = (&state.lens, state.mips.is_empty()) else {
             return Err(TechniqueError::NotBuilt(self.name().into()).into());
         };
         let (proj, depth, offset) = (&lens.proj, &state.depth[0], self.depth.receiver_offset());
-        per_receiver(g, out, |x, y, i| {
+        per_receiver(g, &reach, out, |x, y, i| {
             let m = map_position(light, g.position.data()[i], offset);
             if !on_map(m.uv) {
                 return 1.0;

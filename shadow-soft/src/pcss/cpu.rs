@@ -102,12 +102,12 @@ impl ShadowTechnique<CpuBackend> for Pcss {
         g: &GBuffer,
         out: &mut Image<f32>,
     ) -> Result<(), CpuError> {
-        let LightPass { light, .. } = pass;
+        let LightPass { light, reach, .. } = pass;
         let (Some(lens), Some(map)) = (&state.lens, state.maps.first()) else {
             return Err(TechniqueError::NotBuilt(Self::NAME.into()).into());
         };
         let offset = self.depth.receiver_offset();
-        per_receiver(g, out, |x, y, i| {
+        per_receiver(g, &reach, out, |x, y, i| {
             let m = map_position(light, g.position.data()[i], offset);
             let gradient = lens.proj.depth_gradient(m.world, g.geometric_normal.data()[i]);
             pcss_lookup(map, lens, m.uv, m.depth, gradient, (x, y))

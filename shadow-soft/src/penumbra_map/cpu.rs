@@ -113,12 +113,12 @@ impl ShadowTechnique<CpuBackend> for PenumbraMap {
         g: &GBuffer,
         out: &mut Image<f32>,
     ) -> Result<(), CpuError> {
-        let LightPass { light, .. } = pass;
+        let LightPass { light, reach, .. } = pass;
         let (Some(penumbra), Some(map)) = (&state.penumbra, state.maps.first()) else {
             return Err(TechniqueError::NotBuilt(Self::NAME.into()).into());
         };
         let offset = self.depth.receiver_offset();
-        per_receiver(g, out, |_, _, i| {
+        per_receiver(g, &reach, out, |_, _, i| {
             let m = map_position(light, g.position.data()[i], offset);
             penumbra_lookup(map, penumbra, m.uv, m.depth)
         });

@@ -90,7 +90,7 @@ impl ShadowTechnique<CpuBackend> for PenumbraWedges {
         g: &GBuffer,
         out: &mut Image<f32>,
     ) -> Result<(), CpuError> {
-        let LightPass { frame, stats, .. } = pass;
+        let LightPass { frame, stats, reach, .. } = pass;
         let (built, light) = state.built.as_ref().ok_or_else(|| TechniqueError::NotBuilt(Self::NAME.into()))?;
         let (eye, c) = (g.camera.eye, light.centre);
         let eye_counts = built.eye_counts(frame, eye);
@@ -119,7 +119,7 @@ impl ShadowTechnique<CpuBackend> for PenumbraWedges {
         };
         // The soft visibility, times the cut-out casters' map's.
         let cutouts = &state.cutouts;
-        per_receiver(g, out, |x, y, i| {
+        per_receiver(g, &reach, out, |x, y, i| {
             let p = g.position.data()[i];
             let horizon = horizon_share(p, g.geometric_normal.data()[i], *light);
             let [closed, facing, turned] = std::array::from_fn(|k| eye_counts[k] + occluded.data()[i][k]);

@@ -5,6 +5,7 @@
 
 use bytemuck::{Pod, Zeroable};
 use shadow_core::glam::Vec4;
+use shadow_core::light::PixelRect;
 use shadow_core::technique::LightPass;
 use shadow_core::technique::{ShadowTechnique, TechniqueError};
 use shadow_wgpu::pipelines::{VISIBILITY, attribute_entry, buffer_entry, full_screen_pipeline};
@@ -293,10 +294,11 @@ impl ShadowTechnique<WgpuBackend> for PenumbraWedges {
                     let resource = wgpu::BindingResource::TextureView(visibility);
                     entries.push(wgpu::BindGroupEntry { binding: 5, resource });
                     let group = bind(layout, &entries);
-                    passes::full_screen(cx, "wedge resolve", &out.view, resolve, &[&g.frame_group, &group], None);
+                    passes::answer(cx, ("wedge resolve", out, passes::LIT), resolve, &[&g.frame_group, &group], None);
                 }
                 _ => {
-                    passes::full_screen(cx, "wedge resolve", &out.view, &state.resolve, &[&g.frame_group, &group], None)
+                    let groups = [&g.frame_group, &group];
+                    passes::answer(cx, ("wedge resolve", out, passes::LIT), &state.resolve, &groups, None);
                 }
             }
         })
@@ -322,7 +324,8 @@ fn cutout_visibility(
         }
     };
     let view = target.create_view(&Default::default());
-    let visibility = GpuVisibility { view: view.clone(), width: g.width, height: g.height };
+    let rect = PixelRect::full(g.width, g.height);
+    let visibility = GpuVisibility { view: view.clone(), width: g.width, height: g.height, rect };
     state.cutouts.query(cx, g, &visibility)?;
     if state.cutout_resolve.is_none() {
         let layout = cx.pipelines.group_layout("penumbra wedges, cut out", &group_entries(true));

@@ -145,12 +145,12 @@ impl ShadowTechnique<CpuBackend> for Smoothies {
         g: &GBuffer,
         out: &mut Image<f32>,
     ) -> Result<(), CpuError> {
-        let LightPass { light, .. } = pass;
+        let LightPass { light, reach, .. } = pass;
         let not_built = || TechniqueError::NotBuilt(Self::NAME.into());
         let (Some(buffer), Some(map)) = (&state.buffer, state.maps.first()) else { return Err(not_built().into()) };
         let offset = self.depth.receiver_offset();
         let falloff = FalloffTable::new(self.falloff);
-        per_receiver(g, out, |_, _, i| {
+        per_receiver(g, &reach, out, |_, _, i| {
             let m = map_position(light, g.position.data()[i], offset);
             falloff.apply(smoothie_lookup(map, buffer, m.uv, m.depth))
         });

@@ -5,11 +5,11 @@
 //! [`CutoutMaps`] holds the casters their texture cuts out alone, for the techniques built on silhouettes.
 
 use bytemuck::{Pod, Zeroable};
-use shadow_core::FrameInputs;
 use shadow_core::frame::Coverage;
 use shadow_core::light::LightView;
 use shadow_core::technique::maps::{Casters, CutoutMap, DepthMap};
 use shadow_core::technique::settings::{BiasMode, Filter};
+use shadow_core::{FrameInputs, Instance};
 
 use crate::context::{WgpuContext, WgpuError};
 use crate::frame::{GpuVisibility, layer_view, layered};
@@ -248,7 +248,7 @@ impl MapQuery {
         }
         cx.scoped("the shadow-map query", |cx| {
             let group = self.bindings.group_of(cx, maps, &params, g, extras);
-            super::full_screen(cx, "map query", &out.view, &self.pipeline, &[&g.frame_group, &group], None);
+            super::answer(cx, ("map query", out, super::LIT), &self.pipeline, &[&g.frame_group, &group], None);
         })
     }
 }
@@ -379,7 +379,8 @@ pub fn render_maps(
     render_casters(cx, pipelines, (frame, Casters::All), light, (maps, ids), instances);
 }
 
-/// [`render_maps`] of the casters `casters` names.
+/// [`render_maps`] of the casters `casters` names; a caster wholly outside a projection's frustum is not
+/// drawn into its map (it would draw nothing there) where the frame saves so.
 fn render_casters(
     cx: &WgpuContext,
     pipelines: &LightPipelines,
@@ -391,7 +392,9 @@ fn render_casters(
     let res = maps.width();
     let cutouts = frame.has_cutout_casters();
     let mut enc = cx.encoder("light pass");
+    let culling = frame.savings.culling;
     for (k, p) in light.projections.iter().enumerate() {
+        let in_view = |i: &Instance| !culling || p.may_hold(i.bounds);
         let group = cx.shared.frame_group(cx, &ViewRaw::new(p.clip_from_world, glam::Vec3::ZERO, res, res), instances);
         let view = layer_view(maps, k as u32);
         let id_view = ids.map(|t| layer_view(t, k as u32));
@@ -417,11 +420,13 @@ fn render_casters(
         pass.set_bind_group(0, &group, &[]);
         if casters != Casters::CutOut {
             pass.set_pipeline(&pipelines.solid);
-            draw_instances(cx, &mut pass, frame, |i| casters.takes(i) && i.coverage() == Coverage::Solid, false);
+            let solid = |i: &Instance| casters.takes(i) && i.coverage() == Coverage::Solid && in_view(i);
+            draw_instances(cx, &mut pass, frame, solid, false);
         }
         if cutouts && casters != Casters::Solid {
             pass.set_pipeline(pipelines.cutout(cx));
-            draw_textured(cx, &mut pass, frame, |i| casters.takes(i) && i.coverage() == Coverage::Cutout, false);
+            let cut_out = |i: &Instance| casters.takes(i) && i.coverage() == Coverage::Cutout && in_view(i);
+            draw_textured(cx, &mut pass, frame, cut_out, false);
         }
     }
     cx.submit(enc);

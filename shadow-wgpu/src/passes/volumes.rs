@@ -161,7 +161,7 @@ impl StencilResolve {
     pub fn run(&self, cx: &WgpuContext, g: &GpuGBuffer, out: &GpuVisibility, depth: &wgpu::TextureView) {
         let group = self.group(cx, g);
         let groups = [&g.frame_group, &group];
-        super::full_screen(cx, "stencil resolve", &out.view, &self.pipeline, &groups, Some((depth, 0)));
+        super::answer(cx, ("stencil resolve", out, super::LIT), &self.pipeline, &groups, Some((depth, 0)));
     }
 
     /// Shadows the receivers whose stencil is not 0 in the visibility `out` already holds (what another
@@ -169,8 +169,8 @@ impl StencilResolve {
     pub fn run_onto(&self, cx: &WgpuContext, g: &GpuGBuffer, out: &GpuVisibility, depth: &wgpu::TextureView) {
         let group = self.group(cx, g);
         let groups = [&g.frame_group, &group];
-        let target = ("stencil resolve", &out.view, wgpu::LoadOp::Load);
-        super::full_screen_to(cx, target, &self.pipeline, &groups, Some((depth, 0)));
+        let target = ("stencil resolve", out, wgpu::LoadOp::Load);
+        super::answer(cx, target, &self.pipeline, &groups, Some((depth, 0)));
     }
 
     fn group(&self, cx: &WgpuContext, g: &GpuGBuffer) -> wgpu::BindGroup {

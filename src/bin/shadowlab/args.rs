@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 use clap::{Args, Parser, Subcommand};
 use shadow_core::FrameInputs;
 use shadow_core::assets::FileAccess;
+use shadow_core::scene::ShadowUpdate;
 use shadow_core::scenes::SceneParams;
 use shadowlab::Error;
 use shadowlab::setup::{SceneSetup, parse_size};
@@ -60,6 +61,15 @@ pub(crate) struct SceneArgs {
     /// copies of them turned about the scene's centre.
     #[arg(long, value_name = "N")]
     pub(crate) lights: Option<usize>,
+    /// When every light's shadow is built again: every-frame, on-change (when the light or its casters
+    /// moved: the scene's own default), every-N (frames) or once.
+    #[arg(long, value_name = "POLICY", value_parser = parse_update)]
+    pub(crate) shadow_update: Option<ShadowUpdate>,
+}
+
+/// A shadow update policy, by name.
+fn parse_update(text: &str) -> Result<ShadowUpdate, String> {
+    ShadowUpdate::parse(text.trim()).map_err(|e| e.to_string())
 }
 
 /// A time in seconds: a finite number.
@@ -149,6 +159,7 @@ impl SceneArgs {
             time: self.time,
             unshare: self.unshare,
             lights: self.lights,
+            shadow_update: self.shadow_update,
         }
     }
 
@@ -242,6 +253,11 @@ pub(crate) enum Command {
         /// Output folder for the sweep (default out/bench-SCENE).
         #[arg(long)]
         out_dir: Option<PathBuf>,
+        /// What the frames leave out that no pixel shows: all (each light queried within its reach, lights
+        /// that reach no pixel skipped, casters outside a light's frustums culled, maps sized by the shadow
+        /// atlas), none (every light from every caster over the whole view), or both, side by side.
+        #[arg(long, default_value = "all")]
+        savings: String,
     },
     /// Temporal flicker along a walk, on the CPU: the fraction of the receivers seen at the start whose lit
     /// state changes between consecutive frames as the maps follow the moving camera (the reference's

@@ -4,6 +4,7 @@
 use std::path::PathBuf;
 
 use shadow_core::FrameInputs;
+use shadow_core::frame::Savings;
 use shadow_core::technique::TechniqueSpec;
 use shadowlab::{Error, Renderer, TechniqueRegistry};
 
@@ -23,6 +24,17 @@ pub(crate) struct BenchArgs {
     pub(crate) animate: bool,
     pub(crate) sweep: Option<String>,
     pub(crate) out_dir: Option<PathBuf>,
+    pub(crate) savings: Vec<Savings>,
+}
+
+/// `--savings`: all, none or both (every technique twice, side by side).
+pub(crate) fn parse_savings(s: &str) -> Result<Vec<Savings>, Error> {
+    match s {
+        "all" => Ok(vec![Savings::ALL]),
+        "none" => Ok(vec![Savings::NONE]),
+        "both" => Ok(vec![Savings::ALL, Savings::NONE]),
+        _ => Err(Error::Usage(format!("bad --savings '{s}': expected all, none or both"))),
+    }
 }
 
 /// `--sweep KEY=V,V,...` as (key, values).
@@ -114,6 +126,7 @@ fn bench_once(
         backends: kinds,
         rebuild: b.rebuild,
         clip,
+        savings: b.savings.clone(),
     };
     let bar = progress_bar(if b.realtime { realtime_steps(&job) } else { job.steps() });
     let (json, table) = if b.realtime {
@@ -195,6 +208,7 @@ fn bench_sweep(
             backends: kinds.clone(),
             rebuild: b.rebuild,
             clip: None,
+            savings: b.savings.clone(),
         };
         let r = run_bench(renderer, &job, |m| report_progress(&bar, &format!("{key}={v}: {m}")))?;
         for e in &r.results {

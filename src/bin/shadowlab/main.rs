@@ -119,8 +119,22 @@ fn run(cli: Cli) -> Result<(), Error> {
         Command::Compare { scene, view, choice, reference, out_dir } => {
             compare(&scene, &view, &choice, reference.as_deref(), out_dir)
         }
-        Command::Bench { scene, view, choice, frames, warmup, json, realtime, rebuild, animate, sweep, out_dir } => {
-            let b = BenchArgs { choice, frames, warmup, json, realtime, rebuild, animate, sweep, out_dir };
+        Command::Bench {
+            scene,
+            view,
+            choice,
+            frames,
+            warmup,
+            json,
+            realtime,
+            rebuild,
+            animate,
+            sweep,
+            out_dir,
+            savings,
+        } => {
+            let savings = bench::parse_savings(&savings)?;
+            let b = BenchArgs { choice, frames, warmup, json, realtime, rebuild, animate, sweep, out_dir, savings };
             bench(&scene, &view, b)
         }
         Command::Export { scene, out } => export(&scene, &out),
