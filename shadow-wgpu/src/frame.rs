@@ -291,7 +291,7 @@ pub(crate) fn shade_group(
     let mut table: LightTable = bytemuck::Zeroable::zeroed();
     table.count[0] = frame.lights.len() as u32;
     for (slot, l) in table.lights.iter_mut().zip(&frame.lights) {
-        *slot = LightRaw::from(l);
+        *slot = LightRaw::from(l).within(frame.reach(l, g.width, g.height).rect);
     }
     let lights = cx.transient(bytemuck::bytes_of(&table));
     let vis_view = vis.create_view(&wgpu::TextureViewDescriptor {

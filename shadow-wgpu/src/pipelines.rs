@@ -3,6 +3,7 @@
 
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
+use shadow_core::light::PixelRect;
 use shadow_core::scene::{Light, LightKind};
 
 use crate::pipeline_cache::PipelineCache;
@@ -51,6 +52,17 @@ pub struct LightRaw {
     color: [f32; 4],
 }
 
+impl LightRaw {
+    /// The light, reaching only the pixels of `rect` in the shading pass (it adds nothing elsewhere):
+    /// `kind.y` and `kind.z` hold its first and one-past-last column and row, 16 bits each.
+    #[must_use]
+    pub fn within(self, rect: PixelRect) -> Self {
+        let pack = |x: u32, y: u32| x.min(0xffff) | (y.min(0xffff) << 16);
+        let [kind, _, _, w] = self.kind;
+        Self { kind: [kind, pack(rect.x0, rect.y0), pack(rect.x1, rect.y1), w], ..self }
+    }
+}
+
 impl From<&Light> for LightRaw {
     fn from(l: &Light) -> Self {
         let (kind, position, direction, cone) = match l.kind {
@@ -62,7 +74,8 @@ impl From<&Light> for LightRaw {
             LightKind::Point { position } => (2, position, Vec3::NEG_Y, [0.0, 0.0]),
         };
         Self {
-            kind: [kind, 0, 0, 0],
+            // y, z: every pixel (see `within`).
+            kind: [kind, 0, u32::MAX, 0],
             position: position.extend(1.0).to_array(),
             direction: direction.extend(0.0).to_array(),
             // z: the range, 0 for none.

@@ -26,7 +26,8 @@ struct Instance {
 };
 
 struct Light {
-    // x: kind (0 spot, 1 directional, 2 point)
+    // x: kind (0 spot, 1 directional, 2 point); y, z: in shading, the pixels it reaches, its first and
+    // one-past-last column (low 16 bits) and row (high 16 bits)
     kind: vec4<u32>,
     position: vec4<f32>,
     // unit direction the light travels (spot axis)

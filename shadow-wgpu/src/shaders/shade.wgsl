@@ -37,6 +37,14 @@ fn shaded(px: vec2<i32>) -> vec3<f32> {
         let n = textureLoad(g_normal, px, 0).xyz;
         var direct = vec3<f32>(0.0);
         for (var i = 0u; i < lights.count.x; i = i + 1u) {
+            // A light adds nothing outside the pixels it reaches: the same sum without its term.
+            let k = lights.items[i].kind;
+            let lo = vec2<u32>(k.y & 0xffffu, k.y >> 16u);
+            let hi = vec2<u32>(k.z & 0xffffu, k.z >> 16u);
+            let at = vec2<u32>(px);
+            if (any(at < lo) || any(at >= hi)) {
+                continue;
+            }
             let v = textureLoad(visibility, px, i32(i), 0).x;
             direct = direct + direct_light(lights.items[i], p, n) * v;
         }
