@@ -48,14 +48,16 @@ pub trait FrameSteps<B: Backend> {
     /// Backend failures.
     fn lit(&mut self, cx: &mut B::Context, visibility: &mut B::Visibility) -> Result<(), B::Error>;
 
-    /// Shades the G-buffer with every light's visibility.
+    /// Shades the G-buffer with every light's visibility: `lights` holds the frame and each light's reach
+    /// in the view, in the frame's light order; a light adds nothing to a pixel outside its reach's
+    /// rectangle.
     ///
     /// # Errors
     /// Backend failures.
     fn shade(
         &mut self,
         cx: &mut B::Context,
-        frame: &FrameInputs,
+        lights: (&FrameInputs, &[Reach]),
         gbuffer: &B::GBuffer,
     ) -> Result<Self::Shaded, B::Error>;
 
@@ -152,7 +154,7 @@ pub fn run_frame<'t, 'o: 't, B: Backend, S: FrameSteps<B>>(
     let aspect = width as f32 / height.max(1) as f32;
     let reaches: Vec<Reach> = frame.lights.iter().map(|l| frame.reach(l, width, height)).collect();
     let atlas = match frame.savings.atlas {
-        Some(side) => Some(plan_atlas(frame, &reaches, side, &mut techniques)?),
+        Some(side) => Some(plan_atlas(frame, &reaches, (side, width * height), &mut techniques)?),
         None => None,
     };
     let mut light_views = Vec::with_capacity(frame.lights.len());
@@ -188,24 +190,24 @@ pub fn run_frame<'t, 'o: 't, B: Backend, S: FrameSteps<B>>(
         phases.stats.add_light(light_stats);
         light_views.push(view);
     }
-    let shaded = phases.run(cx, Phase::Shade, |cx, steps| steps.shade(cx, frame, &gbuffer))?;
+    let shaded = phases.run(cx, Phase::Shade, |cx, steps| steps.shade(cx, (frame, &reaches), &gbuffer))?;
 
     stats.timings.total = ms(start.elapsed());
     let output = steps.finish(cx, gbuffer, shaded, &mut stats)?;
     Ok(FrameRun { output, light_views, atlas, stats })
 }
 
-/// The frame's shadow atlas of `side` texels: a tile for each face of each spot and point light with a
+/// The frame's shadow atlas of `side` texels for a view of `pixels`: a tile for each face of each spot and point light with a
 /// range that casts with a technique asking for one ([`crate::technique::ShadowTechnique::atlas_side`])
 /// and reaches some of the view, sized by the share of the view its reach's rectangle covers. A light
 /// without a range lights the whole scene: its maps stay its own, of its technique's size.
 fn plan_atlas<B: Backend>(
     frame: &FrameInputs,
     reaches: &[Reach],
-    side: u32,
+    (side, pixels): (u32, u32),
     techniques: &mut LightTechniques<'_, '_, B>,
 ) -> Result<AtlasPlan, TechniqueError> {
-    let view = reaches.first().map_or(1, |r| r.view_area()).max(1) as f32;
+    let view = pixels.max(1) as f32;
     let mut requests = Vec::with_capacity(frame.lights.len());
     for (k, (light, reach)) in frame.lights.iter().zip(reaches).enumerate() {
         let shadow = frame.shadow(k);

@@ -112,9 +112,14 @@ impl FrameSteps<CpuBackend> for CpuSteps {
         Ok(())
     }
 
-    fn shade(&mut self, _cx: &mut CpuContext, frame: &FrameInputs, gbuffer: &GBuffer) -> Result<Image<Rgb8>, CpuError> {
+    fn shade(
+        &mut self,
+        _cx: &mut CpuContext,
+        (frame, reaches): (&FrameInputs, &[Reach]),
+        gbuffer: &GBuffer,
+    ) -> Result<Image<Rgb8>, CpuError> {
         let refs: Vec<&Image<f32>> = self.visibility.iter().collect();
-        Ok(shade(gbuffer, frame, &refs))
+        Ok(shade(gbuffer, (&frame.lights, reaches), &refs))
     }
 
     fn finish(

@@ -2,19 +2,20 @@
 
 use rayon::prelude::*;
 use shadow_core::image::{Rgb8, linear_rgb_to_srgb8};
-use shadow_core::light::PixelRect;
-use shadow_core::{FrameInputs, Image, shading};
+use shadow_core::light::{PixelRect, Reach};
+use shadow_core::scene::Light;
+use shadow_core::{Image, shading};
 
 use crate::gbuffer::{GBuffer, NO_INSTANCE};
 
-/// The shaded sRGB image of a G-buffer of `frame`'s view lit by its lights, with one visibility image per
-/// light. A light adds nothing to a pixel outside its reach's rectangle (its direct term there is 0), so
-/// the pixel does not evaluate it: the same sum, to the bit.
+/// The shaded sRGB image of a G-buffer lit by `lights` with their reaches in its view, and one visibility
+/// image per light. A light adds nothing to a pixel outside its reach's rectangle (its direct term there
+/// is 0), so the pixel does not evaluate it: the same sum, to the bit.
 #[must_use]
-pub fn shade(g: &GBuffer, frame: &FrameInputs, visibility: &[&Image<f32>]) -> Image<Rgb8> {
+pub fn shade(g: &GBuffer, (lights, reaches): (&[Light], &[Reach]), visibility: &[&Image<f32>]) -> Image<Rgb8> {
     let (width, height) = (g.width(), g.height());
     let lights: Vec<(shading::LightTerms, PixelRect)> =
-        frame.lights.iter().map(|l| (shading::LightTerms::new(l), frame.reach(l, width, height).rect)).collect();
+        lights.iter().zip(reaches).map(|(l, r)| (shading::LightTerms::new(l), r.rect)).collect();
     let data: Vec<Rgb8> = (0..g.depth.data().len())
         .into_par_iter()
         .with_min_len(1024)

@@ -55,7 +55,7 @@ fn whole_frame<T: ShadowTechnique<shadow_cpu::CpuBackend>>(b: Bencher, t: T) {
         t.build(&mut cx, &mut state, pass.reborrow()).expect("build");
         let mut out = shadow_core::Image::new(1024, 768, 1.0f32);
         t.query(&mut cx, &mut state, pass.reborrow(), &g, &mut out).expect("query");
-        let color = shadow_cpu::shade::shade(&g, &f, &[&out]);
+        let color = shadow_cpu::shade::shade(&g, (&f.lights, &[f.reach(&f.lights[0], 1024, 768)]), &[&out]);
         spare = Some(g);
         color
     });

@@ -174,8 +174,13 @@ impl FrameSteps<WgpuBackend> for MeasuredSteps {
         Ok(())
     }
 
-    fn shade(&mut self, cx: &mut WgpuContext, frame: &FrameInputs, g: &GpuGBuffer) -> Result<Self::Shaded, WgpuError> {
-        shade(cx, frame, g, &self.visibility)
+    fn shade(
+        &mut self,
+        cx: &mut WgpuContext,
+        lights: (&FrameInputs, &[Reach]),
+        g: &GpuGBuffer,
+    ) -> Result<Self::Shaded, WgpuError> {
+        shade(cx, lights, g, &self.visibility)
     }
 
     fn finish(
@@ -281,17 +286,18 @@ pub(crate) fn clear_lit(cx: &WgpuContext, visibility: &GpuVisibility) {
 }
 
 /// The shading pass's inputs: the G-buffer's position, normal and albedo, every light's visibility (a
-/// layer each of `vis`) and the frame's lights (in the frame's transient buffer).
+/// layer each of `vis`) and the frame's lights with their reaches' rectangles (in the frame's transient
+/// buffer).
 pub(crate) fn shade_group(
     cx: &WgpuContext,
-    frame: &FrameInputs,
+    (frame, reaches): (&FrameInputs, &[Reach]),
     g: &GpuGBuffer,
     vis: &wgpu::Texture,
 ) -> wgpu::BindGroup {
     let mut table: LightTable = bytemuck::Zeroable::zeroed();
     table.count[0] = frame.lights.len() as u32;
-    for (slot, l) in table.lights.iter_mut().zip(&frame.lights) {
-        *slot = LightRaw::from(l).within(frame.reach(l, g.width, g.height).rect);
+    for ((slot, l), reach) in table.lights.iter_mut().zip(&frame.lights).zip(reaches) {
+        *slot = LightRaw::from(l).within(reach.rect);
     }
     let lights = cx.transient(bytemuck::bytes_of(&table));
     let vis_view = vis.create_view(&wgpu::TextureViewDescriptor {
@@ -350,13 +356,13 @@ pub(crate) fn full_screen_shade(
 /// shades. Returns the shaded texture and the query's resolve buffer.
 fn shade(
     cx: &WgpuContext,
-    frame: &FrameInputs,
+    lights: (&FrameInputs, &[Reach]),
     g: &GpuGBuffer,
     vis: &wgpu::Texture,
 ) -> Result<(wgpu::Texture, wgpu::Buffer), WgpuError> {
     cx.scoped("the shading pass", |cx| {
         let color = layered(cx, "color", g.width, g.height, 1, COLOR);
-        let group = shade_group(cx, frame, g, vis);
+        let group = shade_group(cx, lights, g, vis);
         let view = color.create_view(&Default::default());
         let query = cx.device.create_query_set(&wgpu::QuerySetDescriptor {
             label: Some("receivers"),

@@ -329,11 +329,16 @@ impl FrameSteps<WgpuBackend> for RecordSteps<'_> {
         Ok(())
     }
 
-    fn shade(&mut self, cx: &mut WgpuContext, frame: &FrameInputs, g: &GpuGBuffer) -> Result<(), WgpuError> {
+    fn shade(
+        &mut self,
+        cx: &mut WgpuContext,
+        lights: (&FrameInputs, &[Reach]),
+        g: &GpuGBuffer,
+    ) -> Result<(), WgpuError> {
         let Some((pipeline, target)) = self.shade else { return Ok(()) };
         self.mark(cx, "shadows");
         cx.scoped("the recorded shading pass", |cx| {
-            let group = shade_group(cx, frame, g, self.visibility);
+            let group = shade_group(cx, lights, g, self.visibility);
             let mut enc = cx.encoder("shade");
             full_screen_shade(&mut enc, target, pipeline, g, &group, None);
             cx.submit(enc);

@@ -137,8 +137,6 @@ pub struct Reach {
     /// The pixels whose surfaces it may reach; none outside.
     pub rect: PixelRect,
     sector: Option<Sector>,
-    /// The view's width and height.
-    view: (u32, u32),
 }
 
 impl Reach {
@@ -146,7 +144,7 @@ impl Reach {
     /// does not bound its lights.
     #[must_use]
     pub fn everywhere(width: u32, height: u32) -> Self {
-        Self { rect: PixelRect::full(width, height), sector: None, view: (width, height) }
+        Self { rect: PixelRect::full(width, height), sector: None }
     }
 
     /// The reach of `light` in a `width x height` view through `camera`.
@@ -155,13 +153,7 @@ impl Reach {
         let Some(sector) = Sector::of(light) else { return Self::everywhere(width, height) };
         let aspect = width as f32 / height.max(1) as f32;
         let rect = screen_rect(&sector.bounds(), camera.clip_from_world(aspect), width, height);
-        Self { rect, sector: Some(sector), view: (width, height) }
-    }
-
-    /// The pixels of the view it is in.
-    #[must_use]
-    pub fn view_area(&self) -> u64 {
-        u64::from(self.view.0) * u64::from(self.view.1)
+        Self { rect, sector: Some(sector) }
     }
 
     /// True when it lights no pixel of the view.
