@@ -61,7 +61,8 @@ pub struct RunOutput {
     pub atlas: Option<AtlasPlan>,
     /// Counters and timings.
     pub stats: FrameStats,
-    /// Pictures of the technique's internals.
+    /// Pictures of the technique's internals, where the renderer was asked for them
+    /// ([`Renderer::keep_debug_views`]).
     pub debug_views: Vec<DebugView>,
 }
 
@@ -71,13 +72,21 @@ pub struct Renderer {
     cpu: CpuContext,
     adapter: AdapterChoice,
     gpu: Option<WgpuContext>,
+    /// Whether a run makes the technique's debug views (a read-back of its maps on the GPU).
+    debug_views: bool,
 }
 
 impl Renderer {
     /// A renderer over a registry.
     #[must_use]
     pub fn new(registry: TechniqueRegistry) -> Self {
-        Self { registry, cpu: CpuContext::new(), adapter: AdapterChoice::default(), gpu: None }
+        Self { registry, cpu: CpuContext::new(), adapter: AdapterChoice::default(), gpu: None, debug_views: false }
+    }
+
+    /// Makes each run's [`RunOutput::debug_views`] from now on (`true`), or leaves them empty (`false`, the
+    /// default: on the GPU they read the technique's maps back, a cost no frame should pay unasked).
+    pub fn keep_debug_views(&mut self, on: bool) {
+        self.debug_views = on;
     }
 
     /// Picks the wgpu adapter by name substring (else `SHADOWLAB_ADAPTER`, else the first hardware one).
@@ -251,12 +260,13 @@ impl Renderer {
         width: u32,
         height: u32,
     ) -> Result<RunOutput, Error> {
+        let keep_views = self.debug_views;
         let (backend, color, visibility, atlas, stats, debug_views) = match &mut p.technique {
             PreparedKind::Cpu(t, named) => {
                 name_techniques(frame, named, |s| Ok(self.registry.cpu(s)?))?;
                 let techniques = LightTechniques { frame: t.as_mut(), named };
                 let f = shadow_cpu::render_frame(&mut self.cpu, frame, width, height, techniques)?;
-                let views = t.debug_views(&mut self.cpu)?;
+                let views = if keep_views { t.debug_views(&mut self.cpu)? } else { Vec::new() };
                 self.cpu.recycle(f.gbuffer);
                 (BackendKind::Cpu, f.color, f.visibility, f.atlas, f.stats, views)
             }
@@ -265,7 +275,7 @@ impl Renderer {
                 let g = self.gpu(true)?;
                 let techniques = LightTechniques { frame: t.as_mut(), named };
                 let f = shadow_wgpu::render_frame(g, frame, width, height, techniques)?;
-                let views = t.debug_views(g)?;
+                let views = if keep_views { t.debug_views(g)? } else { Vec::new() };
                 (BackendKind::Wgpu, f.color, f.visibility, f.atlas, f.stats, views)
             }
         };

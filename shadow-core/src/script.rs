@@ -167,6 +167,9 @@ pub fn run_frame<'t, 'o: 't, B: Backend, S: FrameSteps<B>>(
             *phases.stats.counters.extra.entry(OUT_OF_VIEW.into()).or_insert(0.0) += 1.0;
         }
         if !shadow.casts || reach.is_empty() {
+            if let Ok(technique) = techniques.pick(shadow.technique.as_ref()) {
+                technique.release_tiles(k);
+            }
             phases.steps.lit(cx, &mut vis)?;
             phases.steps.keep(k, vis);
             light_views.push(view);
@@ -199,7 +202,8 @@ pub fn run_frame<'t, 'o: 't, B: Backend, S: FrameSteps<B>>(
 
 /// The frame's shadow atlas of `side` texels for a view of `pixels`: a tile for each face of each spot and point light with a
 /// range that casts with a technique asking for one ([`crate::technique::ShadowTechnique::atlas_side`])
-/// and reaches some of the view, sized by the share of the view its reach's rectangle covers. A light
+/// and reaches some of the view, sized by the share of the view its reach's rectangle covers, and keeping
+/// the tiles its technique's last build lies in where it can ([`DynShadowTechnique::held_tiles`]). A light
 /// without a range lights the whole scene: its maps stay its own, of its technique's size.
 fn plan_atlas<B: Backend>(
     frame: &FrameInputs,
@@ -216,17 +220,15 @@ fn plan_atlas<B: Backend>(
             LightKind::Point { .. } => 6,
             LightKind::Directional { .. } => 0,
         };
-        let asked = if shadow.casts && !reach.is_empty() && !reach.is_everywhere() {
-            techniques.pick(shadow.technique.as_ref())?.atlas_side()
-        } else {
-            None
-        };
         let coverage = reach.rect.area() as f32 / view;
-        requests.push(asked.map_or(TileRequest { faces: 0, side: 0, coverage }, |side| TileRequest {
-            faces,
-            side,
-            coverage,
-        }));
+        let mut request = TileRequest { faces: 0, side: 0, coverage, held: None };
+        if shadow.casts && !reach.is_empty() && !reach.is_everywhere() {
+            let technique = techniques.pick(shadow.technique.as_ref())?;
+            if let Some(side) = technique.atlas_side() {
+                request = TileRequest { faces, side, coverage, held: technique.held_tiles(k) };
+            }
+        }
+        requests.push(request);
     }
     Ok(AtlasPlan::new(side, &requests)?)
 }

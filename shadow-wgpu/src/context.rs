@@ -223,6 +223,8 @@ pub struct WgpuContext {
     pub depth_stencil: wgpu::TextureFormat,
     /// The maps the lights' techniques lend to a host while a frame is recorded.
     pub(crate) host_maps: crate::host_maps::Capture,
+    /// The shadow atlas the lights' maps were last drawn into ([`crate::passes::maps::shadow_atlas`]).
+    pub(crate) shadow_atlas: Option<wgpu::Texture>,
 }
 
 /// The instance. On a headless Linux machine without `XDG_RUNTIME_DIR`, listing its Vulkan adapters makes
@@ -457,6 +459,7 @@ impl WgpuContext {
             resources: Default::default(),
             depth_stencil,
             host_maps: Default::default(),
+            shadow_atlas: None,
         }
     }
 

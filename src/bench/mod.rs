@@ -49,10 +49,35 @@ pub struct BenchJob<'a> {
     /// ray-casting BVH), so its cost is measured: the adjacency as its own `adjacency` time, the BVH in
     /// the build phase of the techniques that cast rays.
     pub rebuild: bool,
-    /// The scene's clip played through the frames, in place of the moving light.
-    pub clip: Option<&'a Clip>,
+    /// What changes from frame to frame.
+    pub motion: Motion<'a>,
     /// What the frames save ([`Savings`]): each technique is measured under each, side by side.
     pub savings: Vec<Savings>,
+}
+
+/// What changes from frame to frame in a bench.
+#[derive(Clone, Copy, Debug, Default)]
+pub enum Motion<'a> {
+    /// The lights turn about the scene's centre, a quarter turn over the run: no light's build can be kept.
+    #[default]
+    Lights,
+    /// The lights stand still and the camera turns about the point it looks at, an eighth of a turn over
+    /// the run: the builds of still lights may be kept (`--move camera`).
+    Camera,
+    /// The scene's clip plays through the frames (`--animate`): its poses, under its own lights.
+    Clip(&'a Clip),
+}
+
+impl Motion<'_> {
+    /// Its name in reports: "lights", "camera" or "clip".
+    #[must_use]
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::Lights => "lights",
+            Self::Camera => "camera",
+            Self::Clip(_) => "clip",
+        }
+    }
 }
 
 /// The name of `savings` in reports: "all" or "none".
@@ -165,16 +190,24 @@ pub fn moved_light(light: &Light, center: Vec3, k: u32, n: u32) -> Light {
 }
 
 impl BenchJob<'_> {
-    /// The frame of run frame `k` of `total` with `savings`: the clip's `k`-th pose (the last one past its
-    /// end), or the lights turned a `k / total` part of a quarter turn.
+    /// The frame of run frame `k` of `total` with `savings`, as the job's [`Motion`] moves it.
     #[must_use]
     pub fn frame_at(&self, k: u32, total: u32, savings: Savings) -> FrameInputs {
-        let posed = self.clip.and_then(|c| c.frames.get(k as usize).or(c.frames.last()));
-        let mut frame = posed.unwrap_or(self.frame).clone();
-        if posed.is_none() {
-            let center = self.frame.bounds.center();
-            frame.lights = self.frame.lights.iter().map(|l| moved_light(l, center, k, total)).collect();
-        }
+        let mut frame = match self.motion {
+            Motion::Clip(c) => c.frames.get(k as usize).or(c.frames.last()).unwrap_or(self.frame).clone(),
+            Motion::Lights => {
+                let center = self.frame.bounds.center();
+                let lights = self.frame.lights.iter().map(|l| moved_light(l, center, k, total)).collect();
+                FrameInputs { lights, ..self.frame.clone() }
+            }
+            Motion::Camera => {
+                let mut frame = self.frame.clone();
+                let turn = Mat3::from_rotation_y(std::f32::consts::FRAC_PI_4 * k as f32 / total.max(1) as f32);
+                let c = &mut frame.camera;
+                c.eye = c.target + turn * (c.eye - c.target);
+                frame
+            }
+        };
         frame.savings = savings;
         frame
     }
@@ -417,7 +450,7 @@ mod tests {
             techniques: specs.to_vec(),
             backends: vec![BackendKind::Cpu, BackendKind::Cpu],
             rebuild: false,
-            clip: None,
+            motion: Motion::Lights,
             savings: vec![Savings::ALL],
         };
         let mut renderer = Renderer::new(TechniqueRegistry::builtin());
@@ -451,7 +484,7 @@ mod tests {
             techniques: vec![TechniqueSpec::named("shadow-map")],
             backends: vec![BackendKind::Cpu],
             rebuild: false,
-            clip: Some(&clip),
+            motion: Motion::Clip(&clip),
             savings: vec![Savings::ALL],
         };
         let frames: Vec<FrameInputs> = (0..4).map(|k| job.frame_at(k, 3, Savings::ALL)).collect();
@@ -466,6 +499,34 @@ mod tests {
         let mut still = scenes::build("cubes", &SceneParams::default()).expect("a built-in scene");
         let e = Clip::play(&mut still, 0.0, 0.1, 2).expect_err("no animations");
         assert!(e.to_string().contains("no animations"), "{e}");
+    }
+
+    /// With the camera moving, the lights stand still and the eye turns about the point it looks at.
+    #[test]
+    fn a_moving_camera_leaves_the_lights_still() {
+        let scene = scenes::build("cubes", &SceneParams::default()).expect("a built-in scene");
+        let frame = FrameInputs::from_first_camera(&scene).expect("a frame");
+        let job = BenchJob {
+            scene: "cubes".into(),
+            frame: &frame,
+            width: 24,
+            height: 16,
+            frames: 4,
+            warmup: 0,
+            techniques: vec![TechniqueSpec::named("shadow-map")],
+            backends: vec![BackendKind::Cpu],
+            rebuild: false,
+            motion: Motion::Camera,
+            savings: vec![Savings::ALL],
+        };
+        let (first, last) = (job.frame_at(0, 4, Savings::ALL), job.frame_at(4, 4, Savings::ALL));
+        assert_eq!(first.lights[0].kind, last.lights[0].kind, "the light stays");
+        let (a, b) = (first.camera, last.camera);
+        assert_eq!(a.target, b.target);
+        assert!((a.eye - b.eye).length() > 0.1, "the camera moved");
+        assert!(((a.eye - a.target).length() - (b.eye - b.target).length()).abs() < 1e-4, "about its target");
+        let lights = BenchJob { motion: Motion::Lights, ..job };
+        assert_ne!(lights.frame_at(4, 4, Savings::ALL).lights[0].kind, first.lights[0].kind, "the light turns");
     }
 
     #[test]
@@ -484,7 +545,7 @@ mod tests {
                 techniques: vec![TechniqueSpec::named("ray-traced")],
                 backends: vec![BackendKind::Cpu],
                 rebuild,
-                clip: None,
+                motion: Motion::Lights,
                 savings: vec![Savings::ALL],
             };
             let report = run_bench(&mut renderer, &job, |_| {}).expect("bench");

@@ -140,7 +140,10 @@ pub fn run_realtime_bench(
         frames: job.frames,
         adapter,
         in_flight: IN_FLIGHT,
-        pose_ms: job.clip.map(|c| stat(c.pose_ms())),
+        pose_ms: match job.motion {
+            crate::bench::Motion::Clip(c) => Some(stat(c.pose_ms())),
+            _ => None,
+        },
         results,
     })
 }

@@ -2,7 +2,8 @@
 //! light's reach and the shadow atlas and every frame without them (`bench --savings both`), on each
 //! backend; on a GPU adapter the real-time path too, with the host's time to record a frame. From them the
 //! growth exponent of the frame time in the light count (the slope of a least-squares line through
-//! log time against log lights) and the recording cost a light adds.
+//! log time against log lights) and the recording cost a light adds. Then the 64 lights standing still
+//! while the camera turns (`bench --move camera`), beside the same frames with no shadows at all.
 
 use std::fmt::Write as _;
 
@@ -12,7 +13,7 @@ use shadow_core::technique::TechniqueSpec;
 
 use crate::Error;
 use crate::bench::realtime::{RealtimeReport, run_realtime_bench};
-use crate::bench::{BenchJob, BenchReport, run_bench};
+use crate::bench::{BenchJob, BenchReport, Motion, run_bench};
 use crate::renderer::{BackendKind, Renderer};
 
 /// The light counts measured.
@@ -32,6 +33,8 @@ struct Count {
 /// The measurements.
 pub struct LightsReport {
     counts: Vec<Count>,
+    /// The lights still and the camera turning: with shadows, then with none.
+    still: [Count; 2],
     size: (u32, u32),
 }
 
@@ -45,14 +48,51 @@ pub fn run_lights(
     backends: &[BackendKind],
     progress: &mut impl FnMut(&str),
 ) -> Result<LightsReport, Error> {
+    let yard = || scenes::build("yard", &SceneParams::default()).map_err(|e| Error::Usage(e.to_string()));
     let mut counts = Vec::new();
     for lights in LIGHT_COUNTS {
-        let mut scene = scenes::build("yard", &SceneParams::default()).map_err(|e| Error::Usage(e.to_string()))?;
+        let mut scene = yard()?;
         scene.set_light_count(lights).map_err(|e| Error::Usage(e.to_string()))?;
         let frame = shadow_core::FrameInputs::from_first_camera(&scene)?;
+        let both = vec![Savings::ALL, Savings::NONE];
+        let run = Run { label: format!("yard, {lights} lights"), motion: Motion::Lights, savings: both };
+        counts.push(run.measure(renderer, &frame, (size, backends), progress)?);
+    }
+    let shadowed = shadow_core::FrameInputs::from_first_camera(&yard()?)?;
+    let unshadowed = shadow_core::FrameInputs {
+        shadows: vec![shadow_core::LightShadow::NONE; shadowed.lights.len()],
+        ..shadowed.clone()
+    };
+    let mut still = Vec::new();
+    for (frame, what) in [(&shadowed, "shadowed"), (&unshadowed, "no shadows")] {
+        let run =
+            Run { label: format!("yard, still lights, {what}"), motion: Motion::Camera, savings: vec![Savings::ALL] };
+        still.push(run.measure(renderer, frame, (size, backends), progress)?);
+    }
+    let still: [Count; 2] = still.try_into().unwrap_or_else(|_| unreachable!("two runs"));
+    Ok(LightsReport { counts, still, size })
+}
+
+/// One bench of the lights section: what moves and what the frames save.
+struct Run {
+    label: String,
+    motion: Motion<'static>,
+    savings: Vec<Savings>,
+}
+
+impl Run {
+    /// The instrumented frames of `frame` on `backends` at `size`, and the real-time path's on a GPU adapter.
+    fn measure(
+        self,
+        renderer: &mut Renderer,
+        frame: &shadow_core::FrameInputs,
+        (size, backends): ((u32, u32), &[BackendKind]),
+        progress: &mut impl FnMut(&str),
+    ) -> Result<Count, Error> {
+        let label = self.label;
         let job = BenchJob {
-            scene: format!("yard, {lights} lights"),
-            frame: &frame,
+            scene: label.clone(),
+            frame,
             width: size.0,
             height: size.1,
             frames: FRAMES,
@@ -60,19 +100,18 @@ pub fn run_lights(
             techniques: vec![TechniqueSpec::named(TECHNIQUE)],
             backends: backends.to_vec(),
             rebuild: false,
-            clip: None,
-            savings: vec![Savings::ALL, Savings::NONE],
+            motion: self.motion,
+            savings: self.savings,
         };
-        let bench = run_bench(renderer, &job, |m| progress(&format!("yard, {lights} lights: {m}")))?;
+        let bench = run_bench(renderer, &job, |m| progress(&format!("{label}: {m}")))?;
         let realtime = if backends.contains(&BackendKind::Wgpu) {
             let job = BenchJob { backends: vec![BackendKind::Wgpu], ..job };
-            Some(run_realtime_bench(renderer, &job, |m| progress(&format!("yard, {lights} lights, real-time: {m}")))?)
+            Some(run_realtime_bench(renderer, &job, |m| progress(&format!("{label}, real-time: {m}")))?)
         } else {
             None
         };
-        counts.push(Count { lights, bench, realtime });
+        Ok(Count { lights: frame.lights.len(), bench, realtime })
     }
-    Ok(LightsReport { counts, size })
 }
 
 /// The slope of the least-squares line through (ln x, ln y): the exponent b of y = a x^b.
@@ -155,6 +194,7 @@ pub fn markdown(s: &mut String, r: &LightsReport) {
             let _ = writeln!(s, "| {backend} | {:.2} | {:.2} |", growth_exponent(&saving), growth_exponent(&whole));
         }
     }
+    still_markdown(s, r);
     let (saving, whole) = (r.realtime("all"), r.realtime("none"));
     if saving.is_empty() {
         return;
@@ -182,6 +222,39 @@ pub fn markdown(s: &mut String, r: &LightsReport) {
         growth_exponent(&frames(&saving)),
         growth_exponent(&frames(&whole))
     );
+}
+
+/// The still lights' table: each backend's frame with shadows beside the frame with none.
+fn still_markdown(s: &mut String, r: &LightsReport) {
+    let [shadowed, none] = &r.still;
+    let _ = writeln!(
+        s,
+        "\nThe {} lights standing still while the camera turns an eighth of a turn about the point it looks at over \
+         the frames (`bench --move camera`, each light's build kept while it keeps its tiles), beside the same \
+         frames with no shadows at all (`--no-shadows`), median ms; *kept* is the builds kept in the last frame.\n",
+        shadowed.lights
+    );
+    let _ = writeln!(s, "| backend | shadowed: build / query / shade / total | kept | no shadows: total | ratio |");
+    let _ = writeln!(s, "|---|---|---:|---:|---:|");
+    let total = |e: &crate::bench::BenchEntry| e.timings_ms.get("total").map_or(f64::NAN, |t| t.median);
+    for e in &shadowed.bench.results {
+        let Some(bare) = none.bench.results.iter().find(|b| b.backend == e.backend) else { continue };
+        let phases = ["build", "query", "shade", "total"]
+            .map(|p| e.timings_ms.get(p).map_or("-".into(), |st| format!("{:.1}", st.median)))
+            .join(" / ");
+        let kept = e.counters.get("cached_builds").copied().unwrap_or(0.0);
+        let _ = writeln!(
+            s,
+            "| {} | {phases} | {kept:.0} | {:.1} | {:.2} |",
+            e.backend,
+            total(bare),
+            total(e) / total(bare)
+        );
+    }
+    let frame = |c: &Count| c.realtime.as_ref()?.results.first()?.frame_ms;
+    if let (Some(a), Some(b)) = (frame(shadowed), frame(none)) {
+        let _ = writeln!(s, "| wgpu real-time | frame {a:.1} | - | {b:.1} | {:.2} |", a / b);
+    }
 }
 
 #[cfg(test)]

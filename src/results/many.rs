@@ -17,7 +17,7 @@ use shadow_core::{FrameInputs, Material, Mesh, Scene};
 use shadow_cpu::bvh::SceneBvh;
 
 use crate::Error;
-use crate::bench::{BenchJob, BenchReport, run_bench};
+use crate::bench::{BenchJob, BenchReport, Motion, run_bench};
 use crate::renderer::{BackendKind, Renderer};
 
 /// The techniques timed beside the reference (whose BVH keeps each shared mesh once, on the CPU): a map
@@ -132,7 +132,7 @@ fn run_triangles(
         techniques: vec![TechniqueSpec::named("shadow-map")],
         backends: vec![BackendKind::Cpu],
         rebuild: false,
-        clip: None,
+        motion: Motion::Lights,
         savings: vec![shadow_core::frame::Savings::ALL],
     };
     let bench = run_bench(renderer, &job, |m| progress(&format!("triangles as {what}: {m}")))?;
@@ -175,7 +175,7 @@ pub fn run_many(
                 techniques,
                 backends: backends.to_vec(),
                 rebuild: false,
-                clip: None,
+                motion: Motion::Lights,
                 savings: vec![shadow_core::frame::Savings::ALL],
             };
             let what = if shared { "shared" } else { "unshared" };

@@ -110,7 +110,7 @@ pub fn run_results(renderer: &mut Renderer, job: &ResultsJob, mut progress: impl
         techniques,
         backends: job.backends.clone(),
         rebuild: false,
-        clip: None,
+        motion: crate::bench::Motion::Lights,
         savings: vec![shadow_core::frame::Savings::ALL],
     };
     let timing = run_bench(renderer, &bench, |m| progress(&format!("{}: {m}", job.bench_scene)))?;

@@ -268,12 +268,19 @@ impl View {
     pub fn inspect(&mut self, frame: &FrameInputs, (width, height): (u32, u32)) -> Result<Inspection, Error> {
         let spec = self.shadows.technique().clone();
         let run = match (self.backend, &mut self.cpu) {
-            (BackendKind::Cpu, Some(cpu)) => cpu.renderer.run(BackendKind::Cpu, frame, width, height, &spec)?,
+            (BackendKind::Cpu, Some(cpu)) => {
+                cpu.renderer.keep_debug_views(true);
+                let run = cpu.renderer.run(BackendKind::Cpu, frame, width, height, &spec);
+                cpu.renderer.keep_debug_views(false);
+                run?
+            }
             _ => {
                 let adapter = self.shadows.context().adapter.name.clone();
-                let renderer = self
-                    .instrumented
-                    .get_or_insert_with(|| Renderer::new(TechniqueRegistry::builtin()).with_adapter(Some(adapter)));
+                let renderer = self.instrumented.get_or_insert_with(|| {
+                    let mut renderer = Renderer::new(TechniqueRegistry::builtin()).with_adapter(Some(adapter));
+                    renderer.keep_debug_views(true);
+                    renderer
+                });
                 renderer.run(BackendKind::Wgpu, frame, width, height, &spec)?
             }
         };

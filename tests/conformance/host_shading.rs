@@ -65,6 +65,10 @@ fn looked_up_and_recorded(frame: &FrameInputs, spec: &str, (width, height): (u32
     let mut recorder = FrameRecorder::new();
     recorder.record_visibility(&mut cx, &mut encoder, frame, technique.as_mut(), &surfaces).expect("recorded");
     let map = recorder.map(0).unwrap_or_else(|| panic!("{spec}: no maps lent")).clone();
+    if frame.lights[0].range.is_some() {
+        let atlas = shadow_core::frame::Savings::ATLAS_SIDE;
+        assert_eq!(map.texture.width(), atlas, "{spec}: a ranged light's lent maps are the atlas");
+    }
 
     let source = format!("{}\n{}", host_wgsl::MAPS, include_str!("host_maps.wgsl"));
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
@@ -138,29 +142,39 @@ fn a_hosts_own_lookup_into_the_lent_maps_finds_the_techniques_visibility() {
     if crate::with_wgpu("a host's own map lookup").is_none() {
         return;
     }
-    let built = |scene: &str, light: Option<LightType>| {
+    // A light with a range gets tiles of the frame's shadow atlas: the lent maps are that atlas.
+    let built = |scene: &str, light: Option<LightType>, range: Option<f32>| {
         let params = SceneParams { light, ..SceneParams::default() };
-        FrameInputs::from_first_camera(&scenes::build(scene, &params).expect("scene")).expect("frame")
+        let mut frame = FrameInputs::from_first_camera(&scenes::build(scene, &params).expect("scene")).expect("frame");
+        frame.lights[0].range = range;
+        frame
     };
+    let ranged = Some(40.0);
     let cases = [
-        ("cubes", None, "shadow-map"),
-        ("cubes", None, "shadow-map:filter=bilinear"),
-        ("cubes", None, "shadow-map:filter=pcf3x3"),
-        ("cubes", None, "shadow-map:filter=pcf4x4-jitter,filter_radius=2"),
-        ("cubes", None, "shadow-map:filter=poisson16,filter_radius=2,bias=world"),
-        ("cubes", Some(LightType::Point), "shadow-map:filter=pcf3x3"),
-        ("cubes", Some(LightType::Directional), "cascaded-shadow-map"),
-        ("cubes", Some(LightType::Directional), "lispsm"),
-        ("cubes", Some(LightType::Directional), "perspective-shadow-map"),
+        ("cubes", None, None, "shadow-map"),
+        ("cubes", None, None, "shadow-map:filter=bilinear"),
+        ("cubes", None, None, "shadow-map:filter=pcf3x3"),
+        ("cubes", None, None, "shadow-map:filter=pcf4x4-jitter,filter_radius=2"),
+        ("cubes", None, None, "shadow-map:filter=poisson16,filter_radius=2,bias=world"),
+        ("cubes", Some(LightType::Point), None, "shadow-map:filter=pcf3x3"),
+        ("cubes", None, ranged, "shadow-map"),
+        ("cubes", None, ranged, "shadow-map:filter=pcf3x3"),
+        ("cubes", Some(LightType::Point), ranged, "shadow-map:filter=pcf3x3"),
+        ("cubes", Some(LightType::Directional), None, "cascaded-shadow-map"),
+        ("cubes", Some(LightType::Directional), None, "lispsm"),
+        ("cubes", Some(LightType::Directional), None, "perspective-shadow-map"),
     ];
     let mut failures = Vec::new();
-    for (scene, light, spec) in cases {
-        let (looked_up, recorded) = looked_up_and_recorded(&built(scene, light), spec, (240, 180));
+    for (scene, light, range, spec) in cases {
+        let (looked_up, recorded) = looked_up_and_recorded(&built(scene, light, range), spec, (240, 180));
         let covered: Vec<(f32, f32)> =
             looked_up.iter().zip(&recorded).filter(|(l, _)| **l >= 0.0).map(|(l, r)| (*l, *r)).collect();
         let differ = covered.iter().filter(|(l, r)| (l - r).abs() > 0.01).count();
         let shadowed = covered.iter().filter(|(_, r)| *r < 0.5).count();
-        eprintln!("{scene} {light:?} {spec}: {differ} of {} covered pixels differ, {shadowed} shadowed", covered.len());
+        eprintln!(
+            "{scene} {light:?} {range:?} {spec}: {differ} of {} covered pixels differ, {shadowed} shadowed",
+            covered.len()
+        );
         if differ as f64 > 0.001 * covered.len() as f64 || shadowed == 0 {
             failures
                 .push(format!("{scene} / {spec}: {differ} of {} pixels differ ({shadowed} shadowed)", covered.len()));

@@ -7,6 +7,12 @@
 //! largest tile is halved (of equal ones, the least important light's first). The tiles are laid in the
 //! atlas largest first along a Z-order curve: powers of two sorted from large to small then fill the square
 //! without gaps or overlaps.
+//!
+//! A light keeps the tiles it holds from an earlier frame (where its build lies, kept while nothing it
+//! reads changes) as long as the cell it would be granted now is within a factor of 2 of the cell it holds
+//! and no halving for the budget reaches it: a static light keeps its build while the camera moves. The
+//! others are laid around the kept ones, each at the first free place of its size along the curve; where
+//! one finds none, every tile is laid afresh.
 
 use glam::UVec2;
 
@@ -14,7 +20,7 @@ use glam::UVec2;
 pub const MIN_TILE: u32 = 32;
 
 /// What one light asks of the atlas.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct TileRequest {
     /// Tiles it needs: 1 for a spot light, 6 for a point light's cube faces, 0 for a light that takes none
     /// (a directional light, a light out of view, a technique without maps).
@@ -23,6 +29,8 @@ pub struct TileRequest {
     pub side: u32,
     /// The share of the view it lights, in [0, 1].
     pub coverage: f32,
+    /// The tiles it holds from an earlier frame, if any.
+    pub held: Option<LightTiles>,
 }
 
 /// Where a light's maps lie in the atlas.
@@ -33,6 +41,8 @@ pub struct LightTiles {
     pub side: u32,
     /// Each tile's corner in the atlas, in texels, one per face.
     pub origins: Vec<UVec2>,
+    /// The side of the atlas they lie in.
+    pub atlas: u32,
 }
 
 /// Why the tiles do not fit.
@@ -70,8 +80,17 @@ impl AtlasPlan {
         if u64::from(tiles) * u64::from(MIN_TILE * MIN_TILE) > u64::from(side) * u64::from(side) {
             return Err(AtlasFull { side, tiles });
         }
-        // Each light's cell, a power of two; its tiles are the side asked for where that is smaller.
+        // Each light's cell, a power of two; its tiles are the side asked for where that is smaller. A
+        // light keeps the cell it holds where that is within a factor of 2 of the one it would get.
         let mut cells: Vec<u32> = requests.iter().map(|r| wanted(r, side)).collect();
+        for (cell, r) in cells.iter_mut().zip(requests) {
+            if let Some(held) = holding(r, side)
+                && held <= *cell * 2
+                && held * 2 >= *cell
+            {
+                *cell = held;
+            }
+        }
         while area(&cells) > u64::from(side) * u64::from(side) {
             // The largest cell above the smallest, the least important light's first.
             let largest = (0..requests.len())
@@ -80,25 +99,88 @@ impl AtlasPlan {
                 .unwrap_or_else(|| unreachable!("the smallest tiles fit, checked above"));
             cells[largest] /= 2;
         }
-        // Largest first (the light's order among equals), each face at the next place of its size on the
-        // Z-order curve.
-        let mut order: Vec<usize> = (0..requests.len()).filter(|&k| requests[k].faces > 0).collect();
-        order.sort_by_key(|&k| std::cmp::Reverse(cells[k]));
-        let mut lights: Vec<Option<LightTiles>> = vec![None; requests.len()];
-        let mut filled = 0u64;
-        for k in order {
-            let c = cells[k];
-            let origins = (0..requests[k].faces)
-                .map(|_| {
-                    let cell = u64::from(c) * u64::from(c);
-                    let origin = z_order(filled / cell) * c;
-                    filled += cell;
-                    origin
-                })
-                .collect();
-            lights[k] = Some(LightTiles { side: c.min(requests[k].side), origins });
-        }
+        let lay = |keep: bool| {
+            let mut free = Occupancy::new(side, &cells);
+            let mut lights: Vec<Option<LightTiles>> = vec![None; requests.len()];
+            // The tiles kept where they lie, then the others largest first (the light's order among equals).
+            for (k, r) in requests.iter().enumerate() {
+                let Some(held) = r.held.as_ref().filter(|_| keep && holding(r, side) == Some(cells[k])) else {
+                    continue;
+                };
+                let before = free.taken.clone();
+                if held.origins.iter().all(|&o| free.take(o, cells[k])) {
+                    lights[k] = Some(held.clone());
+                } else {
+                    free.taken = before;
+                }
+            }
+            let mut order: Vec<usize> =
+                (0..requests.len()).filter(|&k| requests[k].faces > 0 && lights[k].is_none()).collect();
+            order.sort_by_key(|&k| std::cmp::Reverse(cells[k]));
+            for k in order {
+                let c = cells[k];
+                let origins = (0..requests[k].faces).map(|_| free.first(c)).collect::<Option<Vec<_>>>()?;
+                lights[k] = Some(LightTiles { side: c.min(requests[k].side), origins, atlas: side });
+            }
+            Some(lights)
+        };
+        let lights = lay(true)
+            .or_else(|| lay(false))
+            .unwrap_or_else(|| unreachable!("powers of two from large to small fill the square in Z-order"));
         Ok(Self { side, lights })
+    }
+}
+
+/// The cell of the tiles a request holds, where they were laid in an atlas of `side` for the faces and
+/// side it asks for now.
+fn holding(r: &TileRequest, side: u32) -> Option<u32> {
+    let held = r.held.as_ref()?;
+    let cell = held.side.next_power_of_two();
+    let same = held.atlas == side && held.origins.len() == r.faces as usize && held.side == cell.min(r.side);
+    same.then_some(cell)
+}
+
+/// Which squares of the atlas hold a tile, in squares of the smallest cell's side.
+struct Occupancy {
+    side: u32,
+    unit: u32,
+    taken: Vec<bool>,
+}
+
+impl Occupancy {
+    fn new(side: u32, cells: &[u32]) -> Self {
+        let unit = cells.iter().copied().filter(|&c| c > 0).min().unwrap_or(side).min(side).max(1);
+        let n = (side / unit) as usize;
+        Self { side, unit, taken: vec![false; n * n] }
+    }
+
+    /// Takes the cell of side `c` at `origin` if it lies in the atlas, aligned and free.
+    fn take(&mut self, origin: UVec2, c: u32) -> bool {
+        let aligned = origin.x.is_multiple_of(c) && origin.y.is_multiple_of(c);
+        let fits = aligned && origin.x + c <= self.side && origin.y + c <= self.side;
+        if !fits || !self.is_free(origin, c) {
+            return false;
+        }
+        let (n, u) = ((self.side / self.unit) as usize, self.unit);
+        for y in origin.y / u..(origin.y + c) / u {
+            for x in origin.x / u..(origin.x + c) / u {
+                self.taken[y as usize * n + x as usize] = true;
+            }
+        }
+        true
+    }
+
+    fn is_free(&self, origin: UVec2, c: u32) -> bool {
+        let (n, u) = ((self.side / self.unit) as usize, self.unit);
+        (origin.y / u..(origin.y + c) / u)
+            .all(|y| (origin.x / u..(origin.x + c) / u).all(|x| !self.taken[y as usize * n + x as usize]))
+    }
+
+    /// Takes the first free cell of side `c` along the Z-order curve.
+    fn first(&mut self, c: u32) -> Option<UVec2> {
+        let places = u64::from(self.side / c).pow(2);
+        let origin = (0..places).map(|i| z_order(i) * c).find(|&o| self.is_free(o, c))?;
+        self.take(origin, c).then_some(origin)
     }
 }
 
@@ -129,7 +211,7 @@ mod tests {
     use super::{AtlasFull, AtlasPlan, TileRequest};
 
     fn request(faces: u32, side: u32, coverage: f32) -> TileRequest {
-        TileRequest { faces, side, coverage }
+        TileRequest { faces, side, coverage, held: None }
     }
 
     /// Every tile inside the atlas and no two overlapping.
@@ -172,6 +254,37 @@ mod tests {
         let area: u64 = sides.iter().map(|&s| 6 * u64::from(s * s)).sum();
         assert!(area <= 4096 * 4096 && area > 4096 * 4096 / 2, "{area} texels");
         assert_packed(&plan);
+    }
+
+    #[test]
+    fn lights_keep_their_tiles_while_their_share_stays_within_a_factor_of_2() {
+        let first: Vec<TileRequest> = (0..24).map(|k| request(1 + 5 * (k % 2), 1024, 0.5 / (k + 1) as f32)).collect();
+        let before = AtlasPlan::new(8192, &first).expect("fits");
+        assert_packed(&before);
+        // No halving in an atlas this large. The camera moves: every share changes a little, light 3's fourfold (its side twofold: a cell
+        // of 2x is still within reach of the one it holds), light 15's sixteenfold, light 7 is gone.
+        let mut next: Vec<TileRequest> = first
+            .iter()
+            .zip(&before.lights)
+            .map(|(r, t)| TileRequest { coverage: r.coverage * 1.2, held: t.clone(), ..r.clone() })
+            .collect();
+        next[3].coverage *= 4.0;
+        next[15].coverage *= 16.0;
+        next[7] = TileRequest { faces: 0, held: None, ..next[7].clone() };
+        let after = AtlasPlan::new(8192, &next).expect("fits");
+        assert_packed(&after);
+        for k in (0..24).filter(|&k| k != 15 && k != 7) {
+            assert_eq!(after.lights[k], before.lights[k], "light {k} moved");
+        }
+        let side = |plan: &AtlasPlan, k: usize| plan.lights[k].as_ref().map_or(0, |t| t.side);
+        assert_eq!(side(&after, 15), 4 * side(&before, 15), "light 15 is granted its new share");
+        assert_eq!(after.lights[7], None);
+        // Held tiles of another atlas, or overlapping ones, are laid afresh.
+        let mut clash = next.clone();
+        clash[1].held = clash[0].held.clone().map(|t| super::LightTiles { origins: vec![t.origins[0]; 6], ..t });
+        assert_packed(&AtlasPlan::new(8192, &clash).expect("fits"));
+        let moved = AtlasPlan::new(16384, &next).expect("fits");
+        assert!(moved.lights.iter().flatten().all(|t| t.atlas == 16384));
     }
 
     #[test]

@@ -330,6 +330,12 @@ pub trait DynShadowTechnique<B: Backend>: Send {
     /// Forgets every light's last build, so the next frame builds each light afresh (after a change the
     /// build cannot see: a mesh edited in place, say).
     fn invalidate(&mut self);
+    /// Forgets light `slot`'s last build where it lies in tiles of the frame's shadow atlas: the light was
+    /// given none this frame (it reached no pixel, or cast no shadow), so other lights may draw there.
+    fn release_tiles(&mut self, slot: usize);
+    /// The atlas tiles light `slot`'s last build lies in, if it is held: the frame's atlas leaves them
+    /// where they are while the light's size stays near them, so the build may be kept.
+    fn held_tiles(&self, slot: usize) -> Option<LightTiles>;
     /// See [`ShadowTechnique::atlas_side`].
     fn atlas_side(&self) -> Option<u32>;
 }
@@ -361,13 +367,16 @@ struct Slot<S> {
     built: bool,
     /// Frames its build has been kept since it was made.
     kept: u32,
+    /// The atlas tiles the build lies in: it is kept only while the light holds them.
+    tiles: Option<LightTiles>,
 }
 
 impl<S> Slot<S> {
     /// Whether the build it holds serves a frame whose build would read `read` (`None`: a build that
-    /// cannot be kept), as `update` says.
-    fn keeps(&self, read: Option<u64>, update: ShadowUpdate) -> bool {
-        if !self.built || read.is_none() {
+    /// cannot be kept) into `tiles`, as `update` says. A build in other tiles than the frame gives the light
+    /// is never kept, whatever `update` says: other lights' maps may lie there now.
+    fn keeps(&self, read: Option<u64>, tiles: Option<&LightTiles>, update: ShadowUpdate) -> bool {
+        if !self.built || read.is_none() || self.tiles.as_ref() != tiles {
             return false;
         }
         match update {
@@ -421,14 +430,18 @@ impl<B: Backend, T: ShadowTechnique<B>> DynShadowTechnique<B> for Stateful<B, T>
         self.last = pass.slot;
         let slot = match &mut self.slots[pass.slot] {
             Some(s) => s,
-            slot => slot.insert(Slot { state: self.technique.create_state(cx)?, read: None, built: false, kept: 0 }),
+            slot => {
+                let state = self.technique.create_state(cx)?;
+                slot.insert(Slot { state, read: None, built: false, kept: 0, tiles: None })
+            }
         };
-        if slot.keeps(reads, pass.update) {
+        if slot.keeps(reads, pass.tiles, pass.update) {
             slot.kept += 1;
             *pass.stats.counters.extra.entry("cached_builds".into()).or_insert(0.0) += 1.0;
             return Ok(());
         }
         (slot.read, slot.built, slot.kept) = (None, false, 0);
+        slot.tiles = pass.tiles.cloned();
         self.technique.build(cx, &mut slot.state, pass)?;
         (slot.read, slot.built) = (reads, true);
         Ok(())
@@ -458,6 +471,18 @@ impl<B: Backend, T: ShadowTechnique<B>> DynShadowTechnique<B> for Stateful<B, T>
         for slot in self.slots.iter_mut().flatten() {
             (slot.read, slot.built) = (None, false);
         }
+    }
+
+    fn release_tiles(&mut self, slot: usize) {
+        if let Some(Some(slot)) = self.slots.get_mut(slot)
+            && slot.tiles.take().is_some()
+        {
+            (slot.read, slot.built) = (None, false);
+        }
+    }
+
+    fn held_tiles(&self, slot: usize) -> Option<LightTiles> {
+        self.slots.get(slot)?.as_ref().filter(|s| s.built)?.tiles.clone()
     }
 
     fn atlas_side(&self) -> Option<u32> {

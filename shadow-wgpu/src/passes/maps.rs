@@ -4,10 +4,13 @@
 //! that look into the maps their own way add a fragment entry and bindings from 4 on ([`MapQuery::with_entry`]).
 //! [`CutoutMaps`] holds the casters their texture cuts out alone, for the techniques built on silhouettes.
 
+pub use super::cutout_maps::CutoutMaps;
+
 use bytemuck::{Pod, Zeroable};
 use shadow_core::frame::Coverage;
-use shadow_core::light::LightView;
-use shadow_core::technique::maps::{Casters, CutoutMap, DepthMap};
+use shadow_core::light::atlas::LightTiles;
+use shadow_core::light::{LightProjection, LightView};
+use shadow_core::technique::maps::{Casters, DepthMap};
 use shadow_core::technique::settings::{BiasMode, Filter};
 use shadow_core::{FrameInputs, Instance};
 
@@ -33,6 +36,24 @@ pub struct MapParams {
     cascade: [f32; 4],
     cascade_axis: [f32; 4],
     cascade_far: [f32; 4],
+    tiles: [[f32; 4]; 6],
+}
+
+/// Where a light's depth maps lie: a layer of their own per projection, or a tile each in the one layer of
+/// the frame's shadow atlas.
+#[derive(Clone, Copy, Debug)]
+pub struct MapsIn<'a> {
+    /// The depth array holding them.
+    pub texture: &'a wgpu::Texture,
+    /// Their tiles, in an atlas; `None`: layer `k` is projection `k`'s map.
+    pub tiles: Option<&'a LightTiles>,
+}
+
+impl<'a> From<&'a wgpu::Texture> for MapsIn<'a> {
+    /// Maps of their own, a layer each.
+    fn from(texture: &'a wgpu::Texture) -> Self {
+        Self { texture, tiles: None }
+    }
 }
 
 /// The bindings every map lookup shares (group 1, bindings 0 to 3: G-buffer positions, the maps, the
@@ -104,7 +125,7 @@ impl MapBindings {
         lookup: LookupParams,
         extras: &QueryExtras<'_>,
     ) -> wgpu::BindGroup {
-        self.group_of(cx, maps, &map_params(maps, light, lookup, extras.settings, None), g, extras)
+        self.group_of(cx, maps, &map_params(maps.into(), light, lookup, extras.settings, None), g, extras)
     }
 
     /// [`Self::group`] with the lookup's parameters made already.
@@ -136,10 +157,10 @@ impl MapBindings {
     }
 }
 
-/// The parameters of a lookup into `maps` (one layer per projection of `light`), with `filter` in
+/// The parameters of a lookup into `maps` (a layer or a tile per projection of `light`), with `filter` in
 /// `settings.x` where a host reads it (the backend's own query compiles its filter in).
 fn map_params(
-    maps: &wgpu::Texture,
+    maps: MapsIn<'_>,
     light: &LightView,
     lookup: LookupParams,
     extra: [f32; 4],
@@ -157,15 +178,21 @@ fn map_params(
         cascade_far[..c.far.len()].copy_from_slice(&c.far);
     }
     let filter = filter.map_or(0.0, |f| filter_code(f) as f32);
+    let mut tiles = [[0.0f32; 4]; 6];
+    for (slot, origin) in tiles.iter_mut().zip(maps.tiles.iter().flat_map(|t| &t.origins)) {
+        *slot = [origin.x as f32, origin.y as f32, maps.tiles.map_or(0, |t| t.side) as f32, 0.0];
+    }
+    let side = maps.tiles.map_or(maps.texture.width(), |t| t.side);
     MapParams {
         proj,
         light: LightRaw::from(&light.light),
-        settings: [filter, lookup.radius, maps.width() as f32, lookup.receiver_offset],
+        settings: [filter, lookup.radius, side as f32, lookup.receiver_offset],
         planes,
         extra,
         cascade,
         cascade_axis,
         cascade_far,
+        tiles,
     }
 }
 
@@ -227,27 +254,29 @@ impl MapQuery {
         Self { lent: self.filter.is_some(), ..self }
     }
 
-    /// Writes the visibility of every receiver through the maps (one layer per light projection).
+    /// Writes the visibility of every receiver through the maps (a layer or an atlas tile per light
+    /// projection).
     ///
     /// # Errors
     /// A GPU failure.
-    pub fn run(
+    pub fn run<'m>(
         &self,
         cx: &WgpuContext,
-        maps: &wgpu::Texture,
+        maps: impl Into<MapsIn<'m>>,
         light: &LightView,
         g: &GpuGBuffer,
         out: &GpuVisibility,
         extras: &QueryExtras<'_>,
     ) -> Result<(), WgpuError> {
         // The filter rides in `settings.x` for a host; the backend's own query compiles it in.
+        let maps = maps.into();
         let lent = self.filter.filter(|_| self.lent);
         let params = map_params(maps, light, self.lookup, extras.settings, lent);
         if let Some(filter) = lent {
-            cx.host_maps.lend(|| crate::HostMap { texture: maps.clone(), params, filter });
+            cx.host_maps.lend(|| crate::HostMap { texture: maps.texture.clone(), params, filter });
         }
         cx.scoped("the shadow-map query", |cx| {
-            let group = self.bindings.group_of(cx, maps, &params, g, extras);
+            let group = self.bindings.group_of(cx, maps.texture, &params, g, extras);
             super::answer(cx, ("map query", out, super::LIT), &self.pipeline, &[&g.frame_group, &group], None);
         })
     }
@@ -279,17 +308,47 @@ pub struct LightPipelines {
     bias: wgpu::DepthBiasState,
     ids: bool,
     cutout: std::cell::OnceCell<wgpu::RenderPipeline>,
+    clear_tile: std::cell::OnceCell<wgpu::RenderPipeline>,
 }
 
 impl LightPipelines {
     fn new(cx: &WgpuContext, module: &wgpu::ShaderModule, bias: wgpu::DepthBiasState, ids: bool) -> Self {
         let solid = light_pipeline(cx, module, bias, ids, false);
-        Self { solid, module: module.clone(), bias, ids, cutout: std::cell::OnceCell::new() }
+        let (cutout, clear_tile) = Default::default();
+        Self { solid, module: module.clone(), bias, ids, cutout, clear_tile }
     }
 
     /// The pipeline of the casters their texture cuts out.
     fn cutout(&self, cx: &WgpuContext) -> &wgpu::RenderPipeline {
         self.cutout.get_or_init(|| light_pipeline(cx, &self.module, self.bias, self.ids, true))
+    }
+
+    /// The pipeline clearing one tile of an atlas to the far plane (made by the first light drawn in one).
+    fn clear_tile(&self, cx: &WgpuContext) -> &wgpu::RenderPipeline {
+        self.clear_tile.get_or_init(|| {
+            cx.pipelines.render(&wgpu::RenderPipelineDescriptor {
+                label: Some("atlas tile clear"),
+                layout: Some(&cx.pipelines.layout("atlas tile clear", &[])),
+                vertex: wgpu::VertexState {
+                    module: &self.module,
+                    entry_point: Some("vs_clear_tile"),
+                    compilation_options: Default::default(),
+                    buffers: &[],
+                },
+                primitive: wgpu::PrimitiveState::default(),
+                depth_stencil: Some(wgpu::DepthStencilState {
+                    format: MAP_DEPTH,
+                    depth_write_enabled: Some(true),
+                    depth_compare: Some(wgpu::CompareFunction::Always),
+                    stencil: Default::default(),
+                    bias: wgpu::DepthBiasState::default(),
+                }),
+                multisample: Default::default(),
+                fragment: None,
+                multiview_mask: None,
+                cache: None,
+            })
+        })
     }
 }
 
@@ -376,60 +435,116 @@ pub fn render_maps(
     ids: Option<&wgpu::Texture>,
     instances: &wgpu::Buffer,
 ) {
-    render_casters(cx, pipelines, (frame, Casters::All), light, (maps, ids), instances);
+    render_casters(cx, pipelines, (frame, Casters::All), light, (maps.into(), ids), instances);
 }
 
-/// [`render_maps`] of the casters `casters` names; a caster wholly outside a projection's frustum is not
-/// drawn into its map (it would draw nothing there) where the frame saves so.
+/// [`render_maps`] of the casters `casters` names, into the maps' layers or their atlas tiles (without
+/// IDs); a caster wholly outside a projection's frustum is not drawn into its map (it would draw nothing
+/// there) where the frame saves so.
 fn render_casters(
     cx: &WgpuContext,
     pipelines: &LightPipelines,
     (frame, casters): (&FrameInputs, Casters),
     light: &LightView,
-    (maps, ids): (&wgpu::Texture, Option<&wgpu::Texture>),
+    (maps, ids): (MapsIn<'_>, Option<&wgpu::Texture>),
     instances: &wgpu::Buffer,
 ) {
-    let res = maps.width();
-    let cutouts = frame.has_cutout_casters();
+    let res = maps.tiles.map_or(maps.texture.width(), |t| t.side);
     let mut enc = cx.encoder("light pass");
-    let culling = frame.savings.culling;
-    for (k, p) in light.projections.iter().enumerate() {
-        let in_view = |i: &Instance| !culling || p.may_hold(i.bounds);
-        let group = cx.shared.frame_group(cx, &ViewRaw::new(p.clip_from_world, glam::Vec3::ZERO, res, res), instances);
-        let view = layer_view(maps, k as u32);
-        let id_view = ids.map(|t| layer_view(t, k as u32));
-        let id_attachment = id_view.as_ref().map(|view| wgpu::RenderPassColorAttachment {
-            view,
-            depth_slice: None,
-            resolve_target: None,
-            ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT), store: wgpu::StoreOp::Store },
-        });
-        let colour = [id_attachment];
-        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("light pass"),
-            color_attachments: if ids.is_some() { &colour } else { &[] },
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &view,
-                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        pass.set_bind_group(0, &group, &[]);
-        if casters != Casters::CutOut {
-            pass.set_pipeline(&pipelines.solid);
-            let solid = |i: &Instance| casters.takes(i) && i.coverage() == Coverage::Solid && in_view(i);
-            draw_instances(cx, &mut pass, frame, solid, false);
+    match maps.tiles {
+        // An atlas's tiles, in one pass: each drawn within its viewport and cleared by a draw (the pass's
+        // clear would clear the other lights' tiles too).
+        Some(tiles) => {
+            let mut pass = begin_light_pass(&mut enc, &layer_view(maps.texture, 0), wgpu::LoadOp::Load, None);
+            for (p, origin) in light.projections.iter().zip(&tiles.origins) {
+                pass.set_viewport(origin.x as f32, origin.y as f32, res as f32, res as f32, 0.0, 1.0);
+                pass.set_scissor_rect(origin.x, origin.y, res, res);
+                pass.set_pipeline(pipelines.clear_tile(cx));
+                pass.draw(0..3, 0..1);
+                draw_casters(cx, &mut pass, pipelines, (frame, casters), (p, res), instances);
+            }
         }
-        if cutouts && casters != Casters::Solid {
-            pass.set_pipeline(pipelines.cutout(cx));
-            let cut_out = |i: &Instance| casters.takes(i) && i.coverage() == Coverage::Cutout && in_view(i);
-            draw_textured(cx, &mut pass, frame, cut_out, false);
+        None => {
+            for (k, p) in light.projections.iter().enumerate() {
+                let ids = ids.map(|t| layer_view(t, k as u32));
+                let depth = layer_view(maps.texture, k as u32);
+                let mut pass = begin_light_pass(&mut enc, &depth, wgpu::LoadOp::Clear(1.0), ids.as_ref());
+                draw_casters(cx, &mut pass, pipelines, (frame, casters), (p, res), instances);
+            }
         }
     }
     cx.submit(enc);
+}
+
+/// A light pass into `depth` (loaded as `load`), and into `ids` cleared to no caster where given.
+fn begin_light_pass<'e>(
+    enc: &'e mut wgpu::CommandEncoder,
+    depth: &wgpu::TextureView,
+    load: wgpu::LoadOp<f32>,
+    ids: Option<&wgpu::TextureView>,
+) -> wgpu::RenderPass<'e> {
+    let id_attachment = ids.map(|view| wgpu::RenderPassColorAttachment {
+        view,
+        depth_slice: None,
+        resolve_target: None,
+        ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT), store: wgpu::StoreOp::Store },
+    });
+    let colour = [id_attachment];
+    enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some("light pass"),
+        color_attachments: if ids.is_some() { &colour } else { &[] },
+        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+            view: depth,
+            depth_ops: Some(wgpu::Operations { load, store: wgpu::StoreOp::Store }),
+            stencil_ops: None,
+        }),
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    })
+}
+
+/// Draws the casters `casters` names into projection `p`'s map of side `res`: those everywhere, then those
+/// their texture cuts out; a caster wholly outside the projection's frustum is not drawn where the frame
+/// saves so.
+fn draw_casters(
+    cx: &WgpuContext,
+    pass: &mut wgpu::RenderPass<'_>,
+    pipelines: &LightPipelines,
+    (frame, casters): (&FrameInputs, Casters),
+    (p, res): (&LightProjection, u32),
+    instances: &wgpu::Buffer,
+) {
+    let culling = frame.savings.culling;
+    let in_view = |i: &Instance| !culling || p.may_hold(i.bounds);
+    let group = cx.shared.frame_group(cx, &ViewRaw::new(p.clip_from_world, glam::Vec3::ZERO, res, res), instances);
+    pass.set_bind_group(0, &group, &[]);
+    if casters != Casters::CutOut {
+        pass.set_pipeline(&pipelines.solid);
+        let solid = |i: &Instance| casters.takes(i) && i.coverage() == Coverage::Solid && in_view(i);
+        draw_instances(cx, pass, frame, solid, false);
+    }
+    if frame.has_cutout_casters() && casters != Casters::Solid {
+        pass.set_pipeline(pipelines.cutout(cx));
+        let cut_out = |i: &Instance| casters.takes(i) && i.coverage() == Coverage::Cutout && in_view(i);
+        draw_textured(cx, pass, frame, cut_out, false);
+    }
+}
+
+/// The context's shadow atlas of `side` texels (one layer), made when no atlas of that side was made
+/// before.
+///
+/// # Errors
+/// A side larger than the device allows.
+pub fn shadow_atlas(cx: &mut WgpuContext, side: u32) -> Result<wgpu::Texture, WgpuError> {
+    check_size(cx, "shadow atlas", side, side)?;
+    match &cx.shadow_atlas {
+        Some(atlas) if atlas.width() == side => Ok(atlas.clone()),
+        _ => {
+            let atlas = cx.scoped("allocating the shadow atlas", |cx| map_texture(cx, side, 1))?;
+            Ok(cx.shadow_atlas.insert(atlas).clone())
+        }
+    }
 }
 
 /// A depth array of `layers` square maps.
@@ -454,6 +569,8 @@ fn filter_code(f: Filter) -> f64 {
 pub struct DepthMaps {
     pipelines: LightPipelines,
     maps: Option<wgpu::Texture>,
+    /// The atlas tiles of the last render, when it drew into the frame's atlas.
+    tiles: Option<LightTiles>,
     casters: Casters,
 }
 
@@ -468,7 +585,12 @@ impl DepthMaps {
     /// [`DepthMaps::new`] from a module already holding the shadow-map shader.
     #[must_use]
     pub fn with_module(cx: &WgpuContext, module: &wgpu::ShaderModule, map: &DepthMap) -> Self {
-        Self { pipelines: light_pass_pipeline(cx, module, depth_bias(map)), maps: None, casters: Casters::All }
+        Self {
+            pipelines: light_pass_pipeline(cx, module, depth_bias(map)),
+            maps: None,
+            tiles: None,
+            casters: Casters::All,
+        }
     }
 
     /// The same light pass drawing only the casters `casters` names.
@@ -491,96 +613,59 @@ impl DepthMaps {
     ) -> Result<(), WgpuError> {
         let layers = light.projections.len() as u32;
         check_size(cx, "shadow map", resolution, resolution)?;
-        let maps = match &self.maps {
-            Some(m) if m.width() == resolution && m.depth_or_array_layers() == layers => m.clone(),
-            _ => {
-                let m = cx.scoped("allocating shadow maps", |cx| map_texture(cx, resolution, layers))?;
-                self.maps.insert(m).clone()
-            }
+        let own = self.maps.as_ref().filter(|m| self.tiles.is_none() && m.width() == resolution);
+        let maps = match own {
+            Some(m) if m.depth_or_array_layers() == layers => m.clone(),
+            _ => cx.scoped("allocating shadow maps", |cx| map_texture(cx, resolution, layers))?,
         };
+        self.draw(cx, frame, light, maps, None)
+    }
+
+    /// Renders the casters' depth from every projection of `light` into its tiles of the frame's shadow
+    /// atlas (the texture the context keeps for atlases of their side), each as a map of the tiles' side.
+    ///
+    /// # Errors
+    /// An atlas larger than the device allows, or a GPU failure.
+    pub fn render_tiles(
+        &mut self,
+        cx: &mut WgpuContext,
+        frame: &FrameInputs,
+        light: &LightView,
+        tiles: &LightTiles,
+    ) -> Result<(), WgpuError> {
+        let atlas = shadow_atlas(cx, tiles.atlas)?;
+        self.draw(cx, frame, light, atlas, Some(tiles))
+    }
+
+    fn draw(
+        &mut self,
+        cx: &mut WgpuContext,
+        frame: &FrameInputs,
+        light: &LightView,
+        maps: wgpu::Texture,
+        tiles: Option<&LightTiles>,
+    ) -> Result<(), WgpuError> {
+        self.tiles = tiles.cloned();
+        let maps = self.maps.insert(maps).clone();
         cx.upload_meshes(frame);
         cx.upload_textures(frame)?;
         let instances = cx.instances(frame);
+        let target = MapsIn { texture: &maps, tiles };
         cx.scoped("the shadow-map light pass", |cx| {
-            render_casters(cx, &self.pipelines, (frame, self.casters), light, (&maps, None), &instances)
+            render_casters(cx, &self.pipelines, (frame, self.casters), light, (target, None), &instances)
         })
     }
 
-    /// The maps of the last render, one layer per light projection.
+    /// The maps of the last render, one layer per light projection (or the atlas they are tiles of: see
+    /// [`Self::source`]).
     #[must_use]
     pub fn maps(&self) -> Option<&wgpu::Texture> {
         self.maps.as_ref()
     }
-}
 
-/// The depth maps of the casters their texture cuts out, alone ([`Casters::CutOut`]), and their lookup
-/// ([`CutoutMap`]): where the techniques built on silhouettes (which give such casters no volume or wedge)
-/// take those casters' shadows from (twin: shadow-cpu's `passes::maps::CutoutMaps`). Its pipelines are
-/// made by the first frame with such casters; a frame without them renders nothing.
-#[derive(Default)]
-pub struct CutoutMaps {
-    passes: Option<CutoutPasses>,
-    /// The view of the last render, when its frame had cut-out casters.
-    rendered: Option<LightView>,
-}
-
-/// The light pass and the lookup of one [`CutoutMap`].
-struct CutoutPasses {
-    settings: CutoutMap,
-    maps: DepthMaps,
-    query: MapQuery,
-}
-
-impl CutoutMaps {
-    /// Renders the maps of `frame`'s cut-out casters from every projection of `view` (the light's own, or
-    /// its cascades over the camera's view) as `settings` asks; for a frame without such casters, nothing.
-    ///
-    /// # Errors
-    /// As [`DepthMaps::render`].
-    pub fn render(
-        &mut self,
-        cx: &mut WgpuContext,
-        frame: &FrameInputs,
-        view: &LightView,
-        settings: &CutoutMap,
-    ) -> Result<(), WgpuError> {
-        self.rendered = None;
-        if !frame.has_cutout_casters() {
-            return Ok(());
-        }
-        let passes = match &mut self.passes {
-            Some(p) if p.settings == *settings => p,
-            _ => self.passes.insert(cx.scoped("creating the cut-out casters' map", |cx| {
-                let module = cx.pipelines.module("shadow_map", shaders::shadow_map());
-                let map = settings.map();
-                let lookup = LookupParams { radius: settings.filter_radius(), receiver_offset: map.receiver_offset() };
-                CutoutPasses {
-                    settings: *settings,
-                    maps: DepthMaps::with_module(cx, &module, &map).of(Casters::CutOut),
-                    query: MapQuery::new(cx, &module, settings.filter).with_lookup(lookup),
-                }
-            })?),
-        };
-        passes.maps.render(cx, frame, view, settings.resolution)?;
-        self.rendered = Some(view.clone());
-        Ok(())
-    }
-
-    /// Whether the last render drew maps (its frame had cut-out casters).
+    /// The maps of the last render and where they lie in them: for a lookup.
     #[must_use]
-    pub fn is_rendered(&self) -> bool {
-        self.rendered.is_some()
-    }
-
-    /// Writes into `out` the share of the light the cut-out casters of the last render leave each receiver
-    /// of `g`, and says so; says false and writes nothing when that frame had none.
-    ///
-    /// # Errors
-    /// A GPU failure.
-    pub fn query(&self, cx: &WgpuContext, g: &GpuGBuffer, out: &GpuVisibility) -> Result<bool, WgpuError> {
-        let (Some(passes), Some(view)) = (&self.passes, &self.rendered) else { return Ok(false) };
-        let Some(maps) = passes.maps.maps() else { return Ok(false) };
-        passes.query.run(cx, maps, view, g, out, &QueryExtras::NONE)?;
-        Ok(true)
+    pub fn source(&self) -> Option<MapsIn<'_>> {
+        self.maps.as_ref().map(|texture| MapsIn { texture, tiles: self.tiles.as_ref() })
     }
 }

@@ -10,6 +10,7 @@
 //! what it holds too; [`answer`] the pass that writes a light's visibility, over the pixels of its reach
 //! only.
 
+mod cutout_maps;
 pub mod extrusion;
 pub mod maps;
 pub mod volumes;

@@ -19,6 +19,9 @@ struct MapParams {
     cascade_axis: vec4<f32>,
     // The far end of each cascade.
     cascade_far: vec4<f32>,
+    // Per projection, where its map lies in a shadow atlas: xy its corner in texels, z its side (the map
+    // side above); z = 0: the map is a layer of its own (the projection's index).
+    tiles: array<vec4<f32>, 6>,
 };
 
 // The lookup filter (0 none, 1 bilinear, 2 pcf3x3, 3 pcf4x4-jitter, 4 poisson16), fixed when the query
@@ -39,6 +42,15 @@ struct DepthOut {
 fn vs_light_depth(@location(0) p: vec4<f32>, @builtin(instance_index) instance: u32) -> DepthOut {
     var out: DepthOut;
     out.pos = clip_position(instance, p);
+    return out;
+}
+
+// A triangle over the viewport at the far plane (depth 1, the maps' clear value): drawn with the depth
+// test off, it clears one tile of an atlas, where a clear of the render pass would clear them all.
+@vertex
+fn vs_clear_tile(@builtin(vertex_index) i: u32) -> DepthOut {
+    var out: DepthOut;
+    out.pos = vec4<f32>(f32(i32(i & 1u) * 4 - 1), f32(i32(i >> 1u) * 4 - 1), 1.0, 1.0);
     return out;
 }
 
@@ -91,10 +103,17 @@ fn cube_face(d: vec3<f32>) -> i32 {
     return select(5, 4, d.z >= 0.0);
 }
 
-// Twin: shadow_core::lookup::compare_texel.
+// The layer projection `layer`'s map lies in: its own, or the atlas's one layer.
+fn map_layer(layer: i32) -> i32 {
+    return select(layer, 0, map.tiles[layer].z > 0.0);
+}
+
+// Twin: shadow_core::lookup::compare_texel (within the projection's tile of an atlas, as if it were a map
+// of its own).
 fn compare_texel(layer: i32, x: i32, y: i32, depth: f32) -> f32 {
     let n = i32(map.settings.z);
-    let v = textureLoad(shadow_maps, vec2<i32>(clamp(x, 0, n - 1), clamp(y, 0, n - 1)), layer, 0);
+    let t = vec2<i32>(clamp(x, 0, n - 1), clamp(y, 0, n - 1)) + vec2<i32>(map.tiles[layer].xy);
+    let v = textureLoad(shadow_maps, t, map_layer(layer), 0);
     return select(0.0, 1.0, depth <= v);
 }
 
@@ -104,9 +123,17 @@ fn compare_nearest(layer: i32, uv: vec2<f32>, depth: f32) -> f32 {
     return compare_texel(layer, i32(t.x), i32(t.y), depth);
 }
 
-// Twin: shadow_core::lookup::compare_bilinear, done by the comparison sampler.
+// Twin: shadow_core::lookup::compare_bilinear, done by the comparison sampler. In an atlas's tile, the
+// point is clamped to the centres of the tile's edge texels first, which reads what the sampler's clamp to
+// the edge reads in a map of its own.
 fn compare_bilinear(layer: i32, uv: vec2<f32>, depth: f32) -> f32 {
-    return textureSampleCompareLevel(shadow_maps, shadow_cmp, uv, layer, depth);
+    let tile = map.tiles[layer];
+    if (tile.z == 0.0) {
+        return textureSampleCompareLevel(shadow_maps, shadow_cmp, uv, layer, depth);
+    }
+    let n = map.settings.z;
+    let at = (clamp(uv * n, vec2<f32>(0.5), vec2<f32>(n - 0.5)) + tile.xy) / f32(textureDimensions(shadow_maps).x);
+    return textureSampleCompareLevel(shadow_maps, shadow_cmp, at, 0, depth);
 }
 
 // Twin: shadow_core::lookup::shadow_lookup.

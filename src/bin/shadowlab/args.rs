@@ -258,6 +258,14 @@ pub(crate) enum Command {
         /// atlas), none (every light from every caster over the whole view), or both, side by side.
         #[arg(long, default_value = "all")]
         savings: String,
+        /// What moves from frame to frame: lights (they turn about the scene's centre, a quarter turn over
+        /// the frames: every light is built each frame) or camera (the lights stand still, each kept as
+        /// its update policy says, and the camera turns an eighth of a turn about the point it looks at).
+        #[arg(long = "move", default_value = "lights")]
+        motion: String,
+        /// Every light casts no shadow: the frame the shadows are measured against.
+        #[arg(long)]
+        no_shadows: bool,
     },
     /// Temporal flicker along a walk, on the CPU: the fraction of the receivers seen at the start whose lit
     /// state changes between consecutive frames as the maps follow the moving camera (the reference's

@@ -3,9 +3,9 @@
 
 use std::path::PathBuf;
 
-use shadow_core::FrameInputs;
 use shadow_core::frame::Savings;
 use shadow_core::technique::TechniqueSpec;
+use shadow_core::{FrameInputs, LightShadow};
 use shadowlab::{Error, Renderer, TechniqueRegistry};
 
 use crate::args::{SceneArgs, TechniqueArgs, ViewArgs};
@@ -25,6 +25,18 @@ pub(crate) struct BenchArgs {
     pub(crate) sweep: Option<String>,
     pub(crate) out_dir: Option<PathBuf>,
     pub(crate) savings: Vec<Savings>,
+    /// `--move camera`: the camera moves, the lights stand still.
+    pub(crate) camera: bool,
+    pub(crate) no_shadows: bool,
+}
+
+/// `--move`: lights or camera (true).
+pub(crate) fn parse_motion(s: &str) -> Result<bool, Error> {
+    match s {
+        "lights" => Ok(false),
+        "camera" => Ok(true),
+        _ => Err(Error::Usage(format!("bad --move '{s}': expected lights or camera"))),
+    }
 }
 
 /// `--savings`: all, none or both (every technique twice, side by side).
@@ -64,6 +76,9 @@ pub(crate) fn bench(args: &SceneArgs, view: &ViewArgs, b: BenchArgs) -> Result<(
     if b.animate && sweep.is_some() {
         return Err(Error::Usage("--animate plays the scene's own clip: leave out --sweep".into()));
     }
+    if b.animate && b.camera {
+        return Err(Error::Usage("--animate plays the scene's own clip: leave out --move camera".into()));
+    }
     if b.realtime && b.rebuild {
         return Err(Error::Usage("--rebuild times the instrumented frames: leave out --realtime".into()));
     }
@@ -73,7 +88,10 @@ pub(crate) fn bench(args: &SceneArgs, view: &ViewArgs, b: BenchArgs) -> Result<(
     view.check_adapter(&b.choice.backend)?;
     let mut renderer = Renderer::new(TechniqueRegistry::builtin()).with_adapter(view.adapter.clone());
     // The scene and its view are checked before the backend says which it is.
-    let first = args.frame(view)?;
+    let mut first = args.frame(view)?;
+    if b.no_shadows {
+        first.0.shadows = vec![LightShadow::NONE; first.0.lights.len()];
+    }
     let (specs, left) = technique_specs(&renderer, &b.choice.technique, b.choice.techniques.as_deref(), &first.0)?;
     check_availability(&renderer, &specs, &b.choice.backend)?;
     // A triangle sweep's scenes are built up front too: a count too large is refused before anything runs.
@@ -114,7 +132,7 @@ fn bench_once(
     clip: Option<&shadowlab::bench::Clip>,
 ) -> Result<(), Error> {
     use shadowlab::bench::realtime::{realtime_steps, realtime_table, run_realtime_bench};
-    use shadowlab::bench::{BenchJob, bench_table, run_bench};
+    use shadowlab::bench::{BenchJob, Motion, bench_table, run_bench};
     let job = BenchJob {
         scene: args.name(),
         frame: &frame,
@@ -125,7 +143,11 @@ fn bench_once(
         techniques: specs,
         backends: kinds,
         rebuild: b.rebuild,
-        clip,
+        motion: match clip {
+            Some(clip) => Motion::Clip(clip),
+            None if b.camera => Motion::Camera,
+            None => Motion::Lights,
+        },
         savings: b.savings.clone(),
     };
     let bar = progress_bar(if b.realtime { realtime_steps(&job) } else { job.steps() });
@@ -180,12 +202,15 @@ fn bench_sweep(
     let steps = kinds.len() as u64 * (specs.len() as u64 + u64::from(b.warmup + b.frames));
     let bar = progress_bar(sweep.values.len() as u64 * steps);
     for (i, &v) in sweep.values.iter().enumerate() {
-        let (frame, w, h) = if key == RESOLUTION {
+        let (mut frame, w, h) = if key == RESOLUTION {
             args.frame(view)?
         } else {
             let (w, h) = view.size()?;
             (FrameInputs::from_first_camera(&sweep.scenes[i])?, w, h)
         };
+        if b.no_shadows {
+            frame.shadows = vec![LightShadow::NONE; frame.lights.len()];
+        }
         let with_value: Vec<TechniqueSpec> = specs
             .iter()
             .map(|s| {
@@ -207,7 +232,7 @@ fn bench_sweep(
             techniques: with_value,
             backends: kinds.clone(),
             rebuild: b.rebuild,
-            clip: None,
+            motion: if b.camera { shadowlab::bench::Motion::Camera } else { shadowlab::bench::Motion::Lights },
             savings: b.savings.clone(),
         };
         let r = run_bench(renderer, &job, |m| report_progress(&bar, &format!("{key}={v}: {m}")))?;

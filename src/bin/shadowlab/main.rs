@@ -132,9 +132,25 @@ fn run(cli: Cli) -> Result<(), Error> {
             sweep,
             out_dir,
             savings,
+            motion,
+            no_shadows,
         } => {
             let savings = bench::parse_savings(&savings)?;
-            let b = BenchArgs { choice, frames, warmup, json, realtime, rebuild, animate, sweep, out_dir, savings };
+            let camera = bench::parse_motion(&motion)?;
+            let b = BenchArgs {
+                choice,
+                frames,
+                warmup,
+                json,
+                realtime,
+                rebuild,
+                animate,
+                sweep,
+                out_dir,
+                savings,
+                camera,
+                no_shadows,
+            };
             bench(&scene, &view, b)
         }
         Command::Export { scene, out } => export(&scene, &out),

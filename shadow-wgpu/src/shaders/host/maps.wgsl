@@ -41,6 +41,9 @@ struct ShadowlabMap {
     cascade_axis: vec4<f32>,
     // The far end of each cascade in view depth.
     cascade_far: vec4<f32>,
+    // Per layer, where its map lies in a shadow atlas: xy its corner in texels, z its side (settings.z);
+    // z = 0: the map is the layer itself.
+    tiles: array<vec4<f32>, 6>,
 };
 
 // 16 points in the unit disk (shadow_core::lookup::POISSON16).
@@ -93,6 +96,25 @@ fn shadowlab_map_visibility(
     return v;
 }
 
+// Twin: shadow_map.wgsl's `compare_bilinear`: the comparison sampler's four taps, in the layer's tile of
+// an atlas clamped to the centres of its edge texels.
+fn shadowlab_compare_bilinear(
+    maps: texture_depth_2d_array,
+    cmp: sampler_comparison,
+    map: ShadowlabMap,
+    layer: i32,
+    uv: vec2<f32>,
+    depth: f32,
+) -> f32 {
+    let tile = map.tiles[layer];
+    if (tile.z == 0.0) {
+        return textureSampleCompareLevel(maps, cmp, uv, layer, depth);
+    }
+    let n = map.settings.z;
+    let at = (clamp(uv * n, vec2<f32>(0.5), vec2<f32>(n - 0.5)) + tile.xy) / f32(textureDimensions(maps).x);
+    return textureSampleCompareLevel(maps, cmp, at, 0, depth);
+}
+
 // Twin: shadow_map.wgsl's `in_projection` and `shadow_lookup`.
 fn shadowlab_lookup_layer(
     maps: texture_depth_2d_array,
@@ -115,19 +137,19 @@ fn shadowlab_lookup_layer(
     let texel = 1.0 / side;
     if (kind == 0u) {
         let n = i32(side);
-        let t = vec2<i32>(floor(uv * side));
-        let stored = textureLoad(maps, clamp(t, vec2<i32>(0), vec2<i32>(n - 1)), layer, 0);
+        let t = clamp(vec2<i32>(floor(uv * side)), vec2<i32>(0), vec2<i32>(n - 1)) + vec2<i32>(map.tiles[layer].xy);
+        let stored = textureLoad(maps, t, select(layer, 0, map.tiles[layer].z > 0.0), 0);
         return select(0.0, 1.0, depth <= stored);
     }
     if (kind == 1u) {
-        return textureSampleCompareLevel(maps, cmp, uv, layer, depth);
+        return shadowlab_compare_bilinear(maps, cmp, map, layer, uv, depth);
     }
     var sum = 0.0;
     if (kind == 2u) {
         for (var dy = -1; dy <= 1; dy = dy + 1) {
             for (var dx = -1; dx <= 1; dx = dx + 1) {
                 let o = vec2<f32>(f32(dx), f32(dy)) * texel;
-                sum = sum + textureSampleCompareLevel(maps, cmp, uv + o, layer, depth);
+                sum = sum + shadowlab_compare_bilinear(maps, cmp, map, layer, uv + o, depth);
             }
         }
         return sum / 9.0;
@@ -140,7 +162,7 @@ fn shadowlab_lookup_layer(
                 let jx = shadowlab_hash_unit(h);
                 let jy = shadowlab_hash_unit((h << 12u) | (h >> 20u));
                 let o = (vec2<f32>(f32(i) + jx, f32(j) + jy) * 0.5 - vec2<f32>(1.0)) * radius;
-                sum = sum + textureSampleCompareLevel(maps, cmp, uv + o * texel, layer, depth);
+                sum = sum + shadowlab_compare_bilinear(maps, cmp, map, layer, uv + o * texel, depth);
             }
         }
         return sum / 16.0;
@@ -151,7 +173,7 @@ fn shadowlab_lookup_layer(
     for (var k = 0; k < 16; k = k + 1) {
         let q = SHADOWLAB_POISSON16[k];
         let o = vec2<f32>(co * q.x - s * q.y, s * q.x + co * q.y) * radius;
-        sum = sum + textureSampleCompareLevel(maps, cmp, uv + o * texel, layer, depth);
+        sum = sum + shadowlab_compare_bilinear(maps, cmp, map, layer, uv + o * texel, depth);
     }
     return sum / 16.0;
 }

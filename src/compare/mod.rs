@@ -6,7 +6,6 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 use shadow_core::image::{Rgb8, error_map_over, visibility_to_rgb};
-use shadow_core::material::AlphaMode;
 use shadow_core::metrics::{
     VisibilityMetrics, back_false_light, compare_visibility, flip_mean, light_bleeding, measured_pixels, min_median,
     near_field, texel_density,
@@ -18,7 +17,11 @@ use shadow_core::{FrameInputs, Image};
 
 use crate::Error;
 use crate::renderer::{BackendKind, Renderer, RunOutput};
+
+mod frame;
+
 use crate::sheet::{SheetItem, contact_sheet, disagreement_inset};
+pub use frame::{scene_notes, widest_first};
 use shadow_core::technique::maps::RESOLUTION;
 use shadow_cpu::CpuFrame;
 use shadow_cpu::acne::AcneProbe;
@@ -112,25 +115,6 @@ pub struct CompareReport {
     /// What the reader must know of the scene to read the figures: which content every technique and
     /// the reference take in a simpler way alike.
     pub notes: Vec<String>,
-}
-
-/// The notes of a report on `frame` ([`CompareReport::notes`]).
-#[must_use]
-pub fn scene_notes(frame: &FrameInputs) -> Vec<String> {
-    let mut blended: Vec<&str> = Vec::new();
-    for inst in frame.instances.iter().filter(|i| i.casts_shadow && i.material.alpha_mode == AlphaMode::Blend) {
-        if !blended.contains(&inst.material.name.as_str()) {
-            blended.push(&inst.material.name);
-        }
-    }
-    let mut notes = Vec::new();
-    if !blended.is_empty() {
-        notes.push(format!(
-            "blended casters cast as opaque ones, in every technique and in the reference alike (materials: {})",
-            blended.join(", ")
-        ));
-    }
-    notes
 }
 
 /// The reference for `techniques`: `area-light-reference` when they are all soft, `ray-traced` otherwise
@@ -363,6 +347,7 @@ fn measure(
         mask: &refs.mask,
     };
     let mask = &refs.mask;
+    renderer.keep_debug_views(job.out_dir.is_some());
     let run = renderer.run(backend, job.frame, job.width, job.height, spec)?;
     let metrics = compare_visibility(&run.visibility[0], ref_vis, mask)?;
     let flip = flip_mean(&run.color, ref_color, mask)?;
@@ -553,6 +538,20 @@ pub fn run_compare(
     if let Some(dir) = &job.out_dir {
         std::fs::create_dir_all(dir).map_err(|e| Error::Write { path: dir.clone(), why: e.to_string() })?;
     }
+    // The figures are the first light's: where another reaches more of the view, that one goes first.
+    let moved = widest_first(job.frame, job.width, job.height);
+    let moved_job = moved.as_ref().map(|(frame, _)| CompareJob {
+        scene: job.scene.clone(),
+        frame,
+        width: job.width,
+        height: job.height,
+        techniques: job.techniques.clone(),
+        reference: job.reference.clone(),
+        soft_reference: job.soft_reference.clone(),
+        backends: job.backends.clone(),
+        out_dir: job.out_dir.clone(),
+    });
+    let job = moved_job.as_ref().unwrap_or(job);
     let any_soft = job.techniques.iter().any(|s| renderer.registry().get(&s.name).is_ok_and(|e| e.soft));
     let mut sheet = Vec::new();
     let refs = References::trace(renderer, job, any_soft, &mut sheet, &mut progress)?;
@@ -571,7 +570,10 @@ pub fn run_compare(
         results: runs.iter().map(|m| m.entry.clone()).collect(),
         cross_backend: cross_backend(&runs, &refs.cpu().mask)?,
         reference: job.reference.to_string(),
-        notes: scene_notes(job.frame),
+        notes: scene_notes(job.frame)
+            .into_iter()
+            .chain(moved.as_ref().map(|&(_, k)| frame::measured_note(k)))
+            .collect(),
     };
     if let Some(dir) = &job.out_dir {
         write_reports(dir, job, &refs, (&sheet, &runs), &report)?;
@@ -655,25 +657,4 @@ pub fn report_markdown(r: &CompareReport) -> String {
         s.push_str(&format!("- `{}` ({}): {}\n", e.technique, e.backend, c.join(", ")));
     }
     s
-}
-
-#[cfg(test)]
-mod tests {
-    use shadow_core::scenes::{self, SceneParams};
-
-    use super::*;
-
-    /// A report on a scene with blended casters says they cast as opaque ones, naming their materials;
-    /// one with none says nothing.
-    #[test]
-    fn blended_casters_are_noted() {
-        let mut scene = scenes::build("cutout", &SceneParams::default()).expect("cutout");
-        let notes = |scene: &shadow_core::Scene| scene_notes(&FrameInputs::from_first_camera(scene).expect("frame"));
-        assert!(notes(&scene).is_empty());
-        let card = scene.materials().find(|(_, m)| m.name == "checkerboard").expect("the card").0;
-        scene.material_mut(card).expect("material").alpha_mode = AlphaMode::Blend;
-        let notes = notes(&scene);
-        assert_eq!(notes.len(), 1);
-        assert!(notes[0].contains("cast as opaque") && notes[0].contains("checkerboard"), "{}", notes[0]);
-    }
 }
