@@ -12,7 +12,8 @@
 //! reads changes) as long as the cell it would be granted now is within a factor of 2 of the cell it holds
 //! and no halving for the budget reaches it: a static light keeps its build while the camera moves. The
 //! others are laid around the kept ones, each at the first free place of its size along the curve; where
-//! one finds none, every tile is laid afresh.
+//! one finds none, the less important half of the lights keeping theirs give them up, and so on down to
+//! every tile laid afresh.
 
 use glam::UVec2;
 
@@ -99,14 +100,16 @@ impl AtlasPlan {
                 .unwrap_or_else(|| unreachable!("the smallest tiles fit, checked above"));
             cells[largest] /= 2;
         }
-        let lay = |keep: bool| {
+        // The lights that may keep their tiles, most important first.
+        let mut holders: Vec<usize> =
+            (0..requests.len()).filter(|&k| holding(&requests[k], side) == Some(cells[k])).collect();
+        holders.sort_by(|&a, &b| requests[b].coverage.total_cmp(&requests[a].coverage).then(a.cmp(&b)));
+        let lay = |keep: &[usize]| {
             let mut free = Occupancy::new(side, &cells);
             let mut lights: Vec<Option<LightTiles>> = vec![None; requests.len()];
             // The tiles kept where they lie, then the others largest first (the light's order among equals).
-            for (k, r) in requests.iter().enumerate() {
-                let Some(held) = r.held.as_ref().filter(|_| keep && holding(r, side) == Some(cells[k])) else {
-                    continue;
-                };
+            for &k in keep {
+                let Some(held) = requests[k].held.as_ref() else { continue };
                 let before = free.taken.clone();
                 if held.origins.iter().all(|&o| free.take(o, cells[k])) {
                     lights[k] = Some(held.clone());
@@ -124,9 +127,16 @@ impl AtlasPlan {
             }
             Some(lights)
         };
-        let lights = lay(true)
-            .or_else(|| lay(false))
-            .unwrap_or_else(|| unreachable!("powers of two from large to small fill the square in Z-order"));
+        // Where the others find no room around the kept tiles, the least important lights give theirs up,
+        // half of those keeping at a time, down to none (the square filled afresh, which always fits).
+        let mut keeping = holders.len();
+        let lights = loop {
+            if let Some(lights) = lay(&holders[..keeping]) {
+                break lights;
+            }
+            assert!(keeping > 0, "powers of two from large to small fill the square in Z-order");
+            keeping /= 2;
+        };
         Ok(Self { side, lights })
     }
 }
@@ -285,6 +295,25 @@ mod tests {
         assert_packed(&AtlasPlan::new(8192, &clash).expect("fits"));
         let moved = AtlasPlan::new(16384, &next).expect("fits");
         assert!(moved.lights.iter().flatten().all(|t| t.atlas == 16384));
+    }
+
+    #[test]
+    fn where_a_new_tile_finds_no_room_the_least_important_lights_give_theirs_up() {
+        // A 64 texel tile held in each 128 quadrant of a 256 atlas leaves no room for a new 128 tile.
+        let held =
+            |x: u32, y: u32| Some(super::LightTiles { side: 64, origins: vec![glam::UVec2::new(x, y)], atlas: 256 });
+        let mut requests: Vec<TileRequest> = [(0, 0), (128, 0), (0, 128), (128, 128)]
+            .iter()
+            .enumerate()
+            .map(|(k, &(x, y))| TileRequest { held: held(x, y), ..request(1, 64, 1.0 - k as f32 / 8.0) })
+            .collect();
+        requests.push(request(1, 128, 1.0));
+        let plan = AtlasPlan::new(256, &requests).expect("fits");
+        assert_packed(&plan);
+        assert_eq!(plan.lights[4].as_ref().map(|t| t.side), Some(128));
+        for (k, r) in requests.iter().enumerate().take(2) {
+            assert_eq!(plan.lights[k], r.held, "the more important light {k} keeps its tile");
+        }
     }
 
     #[test]
