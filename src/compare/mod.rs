@@ -28,6 +28,7 @@ use shadow_cpu::acne::AcneProbe;
 use shadow_cpu::bvh::SceneBvh;
 
 /// What to compare.
+#[derive(Clone)]
 pub struct CompareJob<'a> {
     /// Scene name for the report.
     pub scene: String,
@@ -540,17 +541,7 @@ pub fn run_compare(
     }
     // The figures are the first light's: where another reaches more of the view, that one goes first.
     let moved = widest_first(job.frame, job.width, job.height);
-    let moved_job = moved.as_ref().map(|(frame, _)| CompareJob {
-        scene: job.scene.clone(),
-        frame,
-        width: job.width,
-        height: job.height,
-        techniques: job.techniques.clone(),
-        reference: job.reference.clone(),
-        soft_reference: job.soft_reference.clone(),
-        backends: job.backends.clone(),
-        out_dir: job.out_dir.clone(),
-    });
+    let moved_job = moved.as_ref().map(|(frame, _)| CompareJob { frame, ..job.clone() });
     let job = moved_job.as_ref().unwrap_or(job);
     let any_soft = job.techniques.iter().any(|s| renderer.registry().get(&s.name).is_ok_and(|e| e.soft));
     let mut sheet = Vec::new();

@@ -450,6 +450,7 @@ fn render_casters(
     instances: &wgpu::Buffer,
 ) {
     let res = maps.tiles.map_or(maps.texture.width(), |t| t.side);
+    let drawn = (frame, casters, frame.has_cutout_casters());
     let mut enc = cx.encoder("light pass");
     match maps.tiles {
         // An atlas's tiles, in one pass: each drawn within its viewport and cleared by a draw (the pass's
@@ -461,7 +462,7 @@ fn render_casters(
                 pass.set_scissor_rect(origin.x, origin.y, res, res);
                 pass.set_pipeline(pipelines.clear_tile(cx));
                 pass.draw(0..3, 0..1);
-                draw_casters(cx, &mut pass, pipelines, (frame, casters), (p, res), instances);
+                draw_casters(cx, &mut pass, pipelines, drawn, (p, res), instances);
             }
         }
         None => {
@@ -469,7 +470,7 @@ fn render_casters(
                 let ids = ids.map(|t| layer_view(t, k as u32));
                 let depth = layer_view(maps.texture, k as u32);
                 let mut pass = begin_light_pass(&mut enc, &depth, wgpu::LoadOp::Clear(1.0), ids.as_ref());
-                draw_casters(cx, &mut pass, pipelines, (frame, casters), (p, res), instances);
+                draw_casters(cx, &mut pass, pipelines, drawn, (p, res), instances);
             }
         }
     }
@@ -505,13 +506,13 @@ fn begin_light_pass<'e>(
 }
 
 /// Draws the casters `casters` names into projection `p`'s map of side `res`: those everywhere, then those
-/// their texture cuts out; a caster wholly outside the projection's frustum is not drawn where the frame
-/// saves so.
+/// their texture cuts out (where `cutouts`: the frame has any); a caster wholly outside the projection's
+/// frustum is not drawn where the frame saves so.
 fn draw_casters(
     cx: &WgpuContext,
     pass: &mut wgpu::RenderPass<'_>,
     pipelines: &LightPipelines,
-    (frame, casters): (&FrameInputs, Casters),
+    (frame, casters, cutouts): (&FrameInputs, Casters, bool),
     (p, res): (&LightProjection, u32),
     instances: &wgpu::Buffer,
 ) {
@@ -524,7 +525,7 @@ fn draw_casters(
         let solid = |i: &Instance| casters.takes(i) && i.coverage() == Coverage::Solid && in_view(i);
         draw_instances(cx, pass, frame, solid, false);
     }
-    if frame.has_cutout_casters() && casters != Casters::Solid {
+    if cutouts && casters != Casters::Solid {
         pass.set_pipeline(pipelines.cutout(cx));
         let cut_out = |i: &Instance| casters.takes(i) && i.coverage() == Coverage::Cutout && in_view(i);
         draw_textured(cx, pass, frame, cut_out, false);
