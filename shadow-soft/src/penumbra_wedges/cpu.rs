@@ -8,7 +8,6 @@ use shadow_core::technique::LightPass;
 use shadow_core::technique::{DebugView, ShadowTechnique, TechniqueError};
 use shadow_cpu::passes::maps::CutoutMaps;
 use shadow_cpu::passes::per_receiver;
-use shadow_cpu::passes::rays::RayOrigins;
 use shadow_cpu::raster::{CompareFn, CullMode, DepthBias, DepthState, DepthStencil, Fragment, RasterState, Soup, draw};
 use shadow_cpu::{CpuBackend, CpuContext, CpuError, GBuffer};
 
@@ -41,10 +40,9 @@ const QUAD_STATE: RasterState = RasterState {
 };
 
 /// Draws `triangles` (homogeneous world points) over `g`, adding `term(edge, receiver)` of each
-/// fragment's edge (`edge_of(prim)`) into its layer's sum in `occluded`, the receiver's point taken from
-/// `points`. Returns the fragment count.
+/// fragment's edge (`edge_of(prim)`) into its layer's sum in `occluded`. Returns the fragment count.
 fn accumulate(
-    (g, points): (&GBuffer, &RayOrigins<'_>),
+    g: &GBuffer,
     ds: &mut DepthStencil,
     occluded: &mut Image<[f32; LAYERS]>,
     (triangles, state): (&[[Vec4; 3]], &RasterState),
@@ -59,7 +57,7 @@ fn accumulate(
         g.receiver.data()[i].then(|| {
             let edge = edge_of(f.prim);
             let mut sums = [0.0; LAYERS];
-            sums[edge.layer as usize] = edge.weight * term(&edge, points.at(i).0);
+            sums[edge.layer as usize] = edge.weight * term(&edge, g.position.data()[i]);
             sums
         })
     };
@@ -99,9 +97,8 @@ impl ShadowTechnique<CpuBackend> for PenumbraWedges {
         let mut occluded = Image::new(g.width(), g.height(), [0.0f32; LAYERS]);
         let mut ds = DepthStencil::from_depth(&g.depth, 0);
         let edges = &built.edges;
-        let points = RayOrigins::new(g, frame, Self::RECEIVER_OFFSET);
         let quads = accumulate(
-            (g, &points),
+            g,
             &mut ds,
             &mut occluded,
             (&built.side_quads(PixelScale::of(&g.camera, g.height())), &QUAD_STATE),
@@ -110,7 +107,7 @@ impl ShadowTechnique<CpuBackend> for PenumbraWedges {
         );
         let wedges = if self.wedges.is_on() {
             accumulate(
-                (g, &points),
+                g,
                 &mut ds,
                 &mut occluded,
                 (&built.hulls, &WEDGE_STATE),
@@ -123,10 +120,10 @@ impl ShadowTechnique<CpuBackend> for PenumbraWedges {
         // The soft visibility, times the cut-out casters' map's.
         let cutouts = &state.cutouts;
         per_receiver(g, &reach, out, |x, y, i| {
-            let horizon = horizon_share(points.at(i).0, g.geometric_normal.data()[i], *light);
+            let p = g.position.data()[i];
+            let horizon = horizon_share(p, g.geometric_normal.data()[i], *light);
             let [closed, facing, turned] = std::array::from_fn(|k| eye_counts[k] + occluded.data()[i][k]);
-            (1.0 - closed - facing.max(turned) - horizon).clamp(0.0, 1.0)
-                * cutouts.visibility(g.position.data()[i], (x, y))
+            (1.0 - closed - facing.max(turned) - horizon).clamp(0.0, 1.0) * cutouts.visibility(p, (x, y))
         });
         stats.counters.volume_fragments = Some(quads);
         stats.counters.extra.insert("wedge_fragments".into(), wedges as f64);

@@ -21,7 +21,6 @@ use shadow_wgpu::passes::maps::CutoutMaps;
 #[derive(Clone, Copy, Pod, Zeroable)]
 struct WedgeParams {
     light: [f32; 4],
-    /// The eye, and how far off its surface a receiver's point is taken (`RECEIVER_OFFSET` in world units).
     eye: [f32; 4],
     eye_counts: [f32; 4],
     size: [u32; 4],
@@ -227,7 +226,7 @@ impl ShadowTechnique<WgpuBackend> for PenumbraWedges {
         let [closed, facing, turned] = built.geometry.eye_counts(frame, eye);
         let params = WedgeParams {
             light: built.light.centre.extend(built.light.radius).to_array(),
-            eye: eye.extend(Self::RECEIVER_OFFSET * frame.bounds.size().length()).to_array(),
+            eye: eye.extend(0.0).to_array(),
             eye_counts: [closed, facing, turned, 0.0],
             size: [g.width, g.height, 0, 0],
         };

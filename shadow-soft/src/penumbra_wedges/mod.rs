@@ -82,15 +82,6 @@ impl PenumbraWedges {
     /// The technique's name.
     pub const NAME: &'static str = "penumbra-wedges";
 
-    /// How far off its surface a receiver's point is taken, along its normal turned towards the eye, as a
-    /// fraction of the scene's diagonal: where the references' rays start (`area-light-reference`'s and
-    /// `ray-traced`'s `epsilon`). A receiver on a silhouette edge of its own caster lies on that edge's
-    /// side plane, where the count's "inside" and the eye's crossing of the quad are both left to rounding
-    /// and the area (of an edge through the receiver) is nothing: a step of the count that no area takes
-    /// back, a dark pixel in the light. Taken off the surface on its seen side, the point is where the
-    /// references look from, and outside the volume of the face it lies on.
-    pub const RECEIVER_OFFSET: f32 = 5e-7;
-
     /// The light as a sphere.
     ///
     /// # Errors

@@ -6,7 +6,6 @@
 struct WedgeParams {
     // centre, radius
     light: vec4<f32>,
-    // the eye; w: how far off its surface a receiver's point is taken, along its normal (RECEIVER_OFFSET)
     eye: vec4<f32>,
     // the light centre's count at the eye in each layer (closed, facing, turned)
     eye_counts: vec4<f32>,
@@ -47,13 +46,9 @@ fn vs_edge(@location(0) p: vec4<f32>, @location(1) edge: u32) -> EdgeVertex {
     return out;
 }
 
-// The receiver's point under a fragment, off its surface as the references' rays start, or w = 0 where
-// there is none.
+// The receiver under a fragment, or w = 0 where there is none.
 fn receiver(pos: vec4<f32>) -> vec4<f32> {
-    let at = vec2<i32>(pos.xy);
-    let g = textureLoad(g_position, at, 0);
-    let n = textureLoad(g_geometric_normal, at, 0).xyz;
-    return vec4<f32>(g.xyz + n * params.eye.w, g.w);
+    return textureLoad(g_position, vec2<i32>(pos.xy), 0);
 }
 
 // Pixel `pos`'s sum in `layer`: the layers one view after another.
